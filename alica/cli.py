@@ -1,0 +1,208 @@
+"""The ``alica`` command: validate, show, render and convert plan files; list skills.
+
+``main(argv)`` returns the exit code, so tests call it directly. Library code
+raises; only this module turns errors into messages and exit codes.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from alica.errors import AlicaError, PlanFormatError
+from alica.source import Diagnostic
+
+EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
+
+
+def _print_diagnostics(diagnostics: Sequence[Diagnostic]) -> None:
+    for d in diagnostics:
+        print(d.format(), file=sys.stderr)
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from alica.io import plan_files, validate_paths
+
+    files, _ = plan_files(args.paths)
+    diagnostics = validate_paths(args.paths)
+    _print_diagnostics(diagnostics)
+    errors = sum(1 for d in diagnostics if d.severity == "error")
+    if errors:
+        bad = len({d.span.file for d in diagnostics})
+        print(f"{errors} error(s) in {bad} file(s); {len(files)} file(s) checked", file=sys.stderr)
+        return EXIT_INVALID
+    if not args.quiet:
+        print(f"ok: {len(files)} plan file(s) valid")
+    return EXIT_OK
+
+
+def _load(path: str):  # type: ignore[no-untyped-def]
+    from alica.io import Loader, load_library
+
+    library = load_library(path)
+    entry = Loader().read(Path(path)).document
+    return library, entry
+
+
+def _roots(library, entry, name: str | None) -> list[str]:  # type: ignore[no-untyped-def]
+    if name is not None:
+        library.abstract(name)
+        return [name]
+    own = [p.name for p in entry.plans] + [p.name for p in entry.problems] + [b.name for b in entry.behaviours if not entry.plans]
+    used = {c for e in (*entry.plans, *entry.plantypes, *entry.problems) for c in library.children(e)}
+    roots = [n for n in own if n not in used]
+    return roots or own
+
+
+def _cmd_show(args: argparse.Namespace) -> int:
+    from alica.render import dot_graph, svg, text_tree
+
+    library, entry = _load(args.plan)
+    try:
+        roots = _roots(library, entry, args.name)
+    except KeyError as exc:
+        raise AlicaError(str(exc.args[0])) from None
+    if not roots:
+        raise AlicaError(f"{args.plan} defines no plan, planning problem or behaviour to show")
+    if args.format == "text":
+        output = "\n\n".join(text_tree(library, r) for r in roots) + "\n"
+    else:
+        dots = [dot_graph(library, r) for r in roots]
+        output = dots[0] if len(dots) == 1 else "".join(dots)
+        if args.format == "svg":
+            output = svg(dots[0])
+    if args.output:
+        Path(args.output).write_text(output, encoding="utf-8")
+    else:
+        sys.stdout.write(output)
+    return EXIT_OK
+
+
+def _cmd_render(args: argparse.Namespace) -> int:
+    import shutil
+
+    from alica.io import Loader, load_library, plan_files
+    from alica.render import dot_graph, svg, text_tree
+
+    files, problems = plan_files(args.paths)
+    if problems:
+        raise PlanFormatError(problems)
+    out = Path(args.out)
+    has_dot = shutil.which("dot") is not None
+    count = 0
+    for path in files:
+        library = load_library(path)
+        entry = Loader().read(path).document
+        for root in _roots(library, entry, None):
+            stem = out / f"{path.stem}.{root}"
+            stem.parent.mkdir(parents=True, exist_ok=True)
+            Path(f"{stem}.txt").write_text(text_tree(library, root) + "\n", encoding="utf-8")
+            dot = dot_graph(library, root)
+            Path(f"{stem}.dot").write_text(dot, encoding="utf-8")
+            if has_dot:
+                Path(f"{stem}.svg").write_text(svg(dot), encoding="utf-8")
+            count += 1
+    kinds = "text, dot and svg" if has_dot else "text and dot (install Graphviz for svg)"
+    print(f"rendered {count} plan tree(s) from {len(files)} file(s) as {kinds} into {out}/")
+    return EXIT_OK
+
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from alica.io import dump_document, format_of, load_document, load_library, read_text
+
+    fmt = format_of(args.output)
+    if fmt is None or format_of(args.input) is None:
+        raise AlicaError("convert needs files ending in .yaml, .yml or .xml, e.g. 'alica convert roles.yaml roles.xml'")
+    if args.no_validate:
+        document = load_document(args.input)
+    else:
+        load_library(args.input)
+        document = load_document(args.input)
+    text = dump_document(document, fmt)
+    again, problems = read_text(text, args.output, fmt)
+    if problems or again != document:
+        raise AlicaError(f"internal error: {args.output} would not read back as the same plans; please report this")
+    Path(args.output).write_text(text, encoding="utf-8")
+    print(f"wrote {args.output} ({fmt})")
+    return EXIT_OK
+
+
+def _cmd_list_skills(args: argparse.Namespace) -> int:
+    from skills.registry import default_registry
+
+    for spec in default_registry():
+        caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""
+        print(f"{spec.name}: {spec.doc}{caps}")
+        for p in spec.params:
+            need = "required" if p.required else f"default {p.default!r}"
+            print(f"    {p.name} ({p.type}, {need}){': ' + p.doc if p.doc else ''}")
+    return EXIT_OK
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``alica`` command."""
+    parser = argparse.ArgumentParser(prog="alica", description="Teams of robots that carry out missions described as data.")
+    parser.add_argument("--debug", action="store_true", help="show a traceback on internal errors")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub.required = True
+
+    p = sub.add_parser("validate", help="check plan files and everything they import", description="Check plan files (or every plan file in folders). Exit 0 if valid, 1 if not, 2 on wrong usage. Problems are printed as FILE:LINE:COL: error: message.")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
+    p.add_argument("-q", "--quiet", action="store_true", help="print nothing when everything is valid")
+    p.set_defaults(run=_cmd_validate)
+
+    p = sub.add_parser("show", help="print a plan tree", description="Print the plan tree of a plan file: plans, entry points, states, transitions, behaviours.")
+    p.add_argument("plan", metavar="PLAN", help="a plan file")
+    p.add_argument("--format", choices=("text", "dot", "svg"), default="text", help="text (default), Graphviz dot, or SVG (needs Graphviz)")
+    p.add_argument("--name", help="show this plan (default: the file's top-level plans)")
+    p.add_argument("-o", "--output", help="write to this file instead of standard output")
+    p.set_defaults(run=_cmd_show)
+
+    p = sub.add_parser("render", help="render every plan tree under folders to text, dot and svg files", description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed).")
+    p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
+    p.add_argument("--out", default="build/plans", help="output folder (default build/plans)")
+    p.set_defaults(run=_cmd_render)
+
+    p = sub.add_parser("convert", help="convert a plan file between YAML and XML", description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first.")
+    p.add_argument("input", metavar="IN")
+    p.add_argument("output", metavar="OUT")
+    p.add_argument("--no-validate", action="store_true", help="convert without checking references to other files")
+    p.set_defaults(run=_cmd_convert)
+
+    p = sub.add_parser("list-skills", help="list the registered skills and their parameters")
+    p.set_defaults(run=_cmd_list_skills)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``alica`` command; returns the exit code."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:
+        return int(exc.code) if isinstance(exc.code, int) else EXIT_USAGE
+    try:
+        return int(args.run(args))
+    except PlanFormatError as exc:
+        _print_diagnostics(exc.diagnostics)
+        print(f"{len(exc.diagnostics)} problem(s) found", file=sys.stderr)
+        return EXIT_INVALID
+    except AlicaError as exc:
+        print(f"alica: error: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    except OSError as exc:
+        print(f"alica: error: {exc}", file=sys.stderr)
+        return EXIT_INVALID
+    except KeyboardInterrupt:
+        return 130
+    except Exception as exc:  # a bug of ours, not bad input: say so in one line
+        if args.debug:
+            raise
+        print(f"alica: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details and please report it)", file=sys.stderr)
+        return 70
+
+
+if __name__ == "__main__":
+    sys.exit(main())

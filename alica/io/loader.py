@@ -1,0 +1,247 @@
+"""Load plan files: read, follow imports, validate the set, build the library.
+
+A *document set* is an entry file and everything it imports, directly or
+not. Names must be unique within a set; different sets may reuse names (the
+lunar and blocks-world missions both have a ``Pickup``).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from alica.errors import PlanFormatError
+from alica.io.build import build_document
+from alica.io.fields import Problems
+from alica.io.tree import Node
+from alica.lang import Registry, default_registry
+from alica.model import Document, PlanLibrary
+from alica.source import Diagnostic, SourceSpan
+from skills.registry import SkillRegistry
+from skills.registry import default_registry as default_skills
+
+#: File name endings the loader reads, with their format.
+FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
+
+
+def format_of(path: str | os.PathLike[str]) -> str | None:
+    """``yaml`` or ``xml`` by the file's ending, ``None`` for anything else."""
+    return FORMATS.get(Path(path).suffix.lower())
+
+
+def shown(path: Path) -> str:
+    """A path as it appears in messages: relative to the working folder when inside it."""
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return str(path)
+
+
+def parse_text(text: str, name: str, fmt: str) -> tuple[Node | None, list[Diagnostic]]:
+    """Read plan text of format ``fmt`` (``yaml`` or ``xml``) into a located tree."""
+    if fmt == "xml":
+        from alica.io.xml_format import read_xml
+
+        return read_xml(text, name)
+    from alica.io.yaml_format import read_yaml
+
+    return read_yaml(text, name)
+
+
+def read_text(text: str, name: str, fmt: str = "yaml") -> tuple[Document, list[Diagnostic]]:
+    """Build one document from text, without following imports or validating the set."""
+    tree, diagnostics = parse_text(text, name, fmt)
+    problems = Problems()
+    problems.items.extend(diagnostics)
+    if tree is None:
+        return Document(path=name), problems.items
+    return build_document(tree, name, problems), problems.items
+
+
+@dataclass
+class _Read:
+    document: Document
+    diagnostics: list[Diagnostic]
+    imports: list[tuple[Path, SourceSpan]]
+
+
+@dataclass
+class Loader:
+    """Reads plan files once each and validates document sets.
+
+    Args:
+        skills: skill declarations behaviours are checked against.
+        functions: predicates and functions formulas may call.
+    """
+
+    skills: SkillRegistry = field(default_factory=default_skills)
+    functions: Registry = field(default_factory=default_registry)
+    _cache: dict[Path, _Read] = field(default_factory=dict)
+
+    def read(self, path: Path) -> _Read:
+        """Read and build one file (cached)."""
+        path = path.resolve()
+        if path in self._cache:
+            return self._cache[path]
+        name = shown(path)
+        fmt = format_of(path)
+        try:
+            raw = path.read_bytes()
+        except OSError as exc:
+            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"cannot read the file: {exc.strerror or exc}", "check the path and its permissions")], [])
+            self._cache[path] = result
+            return result
+        try:
+            text = raw.decode("utf-8-sig") if fmt != "xml" else raw.decode("utf-8", errors="strict")
+        except UnicodeDecodeError as exc:
+            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"the file is not UTF-8 text (byte {exc.start})", "save it as UTF-8")], [])
+            self._cache[path] = result
+            return result
+        if fmt is None:
+            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"unknown plan file type '{path.suffix}'", "use .yaml, .yml or .xml")], [])
+            self._cache[path] = result
+            return result
+        tree, diagnostics = parse_text(text, name, fmt)
+        problems = Problems()
+        problems.items.extend(diagnostics)
+        imports: list[tuple[Path, SourceSpan]] = []
+        document = Document(path=name)
+        if tree is not None:
+            document = build_document(tree, name, problems)
+            import_nodes = tree.value.get("imports") if isinstance(tree.value, dict) else None
+            nodes = import_nodes.value if import_nodes is not None and isinstance(import_nodes.value, list) else [import_nodes] if import_nodes is not None else []
+            for node in nodes:
+                if isinstance(node.value, str) and node.value.strip():
+                    imports.append(((path.parent / node.value.strip()), node.span))
+        result = _Read(document, problems.items, imports)
+        self._cache[path] = result
+        return result
+
+    def document_set(self, entry: Path) -> tuple[list[Document], list[Diagnostic]]:
+        """The entry file's document and every document it imports, with read problems."""
+        documents: list[Document] = []
+        diagnostics: list[Diagnostic] = []
+        seen: set[Path] = set()
+        todo = [entry.resolve()]
+        while todo:
+            path = todo.pop(0)
+            if path in seen:
+                continue
+            seen.add(path)
+            read = self.read(path)
+            documents.append(read.document)
+            diagnostics.extend(read.diagnostics)
+            for target, span in read.imports:
+                if not target.is_file():
+                    diagnostics.append(Diagnostic(span, f"imported file '{shown(target)}' does not exist", "fix the path; imports are relative to the importing file"))
+                    seen.add(target.resolve())
+                elif format_of(target) is None:
+                    diagnostics.append(Diagnostic(span, f"imported file '{shown(target)}' is not a plan file", "import .yaml, .yml or .xml files"))
+                else:
+                    todo.append(target.resolve())
+        return documents, diagnostics
+
+    def check(self, entry: Path) -> tuple[list[Document], list[Diagnostic]]:
+        """Read and validate one document set; returns its documents and every problem."""
+        from alica.io.validate import Validator
+
+        documents, diagnostics = self.document_set(entry)
+        problems = Problems()
+        Validator(documents, self.skills, self.functions, problems).run()
+        return documents, _unique(diagnostics + problems.items)
+
+    def load(self, *entries: str | os.PathLike[str]) -> PlanLibrary:
+        """Load and validate the document set of one or more entry files.
+
+        Raises:
+            PlanFormatError: with every problem found, if any.
+        """
+        from alica.io.validate import Validator
+
+        documents: list[Document] = []
+        diagnostics: list[Diagnostic] = []
+        seen: set[str] = set()
+        for entry in entries:
+            docs, diags = self.document_set(Path(entry))
+            diagnostics.extend(diags)
+            for doc in docs:
+                if doc.path not in seen:
+                    seen.add(doc.path)
+                    documents.append(doc)
+        problems = Problems()
+        Validator(documents, self.skills, self.functions, problems).run()
+        diagnostics = _unique(diagnostics + problems.items)
+        if diagnostics:
+            raise PlanFormatError(diagnostics)
+        return PlanLibrary(tuple(documents))
+
+
+def _unique(diagnostics: Iterable[Diagnostic]) -> list[Diagnostic]:
+    return sorted(set(diagnostics), key=lambda d: (d.span.file, d.span.line, d.span.column, d.message))
+
+
+def plan_files(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[Path], list[Diagnostic]]:
+    """Expand files and folders into plan files (folders: every .yaml, .yml, .xml below)."""
+    files: list[Path] = []
+    problems: list[Diagnostic] = []
+    for raw in paths:
+        path = Path(raw)
+        if path.is_dir():
+            files.extend(sorted(p for p in path.rglob("*") if p.is_file() and format_of(p) is not None))
+        elif path.is_file():
+            files.append(path)
+        else:
+            problems.append(Diagnostic(SourceSpan(str(raw), 1, 1), "no such file or folder", "check the path"))
+    return files, problems
+
+
+def validate_paths(paths: Iterable[str | os.PathLike[str]], loader: Loader | None = None) -> list[Diagnostic]:
+    """Validate every plan file under ``paths``, each as the entry of its document set."""
+    loader = loader or Loader()
+    files, diagnostics = plan_files(paths)
+    for path in files:
+        diagnostics.extend(loader.check(path)[1])
+    return _unique(diagnostics)
+
+
+def load_library(*paths: str | os.PathLike[str], skills: SkillRegistry | None = None, functions: Registry | None = None) -> PlanLibrary:
+    """Load and validate plan files into a :class:`PlanLibrary`.
+
+    Args:
+        paths: entry files (their imports are followed).
+        skills: skill declarations; the library's own by default.
+        functions: formula predicates and functions; the built-ins by default.
+
+    Raises:
+        PlanFormatError: with every problem found.
+    """
+    loader = Loader(skills or default_skills(), functions or default_registry())
+    return loader.load(*paths)
+
+
+def load_document(path: str | os.PathLike[str]) -> Document:
+    """Read one file into a document without validating references.
+
+    Raises:
+        PlanFormatError: the file cannot be read or has structural problems.
+    """
+    read = Loader().read(Path(path))
+    if read.diagnostics:
+        raise PlanFormatError(read.diagnostics)
+    return read.document
+
+
+def dump_document(document: Document, fmt: str = "yaml") -> str:
+    """A document as YAML or XML text; reading it back gives an equal document."""
+    from alica.io.dump import document_data
+
+    data = document_data(document)
+    if fmt == "xml":
+        from alica.io.xml_format import write_xml
+
+        return write_xml(data)
+    from alica.io.yaml_format import write_yaml
+
+    return write_yaml(data)

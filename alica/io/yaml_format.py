@@ -1,0 +1,170 @@
+"""YAML plan files: read into a located tree, write plain data back as YAML.
+
+PyYAML's composer keeps a mark (line, column) on every node; we keep them on
+the tree so every later error can name its place. Duplicate keys, which
+PyYAML would silently overwrite, are reported, and alias expansion is capped.
+"""
+
+from __future__ import annotations
+
+import datetime
+from typing import Any
+
+import yaml
+
+from alica.io.tree import Node
+from alica.source import Diagnostic, SourceSpan
+
+#: Largest number of tree nodes one file may expand to (guards against alias bombs).
+MAX_NODES = 200_000
+
+_Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+class _TooLarge(Exception):
+    pass
+
+
+class _Reader:
+    def __init__(self, text: str, path: str) -> None:
+        self.path = path
+        self.lines = text.splitlines()
+        self.constructor = yaml.SafeLoader("")
+        self.count = 0
+        self.diagnostics: list[Diagnostic] = []
+
+    def span(self, mark: Any) -> SourceSpan:
+        return SourceSpan(self.path, mark.line + 1, mark.column + 1)
+
+    def convert(self, node: yaml.Node) -> Node:
+        self.count += 1
+        if self.count > MAX_NODES:
+            raise _TooLarge
+        span = self.span(node.start_mark)
+        if isinstance(node, yaml.MappingNode):
+            return self._mapping(node, span)
+        if isinstance(node, yaml.SequenceNode):
+            return Node([self.convert(item) for item in node.value], span)
+        value = self.constructor.construct_object(node, deep=True)
+        if isinstance(value, (datetime.date, datetime.datetime)):
+            value = str(node.value)
+        elif isinstance(value, bytes):
+            value = node.value
+        if isinstance(value, str):
+            return Node(value, span, text_offset=self._text_offset(node))
+        return Node(value, span)
+
+    def _mapping(self, node: yaml.MappingNode, span: SourceSpan) -> Node:
+        items: dict[str, Node] = {}
+        key_spans: dict[str, SourceSpan] = {}
+        explicit: set[str] = set()
+        merged: list[tuple[yaml.Node, yaml.Node]] = []
+        own: list[tuple[yaml.Node, yaml.Node]] = []
+        for key_node, value_node in node.value:
+            if key_node.tag != "tag:yaml.org,2002:merge":
+                own.append((key_node, value_node))
+                continue
+            sources = value_node.value if isinstance(value_node, yaml.SequenceNode) else [value_node]
+            merged.extend(pair for source in sources if isinstance(source, yaml.MappingNode) for pair in source.value)
+        for from_merge, pairs in ((True, merged), (False, own)):
+            for key_node, value_node in pairs:
+                key_span = self.span(key_node.start_mark)
+                if not isinstance(key_node, yaml.ScalarNode):
+                    self.diagnostics.append(
+                        Diagnostic(key_span, "a mapping key must be a plain name", "write the key as text")
+                    )
+                    continue
+                key = str(key_node.value)
+                if not from_merge and key in explicit:
+                    self.diagnostics.append(
+                        Diagnostic(
+                            key_span,
+                            f"duplicate key '{key}' (first written at line {key_spans[key].line})",
+                            "remove one of them; YAML would silently keep only the last",
+                        )
+                    )
+                    continue
+                if not from_merge:
+                    explicit.add(key)
+                items[key] = self.convert(value_node)
+                key_spans[key] = key_span
+        return Node(items, span, key_spans)
+
+    def _text_offset(self, node: yaml.ScalarNode) -> tuple[int, int] | None:
+        line, column = node.start_mark.line + 1, node.start_mark.column + 1
+        if node.style is None:
+            return (line, column)
+        if node.style in ("'", '"'):
+            return (line, column + 1)
+        if node.style == "|" and line < len(self.lines):
+            body = self.lines[line]
+            return (line + 1, len(body) - len(body.lstrip()) + 1)
+        return None
+
+
+def read_yaml(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
+    """Parse one YAML document into a located tree.
+
+    Args:
+        text: the file's contents.
+        path: the name used in diagnostics.
+
+    Returns:
+        The tree (``None`` if the file could not be parsed) and the problems found.
+    """
+    reader = _Reader(text, path)
+    try:
+        documents = list(yaml.compose_all(text, Loader=_Loader))
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        span = reader.span(mark) if mark else SourceSpan(path, 1, 1)
+        problem = exc.problem or "malformed YAML"
+        context = f" {exc.context}" if exc.context else ""
+        return None, [Diagnostic(span, f"YAML syntax: {problem}{context}", "fix the YAML syntax at this place")]
+    except yaml.YAMLError as exc:
+        return None, [Diagnostic(SourceSpan(path, 1, 1), f"YAML syntax: {exc}", "fix the YAML syntax")]
+    documents = [d for d in documents if d is not None]
+    if not documents:
+        return None, [Diagnostic(SourceSpan(path, 1, 1), "the file holds no plan data", "add sections such as 'plans:' or 'tasks:'")]
+    if len(documents) > 1:
+        span = reader.span(documents[1].start_mark)
+        return None, [Diagnostic(span, "more than one YAML document in a plan file", "put each document in its own file")]
+    try:
+        tree = reader.convert(documents[0])
+    except _TooLarge:
+        return None, [
+            Diagnostic(
+                SourceSpan(path, 1, 1),
+                f"the file expands to more than {MAX_NODES} values (anchors and aliases nested too deep)",
+                "write the data out instead of nesting aliases",
+            )
+        ]
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        span = reader.span(mark) if mark else SourceSpan(path, 1, 1)
+        return None, [Diagnostic(span, f"YAML value: {getattr(exc, 'problem', exc)}", "fix the value")]
+    return tree, reader.diagnostics
+
+
+class _Dumper(yaml.SafeDumper):
+    pass
+
+
+def _represent_str(dumper: yaml.SafeDumper, value: str) -> yaml.ScalarNode:
+    if "\n" in value:
+        return dumper.represent_scalar("tag:yaml.org,2002:str", value, style="|")
+    return dumper.represent_scalar("tag:yaml.org,2002:str", value)
+
+
+def _represent_list(dumper: yaml.SafeDumper, value: list[Any]) -> yaml.SequenceNode:
+    flow = bool(value) and all(isinstance(v, (str, int, float, bool)) and len(str(v)) < 40 for v in value)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", value, flow_style=flow)
+
+
+_Dumper.add_representer(str, _represent_str)
+_Dumper.add_representer(list, _represent_list)
+
+
+def write_yaml(data: object) -> str:
+    """Plain data (dicts, lists, scalars) as a YAML document, keys in the given order."""
+    return yaml.dump(data, Dumper=_Dumper, sort_keys=False, allow_unicode=True, width=100, indent=2)

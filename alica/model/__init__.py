@@ -1,0 +1,66 @@
+"""The team language as immutable, typed objects.
+
+Elements refer to each other by name; a :class:`PlanLibrary` resolves names.
+Every element keeps the :class:`~alica.source.SourceSpan` it was read from,
+which ``==`` ignores, so a plan read from YAML equals the same plan read from XML.
+"""
+
+from alica.model.behaviour import Behaviour, Param, ParamValue
+from alica.model.common import (
+    UNBOUNDED,
+    Condition,
+    ConditionKind,
+    Constraint,
+    StateKind,
+    Variable,
+    format_cardinality,
+)
+from alica.model.library import SECTIONS, AbstractPlan, Document, PlanLibrary
+from alica.model.plan import (
+    Binding,
+    ChildRef,
+    EntryPoint,
+    Plan,
+    PlanningSignature,
+    PlanType,
+    State,
+    Summand,
+    Synchronisation,
+    Transition,
+    UtilityFunction,
+)
+from alica.model.planning import PlanningProblem
+from alica.model.roles import Priority, Role, RoleSet, Task
+
+__all__ = [
+    "SECTIONS",
+    "UNBOUNDED",
+    "AbstractPlan",
+    "Behaviour",
+    "Binding",
+    "ChildRef",
+    "Condition",
+    "ConditionKind",
+    "Constraint",
+    "Document",
+    "EntryPoint",
+    "Param",
+    "ParamValue",
+    "Plan",
+    "PlanLibrary",
+    "PlanType",
+    "PlanningProblem",
+    "PlanningSignature",
+    "Priority",
+    "Role",
+    "RoleSet",
+    "State",
+    "StateKind",
+    "Summand",
+    "Synchronisation",
+    "Task",
+    "Transition",
+    "UtilityFunction",
+    "Variable",
+    "format_cardinality",
+]

@@ -1,0 +1,130 @@
+"""Documents (one file's elements) and the library (every element of a document set)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from functools import cached_property
+
+from alica.model.behaviour import Behaviour
+from alica.model.plan import Plan, PlanType
+from alica.model.planning import PlanningProblem
+from alica.model.roles import RoleSet, Task
+
+#: Anything a state can run.
+AbstractPlan = Behaviour | Plan | PlanType | PlanningProblem
+
+#: The document sections in file order, with the element type each holds.
+SECTIONS: tuple[tuple[str, type], ...] = (
+    ("tasks", Task),
+    ("rolesets", RoleSet),
+    ("behaviours", Behaviour),
+    ("plans", Plan),
+    ("plantypes", PlanType),
+    ("problems", PlanningProblem),
+)
+
+
+@dataclass(frozen=True, slots=True)
+class Document:
+    """The elements written in one plan file, in file order.
+
+    Args:
+        path: the file, as given to the loader (ignored by ``==``).
+        imports: other files this one refers to, relative to it.
+    """
+
+    imports: tuple[str, ...] = ()
+    tasks: tuple[Task, ...] = ()
+    rolesets: tuple[RoleSet, ...] = ()
+    behaviours: tuple[Behaviour, ...] = ()
+    plans: tuple[Plan, ...] = ()
+    plantypes: tuple[PlanType, ...] = ()
+    problems: tuple[PlanningProblem, ...] = ()
+    path: str = field(default="", compare=False)
+
+    def elements(self) -> Iterator[Task | RoleSet | AbstractPlan]:
+        """Every element, section by section."""
+        for section, _ in SECTIONS:
+            yield from getattr(self, section)
+
+
+@dataclass(frozen=True, eq=False)
+class PlanLibrary:
+    """Every element of a validated document set, by name.
+
+    Build it with :func:`alica.io.load_library`, which validates first; the
+    constructor itself trusts its input (unique names, resolved references).
+    Two libraries are equal when they hold equal elements, whatever files
+    and formats the elements came from.
+    """
+
+    documents: tuple[Document, ...]
+
+    @cached_property
+    def tasks(self) -> dict[str, Task]:
+        """Task name -> task."""
+        return self._index("tasks")
+
+    @cached_property
+    def rolesets(self) -> dict[str, RoleSet]:
+        """Role set name -> role set."""
+        return self._index("rolesets")
+
+    @cached_property
+    def behaviours(self) -> dict[str, Behaviour]:
+        """Behaviour name -> behaviour."""
+        return self._index("behaviours")
+
+    @cached_property
+    def plans(self) -> dict[str, Plan]:
+        """Plan name -> plan."""
+        return self._index("plans")
+
+    @cached_property
+    def plantypes(self) -> dict[str, PlanType]:
+        """Plan type name -> plan type."""
+        return self._index("plantypes")
+
+    @cached_property
+    def problems(self) -> dict[str, PlanningProblem]:
+        """Planning problem name -> problem."""
+        return self._index("problems")
+
+    def _index(self, section: str) -> dict:  # type: ignore[type-arg]
+        return {e.name: e for doc in self.documents for e in getattr(doc, section)}
+
+    def abstract(self, name: str) -> AbstractPlan:
+        """The behaviour, plan, plan type or problem called ``name``.
+
+        Raises:
+            KeyError: nothing has that name.
+        """
+        for index in (self.plans, self.behaviours, self.plantypes, self.problems):
+            if name in index:
+                return index[name]  # type: ignore[no-any-return]
+        raise KeyError(f"no behaviour, plan, plan type or planning problem named '{name}'")
+
+    def children(self, element: AbstractPlan) -> tuple[str, ...]:
+        """Names of the abstract plans ``element`` can run directly (edges of the plan tree)."""
+        if isinstance(element, Plan):
+            return tuple(c.name for s in element.states for c in s.children)
+        if isinstance(element, PlanType):
+            return element.plans
+        if isinstance(element, PlanningProblem):
+            extra = tuple(p for p in (element.wait_plan, element.alternative_plan) if p)
+            return element.elements + extra
+        return ()
+
+    def roots(self) -> tuple[Plan, ...]:
+        """Plans no other element runs: the top of each plan tree."""
+        used = {c for doc in self.documents for e in doc.elements() if not isinstance(e, (Task, RoleSet)) for c in self.children(e)}
+        return tuple(p for p in self.plans.values() if p.name not in used)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PlanLibrary):
+            return NotImplemented
+        return all(self._index(s) == other._index(s) for s, _ in SECTIONS)
+
+    def __hash__(self) -> int:
+        return hash(tuple(sorted(self.plans)))

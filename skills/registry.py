@@ -1,0 +1,192 @@
+"""The skill registry: what each skill is called and which parameters it takes.
+
+Declarations are plain data so ``alica validate`` can check plan files
+without importing pybullet, OMPL or FCL. Each declaration names its
+implementation as ``"module:attribute"``, imported only when asked for.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+from alica.errors import UnknownSkillError
+
+#: Parameter types a skill may declare, with what a literal value of each must be.
+PARAM_TYPES: dict[str, str] = {
+    "float": "a number",
+    "int": "a whole number",
+    "bool": "true or false",
+    "str": "text",
+    "object": "an object name",
+    "position": "a list [x, y] or [x, y, z] of numbers, or a term such as pos(a)",
+    "pose": "a list [x, y, yaw] of numbers, or a term such as pose(a)",
+    "list": "a list",
+    "any": "any value",
+}
+
+
+@dataclass(frozen=True, slots=True)
+class ParamSpec:
+    """One parameter a skill takes.
+
+    Args:
+        name: the key used in a behaviour's ``params``.
+        type: one of :data:`PARAM_TYPES`.
+        required: whether a behaviour must give it.
+        default: the value used when it is not given.
+        doc: one line for ``alica list-skills``.
+    """
+
+    name: str
+    type: str = "any"
+    required: bool = True
+    default: object = None
+    doc: str = ""
+
+    def __post_init__(self) -> None:
+        if self.type not in PARAM_TYPES:
+            raise ValueError(f"parameter '{self.name}': unknown type '{self.type}', use one of {sorted(PARAM_TYPES)}")
+        if self.required and self.default is not None:
+            raise ValueError(f"parameter '{self.name}': a required parameter has no default")
+
+    def check(self, value: object) -> str | None:
+        """Why a literal ``value`` does not fit this parameter, or ``None`` if it does.
+
+        ``$name`` variable references always fit: they are checked at run time.
+        """
+        if isinstance(value, str) and value.startswith("$"):
+            return None
+        ok = {
+            "float": lambda v: isinstance(v, (int, float)) and not isinstance(v, bool),
+            "int": lambda v: isinstance(v, int) and not isinstance(v, bool),
+            "bool": lambda v: isinstance(v, bool),
+            "str": lambda v: isinstance(v, str),
+            "object": lambda v: isinstance(v, str) and bool(v.strip()),
+            "position": lambda v: isinstance(v, str) or _numbers(v, (2, 3)),
+            "pose": lambda v: isinstance(v, str) or _numbers(v, (3,)),
+            "list": lambda v: isinstance(v, tuple),
+            "any": lambda v: True,
+        }[self.type]
+        if ok(value):
+            return None
+        return f"must be {PARAM_TYPES[self.type]}"
+
+
+def _numbers(value: object, lengths: tuple[int, ...]) -> bool:
+    return (
+        isinstance(value, tuple)
+        and len(value) in lengths
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    )
+
+
+@dataclass(frozen=True, slots=True)
+class SkillSpec:
+    """A skill's declaration.
+
+    Args:
+        name: the name plan files use in ``skill:``.
+        params: the parameters it takes.
+        doc: one line saying what it does.
+        capabilities: what a robot needs to run it (e.g. ``arm``).
+        implementation: ``"module:attribute"`` of the py_trees behaviour class
+            or factory, or ``None`` if not implemented yet.
+    """
+
+    name: str
+    params: tuple[ParamSpec, ...] = ()
+    doc: str = ""
+    capabilities: frozenset[str] = frozenset()
+    implementation: str | None = None
+
+    def param(self, name: str) -> ParamSpec | None:
+        """The parameter called ``name``, if declared."""
+        for p in self.params:
+            if p.name == name:
+                return p
+        return None
+
+
+@dataclass
+class SkillRegistry:
+    """Skill declarations by name."""
+
+    _specs: dict[str, SkillSpec] = field(default_factory=dict)
+
+    def register(self, spec: SkillSpec, *, replace: bool = False) -> SkillSpec:
+        """Add a declaration.
+
+        Raises:
+            ValueError: the name is taken and ``replace`` is false, or two
+                parameters share a name.
+        """
+        if spec.name in self._specs and not replace:
+            raise ValueError(f"skill '{spec.name}' is already registered")
+        names = [p.name for p in spec.params]
+        if len(names) != len(set(names)):
+            raise ValueError(f"skill '{spec.name}' declares a parameter twice")
+        self._specs[spec.name] = spec
+        return spec
+
+    def declare(self, name: str, *params: ParamSpec, doc: str = "", capabilities: tuple[str, ...] = (), implementation: str | None = None) -> SkillSpec:
+        """Register a skill from its parts; the one-line way to declare one."""
+        return self.register(SkillSpec(name, tuple(params), doc, frozenset(capabilities), implementation))
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._specs
+
+    def __iter__(self) -> Iterator[SkillSpec]:
+        return iter(sorted(self._specs.values(), key=lambda s: s.name))
+
+    def __len__(self) -> int:
+        return len(self._specs)
+
+    def get(self, name: str) -> SkillSpec:
+        """The declaration of ``name``.
+
+        Raises:
+            UnknownSkillError: no skill has that name.
+        """
+        try:
+            return self._specs[name]
+        except KeyError:
+            raise UnknownSkillError(f"no skill named '{name}' is registered") from None
+
+    def names(self) -> list[str]:
+        """All skill names, sorted."""
+        return sorted(self._specs)
+
+    def copy(self) -> SkillRegistry:
+        """An independent registry with the same declarations."""
+        return SkillRegistry(dict(self._specs))
+
+    def load(self, name: str) -> object:
+        """Import and return the implementation of ``name``.
+
+        Raises:
+            UnknownSkillError: no such skill, no implementation declared, or
+                its module cannot be imported (the message says why).
+        """
+        spec = self.get(name)
+        if spec.implementation is None:
+            raise UnknownSkillError(f"skill '{name}' is declared but has no implementation yet")
+        module_name, _, attribute = spec.implementation.partition(":")
+        try:
+            module = importlib.import_module(module_name)
+        except ImportError as exc:
+            raise UnknownSkillError(f"skill '{name}' needs module '{module_name}', which cannot be imported: {exc}") from exc
+        try:
+            return getattr(module, attribute)
+        except AttributeError:
+            raise UnknownSkillError(f"skill '{name}': module '{module_name}' has no '{attribute}'") from None
+
+
+def default_registry() -> SkillRegistry:
+    """A fresh registry holding every skill the library declares."""
+    from skills.catalog import declare_all
+
+    registry = SkillRegistry()
+    declare_all(registry)
+    return registry
