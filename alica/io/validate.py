@@ -99,10 +99,10 @@ class Validator:
             names.add(item.name)
         return names
 
-    def _formula(self, text: str, span: SourceSpan | None, what: str, *, effect: bool = False) -> None:
+    def _formula(self, text: str, span: SourceSpan | None, what: str, *, effect: bool = False, boolean: bool = False) -> None:
         try:
             node = parse(text)
-            issues = check(node, self.functions, text=text)
+            issues = check(node, self.functions, text=text, boolean=boolean)
             if effect:
                 literals(node)
         except FormulaError as exc:
@@ -112,7 +112,7 @@ class Validator:
 
     def _condition(self, cond: Condition | None, what: str, *, effect: bool = False) -> None:
         if cond is not None:
-            self._formula(cond.text, cond.span, what, effect=effect)
+            self._formula(cond.text, cond.span, what, effect=effect, boolean=True)
 
     def _ref(self, name: str, span: SourceSpan | None, what: str, kinds: tuple[type, ...] | None = None) -> object | None:
         element = self.abstract.get(name)
@@ -239,7 +239,7 @@ class Validator:
         self._utility(plan)
         declared = {v.name for v in plan.variables}
         for c in plan.constraints:
-            self._formula(c.text, c.span, f"constraint '{c.name}' of {what}")
+            self._formula(c.text, c.span, f"constraint '{c.name}' of {what}", boolean=True)
             for var in c.variables:
                 if var not in declared:
                     self.problems.add(c.span, f"constraint '{c.name}' of {what} constrains '{var}', which is not a variable of the plan", "declare it under 'variables:'")

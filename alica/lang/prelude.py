@@ -1,0 +1,139 @@
+"""Built-in functions and the IMPERA distance predicates.
+
+``MaximalDist(a, b, d)`` and ``MinimalDist(a, b, d)`` follow Eq. 3-4 of the
+IMPERA paper: with ``p1 = Pos(a)`` and ``p2 = Pos(b)`` read from the belief
+base function ``Pos``, ``MaximalDist`` holds iff the Euclidean distance of
+``p1`` and ``p2`` is greater than ``d`` and ``MinimalDist`` iff it is smaller.
+Both are false when either position is unknown. The paper's Eq. 1 spreads
+frontier points apart with
+``forall f1, f2 in Frontier: MaximalDist(f1, f2, eps) or f1 = f2``.
+"""
+
+from __future__ import annotations
+
+import builtins
+import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Any
+
+from alica.lang.belief import BeliefBase
+from alica.lang.registry import Registry
+
+
+def coordinates(point: object) -> tuple[float, ...]:
+    """The coordinates of a point.
+
+    Args:
+        point: a sequence of numbers, a mapping with keys ``'x'``, ``'y'``
+            (and optionally ``'z'``), or an object with attributes ``x``,
+            ``y`` (and optionally ``z``).
+
+    Returns:
+        The coordinates as floats.
+
+    Raises:
+        TypeError: when ``point`` is none of these.
+    """
+    if isinstance(point, Mapping):
+        keys = ("x", "y", "z") if "z" in point else ("x", "y")
+        return tuple(float(point[key]) for key in keys)
+    if isinstance(point, Sequence) and not isinstance(point, str):
+        return tuple(float(value) for value in point)
+    if hasattr(point, "x") and hasattr(point, "y"):
+        values = [point.x, point.y]
+        if getattr(point, "z", None) is not None:
+            values.append(point.z)  # type: ignore[attr-defined]
+        return tuple(float(value) for value in values)
+    raise TypeError(f"{point!r} is not a point (use a sequence, a mapping or an object with x, y)")
+
+
+def dist(p: object, q: object) -> float:
+    """Euclidean distance of two points; a missing coordinate counts as 0."""
+    a, b = coordinates(p), coordinates(q)
+    size = max(len(a), len(b))
+    a += (0.0,) * (size - len(a))
+    b += (0.0,) * (size - len(b))
+    return math.dist(a, b)
+
+
+def _position_distance(belief: BeliefBase, a: object, b: object) -> float | None:
+    p1 = belief.lookup("Pos", (a,))
+    p2 = belief.lookup("Pos", (b,))
+    if p1 is None or p2 is None:
+        return None
+    return dist(p1, p2)
+
+
+def maximal_dist(belief: BeliefBase, a: object, b: object, d: float) -> bool:
+    """IMPERA Eq. 3: ``Pos(a)`` and ``Pos(b)`` are farther apart than ``d``."""
+    distance = _position_distance(belief, a, b)
+    return distance is not None and distance > d
+
+
+def minimal_dist(belief: BeliefBase, a: object, b: object, d: float) -> bool:
+    """IMPERA Eq. 4: ``Pos(a)`` and ``Pos(b)`` are closer than ``d``."""
+    distance = _position_distance(belief, a, b)
+    return distance is not None and distance < d
+
+
+def _extreme(pick: Callable[[Iterable[Any]], object], args: tuple[object, ...]) -> object:
+    values: Iterable[Any] = args
+    if len(args) == 1 and isinstance(args[0], Iterable) and not isinstance(args[0], str):
+        values = args[0]
+    return pick(values)
+
+
+def _min(*args: object) -> object:
+    """Smallest argument, or smallest item of one iterable argument."""
+    return _extreme(builtins.min, args)
+
+
+def _max(*args: object) -> object:
+    """Largest argument, or largest item of one iterable argument."""
+    return _extreme(builtins.max, args)
+
+
+def _round(value: float, digits: int | None = None) -> float:
+    """Round to ``digits`` decimals (to an integer when omitted)."""
+    return builtins.round(value, digits) if digits is not None else builtins.round(value)
+
+
+def count(belief: BeliefBase, type_name: object) -> int:
+    """Number of objects of a type in the belief base."""
+    return sum(1 for _ in belief.objects(str(type_name)))
+
+
+def default_registry() -> Registry:
+    """A fresh registry holding the built-in functions and predicates.
+
+    Returns:
+        A registry with ``sqrt``, ``abs``, ``min``, ``max``, ``dist``,
+        ``floor``, ``ceil``, ``round``, ``count``, ``MaximalDist`` and
+        ``MinimalDist``; callers may add to it freely.
+    """
+    registry = Registry()
+    fn = "function"
+    registry.register("sqrt", math.sqrt, 1, kind=fn, doc="square root")
+    registry.register("abs", builtins.abs, 1, kind=fn, doc="absolute value")
+    registry.register("min", _min, (1, None), kind=fn, doc=_min.__doc__ or "")
+    registry.register("max", _max, (1, None), kind=fn, doc=_max.__doc__ or "")
+    registry.register("dist", dist, 2, kind=fn, doc="Euclidean distance of two points")
+    registry.register("floor", math.floor, 1, kind=fn, doc="largest integer <= x")
+    registry.register("ceil", math.ceil, 1, kind=fn, doc="smallest integer >= x")
+    registry.register("round", _round, (1, 2), kind=fn, doc=_round.__doc__ or "")
+    registry.register("count", count, 1, kind=fn, needs_belief=True, doc="count(Type): objects of a type")
+    registry.register(
+        "MaximalDist",
+        maximal_dist,
+        3,
+        needs_belief=True,
+        doc="MaximalDist(a, b, d): distance of Pos(a) and Pos(b) is greater than d",
+    )
+    registry.register(
+        "MinimalDist",
+        minimal_dist,
+        3,
+        needs_belief=True,
+        doc="MinimalDist(a, b, d): distance of Pos(a) and Pos(b) is less than d",
+    )
+    return registry
