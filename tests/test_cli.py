@@ -1,0 +1,124 @@
+"""The ``alica`` command, end to end through ``main(argv)``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from alica import render
+from alica.cli import main
+from alica.io import load_document
+from tests.conftest import PLANS
+
+MISSION = PLANS / "lunar" / "mission.yaml"
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    assert "Traceback" not in out + err
+    return code, out, err
+
+
+def test_validate_shipped_plans(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "validate", str(PLANS))
+    assert code == 0, err
+    assert out.startswith("ok: ")
+
+
+def test_validate_missing_path(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "validate", "no/such/place.yaml")
+    assert code == 1 and "no/such/place.yaml:1:1: error: no such file or folder" in err
+
+
+def test_validate_unknown_extension(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "plan.json"
+    bad.write_text("{}")
+    code, _, err = run(capsys, "validate", str(bad))
+    assert code == 1 and "unknown plan file type '.json'" in err
+
+
+def test_validate_binary_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "plan.yaml"
+    bad.write_bytes(b"\xff\xfe\x00garbage")
+    code, _, err = run(capsys, "validate", str(bad))
+    assert code == 1 and "error:" in err
+
+
+def test_usage_errors_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    assert run(capsys, "validate")[0] == 2
+    assert run(capsys, "frobnicate")[0] == 2
+    assert run(capsys)[0] == 2
+
+
+@pytest.mark.parametrize("command", [[], ["validate"], ["show"], ["convert"], ["render"], ["list-skills"]])
+def test_help(capsys: pytest.CaptureFixture[str], command: list[str]) -> None:
+    code, out, _ = run(capsys, *command, "--help")
+    assert code == 0 and "usage: alica" in out
+
+
+def test_show_text(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "show", str(MISSION))
+    assert code == 0, err
+    assert "plan LunarMission" in out
+    assert "task Explore" in out and "state" in out and "skill" in out
+
+
+def test_show_dot(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "show", str(MISSION), "--format", "dot")
+    assert code == 0 and out.startswith("digraph alica {") and out.rstrip().endswith("}")
+    assert "cluster_LunarMission" in out
+
+
+def test_show_svg_without_graphviz(capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(render.shutil, "which", lambda name: None)
+    code, _, err = run(capsys, "show", str(MISSION), "--format", "svg")
+    assert code == 1 and "Graphviz is not installed" in err
+
+
+def test_show_unknown_plan_name(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "show", str(MISSION), "--name", "NoSuchPlan")
+    assert code == 1 and "NoSuchPlan" in err
+
+
+def test_show_broken_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("plans:\n  - name: P\n    states: []\n")
+    code, _, err = run(capsys, "show", str(bad))
+    assert code == 1 and "bad.yaml:2:5: error: plan 'P' has no 'entry_points'" in err
+
+
+def test_render_writes_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, err = run(capsys, "render", str(PLANS / "lunar"), "--out", str(tmp_path))
+    assert code == 0, err
+    assert list(tmp_path.glob("mission.LunarMission.txt")) and list(tmp_path.glob("*.dot"))
+
+
+def test_convert_both_ways(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    src = PLANS / "roles.yaml"
+    xml = tmp_path / "roles.xml"
+    back = tmp_path / "roles.yaml"
+    assert run(capsys, "convert", str(src), str(xml), "--no-validate")[0] == 0
+    assert xml.read_text().startswith("<?xml")
+    assert run(capsys, "convert", str(xml), str(back), "--no-validate")[0] == 0
+    assert load_document(back) == load_document(src)
+
+
+def test_convert_refuses_invalid_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("tasks: [A]\nplans:\n  - {name: P, entry_points: [{task: B, state: S}], states: [{name: S}]}\n")
+    code, _, err = run(capsys, "convert", str(bad), str(tmp_path / "bad.xml"))
+    assert code == 1 and "names task 'B'" in err
+    assert not (tmp_path / "bad.xml").exists()
+
+
+def test_convert_needs_known_endings(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run(capsys, "convert", str(PLANS / "roles.yaml"), str(tmp_path / "roles.txt"))
+    assert code == 1 and "convert needs files ending in" in err
+
+
+def test_list_skills(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "list-skills")
+    assert code == 0
+    assert "MoveToPosition:" in out and "goal (position, required)" in out
