@@ -42,14 +42,15 @@ def _value(value: object) -> str:
     return str(value)
 
 
-def _text(library: PlanLibrary, element: AbstractPlan, indent: str, lines: list[str], path: set[str]) -> None:
+def _text(library: PlanLibrary, element: AbstractPlan, indent: str, lines: list[str], shown: set[str]) -> None:
+    shown.add(element.name)
     if isinstance(element, Behaviour):
         lines.append(f"{indent}behaviour {element.name}: skill {element.skill}{_params(element)}")
         return
     if isinstance(element, PlanType):
         lines.append(f"{indent}plan type {element.name}: one of {', '.join(element.plans)}")
         for name in element.plans:
-            _child(library, name, indent + "  ", lines, path)
+            _child(library, name, indent + "  ", lines, shown)
         return
     if isinstance(element, PlanningProblem):
         lines.append(f"{indent}planning problem {element.name}: planner {element.planner}, update every {element.update_time:g} s")
@@ -68,23 +69,24 @@ def _text(library: PlanLibrary, element: AbstractPlan, indent: str, lines: list[
     for ep in plan.entry_points:
         flag = ", success required" if ep.success_required else ""
         lines.append(f"{indent}  task {ep.task} [{ep.min}..{format_cardinality(ep.max)}{flag}] -> {ep.state}")
-    path = path | {plan.name}
     for state in plan.states:
         kind = "" if state.kind.value == "normal" else f" ({state.kind.value})"
         lines.append(f"{indent}  state {state.name}{kind}")
         for child in state.children:
-            _child(library, child.name, indent + "    ", lines, path)
+            _child(library, child.name, indent + "    ", lines, shown)
         for t in plan.out_transitions(state.name):
             cond = t.condition.text if t.condition else "always"
             sync = f" [sync {t.synchronisation}]" if t.synchronisation else ""
             lines.append(f"{indent}    -> {t.target} when {cond}{sync}")
 
 
-def _child(library: PlanLibrary, name: str, indent: str, lines: list[str], path: set[str]) -> None:
-    if name in path:
-        lines.append(f"{indent}{name} (already shown above)")
+def _child(library: PlanLibrary, name: str, indent: str, lines: list[str], shown: set[str]) -> None:
+    element = library.abstract(name)
+    if name in shown and not isinstance(element, Behaviour):
+        kind = {Plan: "plan", PlanType: "plan type", PlanningProblem: "planning problem"}[type(element)]
+        lines.append(f"{indent}{kind} {name} (shown above)")
         return
-    _text(library, library.abstract(name), indent, lines, path)
+    _text(library, element, indent, lines, shown)
 
 
 def dot_graph(library: PlanLibrary, root: str) -> str:

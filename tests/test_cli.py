@@ -122,3 +122,9 @@ def test_list_skills(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "list-skills")
     assert code == 0
     assert "MoveToPosition:" in out and "goal (position, required)" in out
+
+
+def test_shipped_plans_are_found_from_the_package() -> None:
+    from alica.io import plans_dir
+
+    assert (plans_dir() / "roles.yaml").is_file()

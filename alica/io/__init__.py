@@ -11,6 +11,7 @@ from alica.io.loader import (
     load_document,
     load_library,
     plan_files,
+    plans_dir,
     read_text,
     validate_paths,
 )
@@ -22,6 +23,7 @@ __all__ = [
     "load_document",
     "load_library",
     "plan_files",
+    "plans_dir",
     "read_text",
     "validate_paths",
 ]

@@ -26,6 +26,21 @@ from skills.registry import default_registry as default_skills
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
 
 
+def plans_dir() -> Path:
+    """The shipped ``plans/`` folder, found next to the installed packages.
+
+    The project installs in editable mode (``make demo``/``make test``), so the
+    folder is the checkout's own ``plans/``.
+
+    Raises:
+        FileNotFoundError: the package was installed without its plans.
+    """
+    folder = Path(__file__).resolve().parents[2] / "plans"
+    if not folder.is_dir():
+        raise FileNotFoundError(f"the shipped plans are not next to the package (looked in {folder}); install the project from its checkout")
+    return folder
+
+
 def format_of(path: str | os.PathLike[str]) -> str | None:
     """``yaml`` or ``xml`` by the file's ending, ``None`` for anything else."""
     return FORMATS.get(Path(path).suffix.lower())
