@@ -147,7 +147,10 @@ def read_yaml(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
 
 
 class _Dumper(yaml.SafeDumper):
-    pass
+    """Indents list entries under their key, as people write YAML."""
+
+    def increase_indent(self, flow: bool = False, indentless: bool = False) -> None:
+        super().increase_indent(flow, False)
 
 
 def _represent_str(dumper: yaml.SafeDumper, value: str) -> yaml.ScalarNode:

@@ -1,0 +1,249 @@
+"""Declarations of every skill the shipped plans bind (IMPERA Section 6.4).
+
+Plain data only: ``alica validate`` checks behaviours against these
+declarations without importing any robotics library. Implementations are
+added later; until then ``implementation`` is ``None``.
+
+Two layers:
+
+* **composite skills** are whole robot abilities (drive to a goal, pick up a
+  sample, stack a block). Other planners (e.g. a ProTaP dispatcher) and the
+  blocks-world skill plans call them directly.
+* **primitive skills** are the steps of the ALICA skill plans under
+  ``plans/skills/`` (Figs. 7, 8, 10, 13, 15 and 16 of the paper); each state
+  of those plans runs one of them.
+
+Capabilities name what a robot needs to run a skill; role sets list the same
+words under ``requires`` (``base``, ``arm``, ``gripper``, ``lidar2d``,
+``camera``, ``lidar3d``, ``stereo_camera``).
+"""
+
+from __future__ import annotations
+
+from skills.registry import ParamSpec, SkillRegistry
+
+
+def _p(name: str, type: str, doc: str, *, default: object = None, required: bool | None = None) -> ParamSpec:
+    """A parameter; required unless a default is given or ``required=False``."""
+    if required is None:
+        required = default is None
+    return ParamSpec(name, type, required, None if required else default, doc)
+
+
+def _composite(registry: SkillRegistry) -> None:
+    registry.declare(
+        "MoveToPosition",
+        _p("goal", "position", "where to drive: [x, y], [x, y, z] or a term such as pos(a)"),
+        _p("tolerance", "float", "distance in metres at which the goal counts as reached", default=0.3),
+        _p("timeout", "float", "seconds before the skill gives up", default=60.0),
+        doc="drive to a goal position, escaping into free space when stuck (Fig. 8)",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "Pickup",
+        _p("object", "object", "the object to pick up"),
+        _p("retries", "int", "grasp attempts before the skill fails", default=3),
+        doc="align with an object, grasp it, lift it to the transport pose and check the grip (Fig. 15)",
+        capabilities=("base", "arm", "gripper"),
+    )
+    registry.declare(
+        "Putdown",
+        _p("object", "object", "the held object to put down"),
+        _p("target", "position", "where to place it: a position or a term such as pos(g); by default in front of the robot", required=False),
+        doc="place the held object, open the gripper, stow the arm and check the placement (Fig. 16)",
+        capabilities=("arm", "gripper"),
+    )
+    registry.declare(
+        "Stack",
+        _p("object", "object", "the held block to place"),
+        _p("target", "object", "the block to place it on"),
+        doc="put the held block on top of another block",
+        capabilities=("base", "arm", "gripper"),
+    )
+    registry.declare(
+        "Unstack",
+        _p("object", "object", "the top block to take"),
+        _p("from", "object", "the block it currently lies on"),
+        doc="take the top block off a stack and hold it",
+        capabilities=("base", "arm", "gripper"),
+    )
+    registry.declare(
+        "Explore",
+        _p("spacing", "float", "minimal distance in metres between the frontiers of different robots (eps of Eq. 7)", default=4.0),
+        _p("timeout", "float", "seconds before the skill stops; 0 explores until no frontier is left", default=0.0),
+        doc="explore unknown terrain frontier by frontier until the map is complete (Fig. 7)",
+        capabilities=("base", "lidar2d"),
+    )
+
+
+def _navigation(registry: SkillRegistry) -> None:
+    registry.declare(
+        "DriveTo",
+        _p("goal", "position", "where to drive: [x, y], [x, y, z] or a term such as pos(a)"),
+        _p("tolerance", "float", "distance in metres at which the goal counts as reached", default=0.3),
+        _p("timeout", "float", "seconds without progress before the skill fails", default=60.0),
+        doc="follow a collision-free path to a goal; fails when stuck",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "DriveToFreeSpace",
+        _p("clearance", "float", "distance in metres to keep from obstacles, robots and work sites", default=1.0),
+        _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
+        doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "Localize",
+        _p("timeout", "float", "seconds before the skill fails", default=30.0),
+        doc="localize the robot in the shared map",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "BuildMap",
+        _p("resolution", "float", "cell size of the occupancy grid in metres", default=0.05),
+        _p("radius", "float", "radius in metres around the start to map before the map counts as ready", default=5.0),
+        doc="build the team's first occupancy map around the robot and share it",
+        capabilities=("base", "lidar2d"),
+    )
+    registry.declare(
+        "ExploreFrontier",
+        _p("frontier", "object", "frontier cell to drive to; by default the best free one by information gain", required=False),
+        _p("spacing", "float", "minimal distance in metres to the frontiers of other robots (eps of Eq. 7)", default=4.0),
+        doc="drive to frontier cells in order of information gain and boundary relation, updating the map",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "Idle",
+        _p("duration", "float", "seconds to wait before succeeding; 0 waits until the state is left", default=0.0),
+        doc="stand still",
+    )
+
+
+def _manipulation(registry: SkillRegistry) -> None:
+    registry.declare(
+        "AlignWithObject",
+        _p("object", "object", "the object to align with"),
+        _p("standoff", "float", "distance in metres from the object to the robot base after aligning", default=0.4),
+        _p("tolerance", "float", "position tolerance in metres", default=0.02),
+        doc="approach an object precisely so the arm can reach it",
+        capabilities=("base",),
+    )
+    registry.declare(
+        "Grasp",
+        _p("object", "object", "the object to grasp"),
+        _p("force", "float", "finger force in newtons", default=10.0),
+        doc="plan and execute a grasp of an object and close the fingers; counts the attempts as attempts(self)",
+        capabilities=("arm", "gripper"),
+    )
+    registry.declare(
+        "MoveArmToTransport",
+        doc="move the arm into its transport (home) pose",
+        capabilities=("arm",),
+    )
+    registry.declare(
+        "ValidateGrip",
+        _p("min_force", "float", "smallest finger force in newtons that counts as holding", default=2.0),
+        doc="check by finger force that the object is still held",
+        capabilities=("gripper",),
+    )
+    registry.declare(
+        "MoveArmToPlace",
+        _p("target", "position", "where to place: a position or a term such as pos(g); by default in front of the robot", required=False),
+        doc="move the held object to its place pose",
+        capabilities=("arm",),
+    )
+    registry.declare(
+        "OpenGripper",
+        doc="open the fingers",
+        capabilities=("gripper",),
+    )
+    registry.declare(
+        "VerifyPlaced",
+        _p("object", "object", "the object that was put down"),
+        _p("target", "position", "where it should lie; by default anywhere on the ground", required=False),
+        doc="check that the gripper is empty and the object lies at its place",
+        capabilities=("gripper",),
+    )
+    registry.declare(
+        "RandomBlockSkill",
+        _p("blocking_radius", "float", "a stack with another robot closer than this many metres is left alone", default=0.5),
+        doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking",
+        capabilities=("base", "arm", "gripper"),
+    )
+
+
+def _directed_vision(registry: SkillRegistry) -> None:
+    registry.declare(
+        "DetectCircles",
+        _p("radius", "float", "radius in metres of the drill samples to look for", default=0.05),
+        _p("tolerance", "float", "allowed radius error in metres", default=0.01),
+        _p("max_range", "float", "farthest distance in metres to consider", default=8.0),
+        doc="find circular shapes of the sample radius in the 2D laser scan and report them as candidates",
+        capabilities=("lidar2d",),
+    )
+    registry.declare(
+        "CropCandidate",
+        _p("margin", "float", "extra border around the candidate in metres", default=0.1),
+        doc="project the candidate into the camera image and crop it",
+        capabilities=("camera",),
+    )
+    registry.declare(
+        "BlobDetect",
+        _p("colours", "list", "colours to search for", default=("green", "red")),
+        _p("min_area", "int", "smallest blob in pixels", default=40),
+        doc="find coloured blobs in the cropped candidate image (short range only)",
+        capabilities=("camera",),
+    )
+    registry.declare(
+        "ClassifySample",
+        doc="decode the sample from its upper, middle and lower sections (green/red, black/white, green/red)",
+        capabilities=("camera",),
+    )
+
+
+def _semantic_perception(registry: SkillRegistry) -> None:
+    registry.declare(
+        "StereoPointCloud",
+        _p("max_depth", "float", "points farther than this many metres are dropped", default=3.0),
+        doc="compute a 3D point cloud from the stereo camera pair",
+        capabilities=("stereo_camera",),
+    )
+    registry.declare(
+        "RansacGroundPlane",
+        _p("distance_threshold", "float", "largest point-to-plane distance in metres of an inlier", default=0.02),
+        _p("iterations", "int", "RANSAC iterations", default=500),
+        doc="fit the ground plane with RANSAC and remove its points from the cloud",
+    )
+    registry.declare(
+        "EuclideanCluster",
+        _p("tolerance", "float", "largest distance in metres between neighbouring points of a cluster", default=0.03),
+        _p("min_points", "int", "smallest cluster kept", default=50),
+        doc="split the remaining points into clusters of nearby points",
+    )
+    registry.declare(
+        "FitModel",
+        _p("model", "str", "geometric model of the object", default="cylinder"),
+        doc="fit the sample's geometric model to every cluster and extract its features",
+    )
+    registry.declare(
+        "FuzzyDLClassify",
+        _p("knowledge_base", "str", "fuzzy description of the objects (radius, height, orientation)", default="drill_sample"),
+        _p("threshold", "float", "smallest degree of membership that counts as a match", default=0.6),
+        doc="rate the fitted clusters against the fuzzy object description with FuzzyDL",
+    )
+
+
+def declare_all(registry: SkillRegistry) -> None:
+    """Declare every skill the shipped plans use.
+
+    Args:
+        registry: the registry to add the declarations to.
+
+    Raises:
+        ValueError: a skill of the same name is already registered.
+    """
+    _composite(registry)
+    _navigation(registry)
+    _manipulation(registry)
+    _directed_vision(registry)
+    _semantic_perception(registry)
