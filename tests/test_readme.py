@@ -1,0 +1,37 @@
+"""The README's examples run and say what the README says."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from alica.io import validate_paths
+from tests.conftest import PLANS, ROOT
+
+README = (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+def _blocks(language: str) -> list[str]:
+    return re.findall(rf"```{language}\n(.*?)```", README, re.S)
+
+
+def test_readme_starts_with_the_two_commands() -> None:
+    first = _blocks("sh")[0]
+    assert first.splitlines()[0].startswith("make demo") and first.splitlines()[1].startswith("make test")
+
+
+def test_readme_plan_example_is_valid(tmp_path: Path) -> None:
+    shutil.copytree(PLANS, tmp_path / "plans")
+    example = tmp_path / "plans" / "lunar" / "fetch_sample.yaml"
+    example.write_text(_blocks("yaml")[0], encoding="utf-8")
+    problems = validate_paths([example])
+    assert not problems, [p.format() for p in problems]
+
+
+def test_readme_python_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(ROOT)
+    exec(compile(_blocks("python")[0], "README.md", "exec"), {})
+    assert capsys.readouterr().out.strip() == "True"
