@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import re
 
-from alica.io.fields import Fields, Problems, kind_of
+from alica.io.fields import Fields, Problems, kind_of, to_number
 from alica.io.tree import Node
 from alica.model import (
     UNBOUNDED,
@@ -147,7 +147,7 @@ def _role(node: Node, problems: Problems) -> Role:
     table = f.mapping("priorities")
     if table is not None:
         for task, value in table.value.items():  # type: ignore[union-attr]
-            number = _number_value(value)
+            number = to_number(value.value)
             if number is None:
                 problems.add(value.span, f"priority of role '{f.values.get('name', node).value}' for task '{task}' must be a number, not {kind_of(value)}", "write a number in [-1, 1]; negative means the role cannot take the task")
                 continue
@@ -159,12 +159,6 @@ def _role(node: Node, problems: Problems) -> Role:
         f.text("description"),
         span=node.span,
     )
-
-
-def _number_value(node: Node) -> float | None:
-    from alica.io.fields import to_number
-
-    return to_number(node.value)
 
 
 def _param_value(node: Node, problems: Problems, where: str) -> ParamValue:

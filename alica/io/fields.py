@@ -137,13 +137,15 @@ class Fields:
         return int(value)
 
     def cardinality(self, key: str, default: float) -> float:
-        """A whole number or ``*`` for no upper bound."""
+        """A whole number, or ``*`` (also ``n``, ``inf``) for no upper bound."""
         node = self.values.get(key)
-        if node is not None and isinstance(node.value, str) and node.value.strip().lower() in _UNBOUNDED:
+        if node is None or node.value is None:
+            return default
+        if isinstance(node.value, str) and node.value.strip().lower() in _UNBOUNDED:
             return math.inf
-        if node is not None and isinstance(node.value, float) and math.isinf(node.value):
+        if isinstance(node.value, float) and node.value == math.inf:
             return math.inf
-        return self.integer(key, int(default) if not math.isinf(default) else 0) if node is not None and node.value is not None else default
+        return self.integer(key, 0)
 
     def flag(self, key: str, default: bool) -> bool:
         """``true`` or ``false``."""

@@ -102,22 +102,20 @@ class Loader:
             return self._cache[path]
         name = shown(path)
         fmt = format_of(path)
-        try:
-            raw = path.read_bytes()
-        except OSError as exc:
-            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"cannot read the file: {exc.strerror or exc}", "check the path and its permissions")], [])
+
+        def failed(message: str, hint: str) -> _Read:
+            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), message, hint)], [])
             self._cache[path] = result
             return result
-        try:
-            text = raw.decode("utf-8-sig") if fmt != "xml" else raw.decode("utf-8", errors="strict")
-        except UnicodeDecodeError as exc:
-            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"the file is not UTF-8 text (byte {exc.start})", "save it as UTF-8")], [])
-            self._cache[path] = result
-            return result
+
         if fmt is None:
-            result = _Read(Document(path=name), [Diagnostic(SourceSpan(name, 1, 1), f"unknown plan file type '{path.suffix}'", "use .yaml, .yml or .xml")], [])
-            self._cache[path] = result
-            return result
+            return failed(f"unknown plan file type '{path.suffix}'", "use .yaml, .yml or .xml")
+        try:
+            text = path.read_bytes().decode("utf-8-sig")
+        except OSError as exc:
+            return failed(f"cannot read the file: {exc.strerror or exc}", "check the path and its permissions")
+        except UnicodeDecodeError as exc:
+            return failed(f"the file is not UTF-8 text (byte {exc.start})", "save it as UTF-8")
         tree, diagnostics = parse_text(text, name, fmt)
         problems = Problems()
         problems.items.extend(diagnostics)

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import TypeVar
 
 from alica.source import SourceSpan
+
+T = TypeVar("T")
 
 #: Written as ``"*"`` (YAML) or ``"*"``/``"inf"`` in files: no upper bound.
 UNBOUNDED = math.inf
@@ -84,6 +88,18 @@ class Constraint:
     text: str
     variables: tuple[str, ...] = ()
     span: SourceSpan | None = span_field()
+
+
+def find_named(items: Iterable[T], name: str, owner: str, kind: str) -> T:
+    """The item of ``items`` whose ``name`` is ``name``.
+
+    Raises:
+        KeyError: none is, with a message naming ``owner`` and ``kind``.
+    """
+    for item in items:
+        if item.name == name:  # type: ignore[attr-defined]
+            return item
+    raise KeyError(f"{owner} has no {kind} '{name}'")
 
 
 def format_cardinality(value: float) -> str:

@@ -11,6 +11,7 @@ from alica.model.common import (
     Constraint,
     StateKind,
     Variable,
+    find_named,
     format_cardinality,
     span_field,
 )
@@ -220,10 +221,7 @@ class Plan:
         Raises:
             KeyError: no such state.
         """
-        for state in self.states:
-            if state.name == name:
-                return state
-        raise KeyError(f"plan '{self.name}' has no state '{name}'")
+        return find_named(self.states, name, f"plan '{self.name}'", "state")
 
     def entry_point(self, name: str) -> EntryPoint:
         """The entry point called ``name`` (by default its task's name).
@@ -231,10 +229,7 @@ class Plan:
         Raises:
             KeyError: no such entry point.
         """
-        for ep in self.entry_points:
-            if ep.name == name:
-                return ep
-        raise KeyError(f"plan '{self.name}' has no entry point '{name}'")
+        return find_named(self.entry_points, name, f"plan '{self.name}'", "entry point")
 
     def out_transitions(self, state: str) -> tuple[Transition, ...]:
         """Transitions leaving ``state``, in declaration order."""

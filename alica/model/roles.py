@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from alica.model.common import span_field
+from alica.model.common import find_named, span_field
 from alica.source import SourceSpan
 
 
@@ -82,10 +82,7 @@ class RoleSet:
         Raises:
             KeyError: no such role.
         """
-        for role in self.roles:
-            if role.name == name:
-                return role
-        raise KeyError(f"role set '{self.name}' has no role '{name}'")
+        return find_named(self.roles, name, f"role set '{self.name}'", "role")
 
     def priority(self, role: str, task: str) -> float:
         """Pref(role, task), falling back to the default priority."""
