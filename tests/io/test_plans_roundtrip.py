@@ -47,7 +47,8 @@ def test_xml_twins_mean_the_same_as_their_yaml() -> None:
 
 
 def test_yaml_files_match_the_json_schema() -> None:
-    jsonschema = pytest.importorskip("jsonschema")
+    import jsonschema
+
     schema = json.loads(resources.files("alica.io").joinpath("schema/plan.schema.json").read_text(encoding="utf-8"))
     for path in FILES:
         if path.suffix == ".yaml":
