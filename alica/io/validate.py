@@ -157,7 +157,7 @@ class Validator:
         variables = {v.name for v in b.variables}
         for p in b.params:
             if p.variable is not None and p.variable not in variables:
-                self.problems.add(p.span, f"parameter '{p.name}' of {what} refers to '${p.variable}', which is not a variable of the behaviour", f"declare it under 'variables:' or fix the name")
+                self.problems.add(p.span, f"parameter '{p.name}' of {what} refers to '${p.variable}', which is not a variable of the behaviour", "declare it under 'variables:' or fix the name")
         if b.skill not in self.skills:
             hint = suggest(b.skill, self.skills.names()) or "run 'alica list-skills' to see the registered skills"
             self.problems.add(b.span, f"{what} binds unknown skill '{b.skill}'", hint)
