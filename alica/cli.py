@@ -38,12 +38,12 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _load(path: str):  # type: ignore[no-untyped-def]
-    from alica.io import Loader, load_library
+def _load(path: str | Path, loader=None):  # type: ignore[no-untyped-def]
+    """The library of a plan file's set and the file's own document, each file read once."""
+    from alica.io import Loader
 
-    library = load_library(path)
-    entry = Loader().read(Path(path)).document
-    return library, entry
+    loader = loader or Loader()
+    return loader.load(path), loader.document(path)
 
 
 def _roots(library, entry, name: str | None) -> list[str]:  # type: ignore[no-untyped-def]
@@ -83,18 +83,18 @@ def _cmd_show(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     import shutil
 
-    from alica.io import Loader, load_library, plan_files
+    from alica.io import Loader, plan_files
     from alica.render import dot_graph, svg, text_tree
 
     files, problems = plan_files(args.paths)
+    loader = Loader()
     if problems:
         raise PlanFormatError(problems)
     out = Path(args.out)
     has_dot = shutil.which("dot") is not None
     count = 0
     for path in files:
-        library = load_library(path)
-        entry = Loader().read(path).document
+        library, entry = _load(path, loader)
         for root in _roots(library, entry, None):
             stem = out / f"{path.stem}.{root}"
             stem.parent.mkdir(parents=True, exist_ok=True)
@@ -110,16 +110,15 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
 
 def _cmd_convert(args: argparse.Namespace) -> int:
-    from alica.io import dump_document, format_of, load_document, load_library, read_text
+    from alica.io import Loader, dump_document, format_of, read_text
 
     fmt = format_of(args.output)
     if fmt is None or format_of(args.input) is None:
         raise AlicaError("convert needs files ending in .yaml, .yml or .xml, e.g. 'alica convert roles.yaml roles.xml'")
-    if args.no_validate:
-        document = load_document(args.input)
-    else:
-        load_library(args.input)
-        document = load_document(args.input)
+    loader = Loader()
+    if not args.no_validate:
+        loader.load(args.input)
+    document = loader.document(args.input)
     text = dump_document(document, fmt)
     again, problems = read_text(text, args.output, fmt)
     if problems or again != document:

@@ -43,7 +43,8 @@ from alica.model import (
 
 #: Keys of the top level of a plan file.
 TOP_KEYS = ("alica", "imports", "tasks", "rolesets", "behaviours", "plans", "plantypes", "problems")
-_TYPED = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\s*$")
+#: ``name`` or ``name - type``, the way typed names are written in both formats.
+TYPED_NAME = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\s*$")
 
 
 def build_document(tree: Node, path: str, problems: Problems) -> Document:
@@ -100,7 +101,7 @@ def _typed(node: Node, f: Fields, key: str) -> Variable | None:
         g = Fields(node, f"an entry of '{key}' in {f.what}", f.problems, ("name", "type"))
         return Variable(g.name(), g.text("type", default="any"), span=node.span)
     if isinstance(node.value, str):
-        match = _TYPED.match(node.value)
+        match = TYPED_NAME.match(node.value)
         if match:
             return Variable(match.group(1), match.group(2) or "any", span=node.span)
     f.problems.add(node.span, f"'{node.value}' in '{key}' of {f.what} is not 'name' or 'name - type'", "write e.g. '?r - robot'")

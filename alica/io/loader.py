@@ -65,14 +65,27 @@ def parse_text(text: str, name: str, fmt: str) -> tuple[Node | None, list[Diagno
     return read_yaml(text, name)
 
 
-def read_text(text: str, name: str, fmt: str = "yaml") -> tuple[Document, list[Diagnostic]]:
-    """Build one document from text, without following imports or validating the set."""
+def _build(text: str, name: str, fmt: str) -> tuple[Node | None, Document, list[Diagnostic]]:
     tree, diagnostics = parse_text(text, name, fmt)
     problems = Problems()
     problems.items.extend(diagnostics)
     if tree is None:
-        return Document(path=name), problems.items
-    return build_document(tree, name, problems), problems.items
+        return None, Document(path=name), problems.items
+    return tree, build_document(tree, name, problems), problems.items
+
+
+def read_text(text: str, name: str, fmt: str = "yaml") -> tuple[Document, list[Diagnostic]]:
+    """Build one document from text, without following imports or validating the set."""
+    _, document, diagnostics = _build(text, name, fmt)
+    return document, diagnostics
+
+
+def _import_nodes(tree: Node | None) -> list[Node]:
+    """The entries of a file's ``imports`` section, with their places."""
+    section = tree.value.get("imports") if tree is not None and isinstance(tree.value, dict) else None
+    if section is None:
+        return []
+    return section.value if isinstance(section.value, list) else [section]
 
 
 @dataclass
@@ -116,19 +129,13 @@ class Loader:
             return failed(f"cannot read the file: {exc.strerror or exc}", "check the path and its permissions")
         except UnicodeDecodeError as exc:
             return failed(f"the file is not UTF-8 text (byte {exc.start})", "save it as UTF-8")
-        tree, diagnostics = parse_text(text, name, fmt)
-        problems = Problems()
-        problems.items.extend(diagnostics)
-        imports: list[tuple[Path, SourceSpan]] = []
-        document = Document(path=name)
-        if tree is not None:
-            document = build_document(tree, name, problems)
-            import_nodes = tree.value.get("imports") if isinstance(tree.value, dict) else None
-            nodes = import_nodes.value if import_nodes is not None and isinstance(import_nodes.value, list) else [import_nodes] if import_nodes is not None else []
-            for node in nodes:
-                if isinstance(node.value, str) and node.value.strip():
-                    imports.append(((path.parent / node.value.strip()), node.span))
-        result = _Read(document, problems.items, imports)
+        tree, document, diagnostics = _build(text, name, fmt)
+        imports = [
+            (path.parent / node.value.strip(), node.span)
+            for node in _import_nodes(tree)
+            if isinstance(node.value, str) and node.value.strip()
+        ]
+        result = _Read(document, diagnostics, imports)
         self._cache[path] = result
         return result
 
@@ -156,14 +163,24 @@ class Loader:
                     todo.append(target.resolve())
         return documents, diagnostics
 
-    def check(self, entry: Path) -> tuple[list[Document], list[Diagnostic]]:
-        """Read and validate one document set; returns its documents and every problem."""
+    def check(self, *entries: str | os.PathLike[str]) -> tuple[list[Document], list[Diagnostic]]:
+        """Read and validate the document set of one or more entry files.
+
+        Returns:
+            The set's documents (each once) and every problem found.
+        """
         from alica.io.validate import Validator
 
-        documents, diagnostics = self.document_set(entry)
+        documents: dict[str, Document] = {}
+        diagnostics: list[Diagnostic] = []
+        for entry in entries:
+            docs, diags = self.document_set(Path(entry))
+            diagnostics.extend(diags)
+            for doc in docs:
+                documents.setdefault(doc.path, doc)
         problems = Problems()
-        Validator(documents, self.skills, self.functions, problems).run()
-        return documents, _unique(diagnostics + problems.items)
+        Validator(list(documents.values()), self.skills, self.functions, problems).run()
+        return list(documents.values()), _unique(diagnostics + problems.items)
 
     def load(self, *entries: str | os.PathLike[str]) -> PlanLibrary:
         """Load and validate the document set of one or more entry files.
@@ -171,24 +188,21 @@ class Loader:
         Raises:
             PlanFormatError: with every problem found, if any.
         """
-        from alica.io.validate import Validator
-
-        documents: list[Document] = []
-        diagnostics: list[Diagnostic] = []
-        seen: set[str] = set()
-        for entry in entries:
-            docs, diags = self.document_set(Path(entry))
-            diagnostics.extend(diags)
-            for doc in docs:
-                if doc.path not in seen:
-                    seen.add(doc.path)
-                    documents.append(doc)
-        problems = Problems()
-        Validator(documents, self.skills, self.functions, problems).run()
-        diagnostics = _unique(diagnostics + problems.items)
+        documents, diagnostics = self.check(*entries)
         if diagnostics:
             raise PlanFormatError(diagnostics)
         return PlanLibrary(tuple(documents))
+
+    def document(self, path: str | os.PathLike[str]) -> Document:
+        """One file's document, without validating references.
+
+        Raises:
+            PlanFormatError: the file cannot be read or has structural problems.
+        """
+        read = self.read(Path(path))
+        if read.diagnostics:
+            raise PlanFormatError(read.diagnostics)
+        return read.document
 
 
 def _unique(diagnostics: Iterable[Diagnostic]) -> list[Diagnostic]:
@@ -240,10 +254,7 @@ def load_document(path: str | os.PathLike[str]) -> Document:
     Raises:
         PlanFormatError: the file cannot be read or has structural problems.
     """
-    read = Loader().read(Path(path))
-    if read.diagnostics:
-        raise PlanFormatError(read.diagnostics)
-    return read.document
+    return Loader().document(path)
 
 
 def dump_document(document: Document, fmt: str = "yaml") -> str:

@@ -22,6 +22,7 @@ from alica.model import (
     PlanningProblem,
     PlanType,
     RoleSet,
+    children_of,
     format_cardinality,
 )
 from alica.source import SourceSpan
@@ -290,20 +291,10 @@ class Validator:
         colour: dict[str, int] = {}
         reported: set[frozenset[str]] = set()
 
-        def children(name: str) -> list[str]:
-            element = self.abstract.get(name)
-            if isinstance(element, Plan):
-                return [c.name for s in element.states for c in s.children]
-            if isinstance(element, PlanType):
-                return list(element.plans)
-            if isinstance(element, PlanningProblem):
-                return [*element.elements, *(x for x in (element.wait_plan, element.alternative_plan) if x)]
-            return []
-
         def visit(name: str, path: list[str]) -> None:
             colour[name] = 1
             path.append(name)
-            for child in children(name):
+            for child in children_of(self.abstract[name]):
                 if child not in self.abstract:
                     continue
                 if colour.get(child) == 1:

@@ -196,7 +196,6 @@ _ENTRIES: dict[str, _Entry] = {
 
 _XSI = "http://www.w3.org/2001/XMLSchema-instance"
 _XML_NS = "http://www.w3.org/XML/1998/namespace"
-_TYPED = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\s*$")
 _NEWLINE = re.compile(r"\r\n?|\n")
 
 # --------------------------------------------------------------------------- YAML scalar rules

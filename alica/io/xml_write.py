@@ -8,10 +8,10 @@ from typing import Any
 
 from lxml import etree
 
+from alica.io.build import TYPED_NAME
 from alica.io.xml_vocabulary import (
     _ENTRIES,
     _SPECS,
-    _TYPED,
     LIST,
     NAMES,
     ONE,
@@ -97,7 +97,7 @@ def _typed_entry(item: Any) -> dict[str, Any]:
     if isinstance(item, dict):
         return item
     text = _scalar_text(item, "a typed name")
-    match = _TYPED.match(text)
+    match = TYPED_NAME.match(text)
     if match:
         return {"name": match.group(1), **({"type": match.group(2)} if match.group(2) else {})}
     if " - " in text:

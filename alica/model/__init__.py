@@ -15,7 +15,7 @@ from alica.model.common import (
     Variable,
     format_cardinality,
 )
-from alica.model.library import SECTIONS, AbstractPlan, Document, PlanLibrary
+from alica.model.library import SECTIONS, AbstractPlan, Document, PlanLibrary, children_of
 from alica.model.plan import (
     Binding,
     ChildRef,
@@ -62,5 +62,6 @@ __all__ = [
     "Transition",
     "UtilityFunction",
     "Variable",
+    "children_of",
     "format_cardinality",
 ]

@@ -25,6 +25,22 @@ SECTIONS: tuple[tuple[str, type], ...] = (
 )
 
 
+def children_of(element: AbstractPlan) -> tuple[str, ...]:
+    """Names of the abstract plans ``element`` runs directly: the edges of the plan tree.
+
+    A plan runs its states' children, a plan type its alternatives, a planning
+    problem its elements, WaitPlan and AlternativePlan; a behaviour runs nothing.
+    """
+    if isinstance(element, Plan):
+        return tuple(c.name for s in element.states for c in s.children)
+    if isinstance(element, PlanType):
+        return element.plans
+    if isinstance(element, PlanningProblem):
+        extra = tuple(p for p in (element.wait_plan, element.alternative_plan) if p)
+        return element.elements + extra
+    return ()
+
+
 @dataclass(frozen=True, slots=True)
 class Document:
     """The elements written in one plan file, in file order.
@@ -107,14 +123,7 @@ class PlanLibrary:
 
     def children(self, element: AbstractPlan) -> tuple[str, ...]:
         """Names of the abstract plans ``element`` can run directly (edges of the plan tree)."""
-        if isinstance(element, Plan):
-            return tuple(c.name for s in element.states for c in s.children)
-        if isinstance(element, PlanType):
-            return element.plans
-        if isinstance(element, PlanningProblem):
-            extra = tuple(p for p in (element.wait_plan, element.alternative_plan) if p)
-            return element.elements + extra
-        return ()
+        return children_of(element)
 
     def roots(self) -> tuple[Plan, ...]:
         """Plans no other element runs: the top of each plan tree."""
