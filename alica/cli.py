@@ -172,6 +172,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("list-skills", help="list the registered skills and their parameters")
     p.set_defaults(run=_cmd_list_skills)
+
+    from alica.cli_run import add_parser as add_run_parser
+
+    add_run_parser(sub)
     return parser
 
 

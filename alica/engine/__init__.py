@@ -1,0 +1,36 @@
+"""The team engine: one ALICA engine per agent, ticked in simulated or real time.
+
+* :class:`AgentEngine` runs one agent's plan tree (:mod:`alica.engine.node`):
+  rules, allocation, repair, synchronised transitions, the team view.
+* :class:`SimulatedTeam` runs a whole team in lock step over a simulated
+  network with faults (loss, delay, partitions, crashes).
+* Behaviours are py_trees behaviours built from skills
+  (:mod:`alica.engine.behaviours`); :mod:`alica.testing` has scripted doubles.
+"""
+
+from alica.engine.agent import AgentEngine
+from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext, SkillFactory
+from alica.engine.config import EngineConfig
+from alica.engine.runner import SimulatedTeam, pick_roleset
+from alica.engine.show import running_tree
+from alica.engine.status import ChildStatus
+from alica.engine.team import Claim, TeamMessage, TeamView
+from alica.engine.trace import JsonlTrace, TraceRecorder
+
+__all__ = [
+    "AgentEngine",
+    "BehaviourRunner",
+    "ChildStatus",
+    "Claim",
+    "EngineConfig",
+    "JsonlTrace",
+    "SimulatedTeam",
+    "SkillBinder",
+    "SkillContext",
+    "SkillFactory",
+    "TeamMessage",
+    "TeamView",
+    "TraceRecorder",
+    "pick_roleset",
+    "running_tree",
+]

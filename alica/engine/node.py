@@ -1,0 +1,354 @@
+"""A running plan in an agent's plan tree: its assignment, the agent's state, the rules.
+
+Each tick the engine visits the tree top-down. For one plan node:
+
+1. **integrate**: teammates' claims (the plans, entry points and states they
+   say they are in) override what this agent predicted for them; agents that
+   left the parent state, or went silent, are taken out;
+2. **allocate**: when the assignment's inputs changed, the best assignment is
+   computed again; the agent switches only when the utility gains more than
+   the plan's threshold (or the current assignment became invalid). An
+   authority's assignment, while it lasts, replaces this step;
+3. **children**: the rules of the child plans run, and failed children are
+   repaired (see :mod:`alica.engine.slot`);
+4. **transitions**: the first out-transition of the agent's state whose
+   condition holds fires (synchronised ones only together with the other
+   agents), up to ``max_rule_applications`` in a row;
+5. **abort**: a failure state, a run-time condition that no longer holds, or a
+   failed child no transition handles makes the plan fail for this agent;
+   the plan succeeds when every success-required entry point has enough
+   agents in success states.
+
+Behaviours are ticked after the rules (see :meth:`AgentEngine.tick`).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import TYPE_CHECKING
+
+from alica.model import Plan, StateKind, Transition
+
+from alica.engine.slot import Slot
+from alica.engine.status import ChildStatus
+from alica.engine.team import Claim, PlanKey, key_text
+
+if TYPE_CHECKING:
+    from alica.allocation import Assignment
+    from alica.engine.agent import AgentEngine
+
+Entry = tuple[str | None, str | None]
+
+
+class PlanNode:
+    """One plan instance as one agent runs it.
+
+    Args:
+        engine: the agent's engine.
+        key: the plan instance's key in the team.
+        slot: the child of the parent state it runs in; ``None`` for the root.
+        plan: the plan.
+        env: its variables, bound by the parent.
+        now: the start time.
+    """
+
+    def __init__(self, engine: AgentEngine, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float) -> None:
+        self.engine = engine
+        self.key = key
+        self.key_text = key_text(key)
+        self.slot = slot
+        self.plan = plan
+        self.env = env
+        self.believed: dict[str, Entry] = {}
+        self.predicted_at: dict[str, float] = {}
+        self.succeeded: dict[str, set[str]] = {}
+        self.ep: str | None = None
+        self.state: str | None = None
+        self.slots: list[Slot] = []
+        self.status = ChildStatus.RUNNING
+        self.reason = ""
+        self.started_at = now
+        self.state_entered_at = now
+        self.dirty = False
+        self.history: deque[tuple[float, str, str, str | None, str | None]] = deque(maxlen=64)
+        self.contested_until = -1.0
+        self.authority_until = -1.0
+        self.authority_window = 0.0
+        self.overridden_until = -1.0
+        self._members: tuple[str, ...] | None = None
+
+    def __repr__(self) -> str:
+        return f"<PlanNode {self.key_text} {self.ep}/{self.state} {self.status.value}>"
+
+    # -- team ----------------------------------------------------------
+
+    def members(self) -> tuple[str, ...]:
+        """Alive agents believed to be in the parent state (all alive agents for the root), sorted."""
+        if self._members is None:
+            engine = self.engine
+            alive = engine.team.alive()
+            if self.slot is None:
+                self._members = alive
+            else:
+                parent = self.slot.parent
+                believed = parent.believed
+                state = parent.state
+                self._members = tuple(a for a in alive if a == engine.name or (believed.get(a) or (None, None))[1] == state)
+        return self._members
+
+    def invalidate(self) -> None:
+        """Inputs of the assignment changed: integrate and allocate again on the next visit."""
+        self.dirty = True
+        self._members = None
+
+    def successes(self) -> dict[str, int]:
+        """Agents whose task succeeded, per entry point."""
+        return {ep: len(agents) for ep, agents in self.succeeded.items() if agents}
+
+    def own_successes(self) -> tuple[str, ...]:
+        """Entry points in which this agent's task succeeded here."""
+        me = self.engine.name
+        return tuple(sorted(ep for ep, agents in self.succeeded.items() if me in agents))
+
+    def claim(self) -> Claim:
+        """What this agent says about this plan in its team message."""
+        return Claim(self.key, self.plan.name, self.ep, self.state, self.own_successes(), self.contested_until > self.engine.now())
+
+    def integrate(self, now: float) -> bool:
+        """Take teammates' claims and the team's liveness into the believed assignment.
+
+        Returns:
+            Whether anything changed.
+        """
+        engine = self.engine
+        me = engine.name
+        team = engine.team
+        members = set(self.members())
+        changed = False
+        for agent in [a for a in self.believed if a != me and a not in members]:
+            del self.believed[agent]
+            changed = True
+        protection = engine.config.assignment_protection
+        for agent in sorted(members - {me}):
+            claim = team.claim(agent, self.key)
+            current = self.believed.get(agent)
+            if claim is not None and claim.plan == self.plan.name:
+                for ep in claim.success:
+                    done = self.succeeded.setdefault(ep, set())
+                    if agent not in done:
+                        done.add(agent)
+                        changed = True
+                new = (claim.entry, claim.state)
+                if current != new:
+                    predicted = self.predicted_at.get(agent)
+                    if predicted is None or team.changed_at(agent) > predicted or now - predicted > protection:
+                        self.believed[agent] = new
+                        self.predicted_at.pop(agent, None)
+                        if current is None or current[0] != new[0]:
+                            self.history.append((now, "message", agent, current[0] if current else None, new[0]))
+                        changed = True
+            elif current is not None and team.has_spoken(agent):
+                since = self.predicted_at.get(agent, self.started_at)
+                if now - since > protection:
+                    del self.believed[agent]
+                    self.predicted_at.pop(agent, None)
+                    changed = True
+        if changed:
+            self._children_membership_changed()
+        return changed
+
+    def _children_membership_changed(self) -> None:
+        for slot in self.slots:
+            if slot.node is not None:
+                slot.node.invalidate()
+
+    # -- own entry point and state --------------------------------------
+
+    def set_entry(self, ep: str | None, now: float) -> None:
+        """Take entry point ``ep`` (``None``: idle) and enter its initial state."""
+        self.ep = ep
+        me = self.engine.name
+        if ep is None:
+            self._leave_state()
+            self.state = None
+            self.believed[me] = (None, None)
+            return
+        state = self.plan.entry_point(ep).state
+        assert state is not None  # validated plans have an initial state per entry point
+        self.enter_state(state, now)
+
+    def enter_state(self, state: str, now: float) -> None:
+        """Leave the current state (stopping its children) and enter ``state``."""
+        self._leave_state()
+        engine = self.engine
+        self.state = state
+        self.state_entered_at = now
+        self.believed[engine.name] = (self.ep, state)
+        model = self.plan.state(state)
+        if model.kind is StateKind.SUCCESS and self.ep is not None:
+            self.succeeded.setdefault(self.ep, set()).add(engine.name)
+        engine.tree_changed()
+        for ref in model.children:
+            slot = Slot(self, ref, engine.bind(self, ref))
+            self.slots.append(slot)
+            if slot.is_behaviour:
+                slot.runner = engine.make_runner(slot)
+                slot.status = slot.runner.status
+            else:
+                slot.start(now)
+
+    def _leave_state(self) -> None:
+        for slot in self.slots:
+            slot.stop()
+        self.slots = []
+        self.engine.drop_syncs(self)
+
+    def stop(self) -> None:
+        """Stop every child: the agent leaves this plan."""
+        self._leave_state()
+        self.engine.forget(self)
+
+    # -- conditions ------------------------------------------------------
+
+    def children_status(self, want: str) -> bool:
+        """``succeeded``: every child succeeded (false without children); ``failed``: some child failed."""
+        if want == "success":
+            return bool(self.slots) and all(s.status is ChildStatus.SUCCESS for s in self.slots)
+        return any(s.status is ChildStatus.FAILURE for s in self.slots)
+
+    def child_status(self, name: str, want: str) -> bool:
+        """Whether the child ``name`` of the current state succeeded / failed."""
+        target = ChildStatus.SUCCESS if want == "success" else ChildStatus.FAILURE
+        return any(s.name == name and s.status is target for s in self.slots)
+
+    # -- the rules -------------------------------------------------------
+
+    def visit(self, now: float) -> None:
+        """Apply the rules to this plan and its children (see the module docstring)."""
+        if self.status is ChildStatus.FAILURE:
+            return
+        engine = self.engine
+        if self.dirty:
+            self.dirty = False
+            self.integrate(now)
+            engine.reallocate(self, now)
+            if self.status is ChildStatus.FAILURE:
+                return
+        for slot in list(self.slots):
+            slot.visit(now)
+        if self.state is None:
+            self._check_success()
+            return
+        fired = False
+        for _ in range(engine.config.max_rule_applications):
+            if self.plan.state(self.state).terminal:
+                break
+            transition = self._transition_rule(now)
+            if transition is None:
+                break
+            fired = True
+            engine.emit("transition", key=self.key_text, plan=self.plan.name, source=transition.source, target=transition.target, name=transition.name)
+            self.enter_state(transition.target, now)
+        if self.status is ChildStatus.FAILURE:
+            return
+        self._abort_rule(fired)
+        if self.status is not ChildStatus.FAILURE:
+            self._check_success()
+
+    def _transition_rule(self, now: float) -> Transition | None:
+        engine = self.engine
+        belief = engine.belief_for(self)
+        for transition in engine.out_transitions(self.plan, self.state):
+            condition = transition.condition.text if transition.condition else None
+            holds = engine.formulas.holds(condition, belief, self.env)
+            if transition.synchronisation is None:
+                if holds:
+                    return transition
+                continue
+            process = engine.sync_process(self, transition.synchronisation)
+            process.update_mine(transition.name, holds, now)
+            if holds and process.complete():
+                engine.emit("sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="fired")
+                process.reset()
+                return transition
+            if process.timed_out(now):
+                process.reset()
+                if process.sync.fail_on_timeout:
+                    self.fail(f"synchronisation '{process.sync.name}' timed out after {process.sync.sync_timeout} s")
+                    return None
+                engine.emit("sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="timeout")
+        return None
+
+    def _abort_rule(self, fired: bool) -> None:
+        assert self.state is not None
+        state = self.plan.state(self.state)
+        if state.kind is StateKind.FAILURE:
+            self.fail(f"reached failure state '{state.name}'")
+            return
+        run = self.plan.run
+        if run is not None and not self.engine.formulas.holds(run.text, self.engine.belief_for(self), self.env):
+            self.fail(f"run-time condition '{run.text}' no longer holds")
+            return
+        if not fired:
+            for slot in self.slots:
+                if slot.status is ChildStatus.FAILURE:
+                    self.fail(f"child '{slot.name}' of state '{state.name}' failed and no transition handles it ({slot.reason})")
+                    return
+
+    def plan_succeeded(self) -> bool:
+        """Plan success: every success-required entry point has enough agents in success states.
+
+        A plan with no success-required entry point succeeds once any agent's task succeeded.
+        """
+        successes = self.successes()
+        if any(ep.success_required for ep in self.plan.entry_points):
+            return self.plan.succeeded(successes)
+        return bool(successes)
+
+    def _check_success(self) -> None:
+        if self.status is ChildStatus.RUNNING and self.plan_succeeded():
+            self.status = ChildStatus.SUCCESS
+            self.engine.emit("success", key=self.key_text, plan=self.plan.name)
+
+    def fail(self, reason: str) -> None:
+        """The plan failed for this agent; the parent repairs it."""
+        if self.status is ChildStatus.FAILURE:
+            return
+        self.status = ChildStatus.FAILURE
+        self.reason = reason
+        self.engine.emit("failure", key=self.key_text, plan=self.plan.name, reason=reason)
+
+    # -- allocation results ---------------------------------------------
+
+    def apply(self, assignment: Assignment, now: float, reason: str) -> None:
+        """Adopt an assignment: predictions for teammates, a new entry point for this agent if it changed."""
+        me = self.engine.name
+        for agent, ep in assignment.entries:
+            if agent == me:
+                continue
+            current = self.believed.get(agent)
+            if current is None or current[0] != ep:
+                state = self.plan.entry_point(ep).state if ep is not None else None
+                self.believed[agent] = (ep, state)
+                self.predicted_at[agent] = now
+                self.history.append((now, reason, agent, current[0] if current else None, ep))
+        self._children_membership_changed()
+        mine = assignment.entry_of(me) if me in assignment.agents else None
+        if mine != self.ep or self.state is None and mine is not None:
+            self.history.append((now, reason, me, self.ep, mine))
+            self.set_entry(mine, now)
+        self.engine.tree_changed()
+
+    def conflicts(self, now: float, window: float) -> int:
+        """Times, within ``window`` seconds, that a teammate's message undid a utility-driven change."""
+        count = 0
+        last_utility: dict[str, tuple[str | None, str | None]] = {}
+        for t, reason, agent, old, new in self.history:
+            if now - t > window:
+                continue
+            if reason == "utility":
+                last_utility[agent] = (old, new)
+            elif reason == "message" and agent in last_utility and last_utility[agent] == (new, old):
+                count += 1
+                del last_utility[agent]
+        return count

@@ -1,0 +1,279 @@
+"""A team in simulation: agents ticked in lock step over a simulated network, with faults.
+
+Every tick, every running agent first takes in what the network delivered,
+then applies its rules and ticks its behaviours; then simulated time moves on
+by one engine period. With the same seed, the same team and the same faults,
+two runs give the same trace.
+"""
+
+from __future__ import annotations
+
+import heapq
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from alica.allocation import AgentSpec, assign_roles
+from alica.clock import ManualClock
+from alica.comm import Delay, SimNetwork
+from alica.errors import AlicaError
+from alica.lang import Registry
+from alica.model import PlanLibrary, RoleSet
+from alica.worldmodel import WorldModel
+
+from alica.engine.agent import AgentEngine, Observer
+from alica.engine.behaviours import SkillBinder, SkillFactory
+from alica.engine.config import EngineConfig
+from alica.engine.status import ChildStatus
+
+
+def pick_roleset(library: PlanLibrary, roles: Iterable[str], name: str | None = None) -> RoleSet:
+    """The role set to allocate with: ``name``, or the one holding every given role.
+
+    Raises:
+        AlicaError: no such role set, or none (or several) fit.
+    """
+    rolesets = library.rolesets
+    if name is not None:
+        if name not in rolesets:
+            raise AlicaError(f"no role set named '{name}'; role sets: {', '.join(sorted(rolesets)) or 'none'}")
+        return rolesets[name]
+    wanted = {r for r in roles if r is not None}
+    fits = [rs for _, rs in sorted(rolesets.items()) if wanted <= {r.name for r in rs.roles}]
+    if not fits:
+        raise AlicaError(f"no role set has the roles {sorted(wanted)}; role sets: {', '.join(sorted(rolesets)) or 'none'} (import one in the plan file)")
+    return fits[0]
+
+
+@dataclass(order=True)
+class _Event:
+    at: float
+    order: int
+    label: str = field(compare=False)
+    action: Callable[[], None] = field(compare=False)
+
+
+class SimulatedTeam:
+    """Runs a team of agents on one plan in simulated time.
+
+    Args:
+        library: the plan library.
+        plan: the root plan every agent runs.
+        agents: agent name -> role name, or -> :class:`AgentSpec` (role or capabilities).
+        seed: seeds the network and the agents.
+        config: engine settings shared by all agents.
+        roleset: the role set's name (by default the one holding the agents' roles).
+        loss: probability that a best-effort message is lost on a link.
+        delay: base message delay in seconds; ``jitter`` adds a uniform random part.
+        skills: skill factories by behaviour or skill name (test doubles, real skills).
+        skill_registry: a :class:`skills.registry.SkillRegistry` for implementations.
+        fallback: factory maker for skills nothing implements; ``None`` makes them fail.
+        registry: predicates and functions of formulas.
+        observers: trace observers.
+        trace_messages: also trace every message sent and delivered.
+    """
+
+    def __init__(
+        self,
+        library: PlanLibrary,
+        plan: str,
+        agents: Mapping[str, str | AgentSpec],
+        *,
+        seed: int = 0,
+        config: EngineConfig | None = None,
+        roleset: str | None = None,
+        loss: float = 0.0,
+        delay: float = 0.0,
+        jitter: float = 0.0,
+        skills: Mapping[str, SkillFactory] | None = None,
+        skill_registry: Any = None,
+        fallback: Callable[[Any], SkillFactory] | None = None,
+        registry: Registry | None = None,
+        observers: Iterable[Observer] = (),
+        trace_messages: bool = False,
+    ) -> None:
+        if not agents:
+            raise AlicaError("a team needs at least one agent")
+        if plan not in library.plans:
+            raise AlicaError(f"no plan named '{plan}' to run; plans: {', '.join(sorted(library.plans))}")
+        specs = {name: spec if isinstance(spec, AgentSpec) else AgentSpec(role=spec) for name, spec in sorted(agents.items())}
+        self.library = library
+        self.plan = plan
+        self.seed = seed
+        self.config = config or EngineConfig()
+        self.roleset = pick_roleset(library, (s.role for s in specs.values()), roleset)
+        self.roles = assign_roles(specs, self.roleset)
+        self.clock = ManualClock()
+        self.observers = list(observers)
+        self.trace_messages = trace_messages
+        self.network = SimNetwork(self.clock, seed=seed, loss=loss, delay=Delay(delay, jitter), lease=self.config.team_timeout, observer=self._network_event, trace_messages=trace_messages)
+        self.binder = SkillBinder(skills, skill_registry, fallback)
+        self.registry = registry
+        self.engines: dict[str, AgentEngine] = {}
+        self.crashed: set[str] = set()
+        self.faults: list[dict[str, Any]] = []
+        self.ticks = 0
+        self._events: list[_Event] = []
+        self._order = 0
+        for name in self.roles:
+            self.engines[name] = self._make_engine(name, self.network.attach(name))
+
+    def _make_engine(self, name: str, transport: Any) -> AgentEngine:
+        return AgentEngine(
+            name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name), self.clock,
+            config=self.config, skills=self.binder, registry=self.registry, seed=self.seed, observers=tuple(self.observers),
+        )
+
+    # -- time -----------------------------------------------------------
+
+    def now(self) -> float:
+        """The simulated time."""
+        return self.clock.now()
+
+    def tick(self) -> None:
+        """One lock-step tick of every running agent, then time moves one period on."""
+        self._run_events()
+        running = [e for name, e in self.engines.items() if name not in self.crashed]
+        for engine in running:
+            engine.receive()
+        for engine in running:
+            engine.step()
+        self.ticks += 1
+        self.clock.advance(self.config.period)
+
+    def run(self, ticks: int | None = None, *, until_done: bool = False, max_time: float | None = None) -> dict[str, Any]:
+        """Tick ``ticks`` times, or until every running agent is done (or ``max_time`` passes).
+
+        Returns:
+            The :meth:`summary`.
+
+        Raises:
+            ValueError: neither ``ticks`` nor ``until_done`` was given.
+        """
+        if ticks is None and not until_done:
+            raise ValueError("say how long to run: ticks=N or until_done=True")
+        limit = max_time if max_time is not None else float("inf")
+        count = 0
+        while True:
+            if ticks is not None and count >= ticks:
+                break
+            if until_done and self.done():
+                break
+            if self.now() >= limit:
+                break
+            self.tick()
+            count += 1
+        return self.summary()
+
+    def done(self) -> bool:
+        """Whether every running agent's root plan succeeded or finally failed."""
+        running = [e for name, e in self.engines.items() if name not in self.crashed]
+        return bool(running) and all(e.done for e in running)
+
+    def at(self, when: float, label: str, action: Callable[[], None]) -> None:
+        """Run ``action`` at the first tick at or after ``when``."""
+        self._order += 1
+        heapq.heappush(self._events, _Event(when, self._order, label, action))
+
+    def _run_events(self) -> None:
+        now = self.now() + 1e-9
+        while self._events and self._events[0].at <= now:
+            heapq.heappop(self._events).action()
+
+    # -- faults ---------------------------------------------------------
+
+    def crash(self, name: str, at: float | None = None) -> None:
+        """Crash an agent now or at time ``at``: it stops acting and talking."""
+        self._agent(name)
+        if at is not None and at > self.now():
+            self.at(at, f"crash {name}", lambda: self.crash(name))
+            return
+        if name in self.crashed:
+            return
+        self.crashed.add(name)
+        self.network.crash(name)
+        self._fault("crash", agent=name)
+
+    def recover(self, name: str, at: float | None = None) -> None:
+        """Restart a crashed agent (with an empty memory) now or at time ``at``."""
+        self._agent(name)
+        if at is not None and at > self.now():
+            self.at(at, f"recover {name}", lambda: self.recover(name))
+            return
+        if name not in self.crashed:
+            return
+        self.crashed.discard(name)
+        self.network.recover(name)
+        old = self.engines[name]
+        self.engines[name] = self._make_engine(name, old.transport)
+        self._fault("recover", agent=name)
+
+    def partition(self, groups: Iterable[Iterable[str]], start: float | None = None, end: float | None = None) -> None:
+        """Cut the network between groups of agents from ``start`` to ``end`` (see :class:`SimNetwork`)."""
+        groups = [sorted(g) for g in groups]
+        for group in groups:
+            for name in group:
+                self._agent(name)
+        self.network.partition(groups, start=start, end=end)
+        self._fault("partition", groups=groups, start=self.now() if start is None else start, end=end)
+
+    def _agent(self, name: str) -> AgentEngine:
+        try:
+            return self.engines[name]
+        except KeyError:
+            raise AlicaError(f"no agent named '{name}' in the team; agents: {', '.join(self.engines)}") from None
+
+    def _fault(self, kind: str, **fields: Any) -> None:
+        record = {"t": round(self.now(), 6), "agent": fields.pop("agent", "-"), "event": "fault", "fault": kind, **fields}
+        self.faults.append(record)
+        for observer in self.observers:
+            observer(record)
+
+    def _network_event(self, event: dict[str, Any]) -> None:
+        kind = event.get("event")
+        if kind in ("send", "deliver", "drop"):
+            if not self.trace_messages:
+                return
+            record = {"t": round(float(event.get("t", self.now())), 6), "agent": event.get("sender", "-"), "event": "message", **{k: v for k, v in event.items() if k not in ("t", "event")}, "what": kind}
+        else:
+            return  # partitions, crashes and heals are traced by the team itself
+        for observer in self.observers:
+            observer(record)
+
+    # -- results --------------------------------------------------------
+
+    def status_of(self, name: str) -> str:
+        """``crashed``, ``running``, ``success`` or ``failure`` (of the root plan)."""
+        if name in self.crashed:
+            return "crashed"
+        engine = self.engines[name]
+        if engine.root is None:
+            return "running"
+        return engine.root.status.value if engine.root.status is not ChildStatus.WAITING else "running"
+
+    def summary(self) -> dict[str, Any]:
+        """What happened: per agent and for the team, as plain data."""
+        agents = {}
+        for name, engine in self.engines.items():
+            path = []
+            node = engine.root
+            tasks = []
+            while node is not None:
+                if node.ep is not None:
+                    tasks.append(node.plan.entry_point(node.ep).task)
+                path.append(f"{node.plan.name}:{node.state or 'idle'}")
+                node = next((s.node for s in node.slots if s.node is not None), None)
+            agents[name] = {"role": engine.role, "status": self.status_of(name), "tasks": tasks, "path": " > ".join(path), **engine.stats}
+        stats = self.network.stats
+        statuses = [a["status"] for a in agents.values() if a["status"] != "crashed"]
+        return {
+            "plan": self.plan,
+            "seed": self.seed,
+            "ticks": self.ticks,
+            "sim_time_s": round(self.now(), 6),
+            "done": self.done(),
+            "success": bool(statuses) and all(s == "success" for s in statuses),
+            "agents": agents,
+            "messages": {"sent": stats.sent, "delivered": stats.delivered, "dropped": stats.dropped_loss + stats.dropped_partition + stats.dropped_crash},
+            "faults": [f["fault"] + (f" {f['agent']}" if f["agent"] != "-" else "") + f" @{f['t']}" for f in self.faults],
+        }

@@ -1,0 +1,141 @@
+"""A child of an agent's current state: a behaviour, or a plan with its repair stages.
+
+Repair of a failed plan (IMPERA/ALICA failure handling), per child:
+
+1. **retry**: the first failure of a plan restarts it: every local agent goes
+   back to the initial state of its entry point and the plan is allocated again;
+2. **replace**: the second failure drops the plan and allocates the next-best
+   alternative of the plan type (each alternative gets its own retry);
+3. **propagate**: when no alternative is left the child fails; the state's
+   ``failed`` conditions hold, and if no transition of the state handles it the
+   plan that holds the state fails in turn.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from alica.model import Behaviour, ChildRef, Plan, PlanningProblem, PlanType
+
+from alica.engine.status import ChildStatus
+
+if TYPE_CHECKING:
+    from alica.engine.behaviours import BehaviourRunner
+    from alica.engine.node import PlanNode
+
+
+class Slot:
+    """One child of the state a plan node is in.
+
+    Args:
+        parent: the plan node whose current state holds the child.
+        ref: the child reference of the model (name and bindings).
+        env: the child's variable bindings, evaluated when the state was entered.
+    """
+
+    __slots__ = ("parent", "ref", "element", "env", "node", "runner", "status", "reason", "failures", "failed_plans")
+
+    def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
+        self.parent = parent
+        self.ref = ref
+        self.element = parent.engine.library.abstract(ref.name)
+        self.env = env
+        self.node: PlanNode | None = None
+        self.runner: BehaviourRunner | None = None
+        self.status = ChildStatus.WAITING
+        self.reason = ""
+        self.failures: dict[str, int] = {}
+        self.failed_plans: list[str] = []
+
+    @property
+    def name(self) -> str:
+        """The child's name, as conditions such as ``succeeded(X)`` use it."""
+        return self.ref.name
+
+    @property
+    def is_behaviour(self) -> bool:
+        """Whether the child is a behaviour (else a plan, plan type or planning problem)."""
+        return isinstance(self.element, Behaviour)
+
+    def candidates(self) -> tuple[Plan, ...]:
+        """The plans this child may run now, in preference order, failed ones left out.
+
+        A planning problem runs its WaitPlan here; the planner runtime fills it in later.
+        """
+        library = self.parent.engine.library
+        element = self.element
+        if isinstance(element, Plan):
+            names: tuple[str, ...] = (element.name,)
+        elif isinstance(element, PlanType):
+            names = element.plans
+        elif isinstance(element, PlanningProblem):
+            names = (element.wait_plan,) if element.wait_plan else ()
+        else:
+            return ()
+        return tuple(library.plans[n] for n in names if n not in self.failed_plans)
+
+    # -- life ----------------------------------------------------------
+
+    def start(self, now: float, only: Plan | None = None) -> None:
+        """Allocate the agents of the parent state to this plan child and start it."""
+        engine = self.parent.engine
+        candidates = (only,) if only is not None else self.candidates()
+        env = self.env
+        usable = tuple(p for p in candidates if engine.formulas.holds(p.pre.text if p.pre else None, engine.belief_for(self.parent), env))
+        if not usable:
+            self.status = ChildStatus.WAITING
+            self.reason = "no plan whose pre-condition holds" if candidates else "no plan left"
+            return
+        node = engine.start_plan(self, usable, now)
+        if node is None:
+            self.status = ChildStatus.WAITING
+            return
+        self.node = node
+        self.status = ChildStatus.RUNNING
+        self.reason = ""
+
+    def visit(self, now: float) -> None:
+        """Run the rules of the child plan, repair it when it failed (behaviours are ticked elsewhere)."""
+        if self.runner is not None:
+            self.status = self.runner.status
+            self.reason = self.runner.reason
+            return
+        if self.status is ChildStatus.FAILURE:
+            return
+        if self.node is None:
+            if self.parent.engine.wants_retry(self, now):
+                self.start(now)
+            return
+        node = self.node
+        node.visit(now)
+        if node.status is ChildStatus.FAILURE:
+            self._repair(node, now)
+        else:
+            self.status = node.status
+
+    def _repair(self, node: PlanNode, now: float) -> None:
+        engine = self.parent.engine
+        plan = node.plan
+        node.stop()
+        self.node = None
+        count = self.failures[plan.name] = self.failures.get(plan.name, 0) + 1
+        if count == 1:
+            engine.emit("repair", key=node.key_text, stage="retry", plan=plan.name, reason=node.reason)
+            self.start(now, only=plan)
+            return
+        self.failed_plans.append(plan.name)
+        if self.candidates():
+            engine.emit("repair", key=node.key_text, stage="replace", plan=plan.name, reason=node.reason)
+            self.start(now)
+            if self.node is not None:
+                return
+        engine.emit("repair", key=node.key_text, stage="propagate", plan=plan.name, reason=node.reason)
+        self.status = ChildStatus.FAILURE
+        self.reason = f"plan '{plan.name}' failed: {node.reason}"
+
+    def stop(self) -> None:
+        """Stop the child and everything below it (the agent leaves the state)."""
+        if self.runner is not None:
+            self.runner.stop()
+        if self.node is not None:
+            self.node.stop()

@@ -1,0 +1,189 @@
+"""Test doubles for users' and our own tests: scripted skills and a simulated clock.
+
+Example::
+
+    from alica.testing import ScriptedSkill, scripted
+    team = SimulatedTeam(library, "Mission", {"r1": "Scout"},
+                         skills={"DriveTo": scripted(["running", "running", "success"])})
+    team.run(ticks=10)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import py_trees
+from py_trees.common import Status
+
+from alica.clock import ManualClock
+from alica.errors import AlicaError
+from alica.lang import literals
+from alica.model import Behaviour
+
+__all__ = ["ManualClock", "ScriptedSkill", "TimedSkill", "default_fallback", "scripted"]
+
+_STATUS = {"running": Status.RUNNING, "success": Status.SUCCESS, "failure": Status.FAILURE}
+Fact = tuple[bool, str, tuple[object, ...]]
+
+
+def _status(value: str | Status) -> Status:
+    if isinstance(value, Status):
+        return value
+    try:
+        return _STATUS[value.lower()]
+    except KeyError:
+        raise ValueError(f"unknown status '{value}' in a script (use running, success or failure)") from None
+
+
+def _write(context: Any, facts: Sequence[Fact]) -> None:
+    world = getattr(context, "world_model", None)
+    if world is None:
+        return
+    me = getattr(context, "agent", None)
+    for positive, name, args in facts:
+        args = tuple(me if a == "self" else a for a in args)
+        if positive:
+            world.assert_fact(name, *args)
+        else:
+            world.retract_fact(name, *args)
+
+
+class ScriptedSkill(py_trees.behaviour.Behaviour):
+    """A behaviour that returns a fixed sequence of statuses, one per tick.
+
+    Args:
+        name: the behaviour's name.
+        script: statuses for the 1st, 2nd, ... tick after each start; the last repeats.
+        facts: ``(positive, predicate, args)`` written to the world model on success
+            (``self`` in args is the agent).
+
+    Attributes:
+        starts: how often ``initialise`` ran; ``stops``: how often ``terminate`` ran;
+        ticks: updates since the last start.
+    """
+
+    def __init__(self, name: str, script: Sequence[str | Status] = ("success",), facts: Sequence[Fact] = ()) -> None:
+        super().__init__(name)
+        if not script:
+            raise ValueError("a script needs at least one status")
+        self.script = [_status(s) for s in script]
+        self.facts = tuple(facts)
+        self.context: Any = None
+        self.starts = 0
+        self.stops = 0
+        self.ticks = 0
+
+    def setup(self, **kwargs: Any) -> None:
+        """Keep the engine's skill context."""
+        self.context = kwargs.get("context")
+
+    def initialise(self) -> None:
+        """Start the script from its first status."""
+        self.starts += 1
+        self.ticks = 0
+
+    def update(self) -> Status:
+        """The next status of the script."""
+        status = self.script[min(self.ticks, len(self.script) - 1)]
+        self.ticks += 1
+        if status is Status.SUCCESS:
+            _write(self.context, self.facts)
+        return status
+
+    def terminate(self, new_status: Status) -> None:
+        """Count stops (the engine stops a running behaviour when its state is left)."""
+        self.stops += 1
+
+
+class TimedSkill(py_trees.behaviour.Behaviour):
+    """A behaviour that runs for a simulated duration, then ends with an outcome.
+
+    Args:
+        name: the behaviour's name.
+        duration: seconds of simulated time until it ends; ``None`` runs forever.
+        outcome: ``success`` or ``failure``.
+        facts: written to the world model on success, as for :class:`ScriptedSkill`.
+    """
+
+    def __init__(self, name: str, duration: float | None, outcome: str = "success", facts: Sequence[Fact] = ()) -> None:
+        super().__init__(name)
+        self.duration = duration
+        self.outcome = _status(outcome)
+        self.facts = tuple(facts)
+        self.context: Any = None
+        self.started = 0.0
+
+    def setup(self, **kwargs: Any) -> None:
+        """Keep the engine's skill context (its clock is used)."""
+        self.context = kwargs.get("context")
+
+    def initialise(self) -> None:
+        """Remember the start time."""
+        self.started = self.context.now() if self.context is not None else 0.0
+
+    def update(self) -> Status:
+        """Running until the duration passed, then the outcome."""
+        if self.duration is None or self.context is None or self.context.now() - self.started < self.duration:
+            return Status.RUNNING
+        if self.outcome is Status.SUCCESS:
+            _write(self.context, self.facts)
+        return self.outcome
+
+
+class scripted:  # noqa: N801 - used like a function: scripted([...])
+    """A skill factory making :class:`ScriptedSkill` behaviours; keeps every instance it made.
+
+    Args:
+        script: as for :class:`ScriptedSkill`.
+        facts: as for :class:`ScriptedSkill`.
+    """
+
+    def __init__(self, script: Sequence[str | Status] = ("success",), facts: Sequence[Fact] = ()) -> None:
+        self.script = list(script)
+        self.facts = tuple(facts)
+        self.instances: list[ScriptedSkill] = []
+
+    def __call__(self, name: str, params: Mapping[str, object], context: Any) -> ScriptedSkill:
+        skill = ScriptedSkill(name, self.script, self.facts)
+        self.instances.append(skill)
+        return skill
+
+
+def post_facts(behaviour: Behaviour) -> tuple[Fact, ...]:
+    """The post-condition of a behaviour as facts to write, when it is a conjunction of ground literals."""
+    if behaviour.post is None:
+        return ()
+    try:
+        found = literals(behaviour.post.text)
+    except AlicaError:
+        return ()
+    return tuple((positive, name, tuple(args)) for positive, name, args in found if name != "=")
+
+
+#: Skills that wait in place until their state is left.
+IDLE_SKILLS = frozenset({"Idle"})
+
+
+def default_fallback(seed: int = 0, low: float = 0.5, high: float = 2.0) -> Any:
+    """Scripted stand-ins for skills that have no implementation, for dry runs of plans.
+
+    ``Idle`` runs until its state is left. Every other skill runs for its
+    ``duration`` parameter if it has one, else for a time drawn from
+    ``[low, high]`` seconds (fixed per behaviour and seed), then succeeds and
+    writes its post-condition's literals to the world model.
+    """
+    import random
+
+    def fallback(behaviour: Behaviour) -> Any:
+        def factory(name: str, params: Mapping[str, object], context: Any) -> TimedSkill:
+            if behaviour.skill in IDLE_SKILLS:
+                return TimedSkill(name, None)
+            duration = params.get("duration")
+            if not isinstance(duration, (int, float)) or isinstance(duration, bool) or duration <= 0:
+                duration = round(random.Random(f"{seed}:{behaviour.name}").uniform(low, high), 3)
+            return TimedSkill(name, float(duration), "success", post_facts(behaviour))
+
+        return factory
+
+    return fallback
