@@ -99,6 +99,12 @@ class AgentEngine:
         self.stats = {"ticks": 0, "transitions": 0, "allocations": 0, "messages_in": 0, "messages_out": 0, "repairs": 0}
         for topic in (TEAM_TOPIC, SYNC_TOPIC, WORLD_TOPIC):
             transport.subscribe(topic)
+        self._world_changed = False
+        if hasattr(world_model, "on_change"):
+            world_model.on_change(self._on_world_change)
+
+    def _on_world_change(self, keys: object) -> None:
+        self._world_changed = True
 
     # -- the tick ---------------------------------------------------------
 
@@ -147,6 +153,12 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self._invalidate_all()
+        if self._world_changed:
+            # utilities with summands read the world: allocate those plans again
+            self._world_changed = False
+            for node in self.index.values():
+                if node.plan.utility.summands:
+                    node.invalidate()
         if self.root is None:
             self._start_root(now)
         root = self.root

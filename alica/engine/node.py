@@ -132,6 +132,8 @@ class PlanNode:
         for agent in sorted(members - {me}):
             claim = team.claim(agent, self.key)
             current = self.believed.get(agent)
+            predicted = self.predicted_at.get(agent)
+            expired = predicted is not None and now - predicted > protection
             if claim is not None and claim.plan == self.plan.name:
                 for ep in claim.success:
                     done = self.succeeded.setdefault(ep, set())
@@ -139,20 +141,25 @@ class PlanNode:
                         done.add(agent)
                         changed = True
                 new = (claim.entry, claim.state)
-                if current != new:
-                    predicted = self.predicted_at.get(agent)
-                    if predicted is None or team.changed_at(agent) > predicted or now - predicted > protection:
-                        self.believed[agent] = new
-                        self.predicted_at.pop(agent, None)
-                        if current is None or current[0] != new[0]:
-                            self.history.append((now, "message", agent, current[0] if current else None, new[0]))
-                        changed = True
+                if current == new:
+                    self.predicted_at.pop(agent, None)
+                elif predicted is None or expired or team.changed_at(agent) > predicted:
+                    # the teammate's own word trumps a prediction, once it is news or the prediction expired
+                    self.believed[agent] = new
+                    self.predicted_at.pop(agent, None)
+                    if current is None or current[0] != new[0]:
+                        self.history.append((now, "message", agent, current[0] if current else None, new[0]))
+                    changed = True
             elif current is not None and team.has_spoken(agent):
-                since = self.predicted_at.get(agent, self.started_at)
+                since = predicted if predicted is not None else self.started_at
                 if now - since > protection:
                     del self.believed[agent]
                     self.predicted_at.pop(agent, None)
                     changed = True
+                else:
+                    self.predicted_at[agent] = since
+            elif expired:
+                self.predicted_at.pop(agent, None)
         if changed:
             self._children_membership_changed()
         return changed
@@ -228,6 +235,14 @@ class PlanNode:
         if self.status is ChildStatus.FAILURE:
             return
         engine = self.engine
+        if 0 <= self.overridden_until <= now:
+            # an authority's window ended: look at the allocation again
+            self.overridden_until = -1.0
+            self.dirty = True
+        if self.predicted_at and not self.dirty:
+            # a prediction not confirmed by the teammate's claim within the protection time expires
+            if now - min(self.predicted_at.values()) > engine.config.assignment_protection:
+                self.dirty = True
         if self.dirty:
             self.dirty = False
             self.integrate(now)

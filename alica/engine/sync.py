@@ -5,7 +5,8 @@ Each agent whose synchronised transition's condition holds sends a
 and the agents whose holding rows it has seen (its acknowledgements). The
 synchronisation is complete, in an agent's view, when every transition of
 the synchronisation has a holding row and every holder has acknowledged
-every other holder. Then each holder fires on its own next tick, so with the
+every other holder (an agent's own acknowledgements count once it has sent
+them). Then each holder fires on its own next tick, so with the
 same messages all fire in the same tick. A synchronisation that is not
 complete ``sync_timeout`` seconds after the agent's condition began to hold
 fails the plan (``fail_on_timeout``) or starts over.
@@ -93,7 +94,12 @@ class SyncProcess:
         covered = {self.rows[a].transition for a in holders}
         if not all(t in covered for t in self.sync.transitions):
             return False
-        return all(holders <= (self.rows[a].acks | {a}) for a in holders)
+        sent = self.last_sent
+        if sent is None or not sent.holds:
+            return False
+        # My own acknowledgements count only once sent: the others must see them too.
+        mine = frozenset(sent.acks)
+        return all(holders <= ((mine if a == self.me else self.rows[a].acks) | {a}) for a in holders)
 
     def timed_out(self, now: float) -> bool:
         """Whether my condition has held for longer than the synchronisation's timeout."""
