@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import random
 from collections.abc import Callable, Mapping
+from dataclasses import replace
 from typing import Any
 
 from alica.allocation import AllocationProblem, Assignment, allocate, utility
@@ -16,7 +17,7 @@ from alica.clock import Clock
 from alica.comm import QoS, Transport
 from alica.errors import AlicaError
 from alica.lang import FactBase, Registry
-from alica.model import Behaviour, Plan, PlanLibrary, RoleSet, Summand, Transition
+from alica.model import Behaviour, Plan, PlanLibrary, RoleSet, StateKind, Summand, Transition
 from alica.model.plan import EntryPoint
 
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext
@@ -383,9 +384,51 @@ class AgentEngine:
         return node
 
     def reallocate(self, node: PlanNode, now: float) -> None:
-        """The dynamic allocation rule: switch when the best assignment gains more than the threshold."""
+        """The dynamic allocation rule, then the reuse of agents whose task succeeded."""
         if node.status is not ChildStatus.RUNNING or now < node.overridden_until:
             return
+        self._reallocate(node, now)
+        if node.status is ChildStatus.RUNNING:
+            self._reuse_succeeded(node, now)
+
+    def _reuse_succeeded(self, node: PlanNode, now: float) -> None:
+        """Agents whose task succeeded take success-required tasks nobody has done or is doing.
+
+        Every agent computes this from the same view, like any allocation: the
+        free agents (in success states) are allocated, by the same utility, to
+        the entry points that need a success and have nobody working on them.
+        """
+        plan = node.plan
+        successes = node.successes()
+        free, busy = [], set()
+        for agent in node.members():
+            entry = node.believed.get(agent)
+            if entry is None or entry[1] is None:
+                continue
+            kind = plan.state(entry[1]).kind
+            if kind is StateKind.SUCCESS:
+                free.append(agent)
+            elif kind is StateKind.NORMAL and entry[0] is not None:
+                busy.add(entry[0])
+        if not free:
+            return
+        needy = tuple(
+            replace(ep, min=0, max=max(1, ep.max - successes.get(ep.name, 0)))
+            for ep in plan.entry_points
+            if ep.success_required and successes.get(ep.name, 0) < max(ep.min, 1) and ep.name not in busy
+        )
+        if not needy:
+            return
+        reduced = replace(plan, entry_points=needy)
+        result = allocate(self._problem(tuple(free), (reduced,), {}, None, node.env, node.slot.parent if node.slot else None))
+        best = result.assignment
+        if best is None or all(ep is None for _, ep in best.entries):
+            return
+        moves = tuple((a, ep) for a, ep in best.entries if ep is not None)
+        self.emit("allocation", key=node.key_text, plan=plan.name, reason="reuse", entries=dict(moves))
+        node.apply(Assignment(plan.name, moves, best.utility), now, "reuse")
+
+    def _reallocate(self, node: PlanNode, now: float) -> None:
         plan = node.plan
         members = node.members()
         current: dict[str, str | None] = {}

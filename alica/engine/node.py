@@ -194,6 +194,7 @@ class PlanNode:
         model = self.plan.state(state)
         if model.kind is StateKind.SUCCESS and self.ep is not None:
             self.succeeded.setdefault(self.ep, set()).add(engine.name)
+            self.dirty = True  # free now: maybe needed for another task
         engine.tree_changed()
         for ref in model.children:
             slot = Slot(self, ref, engine.bind(self, ref))
@@ -348,10 +349,11 @@ class PlanNode:
                 self.predicted_at[agent] = now
                 self.history.append((now, reason, agent, current[0] if current else None, ep))
         self._children_membership_changed()
-        mine = assignment.entry_of(me) if me in assignment.agents else None
-        if mine != self.ep or self.state is None and mine is not None:
-            self.history.append((now, reason, me, self.ep, mine))
-            self.set_entry(mine, now)
+        if me in assignment.agents:
+            mine = assignment.entry_of(me)
+            if mine != self.ep or self.state is None and mine is not None:
+                self.history.append((now, reason, me, self.ep, mine))
+                self.set_entry(mine, now)
         self.engine.tree_changed()
 
     def conflicts(self, now: float, window: float) -> int:
