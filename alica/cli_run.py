@@ -37,7 +37,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--jitter", type=float, default=0.0, metavar="MS", help="random extra delay up to this many milliseconds")
     p.add_argument("--crash", action="append", default=[], metavar="NAME@T", help="crash agent NAME at simulated second T (repeatable)")
     p.add_argument("--recover", action="append", default=[], metavar="NAME@T", help="restart agent NAME at second T (repeatable)")
-    p.add_argument("--partition", action="append", default=[], metavar="A,B|C@T1-T2", help="cut the network between groups from T1 to T2 (repeatable)")
+    p.add_argument("--partition", action="append", default=[], metavar="A,B|C@T1-T2", help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)")
     p.add_argument("--fact", action="append", default=[], metavar="LITERALS@T", help="the operator sets facts at second T, e.g. 'found(a) and not stop@5' (repeatable)")
     p.add_argument("--trace", metavar="FILE", help="write a JSON Lines trace of allocations, transitions, repairs, messages and faults")
     p.add_argument("--trace-messages", action="store_true", help="trace every message too (large)")
