@@ -13,13 +13,15 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
-# The main demo. Until a mission demo exists: validate every plan in plans/
-# and render each plan tree as text and Graphviz dot (SVG too when Graphviz is installed).
+# The main demo. Until the lunar mission demo with robots exists: validate every
+# plan, render the plan trees, and run the lunar mission's team in simulation
+# (scripted skills; Scout crashes and Stummel takes over the exploration).
 demo: $(STAMP)
 	$(BIN)/alica validate plans/
-	$(BIN)/alica show plans/lunar/mission.yaml
-	$(BIN)/alica show plans/blocksworld/mission.yaml
 	$(BIN)/alica render plans/ --out build/plans
+	$(BIN)/alica run plans/lunar/mission.yaml --agents scout,stummel,amparo \
+		--fact "found(a) and found(b)@5" --crash scout@2 --loss 0.1 --delay 20 \
+		--seed 1 --trace build/lunar.jsonl
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

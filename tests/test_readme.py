@@ -35,3 +35,9 @@ def test_readme_python_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.C
     monkeypatch.chdir(ROOT)
     exec(compile(_blocks("python")[0], "README.md", "exec"), {})
     assert capsys.readouterr().out.strip() == "True"
+
+
+def test_readme_team_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(ROOT)
+    exec(compile(_blocks("python")[1], "README.md", "exec"), {})
+    assert capsys.readouterr().out.strip() == "Explore"
