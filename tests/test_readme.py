@@ -33,11 +33,11 @@ def test_readme_plan_example_is_valid(tmp_path: Path) -> None:
 
 def test_readme_python_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.chdir(ROOT)
-    exec(compile(_blocks("python")[0], "README.md", "exec"), {})
+    exec(compile(_blocks("python")[1], "README.md", "exec"), {})
     assert capsys.readouterr().out.strip() == "True"
 
 
 def test_readme_team_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.chdir(ROOT)
-    exec(compile(_blocks("python")[1], "README.md", "exec"), {})
+    exec(compile(_blocks("python")[0], "README.md", "exec"), {})
     assert capsys.readouterr().out.strip() == "Explore"
