@@ -154,6 +154,9 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self._invalidate_all()
+        refresh = getattr(self.world_model, "refresh", None)
+        if refresh is not None:
+            refresh()  # values whose time to live ran out
         if self._world_changed:
             # utilities with summands read the world: allocate those plans again
             self._world_changed = False

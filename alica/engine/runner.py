@@ -120,7 +120,7 @@ class SimulatedTeam:
 
     def _make_engine(self, name: str, transport: Any) -> AgentEngine:
         return AgentEngine(
-            name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name), self.clock,
+            name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name, clock=self.clock, relay=False), self.clock,
             config=self.config, skills=self.binder, registry=self.registry, seed=self.seed, observers=tuple(self.observers),
         )
 
