@@ -23,7 +23,7 @@ def add_parser(sub: Any) -> None:
         "while and write their post-condition). Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
-    p.add_argument("--agents", required=True, metavar="NAME:ROLE,...", help="the team, e.g. scout:Scout,stummel:Stummel (NAME alone takes the role of that name)")
+    p.add_argument("--agents", required=True, metavar="NAME:ROLE,...", help="the team, e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; NAME:+cap1+cap2 derives the role from capabilities")
     p.add_argument("--name", help="the root plan (default: the file's top-level plan)")
     p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
     p.add_argument("--seed", type=int, default=0, help="seed of the network and the agents (default 0)")
@@ -46,8 +46,8 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(run=cmd_run)
 
 
-def _agents(text: str) -> dict[str, str | None]:
-    agents: dict[str, str | None] = {}
+def _agents(text: str) -> dict[str, str | frozenset[str] | None]:
+    agents: dict[str, str | frozenset[str] | None] = {}
     for part in (p.strip() for p in text.split(",")):
         if not part:
             continue
@@ -57,7 +57,13 @@ def _agents(text: str) -> dict[str, str | None]:
             raise AlicaError(f"--agents: '{part}' is not NAME or NAME:ROLE (names are letters, digits, '_' and '-')")
         if name in agents:
             raise AlicaError(f"--agents: agent '{name}' is given twice")
-        agents[name] = role or None
+        if role.startswith("+"):
+            caps = frozenset(c.strip() for c in role.split("+") if c.strip())
+            if not caps:
+                raise AlicaError(f"--agents: '{part}' names no capabilities; write NAME:+cap1+cap2")
+            agents[name] = caps
+        else:
+            agents[name] = role or None
     if not agents:
         raise AlicaError("--agents: give at least one agent, e.g. --agents scout:Scout")
     return agents
@@ -72,18 +78,22 @@ def _timed(option: str, text: str, span: bool = False) -> tuple[str, float, floa
     return match.group("what").strip(), float(match.group("start")), end
 
 
-def _roles(library: Any, agents: dict[str, str | None], roleset: str | None) -> dict[str, str]:
+def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset: str | None) -> dict[str, Any]:
+    from alica.allocation import AgentSpec
     from alica.engine import pick_roleset
 
     names = {r.name.lower(): r.name for rs in library.rolesets.values() for r in rs.roles}
-    out = {}
+    out: dict[str, Any] = {}
     for name, role in agents.items():
+        if isinstance(role, frozenset):
+            out[name] = AgentSpec(capabilities=role)
+            continue
         if role is None:
             if name.lower() not in names:
                 raise AlicaError(f"--agents: agent '{name}' has no role and no role is called like it; write {name}:ROLE (roles: {', '.join(sorted(set(names.values())))})")
             role = names[name.lower()]
         out[name] = role
-    pick_roleset(library, out.values(), roleset)
+    pick_roleset(library, [r for r in out.values() if isinstance(r, str)], roleset)
     return out
 
 

@@ -51,6 +51,9 @@ class AgentEngine:
         seed: seeds the agent's random generator (handed to skills).
         observers: called with every trace event.
         world: the robot interface handed to skills.
+        listen_first: seconds to listen to the team before the first allocation; an
+            agent (re)joining a running team uses it to learn its teammates' claims
+            first, so it does not take a task that is already taken.
     """
 
     def __init__(
@@ -69,6 +72,7 @@ class AgentEngine:
         seed: int = 0,
         observers: tuple[Observer, ...] = (),
         world: object | None = None,
+        listen_first: float = 0.0,
     ) -> None:
         if plan not in library.plans:
             raise AlicaError(f"no plan named '{plan}' to run; plans: {', '.join(sorted(library.plans))}")
@@ -86,6 +90,7 @@ class AgentEngine:
         self.observers = list(observers)
         self.world = world
         self.rng = random.Random(f"{seed}:{name}")
+        self.start_at = clock.now() + listen_first
         self.formulas = Formulas(registry, on_error=self._formula_error)
         self.team = TeamView(name, roster, self.now(), self.config.team_timeout)
         self.own = FactBase()
@@ -163,7 +168,7 @@ class AgentEngine:
             for node in self.index.values():
                 if node.plan.utility.summands:
                     node.invalidate()
-        if self.root is None:
+        if self.root is None and now >= self.start_at:
             self._start_root(now)
         root = self.root
         if root is not None and root.status is ChildStatus.RUNNING:

@@ -118,10 +118,11 @@ class SimulatedTeam:
         for name in self.roles:
             self.engines[name] = self._make_engine(name, self.network.attach(name))
 
-    def _make_engine(self, name: str, transport: Any) -> AgentEngine:
+    def _make_engine(self, name: str, transport: Any, listen_first: float = 0.0) -> AgentEngine:
         return AgentEngine(
             name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name, clock=self.clock, relay=False), self.clock,
             config=self.config, skills=self.binder, registry=self.registry, seed=self.seed, observers=tuple(self.observers),
+            listen_first=listen_first,
         )
 
     # -- time -----------------------------------------------------------
@@ -205,7 +206,8 @@ class SimulatedTeam:
         self.crashed.discard(name)
         self.network.recover(name)
         old = self.engines[name]
-        self.engines[name] = self._make_engine(name, old.transport)
+        # a restarted agent listens for a broadcast interval before it allocates
+        self.engines[name] = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
         self._fault("recover", agent=name)
 
     def partition(self, groups: Iterable[Iterable[str]], start: float | None = None, end: float | None = None) -> None:

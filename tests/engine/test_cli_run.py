@@ -72,3 +72,16 @@ def test_bad_input_gets_a_clear_error(argv, message, capsys):
 def test_missing_plan_file(capsys):
     assert main(["run", "no/such/plan.yaml", "--agents", "scout"]) == 1
     assert "no/such/plan.yaml" in capsys.readouterr().err
+
+
+def test_roles_from_capabilities(capsys):
+    agents = "r1:+base+lidar2d+camera,r2:+base+arm+gripper+lidar2d+camera,r3:+base+arm+gripper+lidar3d+stereo_camera"
+    assert main(["run", LUNAR, "--agents", agents, "--ticks", "3", "--json"]) == 0
+    roles = {name: a["role"] for name, a in json.loads(capsys.readouterr().out)["agents"].items()}
+    assert roles == {"r1": "Scout", "r2": "Stummel", "r3": "Amparo"}
+
+
+def test_capabilities_that_fit_no_role(capsys):
+    assert main(["run", LUNAR, "--agents", "r1:+wings", "--ticks", "1"]) == 1
+    err = capsys.readouterr().err
+    assert "fits no role" in err and "Scout:" in err and "missing" in err

@@ -124,3 +124,60 @@ def test_lossy_network_still_converges_on_one_assignment(tmp_path):
     assert where(sim, "w") == ("Work", "Working") and where(sim, "h") == ("Help", "Helping")
     views = {name: dict(e.root.believed) for name, e in sim.engines.items()}
     assert views["w"] == views["h"]
+
+
+STICKY = PLANS.replace("  - name: Shop\n", "  - name: Shop\n    utility: {priority_weight: 0.5, similarity_weight: 0.5, threshold: 0.3}\n")
+
+
+def test_threshold_keeps_the_current_assignment(tmp_path):
+    lib = library(tmp_path, STICKY)
+    sim, trace = team(lib, "Shop", {"w": "Worker", "h": "Helper"}, SKILLS)
+    sim.run(ticks=3)
+    sim.crash("w")
+    sim.run(ticks=10)
+    assert where(sim, "h") == ("Work", "Working")
+    sim.recover("w")
+    sim.run(ticks=10)
+    # w back on Work would gain (0.9 + 0.8 - 0.3) / 2 * 0.5 = 0.35 in priority but lose 0.5 * 1/2 in
+    # similarity: a gain of 0.1, below the threshold 0.3, so the helper keeps Work
+    assert where(sim, "h") == ("Work", "Working")
+    assert where(sim, "w") == ("Help", "Helping")
+    assert not trace.of("allocation", agent="h", reason="utility", t=sim.now())
+
+
+PROBLEM = """
+behaviours:
+  - {name: Hold, skill: Wait}
+plans:
+  - name: Step
+    signature: {parameters: [], precondition: "not done", effect: "done"}
+    entry_points: [{task: Work, state: Stepping, min: 1, max: 1}]
+    states:
+      - {name: Stepping, children: [Hold]}
+  - name: Park
+    entry_points: [{task: Watch, state: Parked, min: 1, max: "*"}]
+    states:
+      - {name: Parked, children: [Hold]}
+  - name: Top
+    entry_points: [{task: Default, state: Solve, min: 1, max: "*"}]
+    states:
+      - name: Solve
+        children: [Solve]
+        transitions:
+          - {to: Done, condition: "succeeded(Solve)"}
+      - {name: Done, kind: success}
+problems:
+  - name: Solve
+    elements: [Step]
+    wait_plan: Park
+    goal: "done"
+"""
+
+
+def test_a_planning_problem_runs_its_wait_plan_until_a_plan_exists(tmp_path):
+    lib = library(tmp_path, PROBLEM)
+    sim, _ = team(lib, "Top", {"w": "Worker", "h": "Helper"}, {"Wait": scripted(["running"])})
+    sim.run(ticks=3)
+    for agent in ("w", "h"):
+        assert where(sim, agent, 1) == ("Watch", "Parked")
+        assert sim.engines[agent].root.slots[0].node.plan.name == "Park"
