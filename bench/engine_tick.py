@@ -2,7 +2,7 @@
 
 Each team runs the shipped LunarMission (roles Scout, Stummel, Amparo in turn)
 with scripted skills over the simulated network, at 30 Hz. After a warm-up,
-the wall time of ``--ticks`` lock-step ticks is divided by ticks x agents; the
+the wall time of ``--ticks`` lock-step ticks is divided by the agent ticks run; the
 figure includes message delivery, team-view integration, rules, allocation and
 behaviour ticks. In the same run, the peer: a plain py_trees tree per agent
 with as many behaviours as the agent runs, ticked as often (the cost of the
@@ -28,10 +28,11 @@ ROOT = Path(__file__).resolve().parent.parent
 ROLES = ("Scout", "Stummel", "Amparo")
 
 
-def make_team(size: int, seed: int) -> SimulatedTeam:
+def make_team(size: int, seed: int, broadcast: float = 0.2) -> SimulatedTeam:
     library = load_library(ROOT / "plans" / "lunar" / "mission.yaml")
     agents = {f"r{i:02d}": ROLES[i % 3] for i in range(size)}
-    return SimulatedTeam(library, "LunarMission", agents, seed=seed, config=EngineConfig(frequency=30.0), fallback=default_fallback(seed, 5.0, 20.0))
+    config = EngineConfig(frequency=30.0, broadcast_interval=broadcast)
+    return SimulatedTeam(library, "LunarMission", agents, seed=seed, config=config, fallback=default_fallback(seed, 5.0, 20.0))
 
 
 def behaviours_running(team: SimulatedTeam) -> int:
@@ -48,15 +49,36 @@ def behaviours_running(team: SimulatedTeam) -> int:
     return count
 
 
-def engine_cost(size: int, ticks: int, seed: int) -> tuple[float, float, int]:
-    team = make_team(size, seed)
+def _events(team: SimulatedTeam, ticks: int) -> None:
+    """Work for the measured window: samples found (transports start), a tenth of the team crashes."""
+    start = team.now()
+    period = team.config.period
+
+    def found() -> None:
+        for name, engine in team.engines.items():
+            if name not in team.crashed:
+                engine.world_model.assert_fact("found", "a")
+                engine.world_model.assert_fact("found", "b")
+
+    team.at(start + 0.2 * ticks * period, "found", found)
+    names = sorted(team.engines)
+    for name in names[: max(1, len(names) // 10)]:
+        team.crash(name, at=start + 0.5 * ticks * period)
+
+
+def engine_cost(size: int, ticks: int, seed: int, faults: bool = False, broadcast: float = 0.2) -> tuple[float, float, int]:
+    team = make_team(size, seed, broadcast)
     team.run(ticks=30)
+    if faults:
+        _events(team, ticks)
     sent = team.network.stats.sent
+    before = sum(e.stats["ticks"] for e in team.engines.values())
     start = time.perf_counter()
     team.run(ticks=ticks)
     elapsed = time.perf_counter() - start
+    agent_ticks = sum(e.stats["ticks"] for e in team.engines.values()) - before
     per_tick_msgs = (team.network.stats.sent - sent) / ticks
-    return elapsed / (ticks * size) * 1000.0, per_tick_msgs, behaviours_running(team)
+    return elapsed / agent_ticks * 1000.0, per_tick_msgs, behaviours_running(team)
 
 
 class _Poll(py_trees.behaviour.Behaviour):
@@ -83,16 +105,24 @@ def main() -> None:
     args = parser.parse_args()
     print(f"engine tick cost per agent, LunarMission at 30 Hz, {args.ticks} ticks after 30 warm-up ticks, median of {args.repeat}")
     print()
-    print("| agents | ms per agent tick | goal | agent ticks per second | messages per tick | behaviours running | py_trees alone, ms per agent tick |")
-    print("|---:|---:|---:|---:|---:|---:|---:|")
+    print("steady: agents run their tasks, team messages every 0.2 s; with faults: the samples are found (transports start)")
+    print("and a tenth of the team crashes; last: the same with a team message from every agent on every tick")
+    print()
+    print("| agents | steady, ms per agent tick | with faults | with faults, team message every tick | goal | messages per tick (steady / every tick) | behaviours running | py_trees alone, ms per agent tick |")
+    print("|---:|---:|---:|---:|---:|---:|---:|---:|")
     for size in (5, 20, 50):
         runs = [engine_cost(size, args.ticks, seed) for seed in range(args.repeat)]
+        faulty = [engine_cost(size, args.ticks, seed, faults=True) for seed in range(args.repeat)]
         ms = statistics.median(r[0] for r in runs)
+        ms_faults = statistics.median(r[0] for r in faulty)
+        loud = [engine_cost(size, args.ticks, seed, faults=True, broadcast=1 / 30) for seed in range(args.repeat)]
+        ms_loud = statistics.median(r[0] for r in loud)
         msgs = statistics.median(r[1] for r in runs)
+        msgs_loud = statistics.median(r[1] for r in loud)
         running = runs[0][2]
         peer = statistics.median(pytrees_cost(size, round(running / size), args.ticks) for _ in range(args.repeat))
-        verdict = "ok" if ms <= 0.66 else "over"
-        print(f"| {size} | {ms:.3f} | 0.66 ({verdict}) | {1000.0 / ms:,.0f} | {msgs:.1f} | {running} | {peer:.3f} |")
+        verdict = "ok" if max(ms, ms_faults, ms_loud) <= 0.66 else "over"
+        print(f"| {size} | {ms:.3f} | {ms_faults:.3f} | {ms_loud:.3f} | 0.66 ({verdict}) | {msgs:.1f} / {msgs_loud:.1f} | {running} | {peer:.3f} |")
 
 
 if __name__ == "__main__":

@@ -539,7 +539,7 @@ class AgentEngine:
 
     def _broadcast(self, now: float) -> None:
         config = self.config
-        since = now - self._last_broadcast
+        since = now - self._last_broadcast + 1e-9  # ticks land on the interval up to rounding
         if not ((self._tree_changed and since >= config.min_broadcast_gap) or since >= config.broadcast_interval):
             return
         self._tree_changed = False
