@@ -131,7 +131,7 @@ class TimedSkill(py_trees.behaviour.Behaviour):
         return self.outcome
 
 
-class scripted:  # noqa: N801 - used like a function: scripted([...])
+class scripted:
     """A skill factory making :class:`ScriptedSkill` behaviours; keeps every instance it made.
 
     Args:

@@ -15,11 +15,6 @@ from typing import Any
 from alica.allocation import AllocationProblem, Assignment, allocate, utility
 from alica.clock import Clock
 from alica.comm import QoS, Transport
-from alica.errors import AlicaError
-from alica.lang import FactBase, Registry
-from alica.model import Behaviour, Plan, PlanLibrary, RoleSet, StateKind, Summand, Transition
-from alica.model.plan import EntryPoint
-
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext
 from alica.engine.belief import AgentBelief
 from alica.engine.conditions import Formulas
@@ -29,6 +24,10 @@ from alica.engine.slot import Slot
 from alica.engine.status import ChildStatus
 from alica.engine.sync import SyncProcess, SyncTalk
 from alica.engine.team import SYNC_TOPIC, TEAM_TOPIC, WORLD_TOPIC, AuthorityClaim, PlanKey, TeamMessage, TeamView
+from alica.errors import AlicaError
+from alica.lang import FactBase, Registry
+from alica.model import Behaviour, Plan, PlanLibrary, RoleSet, StateKind, Summand, Transition
+from alica.model.plan import EntryPoint
 
 Observer = Callable[[dict[str, Any]], None]
 

@@ -19,10 +19,9 @@ from typing import TYPE_CHECKING, Any
 
 import py_trees
 
+from alica.engine.status import ChildStatus
 from alica.errors import AlicaError, UnknownSkillError
 from alica.model import Behaviour
-
-from alica.engine.status import ChildStatus
 
 if TYPE_CHECKING:
     from alica.engine.belief import AgentBelief
@@ -128,7 +127,7 @@ class BehaviourRunner:
         context: handed to the skill.
     """
 
-    __slots__ = ("model", "params", "factory", "context", "status", "reason", "bt", "_next_tick", "_period")
+    __slots__ = ("_next_tick", "_period", "bt", "context", "factory", "model", "params", "reason", "status")
 
     def __init__(self, model: Behaviour, params: Mapping[str, object], factory: SkillFactory, context: SkillContext) -> None:
         self.model = model
@@ -161,7 +160,7 @@ class BehaviourRunner:
         assert bt is not None
         try:
             bt.tick_once()
-        except Exception as exc:  # a skill's bug must not stop the team: the behaviour fails, with its path
+        except Exception as exc:  # noqa: BLE001 - a skill's bug must not stop the team: the behaviour fails, with its path
             self._finish(ChildStatus.FAILURE, f"exception in '{self.context.path}' [{model.skill}]: {type(exc).__name__}: {exc}")
             return self.status
         self.status = _STATUS.get(bt.status, ChildStatus.RUNNING)
@@ -176,7 +175,7 @@ class BehaviourRunner:
         except AlicaError as exc:
             self._finish(ChildStatus.FAILURE, str(exc))
             return False
-        except Exception as exc:  # the skill could not be built: fail this behaviour, say where
+        except Exception as exc:  # noqa: BLE001 - the skill could not be built: fail this behaviour, say where
             self._finish(ChildStatus.FAILURE, f"cannot start '{self.context.path}' [{self.model.skill}]: {type(exc).__name__}: {exc}")
             return False
         self.bt = bt
@@ -194,5 +193,5 @@ class BehaviourRunner:
         if bt is not None and bt.status == py_trees.common.Status.RUNNING:
             try:
                 bt.stop(py_trees.common.Status.INVALID)
-            except Exception as exc:  # a failing terminate must not stop the engine
+            except Exception as exc:  # noqa: BLE001 - a failing terminate must not stop the engine
                 logger.warning("terminate of '%s' raised %s: %s", self.context.path, type(exc).__name__, exc)

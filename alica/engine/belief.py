@@ -39,7 +39,7 @@ class AgentBelief:
         clock_now: a function giving the current time.
     """
 
-    __slots__ = ("agent", "world", "team", "own", "node", "_now")
+    __slots__ = ("_now", "agent", "node", "own", "team", "world")
 
     def __init__(self, agent: str, world: BeliefBase, team: TeamView, own: FactBase, clock_now) -> None:  # type: ignore[no-untyped-def]
         self.agent = agent

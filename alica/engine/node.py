@@ -27,11 +27,10 @@ from __future__ import annotations
 from collections import deque
 from typing import TYPE_CHECKING
 
-from alica.model import Plan, StateKind, Transition
-
 from alica.engine.slot import Slot
 from alica.engine.status import ChildStatus
 from alica.engine.team import Claim, PlanKey, key_text
+from alica.model import Plan, StateKind, Transition
 
 if TYPE_CHECKING:
     from alica.allocation import Assignment
@@ -240,10 +239,9 @@ class PlanNode:
             # an authority's window ended: look at the allocation again
             self.overridden_until = -1.0
             self.dirty = True
-        if self.predicted_at and not self.dirty:
-            # a prediction not confirmed by the teammate's claim within the protection time expires
-            if now - min(self.predicted_at.values()) > engine.config.assignment_protection:
-                self.dirty = True
+        # a prediction not confirmed by the teammate's claim within the protection time expires
+        if self.predicted_at and not self.dirty and now - min(self.predicted_at.values()) > engine.config.assignment_protection:
+            self.dirty = True
         if self.dirty:
             self.dirty = False
             self.integrate(now)

@@ -16,15 +16,14 @@ from typing import Any
 from alica.allocation import AgentSpec, assign_roles
 from alica.clock import ManualClock
 from alica.comm import Delay, SimNetwork
-from alica.errors import AlicaError
-from alica.lang import Registry
-from alica.model import PlanLibrary, RoleSet
-from alica.worldmodel import WorldModel
-
 from alica.engine.agent import AgentEngine, Observer
 from alica.engine.behaviours import SkillBinder, SkillFactory
 from alica.engine.config import EngineConfig
 from alica.engine.status import ChildStatus
+from alica.errors import AlicaError
+from alica.lang import Registry
+from alica.model import PlanLibrary, RoleSet
+from alica.worldmodel import WorldModel
 
 
 def pick_roleset(library: PlanLibrary, roles: Iterable[str], name: str | None = None) -> RoleSet:

@@ -15,9 +15,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from alica.model import Behaviour, ChildRef, Plan, PlanningProblem, PlanType
-
 from alica.engine.status import ChildStatus
+from alica.model import Behaviour, ChildRef, Plan, PlanningProblem, PlanType
 
 if TYPE_CHECKING:
     from alica.engine.behaviours import BehaviourRunner
@@ -33,7 +32,7 @@ class Slot:
         env: the child's variable bindings, evaluated when the state was entered.
     """
 
-    __slots__ = ("parent", "ref", "element", "env", "node", "runner", "status", "reason", "failures", "failed_plans")
+    __slots__ = ("element", "env", "failed_plans", "failures", "node", "parent", "reason", "ref", "runner", "status")
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
         self.parent = parent

@@ -16,9 +16,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from alica.model import Synchronisation
-
 from alica.engine.team import PlanKey
+from alica.model import Synchronisation
 
 
 @dataclass(frozen=True, slots=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Self
 
 
 class TraceRecorder:
@@ -57,7 +57,7 @@ class JsonlTrace:
             self._file.close()
             self._file = None
 
-    def __enter__(self) -> JsonlTrace:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:

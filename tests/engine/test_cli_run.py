@@ -7,7 +7,6 @@ import json
 import pytest
 
 from alica.cli import main
-
 from tests.conftest import PLANS
 
 LUNAR = str(PLANS / "lunar" / "mission.yaml")

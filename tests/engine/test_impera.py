@@ -7,7 +7,6 @@ import pytest
 from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
 from alica.io import load_library
 from alica.testing import default_fallback
-
 from tests.conftest import PLANS
 
 TEAM = {"scout": "Scout", "stummel": "Stummel", "amparo": "Amparo"}

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from alica.testing import scripted
-
 from tests.engine.helpers import library, team, where
 
 PLANS = """

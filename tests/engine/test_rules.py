@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from alica.engine import ChildStatus
 from alica.testing import scripted
-
 from tests.engine.helpers import library, team, where
 
 PLANS = """

@@ -9,7 +9,6 @@ import sys
 
 from alica.engine import EngineConfig
 from alica.testing import scripted
-
 from tests.conftest import ROOT
 from tests.engine.helpers import library, team, where
 
