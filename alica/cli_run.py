@@ -143,8 +143,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         team.partition([g.split(",") for g in what.split("|")], start=start, end=end)
     for text in args.fact:
         what, at, _ = _timed("--fact", text)
-        facts = literals(what)
-        team.at(at, f"fact {what}", lambda facts=facts: _set_facts(team, facts))
+        team.set_facts(literals(what), at=at)
     try:
         if args.show_tree:
             _run_showing(team, args, changed, running_tree)
@@ -166,15 +165,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0 if summary["success"] else 1
 
 
-def _set_facts(team: Any, facts: list[tuple[bool, str, tuple[object, ...]]]) -> None:
-    for name, engine in team.engines.items():
-        if name in team.crashed:
-            continue
-        for positive, pred, fact_args in facts:
-            (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
-    team._fault("operator", facts=[("" if p else "not ") + f"{n}({', '.join(map(str, a))})" for p, n, a in facts])
-
-
 def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running_tree: Any) -> None:
     ticks = 0
     while True:
@@ -194,10 +184,10 @@ def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running
 def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
     verdict = "success" if summary["success"] else ("ended" if summary["done"] else "not finished")
     print(f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}")
-    header = f"{'agent':<12} {'role':<10} {'status':<8} {'transitions':>11} {'allocations':>11} {'sent':>6} {'recv':>6} {'repairs':>7}  where"
+    header = f"{'agent':<12} {'role':<12} {'status':<8} {'transitions':>11} {'allocations':>11} {'sent':>6} {'recv':>6} {'repairs':>7}  where"
     print(header)
     for name, a in summary["agents"].items():
-        print(f"{name:<12} {a['role']:<10} {a['status']:<8} {a['transitions']:>11} {a['allocations']:>11} {a['messages_out']:>6} {a['messages_in']:>6} {a['repairs']:>7}  {a['path']}")
+        print(f"{name:<12} {a['role']:<12} {a['status']:<8} {a['transitions']:>11} {a['allocations']:>11} {a['messages_out']:>6} {a['messages_in']:>6} {a['repairs']:>7}  {a['path']}")
     m = summary["messages"]
     print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
     if summary["faults"]:

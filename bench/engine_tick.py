@@ -54,13 +54,7 @@ def _events(team: SimulatedTeam, ticks: int) -> None:
     start = team.now()
     period = team.config.period
 
-    def found() -> None:
-        for name, engine in team.engines.items():
-            if name not in team.crashed:
-                engine.world_model.assert_fact("found", "a")
-                engine.world_model.assert_fact("found", "b")
-
-    team.at(start + 0.2 * ticks * period, "found", found)
+    team.set_facts([(True, "found", ("a",)), (True, "found", ("b",))], at=start + 0.2 * ticks * period)
     names = sorted(team.engines)
     for name in names[: max(1, len(names) // 10)]:
         team.crash(name, at=start + 0.5 * ticks * period)

@@ -218,6 +218,25 @@ class SimulatedTeam:
         self.network.partition(groups, start=start, end=end)
         self._fault("partition", groups=groups, start=self.now() if start is None else start, end=end)
 
+    def set_facts(self, facts: Iterable[tuple[bool, str, tuple[object, ...]]], at: float | None = None) -> None:
+        """The operator sets facts, ``(positive, predicate, args)``, in every running agent's world model.
+
+        With ``at`` in the future, at that time.
+        """
+        facts = [(bool(p), str(n), tuple(a)) for p, n, a in facts]
+        if at is not None and at > self.now():
+            self.at(at, "operator", lambda: self.set_facts(facts))
+            return
+        for name, engine in self.engines.items():
+            if name in self.crashed:
+                continue
+            for positive, pred, args in facts:
+                (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *args)
+        record = {"t": round(self.now(), 6), "agent": "-", "event": "operator",
+                  "facts": [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts]}
+        for observer in self.observers:
+            observer(record)
+
     def _agent(self, name: str) -> AgentEngine:
         try:
             return self.engines[name]
