@@ -12,7 +12,6 @@ from alica.engine import AgentEngine, EngineConfig, SimulatedTeam, SkillBinder
 from alica.io import load_library
 from alica.testing import ScriptedSkill, default_fallback
 from alica.worldmodel import WorldModel
-
 from tests.conftest import PLANS
 from tests.engine.helpers import library
 
