@@ -275,10 +275,6 @@ class AgentEngine:
 
         return BehaviourRunner(behaviour, params, factory, context)
 
-    def wants_retry(self, slot: Slot, now: float) -> bool:
-        """Whether a waiting plan child should try to start again now (its parent's inputs changed)."""
-        return True
-
     def sync_process(self, node: PlanNode, name: str) -> SyncProcess:
         """This agent's process of synchronisation ``name`` in ``node``."""
         key = (node.key, name)
@@ -324,7 +320,8 @@ class AgentEngine:
 
         return summand
 
-    def _members_of(self, parent: PlanNode | None) -> tuple[str, ...]:
+    def members_of(self, parent: PlanNode | None) -> tuple[str, ...]:
+        """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""
         alive = self.team.alive()
         if parent is None:
             return alive
@@ -352,7 +349,7 @@ class AgentEngine:
 
     def _allocate_new(self, slot: Slot | None, plans: tuple[Plan, ...], key: PlanKey, env: dict[str, object], now: float) -> PlanNode | None:
         parent = slot.parent if slot is not None else None
-        members = self._members_of(parent)
+        members = self.members_of(parent)
         # Teammates already in this plan keep their entry points (their claims trump predictions).
         fixed: dict[str, tuple[str | None, str | None]] = {}
         successes: dict[str, dict[str, int]] = {}

@@ -84,15 +84,7 @@ class PlanNode:
     def members(self) -> tuple[str, ...]:
         """Alive agents believed to be in the parent state (all alive agents for the root), sorted."""
         if self._members is None:
-            engine = self.engine
-            alive = engine.team.alive()
-            if self.slot is None:
-                self._members = alive
-            else:
-                parent = self.slot.parent
-                believed = parent.believed
-                state = parent.state
-                self._members = tuple(a for a in alive if a == engine.name or (believed.get(a) or (None, None))[1] == state)
+            self._members = self.engine.members_of(self.slot.parent if self.slot is not None else None)
         return self._members
 
     def invalidate(self) -> None:

@@ -32,7 +32,7 @@ class Slot:
         env: the child's variable bindings, evaluated when the state was entered.
     """
 
-    __slots__ = ("element", "env", "failed_plans", "failures", "node", "parent", "reason", "ref", "runner", "status")
+    __slots__ = ("element", "env", "failed_plans", "failures", "next_try", "node", "parent", "reason", "ref", "runner", "status")
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
         self.parent = parent
@@ -45,6 +45,7 @@ class Slot:
         self.reason = ""
         self.failures: dict[str, int] = {}
         self.failed_plans: list[str] = []
+        self.next_try = 0.0
 
     @property
     def name(self) -> str:
@@ -82,16 +83,21 @@ class Slot:
         env = self.env
         usable = tuple(p for p in candidates if engine.formulas.holds(p.pre.text if p.pre else None, engine.belief_for(self.parent), env))
         if not usable:
-            self.status = ChildStatus.WAITING
-            self.reason = "no plan whose pre-condition holds" if candidates else "no plan left"
+            self._wait(now, "no plan whose pre-condition holds" if candidates else "no plan left")
             return
         node = engine.start_plan(self, usable, now)
         if node is None:
-            self.status = ChildStatus.WAITING
+            self._wait(now, self.reason)
             return
         self.node = node
         self.status = ChildStatus.RUNNING
         self.reason = ""
+
+    def _wait(self, now: float, reason: str) -> None:
+        """Not startable now: try again after a broadcast interval (teammates or the world may change)."""
+        self.status = ChildStatus.WAITING
+        self.reason = reason
+        self.next_try = now + self.parent.engine.config.broadcast_interval
 
     def visit(self, now: float) -> None:
         """Run the rules of the child plan, repair it when it failed (behaviours are ticked elsewhere)."""
@@ -102,7 +108,7 @@ class Slot:
         if self.status is ChildStatus.FAILURE:
             return
         if self.node is None:
-            if self.parent.engine.wants_retry(self, now):
+            if now >= self.next_try:
                 self.start(now)
             return
         node = self.node
