@@ -174,8 +174,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_cmd_list_skills)
 
     from alica.cli_run import add_parser as add_run_parser
+    from alica.cli_skill import add_parser as add_skill_parser
 
     add_run_parser(sub)
+    add_skill_parser(sub)
     return parser
 
 

@@ -19,8 +19,8 @@ def add_parser(sub: Any) -> None:
         "run",
         help="run a team on a plan in simulated time",
         description="Run a team of agents on a plan in simulated time over a simulated network. "
-        "Skills without an implementation are replaced by scripted stand-ins (Idle waits; others succeed after a "
-        "while and write their post-condition). Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
+        "Team runs have no simulated world yet, so every skill is a scripted stand-in (Idle waits; others succeed "
+        "after a while and write their post-condition). Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
     p.add_argument("--agents", required=True, metavar="NAME:ROLE,...", help="the team, e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; NAME:+cap1+cap2 derives the role from capabilities")
@@ -103,7 +103,6 @@ def cmd_run(args: argparse.Namespace) -> int:
     from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
     from alica.testing import default_fallback
-    from skills.registry import default_registry
 
     if not 0 <= args.loss < 1:
         raise AlicaError(f"--loss must lie in [0, 1), got {args.loss}")
@@ -129,7 +128,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         observers.append(lambda e: changed.add(e["agent"]) if e["event"] in ("transition", "allocation", "repair") else None)
     team = SimulatedTeam(
         library, plan, roles, seed=args.seed, config=EngineConfig(frequency=args.frequency), roleset=args.roleset,
-        loss=args.loss, delay=args.delay / 1000.0, jitter=args.jitter / 1000.0, skill_registry=default_registry(),
+        loss=args.loss, delay=args.delay / 1000.0, jitter=args.jitter / 1000.0,
         fallback=default_fallback(args.seed), observers=observers, trace_messages=args.trace_messages,
     )
     for text in args.crash:

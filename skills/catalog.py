@@ -1,8 +1,9 @@
 """Declarations of every skill the shipped plans bind (IMPERA Section 6.4).
 
 Plain data only: ``alica validate`` checks behaviours against these
-declarations without importing any robotics library. Implementations are
-added later; until then ``implementation`` is ``None``.
+declarations without importing any robotics library. A skill's ``implementation`` names
+the py_trees behaviour class that runs it (imported only when it runs), or is
+``None`` while the skill has none yet.
 
 Two layers:
 
@@ -38,6 +39,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("timeout", "float", "seconds before the skill gives up", default=60.0),
         doc="drive to a goal position, escaping into free space when stuck (Fig. 8)",
         capabilities=("base",),
+        implementation="skills.navigation:MoveToPosition",
     )
     registry.declare(
         "Pickup",
@@ -45,6 +47,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("retries", "int", "grasp attempts before the skill fails", default=3),
         doc="align with an object, grasp it, lift it to the transport pose and check the grip (Fig. 15)",
         capabilities=("base", "arm", "gripper"),
+        implementation="skills.handling:Pickup",
     )
     registry.declare(
         "Putdown",
@@ -52,6 +55,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("target", "position", "where to place it: a position or a term such as pos(g); by default in front of the robot", required=False),
         doc="place the held object, open the gripper, stow the arm and check the placement (Fig. 16)",
         capabilities=("arm", "gripper"),
+        implementation="skills.handling:Putdown",
     )
     registry.declare(
         "Stack",
@@ -59,6 +63,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("target", "object", "the block to place it on"),
         doc="put the held block on top of another block",
         capabilities=("base", "arm", "gripper"),
+        implementation="skills.handling:Stack",
     )
     registry.declare(
         "Unstack",
@@ -66,6 +71,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("from", "object", "the block it currently lies on"),
         doc="take the top block off a stack and hold it",
         capabilities=("base", "arm", "gripper"),
+        implementation="skills.handling:Unstack",
     )
     registry.declare(
         "Explore",
@@ -84,6 +90,7 @@ def _navigation(registry: SkillRegistry) -> None:
         _p("timeout", "float", "seconds without progress before the skill fails", default=60.0),
         doc="follow a collision-free path to a goal; fails when stuck",
         capabilities=("base",),
+        implementation="skills.navigation:MoveToPosition",
     )
     registry.declare(
         "DriveToFreeSpace",
@@ -91,6 +98,7 @@ def _navigation(registry: SkillRegistry) -> None:
         _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
         doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
         capabilities=("base",),
+        implementation="skills.navigation:DriveToFreeSpace",
     )
     registry.declare(
         "Localize",
@@ -116,6 +124,7 @@ def _navigation(registry: SkillRegistry) -> None:
         "Idle",
         _p("duration", "float", "seconds to wait before succeeding; 0 waits until the state is left", default=0.0),
         doc="stand still",
+        implementation="skills.navigation:Idle",
     )
 
 

@@ -1,0 +1,89 @@
+"""``alica skill run``: one skill alone in a small simulated world."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import yaml
+
+from alica.errors import AlicaError
+
+
+def add_parser(sub: Any) -> None:
+    """Add the ``skill`` subcommand to the ``alica`` parser."""
+    p = sub.add_parser("skill", help="run one skill alone in a simulated world", description="Run one skill alone in a simulated world, in simulated time.")
+    skill_sub = p.add_subparsers(dest="skill_command", metavar="ACTION")
+    skill_sub.required = True
+    r = skill_sub.add_parser("run", help="run a skill until it ends", description="Run a skill on one robot of a lunar or blocks world until it succeeds, fails or times out. Exit 0 on success, 1 otherwise.")
+    r.add_argument("name", metavar="NAME", help="the skill, e.g. MoveToPosition (alica list-skills lists them)")
+    r.add_argument("--world", choices=("lunar", "blocks"), default="lunar", help="the scenario (default lunar)")
+    r.add_argument("--param", action="append", default=[], metavar="KEY=VALUE", help="a parameter; VALUE is read as YAML, e.g. goal=[5, 5] (repeatable)")
+    r.add_argument("--robot", help="the robot (default: the first one that has what the skill needs)")
+    r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
+    r.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
+    r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
+    r.add_argument("--timeout", type=float, default=120.0, help="simulated seconds before giving up (default 120)")
+    r.add_argument("--json", action="store_true", help="print the result as JSON")
+    r.set_defaults(run=cmd_skill_run)
+
+
+def _params(items: list[str]) -> dict[str, object]:
+    params: dict[str, object] = {}
+    for item in items:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise AlicaError(f"--param: '{item}' is not KEY=VALUE, e.g. --param goal=[5, 5]")
+        try:
+            value = yaml.safe_load(text) if text.strip() else ""
+        except yaml.YAMLError as exc:
+            raise AlicaError(f"--param {key}: '{text}' is not a YAML value ({exc.problem if hasattr(exc, 'problem') else exc})") from None
+        params[key] = tuple(value) if isinstance(value, list) else value
+    return params
+
+
+def _world(args: argparse.Namespace) -> Any:
+    if args.world == "lunar":
+        from worldsim.scenarios import lunar
+
+        if args.rocks < 0:
+            raise AlicaError(f"--rocks must be >= 0, got {args.rocks}")
+        return lunar(seed=args.seed, rocks=args.rocks)
+    from worldsim.scenarios import blocksworld
+
+    stacks = [[b.strip() for b in stack.split(",") if b.strip()] for stack in args.stacks.split(";") if stack.strip()]
+    if not stacks:
+        raise AlicaError(f"--stacks: '{args.stacks}' names no blocks; write e.g. 'a,b;c'")
+    return blocksworld(stacks, agents=2, seed=args.seed)
+
+
+def cmd_skill_run(args: argparse.Namespace) -> int:
+    """Run ``alica skill run``; returns the exit code."""
+    from skills.registry import default_registry
+    from skills.testing import run_skill
+
+    registry = default_registry()
+    spec = registry.get(args.name)
+    params = _params(args.param)
+    world = _world(args)
+    try:
+        robot = args.robot
+        if robot is None:
+            fits = [n for n, r in sorted(world.robots.items()) if spec.capabilities <= r.spec.capabilities]
+            if not fits:
+                raise AlicaError(f"no robot of the {args.world} world can run {args.name} (it needs {', '.join(sorted(spec.capabilities))})")
+            robot = fits[0]
+        run = run_skill(args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry)
+    finally:
+        world.close()
+    if args.json:
+        print(json.dumps({"skill": run.skill, "robot": run.robot, "status": run.status, "reason": run.reason, "sim_time_s": run.sim_time_s, "ticks": run.ticks, "trace": run.trace, "facts": [list(map(str, f)) for f in run.facts]}, indent=2))
+    else:
+        print(f"{run.skill} on {run.robot}: {run.status} after {run.sim_time_s:.2f} s simulated ({run.ticks} ticks)")
+        if run.reason:
+            print(f"  {run.reason}")
+        for fact in run.facts:
+            print(f"  fact: {fact}")
+    return 0 if run.ok else 1

@@ -1,0 +1,418 @@
+"""Manipulation skills: Pickup, Putdown, Stack and Unstack, with the IPC blocks-world semantics.
+
+Each skill runs the same phases, polled tick by tick:
+
+1. **approach**: if the work site is out of the arm's reach, drive to a
+   stand-off point facing it (an inner :class:`MoveToPosition`), then turn to it;
+2. **plan**: a job plans the arm motion on the robot's own planning scene
+   (:mod:`skills.manipulation`: IK with joint-limit checks and random
+   restarts, OMPL joint-space paths with collision checks, the held object
+   included);
+3. **execute**: the arm follows the paths in simulated time; the gripper
+   closes and the object becomes an attachment (Pickup, Unstack) or is
+   released (Putdown, Stack);
+4. **verify**: the grip (finger force, the object still held) or the
+   placement (the object rests where it should) is checked against the
+   simulated state; a failed grasp opens the hand and retries, up to
+   ``retries`` times, then the skill fails and says why.
+
+For blocks, preconditions and effects are those of the IPC blocks domain
+(``clear``, ``on``, ``ontable``, ``holding``, ``handempty``), checked on the
+simulated state before and after; the effects are written to the world model.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from skills.navigation import MoveToPosition
+from skills.world_skill import WorldSkill, distance, world_cache
+
+#: Horizontal distance from the arm's base at which the arm works best.
+REACH = 0.55
+#: Joint speed used to time arm paths, rad/s.
+JOINT_SPEED = 1.5
+#: Seconds a released object gets to settle before the placement is checked.
+SETTLE = 0.5
+
+
+def _box(obj: Any) -> Any:
+    from skills.manipulation import Box
+
+    low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
+    return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
+
+
+def _duration(path: np.ndarray) -> float:
+    steps = np.abs(np.diff(np.asarray(path), axis=0)).max(axis=1) if len(path) > 1 else np.zeros(1)
+    return max(0.2, float(steps.sum()) / JOINT_SPEED)
+
+
+def blocks_state(world: Any) -> set[tuple[object, ...]]:
+    """The IPC blocks facts of the simulated state."""
+    from worldsim.scenarios import blocks_facts
+
+    return set(blocks_facts(world))
+
+
+class ArmSkill(WorldSkill):
+    """The phases shared by the manipulation skills; subclasses say what to plan and check."""
+
+    #: Whether the skill grasps (else it releases what it holds).
+    grasps = True
+
+    def setup(self, **kwargs: Any) -> None:
+        """Find the robot; it needs an arm."""
+        super().setup(**kwargs)
+        if getattr(self.robot, "arm", None) is None:
+            from alica.errors import SkillError
+
+            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no arm")
+
+    # -- what subclasses define -----------------------------------------------
+
+    def target_object(self) -> Any:
+        """The object grasped (or held, for placing)."""
+        return self.object_named(self.param("object"))
+
+    def site(self) -> tuple[float, float]:
+        """Where the work happens, for the approach."""
+        return tuple(self.target_object().position()[:2])  # type: ignore[return-value]
+
+    def check_before(self) -> str | None:
+        """Why the skill cannot start now, or None."""
+        return None
+
+    def plan(self, scene: Any, q: np.ndarray, rng: np.random.Generator) -> Any:
+        """The arm plan, run as a job: grasp and lift, or place at :meth:`place_top` and retreat."""
+        from skills.manipulation import plan_pickup, plan_place
+
+        if self.grasps:
+            return plan_pickup(scene, _box(self.target_object()), q, rng=rng)
+        return plan_place(scene, _box(self.target_object()), self.place_top(), q, rng=rng)
+
+    def place_top(self) -> tuple[float, float, float]:
+        """Where the bottom of a placed object goes (placing skills say)."""
+        x, y = self.site()
+        return x, y, 0.0
+
+    def check_after(self) -> str | None:
+        """Why the outcome is wrong, or None; writes the outcome facts when right."""
+        return None
+
+    # -- the phases --------------------------------------------------------------
+
+    def initialise(self) -> None:
+        """Start with the approach."""
+        self.retries = int(self.param("retries", 3))  # type: ignore[arg-type]
+        self.attempts = 0
+        self.phase = "check"
+        self.mover: MoveToPosition | None = None
+        self.queue: list[np.ndarray] = []
+        self.release_after = -1
+        self.job: Any = None
+        self.settle_until = 0.0
+        self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
+
+    def update(self) -> Status:
+        """One step of the current phase."""
+        handler = getattr(self, f"_phase_{self.phase}")
+        return handler()
+
+    def _phase_check(self) -> Status:
+        reason = self.check_before()
+        if reason is not None:
+            return self.fail(reason)
+        self.phase = "approach"
+        return self._phase_approach()
+
+    def _arm_xy(self) -> tuple[float, float]:
+        position = self.robot.arm.base_pose()[0]
+        return float(position[0]), float(position[1])
+
+    def _phase_approach(self) -> Status:
+        robot = self.robot
+        site = self.site()
+        x, y, yaw = robot.pose
+        if self.mover is None:
+            gap = distance(self._arm_xy(), site)
+            facing = abs(_wrap(math.atan2(site[1] - y, site[0] - x) - yaw))
+            if abs(gap - REACH) <= 0.12 and facing < 0.15:
+                self.phase = "plan"
+                return self._phase_plan()
+            heading = math.atan2(site[1] - y, site[0] - x)
+            standoff = REACH + _mount_ahead(robot)
+            goal = (site[0] - standoff * math.cos(heading), site[1] - standoff * math.sin(heading))
+            self.mover = MoveToPosition(f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context)
+            self.mover.setup(context=self.context)
+        if self.mover.status != Status.SUCCESS:
+            self.mover.tick_once()
+            if self.mover.status == Status.FAILURE:
+                return self.fail(f"cannot get to {site}: {self.mover.feedback_message}")
+            if self.mover.status == Status.RUNNING:
+                return self.running(f"approaching: {self.mover.feedback_message}")
+        error = _wrap(math.atan2(site[1] - y, site[0] - x) - yaw)
+        if abs(error) > 0.03:
+            robot.drive(0.0, max(-robot.spec.max_yaw_rate, min(robot.spec.max_yaw_rate, 2.0 * error)))
+            return self.running("turning to the work site")
+        robot.stop()
+        self.phase = "plan"
+        return self._phase_plan()
+
+    def _scene(self) -> Any:
+        from skills.manipulation import ArmScene
+
+        cache = world_cache(self.world)
+        key = f"arm-scene:{self.robot.name}"
+        scene = cache.get(key)
+        if scene is None:
+            scene = cache[key] = ArmScene(self.robot.arm.urdf_path, self.robot.arm.base_pose(), seed=self.world.seed)
+        scene.set_base_pose(self.robot.arm.base_pose())
+        target = self.target_object()
+        boxes = [_box(o) for name, o in sorted(self.world.objects.items()) if name != target.name and _near(o, self._arm_xy()) and getattr(o, "kind", "") not in ("collection_point",)]
+        scene.set_obstacles(boxes)
+        return scene
+
+    def _phase_plan(self) -> Status:
+        if self.job is None:
+            self.job = self.jobs.submit(self.plan, self._scene(), np.asarray(self.robot.arm.q(), dtype=float), self.np_rng)
+            return self.running("planning the arm motion")
+        if not self.job.done():
+            return self.running("planning the arm motion")
+        result = self.job.result()
+        self.job = None
+        if not result.ok:
+            return self._retry(f"no arm plan: {result.reason}")
+        self.queue = [np.asarray(p) for p in result.paths]
+        self.release_after = getattr(result, "release_after", 1 if self.grasps else len(self.queue) - 2)
+        self.done_paths = 0
+        self.phase = "execute"
+        if self.grasps:
+            self.robot.arm.open()
+        return self.running("arm plan ready")
+
+    def _phase_execute(self) -> Status:
+        arm = self.robot.arm
+        if arm.busy:
+            return self.running(f"moving the arm ({self.done_paths}/{len(self.queue)})")
+        if self.done_paths > 0 and self.done_paths - 1 == self.release_after:
+            self.release_after = -2  # handled
+        if self.done_paths == len(self.queue):
+            self.phase = "verify"
+            self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
+            return self.running("checking the result")
+        if self.done_paths == self.release_after + 1 and self.release_after >= 0:
+            self._grip_or_release()
+            self.release_after = -2
+        path = self.queue[self.done_paths]
+        arm.follow(path, _duration(path))
+        self.done_paths += 1
+        return self.running(f"moving the arm ({self.done_paths}/{len(self.queue)})")
+
+    def _grip_or_release(self) -> None:
+        arm = self.robot.arm
+        if self.grasps:
+            arm.close()
+            arm.attach(self.target_object())
+        else:
+            arm.detach()
+            arm.open()
+
+    def _phase_verify(self) -> Status:
+        if self.now() < self.settle_until:
+            return self.running("letting the object settle")
+        reason = self.check_after()
+        if reason is None:
+            return self.succeed(f"done after {self.attempts + 1} attempt(s)")
+        return self._retry(reason)
+
+    def _retry(self, reason: str) -> Status:
+        self.attempts += 1
+        if self.world_model is not None:
+            self.world_model.set("attempts", self.robot.name, value=self.attempts)
+        if self.attempts >= self.retries:
+            return self.fail(f"gave up after {self.attempts} attempt(s): {reason}")
+        arm = self.robot.arm
+        if self.grasps and arm.held is not None:
+            arm.detach()
+        if self.grasps:
+            arm.open()
+        self.phase = "plan"
+        self.job = None
+        return self.running(f"retrying ({reason})")
+
+    def terminate(self, new_status: Status) -> None:
+        """Stop the base (and the inner approach) when the skill ends or is stopped."""
+        if self.mover is not None and self.mover.status == Status.RUNNING:
+            self.mover.stop(Status.INVALID)
+        if self.robot is not None:
+            self.robot.stop()
+
+
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2 * math.pi) - math.pi
+
+
+def _mount_ahead(robot: Any) -> float:
+    offset = getattr(robot.arm, "mount_offset", (0.0, 0.0, 0.0))
+    return float(offset[0])
+
+
+def _near(obj: Any, xy: tuple[float, float], radius: float = 1.2) -> bool:
+    position = obj.position()
+    return distance((float(position[0]), float(position[1])), xy) <= radius
+
+
+# -- the skills ---------------------------------------------------------------
+
+
+class Pickup(ArmSkill):
+    """Pick ``object`` up and hold it in the transport pose (retries after a failed grasp)."""
+
+    def check_before(self) -> str | None:
+        """The hand must be empty; a block must be clear and on the table (IPC pickup)."""
+        if self.robot.arm.held is not None:
+            return f"the hand is not empty: it holds {self.robot.arm.held.name}"
+        obj = self.target_object()
+        if getattr(obj, "kind", "") == "block":
+            facts = blocks_state(self.world)
+            if ("clear", obj.name) not in facts:
+                return f"precondition clear({obj.name}) does not hold: something lies on it"
+            if ("ontable", obj.name) not in facts and self.requires_table:
+                return f"precondition ontable({obj.name}) does not hold: use Unstack to take it off a block"
+        return None
+
+    requires_table = True
+
+    def check_after(self) -> str | None:
+        """The object is held with force."""
+        arm = self.robot.arm
+        obj = self.target_object()
+        if arm.held is not obj or arm.grip_force() <= 0:
+            return f"the grip on {obj.name} failed (the object is not held)"
+        me = self.robot.name
+        for positive, fact in ((False, ("ontable", obj.name)), (False, ("clear", obj.name)), (False, ("handempty", me)), (True, ("holding", me, obj.name)), (False, ("onground", obj.name))):
+            self.write(positive, *fact)  # type: ignore[arg-type]
+        return None
+
+
+class Unstack(Pickup):
+    """Take ``object`` off the block ``from`` (IPC unstack)."""
+
+    requires_table = False
+
+    def check_before(self) -> str | None:
+        """``on(object, from)``, ``clear(object)`` and an empty hand."""
+        reason = super().check_before()
+        if reason is not None:
+            return reason
+        below = self.param("from")
+        obj = self.target_object()
+        if ("on", obj.name, below) not in blocks_state(self.world):
+            return f"precondition on({obj.name}, {below}) does not hold"
+        return None
+
+    def check_after(self) -> str | None:
+        """Held, and ``clear(from)`` now holds."""
+        reason = super().check_after()
+        if reason is None:
+            below = str(self.param("from"))
+            self.write(False, "on", self.target_object().name, below)
+            self.write(True, "clear", below)
+        return reason
+
+
+class Putdown(ArmSkill):
+    """Put the held ``object`` down at ``target`` (by default on the ground in front of the robot)."""
+
+    grasps = False
+
+    def check_before(self) -> str | None:
+        """The robot must hold the object."""
+        held = self.robot.arm.held
+        obj = self.target_object()
+        if held is not obj:
+            return f"precondition holding({self.robot.name}, {obj.name}) does not hold (holding {held.name if held else 'nothing'})"
+        return None
+
+    def site(self) -> tuple[float, float]:
+        """The target, or a spot in front of the robot."""
+        target = self.param("target")
+        if target is not None:
+            return self.resolve_position(target)
+        x, y, yaw = self.robot.pose
+        ahead = REACH + _mount_ahead(self.robot)
+        return x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)
+
+    def check_after(self) -> str | None:
+        """Released, resting near the place."""
+        obj = self.target_object()
+        if self.robot.arm.held is not None:
+            return f"{obj.name} is still in the hand"
+        x, y, _ = self.place_top()
+        here = obj.position()
+        if math.hypot(here[0] - x, here[1] - y) > 0.08:
+            return f"{obj.name} lies at ({here[0]:.2f}, {here[1]:.2f}), not at ({x:.2f}, {y:.2f})"
+        me = self.robot.name
+        self.write(False, "holding", me, obj.name)
+        self.write(True, "handempty", me)
+        self.write(True, "clear", obj.name)
+        self.outcome_facts(obj)
+        return None
+
+    def outcome_facts(self, obj: Any) -> None:
+        """Putdown: the object is on the table (blocks) or the ground."""
+        if getattr(obj, "kind", "") == "block":
+            self.write(True, "ontable", obj.name)
+        else:
+            self.write(True, "onground", obj.name)
+        target = self.param("target")
+        if isinstance(target, str):
+            name = target.strip().removeprefix("pos(").removesuffix(")").strip()
+            self.write(True, "at", obj.name, name)
+
+
+class Stack(Putdown):
+    """Put the held ``object`` on top of the clear block ``target`` (IPC stack)."""
+
+    def check_before(self) -> str | None:
+        """Holding the object, and the target block is clear."""
+        reason = super().check_before()
+        if reason is not None:
+            return reason
+        below = self.object_named(self.param("target"))
+        if ("clear", below.name) not in blocks_state(self.world):
+            return f"precondition clear({below.name}) does not hold: something lies on it"
+        return None
+
+    def site(self) -> tuple[float, float]:
+        """The target block."""
+        position = self.object_named(self.param("target")).position()
+        return float(position[0]), float(position[1])
+
+    def place_top(self) -> tuple[float, float, float]:
+        """On top of the target block."""
+        below = self.object_named(self.param("target"))
+        _, high = below.aabb()
+        x, y = self.site()
+        return x, y, float(high[2])
+
+    def check_after(self) -> str | None:
+        """``on(object, target)`` holds in the simulated state."""
+        obj = self.target_object()
+        below = str(self.param("target"))
+        if self.robot.arm.held is not None:
+            return f"{obj.name} is still in the hand"
+        if ("on", obj.name, below) not in blocks_state(self.world):
+            return f"{obj.name} did not come to rest on {below}"
+        me = self.robot.name
+        self.write(False, "holding", me, obj.name)
+        self.write(True, "handempty", me)
+        self.write(True, "clear", obj.name)
+        self.write(True, "on", obj.name, below)
+        self.write(False, "clear", below)
+        return None

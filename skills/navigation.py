@@ -1,0 +1,218 @@
+"""Driving skills: MoveToPosition (and its primitive DriveTo), DriveToFreeSpace, Idle.
+
+MoveToPosition plans in SE2 with OMPL on the world's occupancy grid, inflated
+by the robot's radius (:func:`skills.motion.plan_path`), follows the path,
+replans when another robot or a new obstacle blocks it, and when the robot is
+stuck (bumped, or no progress) drives into free space first. Planning runs as
+a job; ``update`` only polls.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from py_trees.common import Status
+
+from skills.world_skill import WorldSkill, distance, world_cache
+
+#: Replans (after being stuck or blocked) before MoveToPosition gives up.
+MAX_REPLANS = 5
+
+
+def planning_grid(world: Any) -> Any:
+    """The world's static obstacles as an occupancy grid (5 cm cells), built once per world layout."""
+    from worldsim.grid import OccupancyGrid
+
+    cache = world_cache(world)
+    obstacles = tuple(world.ground_truth_obstacles())
+    hit = cache.get("grid")
+    if hit is None or hit[0] != obstacles:
+        hit = cache["grid"] = (obstacles, OccupancyGrid.from_obstacles(list(obstacles), world.bounds, 0.05))
+    return hit[1]
+
+
+class MoveToPosition(WorldSkill):
+    """Drive to ``goal`` within ``tolerance`` metres, or fail with a reason after ``timeout`` seconds."""
+
+    def initialise(self) -> None:
+        """Resolve the goal and start planning."""
+        self.goal = self.resolve_position(self.param("goal"))
+        self.tolerance = float(self.param("tolerance", 0.3))  # type: ignore[arg-type]
+        self.timeout = float(self.param("timeout", 60.0))  # type: ignore[arg-type]
+        self.started = self.now()
+        self.last = self.started
+        self.replans = 0
+        self.follower: Any = None
+        self.escaping = False
+        self.reason = ""
+        self.path_length = 0.0
+        self._plan(self.goal)
+
+    def _others(self) -> list[tuple[float, float, float]]:
+        return [(r.pose[0], r.pose[1], r.spec.radius) for name, r in sorted(self.world.robots.items()) if r is not self.robot]
+
+    def _plan(self, goal: tuple[float, float]) -> None:
+        from skills.motion import plan_path
+
+        grid = planning_grid(self.world)
+        seed = int(self.context.rng.integers(0, 2**31)) if hasattr(self.context.rng, "integers") else self.context.rng.randrange(2**31)
+        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, grid, self.robot.spec.radius, other_robots=self._others(), time_limit=1.0, seed=seed)
+        self.follower = None
+
+    def update(self) -> Status:
+        """Poll the planner, follow the path, replan or escape when needed."""
+        robot = self.robot
+        now = self.now()
+        dt, self.last = now - self.last, now
+        here = (robot.pose[0], robot.pose[1])
+        if not self.escaping and distance(here, self.goal) <= self.tolerance:
+            robot.stop()
+            self._arrived(here)
+            return self.succeed(f"reached {self.goal} after {now - self.started:.1f} s")
+        if now - self.started > self.timeout:
+            robot.stop()
+            return self.fail(f"did not reach {self.goal} within {self.timeout:.0f} s ({self.reason or 'no progress'})")
+        if self.follower is None:
+            return self._poll_plan(now)
+        v, w, done = self.follower.command(robot.pose, dt)
+        if robot.bumped or self.follower.stuck(robot.pose, now):
+            return self._stuck(now)
+        if self._blocked():
+            self.replans += 1
+            if self.replans > MAX_REPLANS:
+                robot.stop()
+                return self.fail(f"the path to {self.goal} stays blocked by other robots after {MAX_REPLANS} replans")
+            robot.stop()
+            self._plan(self.goal)
+            return self.running("path blocked by another robot: replanning")
+        if done:
+            robot.stop()
+            if self.escaping:
+                self.escaping = False
+                self._plan(self.goal)
+                return self.running("out of the tight spot: replanning")
+            self._plan(self.goal)  # the follower ended short of the goal: plan the rest
+            return self.running("close to the goal: planning the last part")
+        robot.drive(v, w)
+        return self.running(f"driving to {self.goal}")
+
+    def _poll_plan(self, now: float) -> Status:
+        from skills.motion import PathFollower
+
+        if not self.job.done():
+            return self.running("planning")
+        result = self.job.result()
+        target = self.goal
+        if result.status != "exact":
+            self.reason = result.reason or result.status
+            if result.status in ("invalid_goal", "unreachable") and not self.escaping:
+                self.robot.stop()
+                return self.fail(f"cannot reach {self.goal}: {self.reason}")
+            self.replans += 1
+            if self.replans > MAX_REPLANS:
+                self.robot.stop()
+                return self.fail(f"no path to {self.goal} after {MAX_REPLANS} attempts: {self.reason}")
+            self._plan(target)
+            return self.running(f"planning again ({self.reason})")
+        spec = self.robot.spec
+        self.path_length += float(result.length)
+        self.follower = PathFollower(result.path, lookahead=max(0.3, 2 * spec.radius), max_speed=spec.max_speed, max_yaw_rate=spec.max_yaw_rate, tolerance=min(self.tolerance, 0.2))
+        return self.running("path found")
+
+    def _stuck(self, now: float) -> Status:
+        from skills.motion import PathFollower, escape_goal
+
+        robot = self.robot
+        robot.stop()
+        self.replans += 1
+        if self.replans > MAX_REPLANS:
+            return self.fail(f"stuck on the way to {self.goal} after {MAX_REPLANS} escapes")
+        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0)
+        if spot is None:
+            return self.fail(f"stuck at {robot.pose[:2]} and no free space within 3 m to drive to")
+        x, y, yaw = robot.pose
+        heading = math.atan2(spot[1] - y, spot[0] - x)
+        path = np.array([[x, y, yaw], [spot[0], spot[1], heading]])
+        spec = robot.spec
+        self.follower = PathFollower(path, lookahead=0.3, max_speed=spec.max_speed * 0.5, max_yaw_rate=spec.max_yaw_rate, tolerance=0.1)
+        self.escaping = True
+        if hasattr(robot, "bumped"):
+            robot.bumped = False
+        return self.running(f"stuck: driving into free space at ({spot[0]:.2f}, {spot[1]:.2f})")
+
+    def _blocked(self) -> bool:
+        """Whether another robot stands on the rest of the path."""
+        follower = self.follower
+        if follower is None or self.escaping:
+            return False
+        rest = follower.remaining() if hasattr(follower, "remaining") else follower.path
+        if len(rest) == 0:
+            return False
+        points = np.asarray(rest)[:, :2]
+        mine = self.robot.spec.radius
+        for x, y, radius in self._others():
+            if float(np.min(np.hypot(points[:, 0] - x, points[:, 1] - y))) < mine + radius:
+                return True
+        return False
+
+    def _arrived(self, here: tuple[float, float]) -> None:
+        wm = self.world_model
+        if wm is not None:
+            wm.set("pos", self.robot.name, value=(round(here[0], 3), round(here[1], 3)))
+        goal = self.param("goal")
+        if isinstance(goal, str):
+            self.write(True, "at", self.robot.name, goal.strip().removeprefix("pos(").removesuffix(")").strip())
+
+    def terminate(self, new_status: Status) -> None:
+        """Stop the base whenever the skill ends or is stopped."""
+        if self.robot is not None:
+            self.robot.stop()
+
+
+class DriveToFreeSpace(MoveToPosition):
+    """Drive to the nearest place with ``clearance`` metres of free space within ``max_distance``."""
+
+    def initialise(self) -> None:
+        """Find the free place, then drive there like MoveToPosition."""
+        from skills.motion import escape_goal
+
+        clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
+        reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
+        grid = planning_grid(self.world)
+        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach)
+        self.spot = spot
+        self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
+        self.params.setdefault("tolerance", 0.2)
+        super().initialise()
+
+    def update(self) -> Status:
+        """Fail when there is no free place, else drive there."""
+        if self.spot is None:
+            return self.fail(f"no free place with the clearance within {self.param('max_distance', 3.0)} m")
+        return super().update()
+
+
+class Idle(WorldSkill):
+    """Stand still; succeed after ``duration`` seconds, or run until the state is left when it is 0."""
+
+    def setup(self, **kwargs: Any) -> None:
+        """Idle needs no world."""
+        self.context = kwargs.get("context", self.context)
+        world = getattr(self.context, "world", None)
+        if world is not None and getattr(self.context, "agent", None) in getattr(world, "robots", {}):
+            super().setup(**kwargs)
+
+    def initialise(self) -> None:
+        """Stop the robot, remember when."""
+        self.started = self.now() if self.context is not None else 0.0
+        if self.robot is not None:
+            self.robot.stop()
+
+    def update(self) -> Status:
+        """Running until the duration passed."""
+        duration = float(self.param("duration", 0.0))  # type: ignore[arg-type]
+        if duration > 0 and self.now() - self.started >= duration:
+            return self.succeed()
+        return self.running("standing still")

@@ -1,0 +1,146 @@
+"""Run one skill alone in a small world, in simulated time: for users' tests and ``alica skill run``.
+
+Example::
+
+    from worldsim.scenarios import lunar
+    from skills.testing import run_skill
+
+    with lunar(seed=1, rocks=20) as world:
+        run = run_skill("MoveToPosition", world, "scout", {"goal": [5.0, 5.0]})
+        assert run.status == "success", run.reason
+
+With pytest, the fixtures of :mod:`skills.pytest_plugin` (``lunar_world``,
+``blocks_world``, ``skill_run``) are available in every test.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+from alica.errors import SkillError
+from skills.registry import SkillRegistry, default_registry
+
+
+@dataclass(slots=True)
+class SkillRun:
+    """What happened when a skill ran alone.
+
+    Attributes:
+        skill: the skill's name.
+        robot: the robot that ran it.
+        status: ``success``, ``failure`` or ``timeout``.
+        reason: the skill's last feedback (why it failed, or what it did).
+        sim_time_s: simulated seconds until it ended.
+        ticks: skill ticks.
+        trace: ``{"t", "status", "feedback"}`` whenever the feedback or status changed.
+        facts: the world-model facts and values after the run (outcome facts the skill wrote).
+    """
+
+    skill: str
+    robot: str
+    status: str
+    reason: str
+    sim_time_s: float
+    ticks: int
+    trace: list[dict[str, object]] = field(default_factory=list)
+    facts: list[tuple[object, ...]] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        """Whether the skill succeeded."""
+        return self.status == "success"
+
+
+def checked_params(spec: Any, params: Mapping[str, object]) -> dict[str, object]:
+    """The parameters with defaults filled in.
+
+    Raises:
+        SkillError: an unknown or missing parameter, or a value of the wrong type.
+    """
+    out: dict[str, object] = {}
+    known = {p.name for p in spec.params}
+    unknown = sorted(set(params) - known)
+    if unknown:
+        raise SkillError(f"skill '{spec.name}' has no parameter {', '.join(map(repr, unknown))} (parameters: {', '.join(sorted(known)) or 'none'})")
+    for p in spec.params:
+        if p.name in params:
+            value = params[p.name]
+            if isinstance(value, list):
+                value = tuple(value)
+            problem = p.check(value)
+            if problem is not None:
+                raise SkillError(f"skill '{spec.name}': parameter '{p.name}' {problem}, got {value!r}")
+            out[p.name] = value
+        elif p.required:
+            raise SkillError(f"skill '{spec.name}' needs the parameter '{p.name}' ({p.type}: {p.doc})")
+        else:
+            out[p.name] = p.default
+    return out
+
+
+def run_skill(
+    name: str,
+    world: Any,
+    robot: str,
+    params: Mapping[str, object] | None = None,
+    *,
+    timeout: float = 120.0,
+    rate: float = 10.0,
+    seed: int = 0,
+    registry: SkillRegistry | None = None,
+    world_model: Any = None,
+) -> SkillRun:
+    """Run skill ``name`` on ``robot`` of ``world`` until it ends or ``timeout`` simulated seconds pass.
+
+    The skill is built from the registry's implementation, ticked ``rate``
+    times per simulated second, and the world steps between ticks.
+
+    Raises:
+        SkillError: bad parameters, no such robot, or no implementation.
+        UnknownSkillError: no skill of that name.
+    """
+    from py_trees.common import Status
+
+    from alica.engine.behaviours import SkillContext
+    from alica.worldmodel import WorldModel
+
+    registry = registry or default_registry()
+    spec = registry.get(name)
+    values = checked_params(spec, params or {})
+    if robot not in world.robots:
+        raise SkillError(f"the world has no robot named '{robot}' (robots: {', '.join(sorted(world.robots))})")
+    factory = registry.load(name)
+    wm = world_model if world_model is not None else WorldModel(robot, clock=world.clock)
+    context = SkillContext(robot, world.now, wm, wm, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
+    behaviour = factory(name, values, context)
+    behaviour.setup(context=context)
+    start = world.now()
+    period = 1.0 / rate
+    trace: list[dict[str, object]] = []
+    ticks = 0
+    last: tuple[str, str] | None = None
+    status = "timeout"
+    while True:
+        behaviour.tick_once()
+        ticks += 1
+        now = world.now()
+        seen = (behaviour.status.value, behaviour.feedback_message)
+        if seen != last:
+            trace.append({"t": round(now - start, 4), "status": seen[0].lower(), "feedback": seen[1]})
+            last = seen
+        if behaviour.status == Status.SUCCESS:
+            status = "success"
+            break
+        if behaviour.status == Status.FAILURE:
+            status = "failure"
+            break
+        if now - start >= timeout:
+            behaviour.stop(Status.INVALID)
+            break
+        world.step(period)
+    reason = behaviour.feedback_message or ("" if status != "timeout" else f"still running after {timeout:.0f} s")
+    facts = sorted((tuple(f) for f in wm.facts()), key=repr) if hasattr(wm, "facts") else []
+    return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts)
