@@ -16,7 +16,7 @@ With pytest, the fixtures of :mod:`skills.pytest_plugin` (``lunar_world``,
 from __future__ import annotations
 
 import random
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -92,11 +92,14 @@ def run_skill(
     seed: int = 0,
     registry: SkillRegistry | None = None,
     world_model: Any = None,
+    on_tick: Callable[[Any, Any], None] | None = None,
 ) -> SkillRun:
     """Run skill ``name`` on ``robot`` of ``world`` until it ends or ``timeout`` simulated seconds pass.
 
     The skill is built from the registry's implementation, ticked ``rate``
     times per simulated second, and the world steps between ticks.
+    ``on_tick(world, behaviour)``, if given, runs before every tick (to inject
+    faults at the right moment, say).
 
     Raises:
         SkillError: bad parameters, no such robot, or no implementation.
@@ -124,6 +127,8 @@ def run_skill(
     last: tuple[str, str] | None = None
     status = "timeout"
     while True:
+        if on_tick is not None:
+            on_tick(world, behaviour)
         behaviour.tick_once()
         ticks += 1
         now = world.now()
