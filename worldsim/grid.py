@@ -98,7 +98,7 @@ class OccupancyGrid:
         ValueError: On a non-positive resolution or size, or cells of the wrong shape or values.
     """
 
-    __slots__ = ("origin", "resolution", "width", "height", "cells")
+    __slots__ = ("cells", "height", "origin", "resolution", "width")
 
     def __init__(
         self,
@@ -121,7 +121,9 @@ class OccupancyGrid:
         else:
             cells = np.asarray(cells)
             if cells.shape != (self.height, self.width):
-                raise ValueError(f"cells must have shape (height, width) = {(self.height, self.width)}, got {cells.shape}")
+                raise ValueError(
+                    f"cells must have shape (height, width) = {(self.height, self.width)}, got {cells.shape}"
+                )
             if cells.dtype != np.uint8:
                 cells = cells.astype(np.uint8)
         self.cells: np.ndarray = cells
@@ -249,7 +251,7 @@ class OccupancyGrid:
             raise ValueError(f"inflation radius must be a finite value >= 0 metres, got {radius}")
         occ = self.cells == OCCUPIED
         out = self.cells.copy()
-        k = int(math.floor(radius / self.resolution + 1e-9))
+        k = math.floor(radius / self.resolution + 1e-9)
         if k == 0 or not occ.any():
             return OccupancyGrid(self.origin, self.resolution, self.width, self.height, out)
         r2 = (radius / self.resolution) ** 2 + 1e-9

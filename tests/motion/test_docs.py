@@ -1,0 +1,26 @@
+"""The example in docs/motion.md runs and prints what the page says."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+PAGE = Path(__file__).resolve().parents[2] / "docs" / "motion.md"
+
+
+def test_motion_page_example(capsys: pytest.CaptureFixture[str]) -> None:
+    [example] = re.findall(r"```python\n(.*?)```", PAGE.read_text(encoding="utf-8"), re.DOTALL)
+    exec(compile(example, str(PAGE.name), "exec"), {})  # noqa: S102 (the page is ours)
+    assert capsys.readouterr().out.splitlines() == ["exact True", "True True"]
+
+
+def test_package_docstring_example() -> None:
+    import doctest
+
+    import skills.motion
+    import worldsim.grid
+
+    for module in (skills.motion, worldsim.grid):
+        assert doctest.testmod(module).failed == 0
