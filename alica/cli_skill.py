@@ -64,6 +64,9 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
     from skills.registry import default_registry
     from skills.testing import run_skill
 
+    from skills.motion import configure_ompl
+
+    configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
     registry = default_registry()
     spec = registry.get(args.name)
     params = _params(args.param)

@@ -30,7 +30,20 @@ def planning_grid(world: Any) -> Any:
     hit = cache.get("grid")
     if hit is None or hit[0] != obstacles:
         hit = cache["grid"] = (obstacles, OccupancyGrid.from_obstacles(list(obstacles), world.bounds, 0.05))
+        cache.pop("checkers", None)
     return hit[1]
+
+
+def planning_checker(world: Any, radius: float) -> Any:
+    """The grid inflated for a robot of ``radius`` (a :class:`skills.motion.GridChecker`), built once per radius."""
+    from skills.motion import GridChecker
+
+    grid = planning_grid(world)
+    checkers = world_cache(world).setdefault("checkers", {})
+    checker = checkers.get(radius)
+    if checker is None:
+        checker = checkers[radius] = GridChecker(grid, radius)
+    return checker
 
 
 class MoveToPosition(WorldSkill):
@@ -56,9 +69,8 @@ class MoveToPosition(WorldSkill):
     def _plan(self, goal: tuple[float, float]) -> None:
         from skills.motion import plan_path
 
-        grid = planning_grid(self.world)
-        seed = int(self.context.rng.integers(0, 2**31)) if hasattr(self.context.rng, "integers") else self.context.rng.randrange(2**31)
-        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, grid, self.robot.spec.radius, other_robots=self._others(), time_limit=1.0, seed=seed)
+        checker = planning_checker(self.world, self.robot.spec.radius)
+        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, other_robots=self._others(), time_limit=1.0)
         self.follower = None
 
     def update(self) -> Status:

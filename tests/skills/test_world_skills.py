@@ -1,0 +1,122 @@
+"""Each skill alone in a small world, in simulated time (the skills.testing fixtures)."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from alica.errors import SkillError
+
+
+def _far_free_goal(world, robot, distance=8.0):
+    x, y, _ = world.robots[robot].pose
+    for angle in [i * math.pi / 8 for i in range(16)]:
+        gx, gy = x + distance * math.cos(angle), y + distance * math.sin(angle)
+        xmin, ymin, xmax, ymax = world.bounds
+        if xmin + 1 < gx < xmax - 1 and ymin + 1 < gy < ymax - 1 and world.is_free(gx, gy, 0.6):
+            return gx, gy
+    raise AssertionError("no free goal")
+
+
+def test_move_to_position_reaches_a_goal_around_rocks(lunar_world, skill_run):
+    goal = _far_free_goal(lunar_world, "scout")
+    run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": list(goal), "tolerance": 0.3})
+    assert run.ok, (run.reason, run.trace[-5:])
+    x, y, _ = lunar_world.robots["scout"].pose
+    assert math.hypot(x - goal[0], y - goal[1]) <= 0.3
+    assert not lunar_world.robots["scout"].bumped
+    assert any(f[0] == "pos" for f in run.facts) or run.facts == []
+
+
+def test_move_to_position_fails_clearly_on_an_unreachable_goal(lunar_world, skill_run):
+    rock = next(o for o in lunar_world.objects.values() if o.kind == "rock")
+    x, y = rock.position()[:2]
+    run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": [float(x), float(y)]})
+    assert run.status == "failure"
+    assert "cannot reach" in run.reason
+    assert run.sim_time_s < 5.0
+
+
+def test_pickup_succeeds(blocks_world, skill_run):
+    run = skill_run("Pickup", blocks_world, "r1", {"object": "c"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    arm = blocks_world.robots["r1"].arm
+    assert arm.held is blocks_world.objects["c"]
+    from worldsim.scenarios import blocks_facts
+
+    facts = blocks_facts(blocks_world)
+    assert ("holding", "r1", "c") in facts and ("ontable", "c") not in facts
+
+
+def test_pickup_retries_after_a_slip(blocks_world, skill_run):
+    from worldsim.faults import set_grasp_slip
+
+    set_grasp_slip(blocks_world, 1.0)
+    attempts = []
+
+    def fault(world, behaviour):
+        tries = getattr(behaviour, "attempts", 0)
+        if tries >= 1 and not attempts:
+            attempts.append(tries)
+            set_grasp_slip(world, 0.0)  # the second grasp holds
+
+    run = skill_run("Pickup", blocks_world, "r1", {"object": "c"}, on_tick=fault)
+    assert run.ok, (run.reason, run.trace[-6:])
+    assert attempts == [1]
+    assert any("retrying" in str(t["feedback"]) for t in run.trace)
+
+
+def test_pickup_fails_after_the_retry_budget(blocks_world, skill_run):
+    from worldsim.faults import set_grasp_slip
+
+    set_grasp_slip(blocks_world, 1.0)
+    run = skill_run("Pickup", blocks_world, "r1", {"object": "c", "retries": 2})
+    assert run.status == "failure"
+    assert "gave up after 2 attempt(s)" in run.reason
+
+
+def test_putdown_on_the_ground_and_stack_on_a_block(blocks_world, skill_run):
+    from worldsim.scenarios import blocks_facts
+
+    assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
+    run = skill_run("Putdown", blocks_world, "r1", {"object": "c"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    facts = blocks_facts(blocks_world)
+    assert ("ontable", "c") in facts and ("handempty", "r1") in facts
+    assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
+    run = skill_run("Stack", blocks_world, "r1", {"object": "c", "target": "b"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    assert ("on", "c", "b") in blocks_facts(blocks_world)
+
+
+def test_unstack_then_stack_follow_the_ipc_domain(blocks_world, skill_run):
+    from worldsim.scenarios import blocks_facts
+
+    before = blocks_facts(blocks_world)
+    assert ("on", "b", "a") in before and ("clear", "b") in before and ("clear", "a") not in before
+    # preconditions are checked on the simulated state: a is not clear
+    refused = skill_run("Unstack", blocks_world, "r1", {"object": "a", "from": "b"})
+    assert refused.status == "failure" and "precondition" in refused.reason
+    run = skill_run("Unstack", blocks_world, "r1", {"object": "b", "from": "a"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    after = blocks_facts(blocks_world)
+    assert ("holding", "r1", "b") in after and ("clear", "a") in after and ("on", "b", "a") not in after
+    run = skill_run("Stack", blocks_world, "r1", {"object": "b", "target": "c"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    final = blocks_facts(blocks_world)
+    assert ("on", "b", "c") in final and ("handempty", "r1") in final and ("clear", "c") not in final
+
+
+def test_bad_parameters_are_refused(blocks_world, skill_run):
+    with pytest.raises(SkillError, match="needs the parameter 'object'"):
+        skill_run("Pickup", blocks_world, "r1", {})
+    with pytest.raises(SkillError, match="has no parameter 'speed'"):
+        skill_run("Pickup", blocks_world, "r1", {"object": "c", "speed": 2})
+    with pytest.raises(SkillError, match="no robot named 'r9'"):
+        skill_run("Pickup", blocks_world, "r9", {"object": "c"})
+
+
+def test_a_robot_without_an_arm_cannot_pick_up(lunar_world, skill_run):
+    with pytest.raises(SkillError, match="has no arm"):
+        skill_run("Pickup", lunar_world, "scout", {"object": "a"})
