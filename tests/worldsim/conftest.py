@@ -1,0 +1,19 @@
+"""Fixtures for the simulated-world tests: small worlds, closed after each test."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+
+from worldsim.world import World
+
+
+@pytest.fixture
+def world() -> Iterator[World]:
+    """An empty 20 x 20 m world with a ground plane (seed 0)."""
+    w = World(seed=0)
+    try:
+        yield w
+    finally:
+        w.close()

@@ -1,0 +1,35 @@
+"""Package hygiene: pybullet is only loaded by the simulation modules; the lazy exports work."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import worldsim
+
+
+def test_alica_skills_and_the_grid_do_not_load_pybullet() -> None:
+    code = (
+        "import sys, alica, skills, worldsim, worldsim.grid, worldsim.errors, worldsim.geometry\n"
+        "assert 'pybullet' not in sys.modules, 'pybullet was imported'\n"
+        "worldsim.World\n"
+        "assert 'pybullet' in sys.modules\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+
+
+def test_lazy_exports() -> None:
+    from worldsim.scenarios import lunar
+    from worldsim.world import World
+
+    assert worldsim.World is World
+    assert worldsim.lunar is lunar
+    assert "blocks_facts" in dir(worldsim)
+
+
+def test_importing_is_quiet() -> None:
+    code = "import worldsim.world as w\nw.World().add_robot('stummel', 's')\n"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == "" and done.stderr == ""

@@ -1,0 +1,364 @@
+"""The robots: heterogeneous kinematic bases (IMPERA Section 2), some with a Panda arm.
+
+Bases are cylinders built in code; they move kinematically: every physics step
+the commanded velocity ``(v, w)`` is integrated (unicycle model) and the base
+body re-posed. A step that would push the footprint into a static obstacle
+(rock, table), a movable object (block, sample), another robot or the field
+border is refused: the robot stops and :attr:`Robot.bumped` becomes true.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from worldsim.arm import Arm
+from worldsim.errors import WorldError
+from worldsim.geometry import Footprints, wrap_angle, yaw_to_quat
+from worldsim.grid import Obstacle2D
+
+if TYPE_CHECKING:
+    from worldsim.world import World
+
+__all__ = ["ROBOT_KINDS", "Arm", "Robot", "RobotSpec"]
+
+logger = logging.getLogger(__name__)
+
+# How far a robot may travel before its list of nearby obstacles is refreshed,
+# and the longest time between refreshes (movable objects may have moved).
+_NEAR_MARGIN = 0.5
+_NEAR_STEPS = 60
+
+
+@dataclass(frozen=True, slots=True)
+class RobotSpec:
+    """What a kind of robot is and can do.
+
+    Attributes:
+        kind: the kind name (a key of :data:`ROBOT_KINDS`).
+        capabilities: the capability words of ``plans/roles.yaml`` ``requires``.
+        radius: footprint radius in metres.
+        max_speed: largest forward or backward speed in m/s.
+        max_yaw_rate: largest turning rate in rad/s.
+        has_arm: carries a Panda arm with a parallel gripper.
+        lidar_range: range of the 2-D laser scanner in metres.
+        perception: ``"camera"`` (directed colour camera) or ``"3d"`` (stereo and 3-D lidar).
+        height: height of the base body (the arm is mounted on top).
+        lidar_height: height of the scan plane above the ground.
+        camera_fov: horizontal field of view of the object perception in radians.
+        perception_range: default range of the object perception in metres.
+        mass: nominal mass in kg (descriptive; the base is kinematic).
+        colour: RGBA of the base body.
+    """
+
+    kind: str
+    capabilities: frozenset[str]
+    radius: float
+    max_speed: float
+    max_yaw_rate: float
+    has_arm: bool
+    lidar_range: float
+    perception: str
+    height: float = 0.25
+    lidar_height: float = 0.1
+    camera_fov: float = math.radians(70.0)
+    perception_range: float = 4.0
+    mass: float = 30.0
+    colour: tuple[float, float, float, float] = (0.5, 0.5, 0.5, 1.0)
+
+
+#: The robot kinds: the three IMPERA robots and a generic mobile manipulator for the blocks world.
+ROBOT_KINDS: dict[str, RobotSpec] = {
+    "scout": RobotSpec(
+        "scout",
+        frozenset({"base", "lidar2d", "camera"}),
+        radius=0.25,
+        max_speed=1.2,
+        max_yaw_rate=2.0,
+        has_arm=False,
+        lidar_range=30.0,
+        perception="camera",
+        height=0.2,
+        camera_fov=math.radians(60.0),
+        perception_range=5.0,
+        mass=25.0,
+        colour=(0.15, 0.45, 0.85, 1.0),
+    ),
+    "stummel": RobotSpec(
+        "stummel",
+        frozenset({"base", "arm", "gripper", "lidar2d", "camera"}),
+        radius=0.3,
+        max_speed=0.8,
+        max_yaw_rate=1.5,
+        has_arm=True,
+        lidar_range=30.0,
+        perception="camera",
+        height=0.25,
+        camera_fov=math.radians(60.0),
+        perception_range=4.0,
+        mass=35.0,
+        colour=(0.9, 0.55, 0.1, 1.0),
+    ),
+    "amparo": RobotSpec(
+        "amparo",
+        frozenset({"base", "arm", "gripper", "lidar3d", "stereo_camera"}),
+        radius=0.35,
+        max_speed=0.5,
+        max_yaw_rate=1.0,
+        has_arm=True,
+        lidar_range=20.0,
+        perception="3d",
+        height=0.28,
+        camera_fov=math.radians(90.0),
+        perception_range=6.0,
+        mass=60.0,
+        colour=(0.75, 0.15, 0.2, 1.0),
+    ),
+    "manipulator": RobotSpec(
+        "manipulator",
+        frozenset({"base", "arm", "gripper", "lidar2d", "camera"}),
+        radius=0.25,
+        max_speed=0.5,
+        max_yaw_rate=1.5,
+        has_arm=True,
+        lidar_range=10.0,
+        perception="camera",
+        height=0.22,
+        camera_fov=math.radians(70.0),
+        perception_range=3.0,
+        mass=30.0,
+        colour=(0.3, 0.6, 0.35, 1.0),
+    ),
+}
+
+
+class Robot:
+    """One robot in a :class:`~worldsim.world.World` (make it with ``world.add_robot``).
+
+    Attributes:
+        name: unique name in the world.
+        spec: the :class:`RobotSpec` of its kind.
+        body_id: the pybullet body of the base.
+        arm: the :class:`~worldsim.arm.Arm` (``None`` for robots without one).
+        bumped: true when the last drive command was stopped by a collision;
+            cleared by the next :meth:`drive` (callers may also reset it).
+    """
+
+    __slots__ = (
+        "_crashed",
+        "_near",
+        "_near_age",
+        "_near_at",
+        "_near_version",
+        "_v",
+        "_w",
+        "_world",
+        "_x",
+        "_y",
+        "_yaw",
+        "arm",
+        "body_id",
+        "bumped",
+        "name",
+        "spec",
+    )
+
+    def __init__(self, world: World, name: str, spec: RobotSpec, pose: Sequence[float]) -> None:
+        self._world = world
+        self.name = name
+        self.spec = spec
+        self._x, self._y, self._yaw = float(pose[0]), float(pose[1]), wrap_angle(float(pose[2]))
+        self._v = 0.0
+        self._w = 0.0
+        self._crashed = False
+        self.bumped = False
+        self._near: list[tuple[float, ...]] = []
+        self._near_at = (math.inf, math.inf)
+        self._near_age = 0
+        self._near_version = -1
+        c = world.client
+        half = 0.5 * spec.height
+        self.body_id: int = c.createMultiBody(
+            baseMass=0.0,
+            baseCollisionShapeIndex=c.createCollisionShape(c.GEOM_CYLINDER, radius=spec.radius, height=spec.height),
+            baseVisualShapeIndex=c.createVisualShape(
+                c.GEOM_CYLINDER, radius=spec.radius, length=spec.height, rgbaColor=spec.colour
+            ),
+            basePosition=(self._x, self._y, half),
+            baseOrientation=yaw_to_quat(self._yaw),
+            useMaximalCoordinates=True,
+        )
+        self.arm: Arm | None = Arm(self, mount_offset=(spec.radius - 0.12, 0.0, spec.height)) if spec.has_arm else None
+
+    # ------------------------------------------------------------------ state
+    @property
+    def world(self) -> World:
+        """The world the robot lives in."""
+        return self._world
+
+    @property
+    def pose(self) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` of the base."""
+        return (self._x, self._y, self._yaw)
+
+    @property
+    def velocity(self) -> tuple[float, float]:
+        """The current command ``(v, w)`` after clipping (zero when stopped)."""
+        return (self._v, self._w)
+
+    @property
+    def crashed(self) -> bool:
+        """A crashed robot ignores every command (see :func:`worldsim.faults.crash`)."""
+        return self._crashed
+
+    @property
+    def gripper(self) -> Arm | None:
+        """The arm, which carries the gripper methods (``open``, ``close``, ``attach``, ...)."""
+        return self.arm
+
+    @property
+    def capabilities(self) -> frozenset[str]:
+        """The capability words of the robot's kind."""
+        return self.spec.capabilities
+
+    def footprint(self) -> Obstacle2D:
+        """The base footprint as a circle."""
+        return Obstacle2D("circle", self._x, self._y, radius=self.spec.radius, name=self.name)
+
+    def set_pose(self, x: float | Sequence[float], y: float | None = None, yaw: float | None = None) -> None:
+        """Put the robot at ``(x, y, yaw)`` (also ``set_pose((x, y, yaw))``), arm and held object with it.
+
+        The pose is checked against the field only; overlaps are allowed (the
+        robot may drive out of them).
+
+        Raises:
+            WorldError: a pose off the field or not three numbers.
+        """
+        if y is None:
+            try:
+                x, y, yaw = (float(v) for v in x)  # type: ignore[union-attr]
+            except (TypeError, ValueError):
+                raise WorldError(f"set_pose of robot '{self.name}' takes (x, y, yaw), got {x!r}") from None
+        x, y = float(x), float(y)  # type: ignore[arg-type]
+        yaw = self._yaw if yaw is None else float(yaw)
+        self._world._check_in_field(x, y, f"robot '{self.name}'", self.spec.radius)
+        self._x, self._y, self._yaw = x, y, wrap_angle(yaw)
+        self._near_at = (math.inf, math.inf)
+        self._apply_pose()
+
+    # --------------------------------------------------------------- commands
+    def drive(self, v: float, w: float) -> None:
+        """Command forward speed ``v`` (m/s) and turn rate ``w`` (rad/s), clipped to the spec.
+
+        The command holds until changed; it clears :attr:`bumped`. A crashed robot ignores it.
+        """
+        if self._crashed:
+            logger.debug("robot %s is crashed; drive(%s, %s) ignored", self.name, v, w)
+            return
+        v, w = float(v), float(w)
+        if not (math.isfinite(v) and math.isfinite(w)):
+            raise WorldError(f"drive of robot '{self.name}' needs finite v and w, got ({v}, {w})")
+        s, r = self.spec.max_speed, self.spec.max_yaw_rate
+        self._v = min(s, max(-s, v))
+        self._w = min(r, max(-r, w))
+        self.bumped = False
+
+    def stop(self) -> None:
+        """Stop the base (the arm keeps following its path)."""
+        self._v = 0.0
+        self._w = 0.0
+
+    def crash(self) -> None:
+        """Stop acting for good: base and arm stop, later commands are ignored."""
+        self._crashed = True
+        self.stop()
+        if self.arm is not None:
+            self.arm.stop()
+        logger.info("robot %s crashed", self.name)
+
+    # --------------------------------------------------------------- internals
+    def _apply_pose(self) -> None:
+        self._world._reset_base(self.body_id, (self._x, self._y, 0.5 * self.spec.height), yaw_to_quat(self._yaw))
+        if self.arm is not None:
+            self.arm._base_moved()
+
+    def _refresh_near(self) -> None:
+        world = self._world
+        reach = self.spec.radius + _NEAR_MARGIN + self.spec.max_speed * _NEAR_STEPS * world.time_step
+        near = world._static_footprints.near(self._x, self._y, reach)
+        held = world._held_bodies()
+        movable = Footprints()
+        for obj in world.objects.values():
+            if obj.movable and obj.body_id not in held:
+                fp = obj.footprint()
+                if fp is None:
+                    continue
+                if fp.kind == "circle":
+                    movable.add_circle(obj.name, fp.x, fp.y, fp.radius)
+                else:
+                    movable.add_box(obj.name, fp.x, fp.y, fp.half_x, fp.half_y, fp.yaw)
+        near.extend(movable.near(self._x, self._y, reach))
+        self._near = near
+        self._near_at = (self._x, self._y)
+        self._near_age = 0
+        self._near_version = world._version
+
+    def _depth(self, x: float, y: float) -> float:
+        """Deepest penetration of the footprint at ``(x, y)`` into anything it must not touch."""
+        r = self.spec.radius
+        xmin, ymin, xmax, ymax = self._world.bounds
+        worst = max(xmin - (x - r), (x + r) - xmax, ymin - (y - r), (y + r) - ymax)
+        d = Footprints.depth(x, y, r, self._near)
+        worst = max(worst, d)
+        for other in self._world.robots.values():
+            if other is not self:
+                d = r + other.spec.radius - math.hypot(x - other._x, y - other._y)
+                worst = max(worst, d)
+        return worst
+
+    def _advance(self, dt: float) -> bool:
+        """Integrate the command over one physics step; returns whether the base moved."""
+        v, w = self._v, self._w
+        if v == 0.0 and w == 0.0:
+            return False
+        yaw = self._yaw
+        if v != 0.0:
+            mid = yaw + 0.5 * w * dt
+            nx = self._x + v * math.cos(mid) * dt
+            ny = self._y + v * math.sin(mid) * dt
+            world = self._world
+            self._near_age += 1
+            if (
+                self._near_version != world._version
+                or self._near_age >= _NEAR_STEPS
+                or math.hypot(nx - self._near_at[0], ny - self._near_at[1]) > _NEAR_MARGIN
+            ):
+                self._refresh_near()
+            new = self._depth(nx, ny)
+            if new > 0.0 and new > self._depth(self._x, self._y) + 1e-12:
+                self._v = 0.0
+                self._w = 0.0
+                self.bumped = True
+                logger.debug("robot %s bumped at (%.3f, %.3f)", self.name, self._x, self._y)
+                return False
+            self._x, self._y = nx, ny
+        self._yaw = wrap_angle(yaw + w * dt)
+        self._apply_pose()
+        return True
+
+    def _state(self) -> dict[str, Any]:
+        return {"pose": self.pose, "v": self._v, "w": self._w, "bumped": self.bumped, "crashed": self._crashed}
+
+    def _restore(self, state: dict[str, Any]) -> None:
+        self._x, self._y, self._yaw = state["pose"]
+        self._v, self._w = state["v"], state["w"]
+        self.bumped = state["bumped"]
+        self._crashed = state["crashed"]
+        self._near_at = (math.inf, math.inf)
+        self._apply_pose()
+
+    def __repr__(self) -> str:
+        return f"Robot({self.name!r}, {self.spec.kind!r}, pose=({self._x:.3f}, {self._y:.3f}, {self._yaw:.3f}))"

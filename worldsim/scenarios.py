@@ -1,0 +1,210 @@
+"""Ready-made worlds: the blocks world (IMPERA Section 8.2) and the lunar field (Sections 2 and 6).
+
+Both are deterministic functions of their arguments.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import string
+
+import numpy as np
+
+from worldsim.errors import WorldError
+from worldsim.objects import SAMPLE_KINDS
+from worldsim.world import World
+
+__all__ = ["blocks_facts", "blocksworld", "lunar", "sample_names"]
+
+logger = logging.getLogger(__name__)
+
+#: Distance between stack centres in the blocks world.
+STACK_SPACING = 0.8
+#: Distance from the line of stacks to the robots' centres.
+ROBOT_STANDOFF = 1.2
+
+
+def blocksworld(
+    stacks: list[list[str]] | None = None,
+    agents: int = 2,
+    seed: int = 0,
+    block_size: float = 0.05,
+    *,
+    time_step: float = 1.0 / 240.0,
+) -> World:
+    """A blocks world: stacks of blocks on the ground in a row, and manipulators ``r1..rN`` around them.
+
+    Args:
+        stacks: the stacks, each bottom block first (default ``[["a", "c"], ["b"]]``: c on a, b alone,
+            the Sussman anomaly for the goal tower a on b on c).
+        agents: number of robots of kind ``manipulator``; they stand on both sides of the
+            row, facing it, :data:`ROBOT_STANDOFF` away.
+        seed: the world seed.
+        block_size: edge of the blocks in metres.
+        time_step: the physics step.
+
+    Raises:
+        WorldError: empty stacks, repeated block names, or fewer than 0 agents.
+    """
+    if stacks is None:
+        stacks = [["a", "c"], ["b"]]
+    names = [b for stack in stacks for b in stack]
+    if any(not stack for stack in stacks):
+        raise WorldError("blocksworld: every stack needs at least one block; drop empty stacks")
+    if len(set(names)) != len(names):
+        raise WorldError(f"blocksworld: block names must be unique, got {names}")
+    if int(agents) < 0:
+        raise WorldError(f"blocksworld: agents must be >= 0, got {agents}")
+    agents = int(agents)
+    n = max(1, len(stacks))
+    row = (n - 1) * STACK_SPACING
+    per_side = max(1, math.ceil(agents / 2))
+    robots_row = (per_side - 1) * 1.0
+    half_x = max(2.5, 0.5 * max(row, robots_row) + 1.5)
+    half_y = ROBOT_STANDOFF + 1.5
+    world = World(seed, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y))
+    for i, stack in enumerate(stacks):
+        x = -0.5 * row + i * STACK_SPACING
+        for level, name in enumerate(stack):
+            world.add_block(name, (x, 0.0, (level + 0.5) * block_size + 0.0005 * level), size=block_size)
+    for k in range(agents):
+        side = -1.0 if k % 2 == 0 else 1.0
+        slot = k // 2
+        x = -0.5 * robots_row + slot * 1.0
+        world.add_robot("manipulator", f"r{k + 1}", (x, side * ROBOT_STANDOFF, -side * 0.5 * math.pi))
+    world.step(0.25)  # let the stacks settle
+    return world
+
+
+def blocks_facts(world: World, tolerance: float | None = None) -> set[tuple[str, ...]]:
+    """The IPC blocks-world facts of the simulated state.
+
+    ``("on", x, y)``, ``("ontable", x)``, ``("clear", x)``, ``("holding", robot, x)``
+    and ``("handempty", robot)`` for every robot with an arm. A block is on another
+    when its bottom lies within ``tolerance`` of the other's top and its centre
+    over the other; on the table when its bottom is within ``tolerance`` of the
+    ground or a table top. A falling block is neither.
+
+    Args:
+        world: the world to read.
+        tolerance: vertical tolerance in metres (default 30 % of the smallest block).
+    """
+    blocks = {n: o for n, o in world.objects.items() if o.kind == "block"}
+    facts: set[tuple[str, ...]] = set()
+    held: dict[str, str] = {}
+    for rname, robot in world.robots.items():
+        if robot.arm is None:
+            continue
+        obj = robot.arm.held
+        if obj is not None and obj.kind == "block":
+            facts.add(("holding", rname, obj.name))
+            held[obj.name] = rname
+        elif obj is None:
+            facts.add(("handempty", rname))
+    if not blocks:
+        return facts
+    tol = 0.3 * min(o.size for o in blocks.values()) if tolerance is None else float(tolerance)
+    boxes = {n: o.aabb() for n, o in blocks.items() if n not in held}
+    tables = [o for o in world.objects.values() if o.kind == "table"]
+    covered: set[str] = set()
+    for x, (lo_x, hi_x) in boxes.items():
+        cx, cy = 0.5 * (lo_x[0] + hi_x[0]), 0.5 * (lo_x[1] + hi_x[1])
+        bottom = lo_x[2]
+        support = None
+        for y, (lo_y, hi_y) in boxes.items():
+            if y != x and abs(bottom - hi_y[2]) <= tol and lo_y[0] <= cx <= hi_y[0] and lo_y[1] <= cy <= hi_y[1]:
+                support = y
+                break
+        if support is not None:
+            facts.add(("on", x, support))
+            covered.add(support)
+            continue
+        floor = 0.0
+        for table in tables:
+            lo_t, hi_t = table.aabb()
+            if lo_t[0] <= cx <= hi_t[0] and lo_t[1] <= cy <= hi_t[1]:
+                floor = max(floor, hi_t[2])
+        if abs(bottom - floor) <= tol:
+            facts.add(("ontable", x))
+    for x in boxes:
+        if x not in covered:
+            facts.add(("clear", x))
+    return facts
+
+
+def sample_names(count: int) -> list[str]:
+    """Names of ``count`` samples: ``a``, ``b``, ... (``g`` is the collection point), then ``s27``, ..."""
+    letters = [ch for ch in string.ascii_lowercase if ch != "g"]
+    return [letters[i] if i < len(letters) else f"s{i + 1}" for i in range(count)]
+
+
+def lunar(
+    seed: int = 0,
+    rocks: int = 60,
+    samples: int = 2,
+    size: float = 40.0,
+    *,
+    time_step: float = 1.0 / 240.0,
+    start_radius: float = 3.0,
+) -> World:
+    """The IMPERA field: rocks, sample containers, the collection point ``g`` and the three robots.
+
+    The field spans ``[-size/2, size/2]`` in x and y with ``g`` at the centre.
+    Rocks (radius 0.2-1.0 m) keep out of the start area (``start_radius``
+    around ``g``) and off each other; samples ``a``, ``b``, ... of random
+    kinds lie in free space at least 0.8 m from rocks and away from ``g``;
+    ``scout``, ``stummel`` and ``amparo`` stand around ``g`` facing outwards.
+
+    Raises:
+        WorldError: negative counts, a field too small, or rocks or samples that do not fit.
+    """
+    if rocks < 0 or samples < 0:
+        raise WorldError(f"lunar: rocks and samples must be >= 0, got {rocks} and {samples}")
+    if not size >= 2.0 * (start_radius + 2.0):
+        raise WorldError(f"lunar: size must be at least {2.0 * (start_radius + 2.0)} m for the start area, got {size}")
+    half = 0.5 * float(size)
+    world = World(seed, time_step=time_step, bounds=(-half, -half, half, half))
+    layout = np.random.default_rng([int(seed), 7])
+    placed: list[tuple[float, float, float]] = []
+    attempts = 0
+    while len(placed) < rocks:
+        attempts += 1
+        if attempts > 200 * max(1, rocks):
+            raise WorldError(
+                f"lunar: could only place {len(placed)} of {rocks} rocks in a {size} m field; "
+                f"ask for fewer rocks or a larger size"
+            )
+        r = float(layout.uniform(0.2, 1.0))
+        x, y = (float(v) for v in layout.uniform(-half + r + 0.5, half - r - 0.5, 2))
+        if math.hypot(x, y) < start_radius + r:
+            continue
+        if any(math.hypot(x - px, y - py) < r + pr + 0.3 for px, py, pr in placed):
+            continue
+        placed.append((x, y, r))
+        world.add_rock(f"rock{len(placed)}", (x, y), r, seed=int(layout.integers(2**31)))
+    world.add_collection_point("g", (0.0, 0.0), radius=0.5)
+    kinds = list(layout.permutation(len(SAMPLE_KINDS)))
+    spots: list[tuple[float, float]] = []
+    away = min(6.0, half - 1.5)
+    attempts = 0
+    for i, name in enumerate(sample_names(samples)):
+        while True:
+            attempts += 1
+            if attempts > 2000 * max(1, samples):
+                raise WorldError(f"lunar: no free space for sample '{name}'; ask for fewer rocks or samples")
+            x, y = (float(v) for v in layout.uniform(-half + 1.0, half - 1.0, 2))
+            if math.hypot(x, y) < away:
+                continue
+            if any(math.hypot(x - px, y - py) < pr + 0.8 for px, py, pr in placed):
+                continue
+            if any(math.hypot(x - sx, y - sy) < 1.0 for sx, sy in spots):
+                continue
+            break
+        spots.append((x, y))
+        kind = SAMPLE_KINDS[int(kinds[i % len(kinds)])] if i < len(kinds) else SAMPLE_KINDS[int(layout.integers(6))]
+        world.add_sample(name, kind, (x, y))
+    for name, angle in (("scout", 0.0), ("stummel", 2.0 * math.pi / 3.0), ("amparo", -2.0 * math.pi / 3.0)):
+        world.add_robot(name, name, (1.5 * math.cos(angle), 1.5 * math.sin(angle), angle))
+    world.step(0.1)  # let the samples settle
+    return world

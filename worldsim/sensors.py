@@ -1,0 +1,229 @@
+"""Simulated sensors: a 2-D lidar, an object perception model, and lidar-to-grid mapping.
+
+* :func:`lidar_scan` casts all rays in one ``rayTestBatch`` from the robot's
+  scan plane; rays that hit the robot's own arm or held object are continued
+  past it. Ranges are from the robot centre; a ray without a hit reads the
+  maximum range.
+* :func:`perceive` reports the samples and blocks in range, inside the field
+  of view and in line of sight, with position noise and (for samples) a
+  chance of a wrong kind: larger for a ``camera`` than for ``3d`` perception.
+* :func:`scan_to_grid` marks a scan in a :class:`~worldsim.grid.OccupancyGrid`.
+
+Noise comes from the world's seeded rng and ``world.noise``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from worldsim.errors import WorldError
+from worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from worldsim.objects import SAMPLE_KINDS
+
+if TYPE_CHECKING:
+    from worldsim.robots import Robot
+    from worldsim.world import World
+
+__all__ = ["Detection", "lidar_angles", "lidar_scan", "perceive", "scan_to_grid", "unknown_grid"]
+
+# Rays start just outside the base so that the robot's own cylinder is never hit.
+_RAY_START_GAP = 0.01
+_CAMERA_HEIGHT_ABOVE_BASE = 0.3
+
+
+@dataclass(frozen=True, slots=True)
+class Detection:
+    """One perceived object.
+
+    Attributes:
+        name: the object's name (data association is assumed).
+        kind: the perceived kind: a sample container kind, or ``"block"``.
+        position: the perceived ``(x, y, z)`` (noisy).
+        confidence: in (0, 1], lower far away and for a camera.
+    """
+
+    name: str
+    kind: str
+    position: tuple[float, float, float]
+    confidence: float
+
+
+def lidar_angles(n_rays: int) -> np.ndarray:
+    """Ray angles relative to the robot heading: ``n_rays`` evenly spaced from -pi (inclusive) to pi."""
+    return -math.pi + (2.0 * math.pi / n_rays) * np.arange(n_rays)
+
+
+def _own_bodies(robot: Robot) -> set[int]:
+    own = {robot.body_id}
+    if robot.arm is not None:
+        own.add(robot.arm.body_id)
+        if robot.arm.held is not None:
+            own.add(robot.arm.held.body_id)
+    return own
+
+
+def _cast(world: World, starts: np.ndarray, ends: np.ndarray, skip: set[int]) -> tuple[np.ndarray, np.ndarray]:
+    """First hit fraction along each segment and its body id, passing through ``skip`` bodies."""
+    c = world.client
+    fractions = np.ones(len(starts))
+    bodies = np.full(len(starts), -1, dtype=int)
+    todo = np.arange(len(starts))
+    offset = np.zeros(len(starts))
+    seg = ends - starts
+    for _ in range(4):
+        if len(todo) == 0:
+            break
+        s = starts[todo] + seg[todo] * offset[todo, None]
+        hits = c.rayTestBatch(s.tolist(), ends[todo].tolist())
+        again = []
+        for k, hit in zip(todo, hits, strict=True):
+            body, frac = hit[0], hit[2]
+            if body < 0:
+                continue
+            total = offset[k] + (1.0 - offset[k]) * frac
+            if body in skip:
+                offset[k] = min(1.0, total + 1e-4)
+                again.append(k)
+                continue
+            fractions[k] = total
+            bodies[k] = body
+        todo = np.array(again, dtype=int)
+    return fractions, bodies
+
+
+def lidar_scan(
+    robot: Robot, n_rays: int = 360, max_range: float | None = None, *, noise: float | None = None
+) -> np.ndarray:
+    """One 2-D scan: ranges in metres from the robot centre, at the angles of :func:`lidar_angles`.
+
+    Args:
+        robot: the scanning robot (its own bodies are not seen).
+        n_rays: rays over the full circle.
+        max_range: the range of a ray without a hit; the spec's ``lidar_range`` when omitted.
+        noise: standard deviation of Gaussian range noise on hits; ``world.noise.lidar_sigma`` when omitted.
+
+    Raises:
+        WorldError: fewer than 1 ray or a non-positive range.
+    """
+    world = robot.world
+    if int(n_rays) < 1:
+        raise WorldError(f"lidar_scan needs at least 1 ray, got {n_rays}")
+    rng_max = robot.spec.lidar_range if max_range is None else float(max_range)
+    start_r = robot.spec.radius + _RAY_START_GAP
+    if not rng_max > start_r:
+        raise WorldError(f"lidar_scan: max_range must exceed the robot radius plus {_RAY_START_GAP} m, got {max_range}")
+    x, y, yaw = robot.pose
+    angles = yaw + lidar_angles(int(n_rays))
+    dirs = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
+    origin = np.array([x, y, robot.spec.lidar_height])
+    starts = origin + start_r * dirs
+    ends = origin + rng_max * dirs
+    fractions, bodies = _cast(world, starts, ends, _own_bodies(robot))
+    ranges = start_r + fractions * (rng_max - start_r)
+    hit = bodies >= 0
+    ranges[~hit] = rng_max
+    sigma = world.noise.lidar_sigma if noise is None else float(noise)
+    if sigma > 0.0 and hit.any():
+        ranges[hit] += world.rng.normal(0.0, sigma, int(hit.sum()))
+        np.clip(ranges, 0.0, rng_max, out=ranges)
+    return ranges
+
+
+def perceive(robot: Robot, max_range: float | None = None, *, fov: float | None = None) -> list[Detection]:
+    """The samples and blocks the robot sees now, in name order.
+
+    An object is seen when its centre is within ``max_range`` of the robot,
+    within half the field of view of the heading, not held, and no other body
+    blocks the line of sight from the camera (on top of the base).
+
+    Args:
+        robot: the perceiving robot; ``spec.perception`` selects the error model.
+        max_range: the spec's ``perception_range`` when omitted.
+        fov: horizontal field of view in radians; the spec's ``camera_fov`` when omitted.
+    """
+    world = robot.world
+    spec = robot.spec
+    reach = spec.perception_range if max_range is None else float(max_range)
+    view = spec.camera_fov if fov is None else float(fov)
+    if not reach > 0.0:
+        raise WorldError(f"perceive: max_range must be positive, got {max_range}")
+    x, y, yaw = robot.pose
+    held = world._held_bodies()
+    candidates = []
+    for name in sorted(world.objects):
+        obj = world.objects[name]
+        if obj.kind not in ("sample", "block") or obj.body_id in held:
+            continue
+        p = obj.position()
+        d = math.hypot(p[0] - x, p[1] - y)
+        bearing = math.atan2(p[1] - y, p[0] - x) - yaw
+        bearing = (bearing + math.pi) % (2.0 * math.pi) - math.pi
+        if d <= reach and abs(bearing) <= 0.5 * view:
+            candidates.append((obj, p, d))
+    if not candidates:
+        return []
+    eye = np.array([x, y, spec.height + _CAMERA_HEIGHT_ABOVE_BASE])
+    targets = np.array([p for _, p, _ in candidates])
+    _, bodies = _cast(world, np.repeat(eye[None, :], len(candidates), axis=0), targets, _own_bodies(robot))
+    noise = world.noise
+    stereo = spec.perception == "3d"
+    sigma0 = noise.position_sigma * (0.25 if stereo else 1.0)
+    wrong = noise.stereo_misclassification if stereo else noise.camera_misclassification
+    out = []
+    for (obj, p, d), body in zip(candidates, bodies, strict=True):
+        if body not in (-1, obj.body_id):
+            continue
+        sigma = sigma0 * (1.0 + d / reach)
+        position = p + world.rng.normal(0.0, sigma, 3)
+        kind = "block"
+        if obj.kind == "sample":
+            kind = obj.sample_kind or SAMPLE_KINDS[0]
+            if wrong > 0.0 and world.rng.random() < wrong:
+                others = [k for k in SAMPLE_KINDS if k != kind]
+                kind = others[int(world.rng.integers(len(others)))]
+        confidence = (0.95 if stereo else 0.85) * (1.0 - 0.5 * d / reach)
+        out.append(Detection(obj.name, kind, (float(position[0]), float(position[1]), float(position[2])), confidence))
+    return out
+
+
+def unknown_grid(bounds: tuple[float, float, float, float], resolution: float = 0.1) -> OccupancyGrid:
+    """An all-unknown grid covering ``bounds`` (e.g. ``world.bounds``), for :func:`scan_to_grid`."""
+    grid = OccupancyGrid.from_obstacles([], bounds, resolution)
+    grid.cells[:] = UNKNOWN
+    return grid
+
+
+def scan_to_grid(grid: OccupancyGrid, robot: Robot, ranges: np.ndarray, max_range: float | None = None) -> int:
+    """Mark a scan of :func:`lidar_scan` taken at the robot's current pose: rays free, hits occupied.
+
+    Args:
+        grid: the grid to update in place.
+        robot: the robot that took the scan (its pose and spec).
+        ranges: the ranges, one per ray at the angles of :func:`lidar_angles`.
+        max_range: the scan's maximum range (a reading at it is no hit); the spec's ``lidar_range`` when omitted.
+
+    Returns:
+        The number of hits marked.
+    """
+    ranges = np.asarray(ranges, dtype=float).reshape(-1)
+    rng_max = robot.spec.lidar_range if max_range is None else float(max_range)
+    x, y, yaw = robot.pose
+    angles = yaw + lidar_angles(len(ranges))
+    c, s = np.cos(angles), np.sin(angles)
+    res = grid.resolution
+    hit = ranges < rng_max - 1e-6
+    free_to = np.where(hit, ranges - 0.5 * res, ranges)
+    along = np.arange(0.0, float(free_to.max(initial=0.0)), 0.5 * res)
+    if len(along):
+        keep = along[None, :] < free_to[:, None]
+        px = x + c[:, None] * along[None, :]
+        py = y + s[:, None] * along[None, :]
+        grid.mark(np.column_stack([px[keep], py[keep]]), FREE)
+    hits = np.column_stack([x + c[hit] * ranges[hit], y + s[hit] * ranges[hit]])
+    if len(hits):
+        grid.mark(hits, OCCUPIED)
+    return int(hit.sum())
