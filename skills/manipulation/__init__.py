@@ -1,0 +1,42 @@
+"""Arm motion planning for the manipulation skills (Pickup, Putdown, Stack, Unstack).
+
+Works from plain data (a URDF, the base pose, boxes), in its own pybullet
+DIRECT client per :class:`ArmScene`; plans are returned as data (configurations
+and joint paths) for someone else to execute. See ``docs/manipulation.md``.
+"""
+
+from __future__ import annotations
+
+from skills.manipulation.arm_planner import ArmPath, interpolate_path, path_is_free, plan_arm
+from skills.manipulation.cartesian import straight_line
+from skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
+from skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps
+from skills.manipulation.ik import IKResult, solve_ik
+from skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
+from skills.manipulation.scene import ArmScene, Box, default_urdf
+
+__all__ = [
+    "ArmPath",
+    "ArmScene",
+    "Box",
+    "Grasp",
+    "IKResult",
+    "PickupPlan",
+    "PlacePlan",
+    "Pose",
+    "Quat",
+    "Vec3",
+    "default_urdf",
+    "held_box",
+    "interpolate_path",
+    "path_is_free",
+    "place_poses",
+    "placed_box",
+    "plan_arm",
+    "plan_pickup",
+    "plan_place",
+    "solve_ik",
+    "straight_line",
+    "top_down_quat",
+    "top_grasps",
+]
