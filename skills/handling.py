@@ -41,9 +41,14 @@ SETTLE = 0.5
 
 
 def _box(obj: Any) -> Any:
+    """An object as a box for arm planning: its own extents and yaw for boxes, else its bounding box."""
     from skills.manipulation import Box
 
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
+    half = tuple(getattr(obj, "half_extents", (0.0, 0.0, 0.0)))
+    if half and half[0] > 0.0:
+        center = tuple(float(v) for v in obj.position())
+        return Box(obj.name, center, half, float(obj.yaw()))
     return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
 
 
@@ -93,7 +98,10 @@ class ArmSkill(WorldSkill):
 
         if self.grasps:
             return plan_pickup(scene, _box(self.target_object()), q, rng=rng)
-        return plan_place(scene, _box(self.target_object()), self.place_top(), q, rng=rng)
+        from skills.manipulation import held_box
+
+        held = held_box(_box(self.target_object()), scene.fk(q))  # the object in the tool's frame
+        return plan_place(scene, held, self.place_top(), q, rng=rng)
 
     def place_top(self) -> tuple[float, float, float]:
         """Where the bottom of a placed object goes (placing skills say)."""
@@ -112,8 +120,8 @@ class ArmSkill(WorldSkill):
         self.attempts = 0
         self.phase = "check"
         self.mover: MoveToPosition | None = None
-        self.queue: list[np.ndarray] = []
-        self.release_after = -1
+        self.steps = []
+        self.step_index = 0
         self.job: Any = None
         self.settle_until = 0.0
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
@@ -173,7 +181,7 @@ class ArmSkill(WorldSkill):
             scene = cache[key] = ArmScene(self.robot.arm.urdf_path, self.robot.arm.base_pose(), seed=self.world.seed)
         scene.set_base_pose(self.robot.arm.base_pose())
         target = self.target_object()
-        boxes = [_box(o) for name, o in sorted(self.world.objects.items()) if name != target.name and _near(o, self._arm_xy()) and getattr(o, "kind", "") not in ("collection_point",)]
+        boxes = [_box(o) for name, o in sorted(self.world.objects.items()) if name != target.name and _near(o, self._arm_xy()) and getattr(o, "kind", "") not in ("terrain", "collection_point")]
         scene.set_obstacles(boxes)
         return scene
 
@@ -187,9 +195,11 @@ class ArmSkill(WorldSkill):
         self.job = None
         if not result.ok:
             return self._retry(f"no arm plan: {result.reason}")
-        self.queue = [np.asarray(p) for p in result.paths]
-        self.release_after = getattr(result, "release_after", 1 if self.grasps else len(self.queue) - 2)
-        self.done_paths = 0
+        paths = [np.asarray(p) for p in result.paths]
+        # pick: to the pre-grasp, down, grip, up to the transport pose;
+        # place: above the place, down, release, up to the transport pose
+        self.steps: list[object] = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
+        self.step_index = 0
         self.phase = "execute"
         if self.grasps:
             self.robot.arm.open()
@@ -198,20 +208,18 @@ class ArmSkill(WorldSkill):
     def _phase_execute(self) -> Status:
         arm = self.robot.arm
         if arm.busy:
-            return self.running(f"moving the arm ({self.done_paths}/{len(self.queue)})")
-        if self.done_paths > 0 and self.done_paths - 1 == self.release_after:
-            self.release_after = -2  # handled
-        if self.done_paths == len(self.queue):
-            self.phase = "verify"
-            self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
-            return self.running("checking the result")
-        if self.done_paths == self.release_after + 1 and self.release_after >= 0:
-            self._grip_or_release()
-            self.release_after = -2
-        path = self.queue[self.done_paths]
-        arm.follow(path, _duration(path))
-        self.done_paths += 1
-        return self.running(f"moving the arm ({self.done_paths}/{len(self.queue)})")
+            return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
+        while self.step_index < len(self.steps):
+            step = self.steps[self.step_index]
+            self.step_index += 1
+            if isinstance(step, str):
+                self._grip_or_release()
+                continue
+            arm.follow(step, _duration(step))
+            return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
+        self.phase = "verify"
+        self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
+        return self.running("checking the result")
 
     def _grip_or_release(self) -> None:
         arm = self.robot.arm
