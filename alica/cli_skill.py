@@ -3,7 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
+import sys
+from collections.abc import Iterator
 from typing import Any
 
 import yaml
@@ -59,17 +63,25 @@ def _world(args: argparse.Namespace) -> Any:
     return blocksworld(stacks, agents=2, seed=args.seed)
 
 
-def cmd_skill_run(args: argparse.Namespace) -> int:
-    """Run ``alica skill run``; returns the exit code."""
-    from skills.registry import default_registry
-    from skills.testing import run_skill
+@contextlib.contextmanager
+def _c_prints_to_stderr() -> Iterator[None]:
+    """pybullet prints from C to file descriptor 1; keep standard output for our own output."""
+    sys.stdout.flush()
+    try:
+        saved = os.dup(1)
+    except OSError:
+        yield
+        return
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
-    from skills.motion import configure_ompl
 
-    configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
-    registry = default_registry()
-    spec = registry.get(args.name)
-    params = _params(args.param)
+def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, object], run_skill: Any) -> Any:
     world = _world(args)
     try:
         robot = args.robot
@@ -78,9 +90,23 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
             if not fits:
                 raise AlicaError(f"no robot of the {args.world} world can run {args.name} (it needs {', '.join(sorted(spec.capabilities))})")
             robot = fits[0]
-        run = run_skill(args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry)
+        return run_skill(args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry)
     finally:
         world.close()
+
+
+def cmd_skill_run(args: argparse.Namespace) -> int:
+    """Run ``alica skill run``; returns the exit code."""
+    from skills.motion import configure_ompl
+    from skills.registry import default_registry
+    from skills.testing import run_skill
+
+    configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
+    registry = default_registry()
+    spec = registry.get(args.name)
+    params = _params(args.param)
+    with _c_prints_to_stderr():
+        run = _run(args, registry, spec, params, run_skill)
     if args.json:
         print(json.dumps({"skill": run.skill, "robot": run.robot, "status": run.status, "reason": run.reason, "sim_time_s": run.sim_time_s, "ticks": run.ticks, "trace": run.trace, "facts": [list(map(str, f)) for f in run.facts]}, indent=2))
     else:

@@ -1,0 +1,42 @@
+"""``alica skill run``: a skill alone from the command line."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from alica.cli import main
+
+
+def test_unstack_in_the_blocks_world(capfd):
+    code = main(["skill", "run", "Unstack", "--world", "blocks", "--param", "object=b", "--param", "from=a", "--json"])
+    out = json.loads(capfd.readouterr().out)
+    assert code == 0, out
+    assert out["status"] == "success" and out["robot"] == "r1"
+    assert ["holding", "r1", "b"] in out["facts"] and ["clear", "a"] in out["facts"]
+
+
+def test_move_to_a_goal_inside_a_rock_fails_with_the_reason(capfd):
+    code = main(["skill", "run", "MoveToPosition", "--world", "lunar", "--robot", "scout", "--rocks", "0", "--param", "goal=[100, 0]"])
+    out = capfd.readouterr().out
+    assert code == 1
+    assert "MoveToPosition on scout: failure" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["Fly"], "no skill named 'Fly'"),
+        (["Pickup", "--world", "blocks"], "needs the parameter 'object'"),
+        (["Pickup", "--world", "blocks", "--param", "object"], "is not KEY=VALUE"),
+        (["Pickup", "--world", "blocks", "--param", "object=c", "--param", "grip=hard"], "has no parameter 'grip'"),
+        (["Pickup", "--world", "lunar", "--robot", "scout", "--param", "object=a"], "has no arm"),
+        (["MoveToPosition", "--world", "lunar", "--param", "goal=[1, 2", "--rocks", "5"], "not a YAML value"),
+    ],
+)
+def test_bad_input(argv, message, capfd):
+    assert main(["skill", "run", *argv]) == 1
+    err = capfd.readouterr().err
+    assert message in err, err
+    assert "Traceback" not in err and "internal error" not in err
