@@ -21,7 +21,8 @@ import pybullet_data
 
 from worldsim._quiet import quiet_stdout
 from worldsim.errors import WorldError
-from worldsim.geometry import pose_inverse, pose_multiply, yaw_to_quat
+from worldsim.geometry import pose_multiply, quat_multiply, yaw_to_quat
+from worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, GripperMixin
 from worldsim.objects import ARM_GROUP, MOVABLE_GROUP, WorldObject
 
 if TYPE_CHECKING:
@@ -33,20 +34,14 @@ logger = logging.getLogger(__name__)
 
 #: The arm model, relative to ``pybullet_data.getDataPath()``.
 PANDA_URDF = "franka_panda/panda.urdf"
-#: How far (m) the point between the fingers may be from an object's bounding box for :meth:`Arm.attach`.
-GRASP_TOLERANCE = 0.015
-#: The finger force (N) that :meth:`Arm.grip_force` reports while holding.
-GRIP_FORCE = 20.0
 
 _ARM_JOINTS = (0, 1, 2, 3, 4, 5, 6)
 _FINGER_JOINTS = (9, 10)
 _EE_LINK = 11  # panda_grasptarget, between the fingertips
-_FINGER_OPEN = 0.04
-_RELEASE_GAP = 0.005
 _HOME_Q = (0.0, -1.1, 0.0, -2.75, 0.0, 1.75, 0.785)
 
 
-class Arm:
+class Arm(GripperMixin):
     """A Panda arm with a parallel gripper on a robot (``robot.arm``).
 
     Attributes:
@@ -66,15 +61,17 @@ class Arm:
         "_all_joints",
         "_base_dirty",
         "_client",
+        "_com_local",
+        "_com_quat",
         "_fingers",
         "_grasp",
         "_held",
-        "_inertial",
         "_joints_dirty",
         "_moved",
         "_path",
         "_q",
         "_reset_joints",
+        "_reset_pose",
         "_seg",
         "_slip_at",
         "_t",
@@ -115,7 +112,10 @@ class Arm:
         self.max_velocity = np.array([i[11] for i in info])
         self.home_q = np.array(_HOME_Q)
         dyn = c.getDynamicsInfo(self.body_id, -1)
-        self._inertial = (tuple(dyn[3]), tuple(dyn[4]))
+        ix, iy, iz = dyn[3]
+        ox, oy, oz = self.mount_offset
+        self._com_local = (ox + ix, oy + iy, oz + iz)
+        self._com_quat = None if tuple(dyn[4]) == (0.0, 0.0, 0.0, 1.0) else tuple(dyn[4])
         # Kinematic arm: no motors, massless links (gravity cannot move it between our re-poses),
         # and contacts only with movable objects (which it pushes like a moving static body).
         n = c.getNumJoints(self.body_id)
@@ -124,9 +124,10 @@ class Arm:
             c.changeDynamics(self.body_id, link, mass=0.0)
             c.setCollisionFilterGroupMask(self.body_id, link, ARM_GROUP, MOVABLE_GROUP)
         self._reset_joints = c.resetJointStatesMultiDof
+        self._reset_pose = c.resetBasePositionAndOrientation
         self._all_joints = list(_ARM_JOINTS + _FINGER_JOINTS)
         self._q = self.home_q.copy()
-        self._fingers = _FINGER_OPEN
+        self._fingers = FINGER_OPEN
         self._path: np.ndarray | None = None
         self._times: np.ndarray | None = None
         self._t = 0.0
@@ -251,127 +252,6 @@ class Arm:
         """Stop where the arm is."""
         self._path = None
 
-    # --------------------------------------------------------------- gripper
-    def open(self) -> None:
-        """Open the fingers; a held object is released (as :meth:`detach`)."""
-        if self.robot.crashed:
-            return
-        if self._held is not None:
-            self.detach()
-        self._fingers = _FINGER_OPEN
-        self._moved = True
-        self._joints_dirty = True
-
-    def close(self) -> None:
-        """Close the fingers, on the object between them if there is one (this does not attach it)."""
-        if self.robot.crashed:
-            return
-        target = self._held or self._between_fingers()
-        self._fingers = 0.0 if target is None else min(_FINGER_OPEN, _half_width(target))
-        self._moved = True
-        self._joints_dirty = True
-
-    def _between_fingers(self) -> WorldObject | None:
-        ee = self.ee_pose()[0]
-        best, best_d = None, GRASP_TOLERANCE
-        for obj in self.robot.world.objects.values():
-            if obj.movable:
-                d = _aabb_distance(ee, *obj.aabb())
-                if d <= best_d:
-                    best, best_d = obj, d
-        return best
-
-    @property
-    def held(self) -> WorldObject | None:
-        """The object in the gripper, or ``None``."""
-        return self._held
-
-    def grip_force(self) -> float:
-        """The sensed finger force: :data:`GRIP_FORCE` while holding, 0 otherwise."""
-        return GRIP_FORCE if self._held is not None else 0.0
-
-    def attach(self, obj: WorldObject | str) -> bool:
-        """Grasp ``obj`` (an object or its name) if the point between the fingers is at it.
-
-        On success the object moves with the end-effector (kinematic, massless
-        in physics) and the fingers close on it. With a grasp slip set (see
-        :mod:`worldsim.faults`) the grasp may fail a short time later.
-
-        Returns:
-            Whether the object is now held (``False`` when it is out of the gripper's
-            reach, :data:`GRASP_TOLERANCE`, or the robot is crashed).
-
-        Raises:
-            WorldError: an unknown, static or already held object, or the hand is not empty.
-        """
-        world = self.robot.world
-        if isinstance(obj, str):
-            if obj not in world.objects:
-                raise WorldError(
-                    f"attach: the world has no object '{obj}' (objects: {', '.join(sorted(world.objects))})"
-                )
-            obj = world.objects[obj]
-        if not isinstance(obj, WorldObject) or world.objects.get(obj.name) is not obj:
-            raise WorldError(f"attach: {obj!r} is not an object of this world")
-        if not obj.movable:
-            raise WorldError(f"attach: {obj.kind} '{obj.name}' is not graspable; only blocks and samples are")
-        if self._held is obj:
-            return True
-        if self._held is not None:
-            raise WorldError(f"attach: robot '{self.robot.name}' already holds '{self._held.name}'; detach it first")
-        for other in world.robots.values():
-            if other.arm is not None and other.arm._held is obj:
-                raise WorldError(f"attach: '{obj.name}' is held by robot '{other.name}'")
-        if self.robot.crashed:
-            return False
-        ee_pos, ee_quat = self.ee_pose()
-        gap = _aabb_distance(ee_pos, *obj.aabb())
-        if gap > GRASP_TOLERANCE:
-            logger.info("robot %s: '%s' is %.3f m from the gripper; not grasped", self.robot.name, obj.name, gap)
-            return False
-        pos, quat = obj.pose()
-        inv = pose_inverse(tuple(ee_pos), ee_quat)
-        self._grasp = pose_multiply(inv[0], inv[1], pos, quat)
-        self._held = obj
-        self._grip_physics(obj, True)
-        self._fingers = min(_FINGER_OPEN, _half_width(obj))
-        self._moved = True
-        self._joints_dirty = True
-        self._slip_at = world.faults._draw_slip(world.now())
-        world._version += 1
-        return True
-
-    def detach(self) -> WorldObject | None:
-        """Release the held object: it is dynamic again and falls or rests. Returns it (or ``None``).
-
-        The fingers open by 5 mm on each side so that they no longer touch it.
-        """
-        obj = self._held
-        if obj is None:
-            return None
-        self._held = None
-        self._grasp = None
-        self._slip_at = None
-        # The fingers ease off a little so that friction does not keep holding the object.
-        self._fingers = max(self._fingers, min(_FINGER_OPEN, _half_width(obj) + _RELEASE_GAP))
-        self._moved = True
-        self._joints_dirty = True
-        self._sync()
-        self._grip_physics(obj, False)
-        self.robot.world._version += 1
-        return obj
-
-    def _grip_physics(self, obj: WorldObject, held: bool) -> None:
-        """Make ``obj`` kinematic (massless, like the arm links, so they do not push each other) or dynamic again.
-
-        Collision filters are left alone: changing them after ``saveState`` breaks ``restoreState``.
-        """
-        c = self._client
-        c.changeDynamics(obj.body_id, -1, mass=0.0 if held else obj.mass)
-        c.resetBaseVelocity(obj.body_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-        if not held:
-            c.changeDynamics(obj.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
-
     # ------------------------------------------------------------- internals
     def _base_moved(self) -> None:
         self._base_dirty = True
@@ -379,11 +259,14 @@ class Arm:
 
     def _sync(self) -> None:
         """Put the pybullet bodies where the kinematic state says (arm base, joints, held object)."""
-        c = self._client
         if self._base_dirty:
-            pos, quat = self.base_pose()
-            com = pose_multiply(pos, quat, *self._inertial)
-            c.resetBasePositionAndOrientation(self.body_id, com[0], com[1])
+            # pybullet poses a base by its centre of mass: mount offset plus the link's inertial offset.
+            r = self.robot
+            cy, sy = r._cos, r._sin
+            lx, ly, lz = self._com_local
+            com = (r._x + cy * lx - sy * ly, r._y + sy * lx + cy * ly, lz)
+            quat = r._quat if self._com_quat is None else quat_multiply(r._quat, self._com_quat)
+            self._reset_pose(self.body_id, com, quat)
             self._base_dirty = False
         if not self._moved:
             return
@@ -395,9 +278,9 @@ class Arm:
             )
             self._joints_dirty = False
         if self._held is not None and self._grasp is not None:
-            state = c.getLinkState(self.body_id, self.ee_link, computeForwardKinematics=1)
+            state = self._client.getLinkState(self.body_id, self.ee_link, computeForwardKinematics=1)
             pos, quat = pose_multiply(state[4], state[5], *self._grasp)
-            c.resetBasePositionAndOrientation(self._held.body_id, pos, quat)
+            self._reset_pose(self._held.body_id, pos, quat)
         self._moved = False
 
     def _update(self, dt: float, now: float) -> None:
@@ -452,15 +335,3 @@ class Arm:
     def __repr__(self) -> str:
         held = self._held.name if self._held else None
         return f"Arm(robot={self.robot.name!r}, busy={self.busy}, held={held!r})"
-
-
-def _half_width(obj: WorldObject) -> float:
-    if obj.half_extents[0] > 0.0:
-        return min(obj.half_extents[0], obj.half_extents[1])
-    return obj.radius
-
-
-def _aabb_distance(point: Sequence[float], lo: np.ndarray, hi: np.ndarray) -> float:
-    """Distance from a point to a box (0 inside)."""
-    p = np.asarray(point, dtype=float)
-    return float(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0)))

@@ -148,11 +148,15 @@ class Robot:
     """
 
     __slots__ = (
+        "_cos",
         "_crashed",
         "_near",
         "_near_age",
         "_near_at",
+        "_near_free",
         "_near_version",
+        "_quat",
+        "_sin",
         "_v",
         "_w",
         "_world",
@@ -179,6 +183,9 @@ class Robot:
         self._near_at = (math.inf, math.inf)
         self._near_age = 0
         self._near_version = -1
+        self._near_free = 0.0
+        self._cos, self._sin = math.cos(self._yaw), math.sin(self._yaw)
+        self._quat = yaw_to_quat(self._yaw)
         c = world.client
         half = 0.5 * spec.height
         self.body_id: int = c.createMultiBody(
@@ -281,7 +288,10 @@ class Robot:
 
     # --------------------------------------------------------------- internals
     def _apply_pose(self) -> None:
-        self._world._reset_base(self.body_id, (self._x, self._y, 0.5 * self.spec.height), yaw_to_quat(self._yaw))
+        yaw = self._yaw
+        self._cos, self._sin = math.cos(yaw), math.sin(yaw)
+        self._quat = (0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw))
+        self._world._reset_base(self.body_id, (self._x, self._y, 0.5 * self.spec.height), self._quat)
         if self.arm is not None:
             self.arm._base_moved()
 
@@ -302,6 +312,13 @@ class Robot:
                     movable.add_box(obj.name, fp.x, fp.y, fp.half_x, fp.half_y, fp.yaw)
         near.extend(movable.near(self._x, self._y, reach))
         self._near = near
+        # Within this distance of the refresh point the footprint cannot touch anything in ``near``
+        # (nor what lies beyond ``reach``), so the per-step check skips them.
+        clearance = reach - self.spec.radius
+        if near:
+            gap = -Footprints.depth(self._x, self._y, self.spec.radius, near)
+            clearance = min(clearance, gap)
+        self._near_free = max(0.0, clearance)
         self._near_at = (self._x, self._y)
         self._near_age = 0
         self._near_version = world._version
@@ -311,8 +328,8 @@ class Robot:
         r = self.spec.radius
         xmin, ymin, xmax, ymax = self._world.bounds
         worst = max(xmin - (x - r), (x + r) - xmax, ymin - (y - r), (y + r) - ymax)
-        d = Footprints.depth(x, y, r, self._near)
-        worst = max(worst, d)
+        if math.hypot(x - self._near_at[0], y - self._near_at[1]) >= self._near_free:
+            worst = max(worst, Footprints.depth(x, y, r, self._near))
         for other in self._world.robots.values():
             if other is not self:
                 d = r + other.spec.radius - math.hypot(x - other._x, y - other._y)

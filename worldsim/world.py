@@ -19,7 +19,8 @@ from typing import Any, Self
 import numpy as np
 
 from alica.clock import ManualClock
-from worldsim import objects as _objects
+from worldsim import bodies as _bodies
+from worldsim import queries as _queries
 from worldsim._quiet import quiet_stdout
 from worldsim.errors import WorldError
 from worldsim.faults import Faults, SensorNoise
@@ -219,15 +220,15 @@ class World:
         mass: float = 0.1,
     ) -> WorldObject:
         """Add a cube of edge ``size`` (a 2-D position puts it on the ground)."""
-        return self._register(name, _objects.make_block, position, size=size, colour=colour, mass=mass)
+        return self._register(name, _bodies.make_block, position, size=size, colour=colour, mass=mass)
 
     def add_sample(self, name: str, kind: str, position: Sequence[float]) -> WorldObject:
         """Add an IMPERA sample container of a kind of :data:`~worldsim.objects.SAMPLE_KINDS`."""
-        return self._register(name, _objects.make_sample, kind, position)
+        return self._register(name, _bodies.make_sample, kind, position)
 
     def add_collection_point(self, name: str, position: Sequence[float], radius: float = 0.5) -> WorldObject:
         """Add a flat marker disc (not an obstacle)."""
-        return self._register(name, _objects.make_collection_point, position, radius=radius)
+        return self._register(name, _bodies.make_collection_point, position, radius=radius)
 
     def add_table(
         self,
@@ -238,7 +239,7 @@ class World:
         yaw: float = 0.0,
     ) -> WorldObject:
         """Add a solid table ``size = (length, width)`` of ``height`` (a static obstacle)."""
-        obj = self._register(name, _objects.make_table, position, size=size, height=height, yaw=yaw)
+        obj = self._register(name, _bodies.make_table, position, size=size, height=height, yaw=yaw)
         pos = obj.pose()[0]
         self._static_footprints.add_box(name, pos[0], pos[1], obj.half_extents[0], obj.half_extents[1], float(yaw))
         return obj
@@ -247,14 +248,14 @@ class World:
         self, name: str, position: Sequence[float], radius: float, seed: int = 0, height_ratio: float = 0.7
     ) -> WorldObject:
         """Add a static convex rock whose footprint is a circle of ``radius``."""
-        obj = self._register(name, _objects.make_rock, position, radius, seed=seed, height_ratio=height_ratio)
+        obj = self._register(name, _bodies.make_rock, position, radius, seed=seed, height_ratio=height_ratio)
         pos = obj.pose()[0]
         self._static_footprints.add_circle(name, pos[0], pos[1], obj.radius)
         return obj
 
     def add_terrain(self, name: str = "ground", friction: float = 0.8) -> WorldObject:
         """Add a flat ground plane at z = 0."""
-        return self._register(name, _objects.make_terrain, friction=friction)
+        return self._register(name, _bodies.make_terrain, friction=friction)
 
     def _register(self, name: str, maker: Any, *args: Any, **kwargs: Any) -> WorldObject:
         self._check_open()
@@ -303,6 +304,7 @@ class World:
         self._check_open()
         state_id = int(self._client.saveState())
         self._states[state_id] = {
+            "objects": set(self.objects),
             "robots": {n: r._state() for n, r in self.robots.items()},
             "arms": {n: r.arm._state() for n, r in self.robots.items() if r.arm is not None},
         }
@@ -321,8 +323,11 @@ class World:
                 f"restore_state: unknown state id {state_id}; use an id returned by save_state "
                 f"(states are dropped when robots or objects are removed)"
             )
-        if set(saved["robots"]) != set(self.robots):
-            raise WorldError(f"restore_state: state {state_id} was saved with other robots; save a new state")
+        if set(saved["robots"]) != set(self.robots) or saved["objects"] != set(self.objects):
+            raise WorldError(
+                f"restore_state: state {state_id} was saved with other robots or objects; "
+                f"save a new state after adding bodies"
+            )
         # Held objects are massless; give them their mass back first so that the bodies match the saved ones.
         for robot in self.robots.values():
             if robot.arm is not None and robot.arm.held is not None:
@@ -356,48 +361,19 @@ class World:
 
         Held objects are left out; samples only with ``include_samples``.
         """
-        held = self._held_bodies()
-        out: list[Obstacle2D] = []
-        for obj in self.objects.values():
-            if obj.kind in ("rock", "table", "block") or (include_samples and obj.kind == "sample"):
-                if obj.body_id in held:
-                    continue
-                fp = obj.footprint()
-                if fp is not None:
-                    out.append(fp)
-        return out
+        return _queries.obstacles(self, include_samples=include_samples)
 
     def is_free(self, x: float, y: float, radius: float, *, margin: float = 0.0) -> bool:
         """Whether a circle fits in the field without touching obstacles, movable objects or robots."""
         return self._inside_field(x, y, radius + margin) and self._blocker(x, y, radius + margin) is None
 
     def contacts(self, robot: Robot | str, *, margin: float = 0.0, include_ground: bool = False) -> set[str]:
-        """Names of the robots and objects that the robot's base, arm or held object touches (within ``margin``)."""
+        """Names of the robots and objects that the robot's base, arm or held object touches (within ``margin``).
+
+        The ground counts only with ``include_ground``.
+        """
         robot = self.robots[robot] if isinstance(robot, str) else robot
-        c = self._client
-        own = [robot.body_id]
-        if robot.arm is not None:
-            own.append(robot.arm.body_id)
-            if robot.arm.held is not None:
-                own.append(robot.arm.held.body_id)
-        names = self._body_names()
-        found: set[str] = set()
-        c.performCollisionDetection()
-        for body in own:
-            n_links = c.getNumJoints(body)
-            for link in range(-1, n_links):
-                lo, hi = c.getAABB(body, link)
-                lo = [v - margin for v in lo]
-                hi = [v + margin for v in hi]
-                for other, _ in c.getOverlappingObjects(lo, hi) or ():
-                    name = names.get(other)
-                    if other in own or name is None or name in found:
-                        continue
-                    if not include_ground and name in self.objects and self.objects[name].kind == "terrain":
-                        continue
-                    if c.getClosestPoints(body, other, margin, linkIndexA=link):
-                        found.add(name)
-        return found
+        return _queries.contacts(self, robot, margin=margin, include_ground=include_ground)
 
     # -------------------------------------------------------------- lifecycle
     def close(self) -> None:
@@ -451,22 +427,5 @@ class World:
         return {r.arm.held.body_id for r in self.robots.values() if r.arm is not None and r.arm.held is not None}
 
     def _blocker(self, x: float, y: float, radius: float) -> str | None:
-        """Name of something a circle at ``(x, y)`` would overlap, or ``None``."""
-        for other in self.robots.values():
-            if math.hypot(x - other.pose[0], y - other.pose[1]) < radius + other.spec.radius:
-                return f"robot '{other.name}'"
-        held = self._held_bodies()
-        for obj in self.objects.values():
-            if obj.kind in ("rock", "table", "block", "sample") and obj.body_id not in held:
-                fp = obj.footprint()
-                if fp is not None and float(fp.distance(np.array(x), np.array(y))) < radius:
-                    return f"{obj.kind} '{obj.name}'"
-        return None
-
-    def _body_names(self) -> dict[int, str]:
-        names = {o.body_id: n for n, o in self.objects.items()}
-        for n, r in self.robots.items():
-            names[r.body_id] = n
-            if r.arm is not None:
-                names[r.arm.body_id] = n
-        return names
+        """What a circle at ``(x, y)`` would overlap (``"rock 'r3'"``), or ``None``."""
+        return _queries.blocker(self, x, y, radius)

@@ -74,19 +74,26 @@ def test_robots_without_an_arm(world: World) -> None:
     assert world.add_robot("scout", "s", (0.0, 0.0, 0.0)).arm is None
 
 
-@pytest.mark.parametrize("reach", [0.35, 0.55, 0.65])
-def test_ik_reaches_a_block_on_the_ground_in_front(world: World, manipulator: Robot, reach: float) -> None:
-    arm = manipulator.arm
+@pytest.mark.parametrize(
+    ("kind", "reach"),
+    [("manipulator", 0.35), ("manipulator", 0.55), ("manipulator", 0.65), ("stummel", 0.55), ("amparo", 0.55)],
+)
+def test_ik_reaches_a_block_on_the_ground_in_front(world: World, kind: str, reach: float) -> None:
+    robot = world.add_robot(kind, "r", (0.0, 0.0, 0.0))
+    arm = robot.arm
     x = arm.mount_offset[0] + reach
     block = world.add_block("b", (x, 0.0))
-    assert x - block.size / 2 > manipulator.spec.radius  # the block is in front of the base, not under it
+    assert x - block.size / 2 > robot.spec.radius  # the block is in front of the base, not under it
     target = tuple(block.position())
     q = ik(arm, target)
     assert q is not None, f"no IK solution to a block {reach} m ahead of the arm base"
     arm.set_q(q)
     assert np.linalg.norm(arm.ee_pose()[0] - target) < 5e-3
     assert lowest_link_z(arm) > 0.0  # the fingertips stay above the ground
-    assert world.contacts(manipulator) <= {"b"}
+    assert world.contacts(robot) <= {"b"}  # the arm touches nothing else
+    c = world.client
+    moving_links = range(c.getNumJoints(arm.body_id))  # link0 (-1) sits on the base by design
+    assert not any(c.getClosestPoints(arm.body_id, robot.body_id, 0.0, linkIndexA=k) for k in moving_links)
 
 
 def test_follow_moves_along_the_path_in_simulated_time(world: World, manipulator: Robot) -> None:

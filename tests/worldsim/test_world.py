@@ -102,6 +102,9 @@ def test_save_and_restore_state(world: World) -> None:
     assert r.velocity == (0.0, 0.0)
     with pytest.raises(WorldError, match="unknown state id"):
         world.restore_state(sid + 100)
+    world.add_block("new", (2.0, 2.0))
+    with pytest.raises(WorldError, match="save a new state after adding bodies"):
+        world.restore_state(sid)
 
 
 def test_restore_state_while_holding(world: World) -> None:
