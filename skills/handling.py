@@ -46,6 +46,10 @@ def _box(obj: Any) -> Any:
 
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
     half = tuple(getattr(obj, "half_extents", (0.0, 0.0, 0.0)))
+    if getattr(obj, "kind", "") == "sample" and getattr(obj, "radius", 0.0):
+        # a standing cylinder: its true size, not a bounding box that grows as it turns in the hand
+        r = float(obj.radius)
+        half = (r, r, 0.5 * float(obj.size))
     if half and half[0] > 0.0:
         center = tuple(float(v) for v in obj.position())
         return Box(obj.name, center, half, float(obj.yaw()))
@@ -97,14 +101,21 @@ class ArmSkill(WorldSkill):
         from skills.manipulation import plan_pickup, plan_place
 
         if self.grasps:
-            return plan_pickup(scene, _box(self.target_object()), q, rng=rng)
+            obj = self.target_object()
+            shape = "cylinder" if getattr(obj, "kind", "") == "sample" else "box"
+            return plan_pickup(scene, _box(obj), q, rng=rng, kind=shape)
         from skills.manipulation import held_box
 
         held = held_box(_box(self.target_object()), scene.fk(q))  # the object in the tool's frame
         return plan_place(scene, held, self.place_top(), q, rng=rng)
 
     def place_top(self) -> tuple[float, float, float]:
-        """Where the bottom of a placed object goes (placing skills say)."""
+        """Where the bottom of a placed object goes: on the ground at the site, or on top of a target block."""
+        target = self.param("target")
+        if isinstance(target, str) and target in self.world.objects and self.world.objects[target].kind == "block":
+            _, high = self.world.objects[target].aabb()
+            x, y = self.site()
+            return x, y, float(high[2])
         x, y = self.site()
         return x, y, 0.0
 
@@ -348,7 +359,7 @@ class Putdown(ArmSkill):
         return None
 
     def site(self) -> tuple[float, float]:
-        """The target, or a spot in front of the robot."""
+        """The target (a position, a place such as ``pos(g)``, or a block to put it on), or a spot in front of the robot."""
         target = self.param("target")
         if target is not None:
             return self.resolve_position(target)
@@ -373,8 +384,12 @@ class Putdown(ArmSkill):
         return None
 
     def outcome_facts(self, obj: Any) -> None:
-        """Putdown: the object is on the table (blocks) or the ground."""
-        if getattr(obj, "kind", "") == "block":
+        """Putdown: the object is on the target block, on the table (blocks) or on the ground."""
+        target = self.param("target")
+        if isinstance(target, str) and getattr(self.world.objects.get(target), "kind", "") == "block":
+            self.write(True, "on", obj.name, target)
+            self.write(False, "clear", target)
+        elif getattr(obj, "kind", "") == "block":
             self.write(True, "ontable", obj.name)
         else:
             self.write(True, "onground", obj.name)

@@ -1,7 +1,8 @@
 """Driving skills: MoveToPosition (and its primitive DriveTo), DriveToFreeSpace, Idle.
 
 MoveToPosition plans in SE2 with OMPL on the world's occupancy grid, inflated
-by the robot's radius (:func:`skills.motion.plan_path`), follows the path,
+by the robot's radius (:func:`skills.motion.plan_path`), checks the path
+exactly with FCL against the rocks' meshes and the other robots, follows it,
 replans when another robot or a new obstacle blocks it, and when the robot is
 stuck (bumped, or no progress) drives into free space first. Planning runs as
 a job; ``update`` only polls.
@@ -31,7 +32,30 @@ def planning_grid(world: Any) -> Any:
     if hit is None or hit[0] != obstacles:
         hit = cache["grid"] = (obstacles, OccupancyGrid.from_obstacles(list(obstacles), world.bounds, 0.05))
         cache.pop("checkers", None)
+        cache.pop("exact", None)
     return hit[1]
+
+
+def exact_checker(world: Any, radius: float) -> Any:
+    """FCL against the world's static obstacles (rocks as their convex meshes, tables) for a robot of ``radius``.
+
+    The final exact check of a path; movable objects (blocks, samples, held or not) are left to the grid.
+    """
+    from skills.motion import FclChecker
+
+    planning_grid(world)  # drops stale checkers when the layout changed
+    checkers = world_cache(world).setdefault("exact", {})
+    checker = checkers.get(radius)
+    if checker is None:
+        shapes: list[Any] = []
+        for _, obj in sorted(world.objects.items()):
+            mesh = obj.world_mesh() if hasattr(obj, "world_mesh") else None
+            if mesh is not None:
+                shapes.append(mesh)
+            elif getattr(obj, "kind", "") == "table" and obj.footprint() is not None:
+                shapes.append(obj.footprint())
+        checker = checkers[radius] = FclChecker(shapes, radius)
+    return checker
 
 
 def planning_checker(world: Any, radius: float) -> Any:
@@ -70,7 +94,8 @@ class MoveToPosition(WorldSkill):
         from skills.motion import plan_path
 
         checker = planning_checker(self.world, self.robot.spec.radius)
-        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, other_robots=self._others(), time_limit=1.0)
+        exact = exact_checker(self.world, self.robot.spec.radius)
+        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, obstacles_exact=exact, other_robots=self._others(), time_limit=1.0)
         self.follower = None
 
     def update(self) -> Status:

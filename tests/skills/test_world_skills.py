@@ -120,3 +120,23 @@ def test_bad_parameters_are_refused(blocks_world, skill_run):
 def test_a_robot_without_an_arm_cannot_pick_up(lunar_world, skill_run):
     with pytest.raises(SkillError, match="has no arm"):
         skill_run("Pickup", lunar_world, "scout", {"object": "a"})
+
+
+def test_transport_a_sample_to_the_collection_point(lunar_world, skill_run):
+    steps = [("Pickup", {"object": "a"}), ("MoveToPosition", {"goal": "pos(g)", "tolerance": 1.0}), ("Putdown", {"object": "a", "target": "pos(g)"})]
+    for name, params in steps:
+        run = skill_run(name, lunar_world, "stummel", params, timeout=200)
+        assert run.ok, (name, run.reason, run.trace[-6:])
+    a, g = lunar_world.objects["a"].position(), lunar_world.objects["g"].position()
+    assert math.hypot(a[0] - g[0], a[1] - g[1]) < 0.1
+    assert ("at", "a", "g") in run.facts and ("onground", "a") in run.facts
+
+
+def test_putdown_on_top_of_a_block(blocks_world, skill_run):
+    from worldsim.scenarios import blocks_facts
+
+    assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
+    run = skill_run("Putdown", blocks_world, "r1", {"object": "c", "target": "b"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    assert ("on", "c", "b") in blocks_facts(blocks_world)
+    assert ("on", "c", "b") in run.facts
