@@ -95,7 +95,11 @@ class MoveToPosition(WorldSkill):
 
         checker = planning_checker(self.world, self.robot.spec.radius)
         exact = exact_checker(self.world, self.robot.spec.radius)
-        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, obstacles_exact=exact, other_robots=self._others(), time_limit=1.0)
+        # An optimizing planner after the first path, when the run allows the time (real robots): anytime
+        # planning by wall time is not repeatable, so simulated runs keep RRTConnect plus simplification.
+        optimize = float((getattr(self.context, "extra", None) or {}).get("optimize_time", 0.0))
+        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, obstacles_exact=exact,
+                                    other_robots=self._others(), time_limit=1.0, optimize_time=optimize)
         self.follower = None
 
     def update(self) -> Status:
@@ -120,10 +124,10 @@ class MoveToPosition(WorldSkill):
             self.replans += 1
             if self.replans > MAX_REPLANS:
                 robot.stop()
-                return self.fail(f"the path to {self.goal} stays blocked by other robots after {MAX_REPLANS} replans")
+                return self.fail(f"the path to {self.goal} stays blocked after {MAX_REPLANS} replans")
             robot.stop()
             self._plan(self.goal)
-            return self.running("path blocked by another robot: replanning")
+            return self.running("path blocked by another robot or a new obstacle: replanning")
         if done:
             robot.stop()
             if self.escaping:
@@ -180,19 +184,14 @@ class MoveToPosition(WorldSkill):
         return self.running(f"stuck: driving into free space at ({spot[0]:.2f}, {spot[1]:.2f})")
 
     def _blocked(self) -> bool:
-        """Whether another robot stands on the rest of the path."""
+        """Whether another robot or a new obstacle stands on the next metres of the path (checked every 0.3 s)."""
         follower = self.follower
-        if follower is None or self.escaping:
+        now = self.now()
+        if follower is None or self.escaping or now < getattr(self, "next_block_check", 0.0):
             return False
-        rest = follower.remaining() if hasattr(follower, "remaining") else follower.path
-        if len(rest) == 0:
-            return False
-        points = np.asarray(rest)[:, :2]
-        mine = self.robot.spec.radius
-        for x, y, radius in self._others():
-            if float(np.min(np.hypot(points[:, 0] - x, points[:, 1] - y))) < mine + radius:
-                return True
-        return False
+        self.next_block_check = now + 0.3
+        checker = planning_checker(self.world, self.robot.spec.radius)  # rebuilt when the layout changed
+        return bool(follower.blocked(checker, self.robot.pose, other_robots=self._others(), horizon=4.0))
 
     def _arrived(self, here: tuple[float, float]) -> None:
         wm = self.world_model

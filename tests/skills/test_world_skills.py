@@ -140,3 +140,24 @@ def test_putdown_on_top_of_a_block(blocks_world, skill_run):
     assert run.ok, (run.reason, run.trace[-6:])
     assert ("on", "c", "b") in blocks_facts(blocks_world)
     assert ("on", "c", "b") in run.facts
+
+
+def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run):
+    goal = _far_free_goal(lunar_world, "scout")
+    robot = lunar_world.robots["scout"]
+    x, y, _ = robot.pose
+    dropped = []
+
+    def drop_a_rock(world, behaviour):
+        follower = getattr(behaviour, "follower", None)
+        if follower is not None and not dropped and world.now() > 1.0:
+            # a rock falls right ahead on the path
+            px, py = robot.pose[:2]
+            ahead = next(p for p in follower.remaining() if math.hypot(p[0] - px, p[1] - py) > 1.5)
+            world.add_rock("fallen", (float(ahead[0]), float(ahead[1]), 0.0), 0.5)
+            dropped.append(tuple(ahead[:2]))
+
+    run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": list(goal)}, on_tick=drop_a_rock)
+    assert dropped, "the rock was never dropped"
+    assert run.ok, (run.reason, run.trace[-5:])
+    assert any("replanning" in str(t["feedback"]) for t in run.trace)
