@@ -145,7 +145,6 @@ def test_putdown_on_top_of_a_block(blocks_world, skill_run):
 def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run):
     goal = _far_free_goal(lunar_world, "scout")
     robot = lunar_world.robots["scout"]
-    x, y, _ = robot.pose
     dropped = []
 
     def drop_a_rock(world, behaviour):
