@@ -133,7 +133,8 @@ def _cmd_list_skills(args: argparse.Namespace) -> int:
 
     for spec in default_registry():
         caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""
-        print(f"{spec.name}: {spec.doc}{caps}")
+        impl = f"  (runs {spec.implementation})" if spec.implementation else "  (no implementation yet: scripted in team runs)"
+        print(f"{spec.name}: {spec.doc}{caps}{impl}")
         for p in spec.params:
             need = "required" if p.required else f"default {p.default!r}"
             print(f"    {p.name} ({p.type}, {need}){': ' + p.doc if p.doc else ''}")

@@ -122,6 +122,7 @@ def test_list_skills(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "list-skills")
     assert code == 0
     assert "MoveToPosition:" in out and "goal (position, required)" in out
+    assert "(runs skills.navigation:MoveToPosition)" in out and "(no implementation yet" in out
 
 
 def test_shipped_plans_are_found_from_the_package() -> None:

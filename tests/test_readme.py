@@ -33,7 +33,7 @@ def test_readme_plan_example_is_valid(tmp_path: Path) -> None:
 
 def test_readme_python_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.chdir(ROOT)
-    exec(compile(_blocks("python")[1], "README.md", "exec"), {})
+    exec(compile(_blocks("python")[2], "README.md", "exec"), {})
     assert capsys.readouterr().out.strip() == "True"
 
 
@@ -41,3 +41,9 @@ def test_readme_team_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.Cap
     monkeypatch.chdir(ROOT)
     exec(compile(_blocks("python")[0], "README.md", "exec"), {})
     assert capsys.readouterr().out.strip() == "Explore"
+
+
+def test_readme_skill_example(monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(ROOT)
+    exec(compile(_blocks("python")[1], "README.md", "exec"), {})
+    assert capfd.readouterr().out.strip().splitlines()[-1] == "success"
