@@ -31,6 +31,7 @@ from py_trees.common import Status
 
 from skills.navigation import MoveToPosition
 from skills.world_skill import WorldSkill, distance, world_cache
+from worldsim.geometry import wrap_angle
 
 #: Horizontal distance from the arm's base at which the arm works best.
 REACH = 0.55
@@ -159,7 +160,7 @@ class ArmSkill(WorldSkill):
         x, y, yaw = robot.pose
         if self.mover is None:
             gap = distance(self._arm_xy(), site)
-            facing = abs(_wrap(math.atan2(site[1] - y, site[0] - x) - yaw))
+            facing = abs(wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw))
             if abs(gap - REACH) <= 0.12 and facing < 0.15:
                 self.phase = "plan"
                 return self._phase_plan()
@@ -174,7 +175,7 @@ class ArmSkill(WorldSkill):
                 return self.fail(f"cannot get to {site}: {self.mover.feedback_message}")
             if self.mover.status == Status.RUNNING:
                 return self.running(f"approaching: {self.mover.feedback_message}")
-        error = _wrap(math.atan2(site[1] - y, site[0] - x) - yaw)
+        error = wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw)
         if abs(error) > 0.03:
             robot.drive(0.0, max(-robot.spec.max_yaw_rate, min(robot.spec.max_yaw_rate, 2.0 * error)))
             return self.running("turning to the work site")
@@ -270,10 +271,6 @@ class ArmSkill(WorldSkill):
             self.mover.stop(Status.INVALID)
         if self.robot is not None:
             self.robot.stop()
-
-
-def _wrap(angle: float) -> float:
-    return (angle + math.pi) % (2 * math.pi) - math.pi
 
 
 def _mount_ahead(robot: Any) -> float:

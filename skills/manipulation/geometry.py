@@ -11,6 +11,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from worldsim.geometry import quat_multiply, quat_rotate  # the same quaternion algebra as the world's
+
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 Pose = tuple[Vec3, Quat]
@@ -50,36 +52,9 @@ def as_pose(pose: Sequence[Sequence[float]], name: str = "pose") -> Pose:
     return as_vec3(pose[0], f"{name} position"), as_quat(pose[1], f"{name} orientation")
 
 
-def quat_multiply(a: Quat, b: Quat) -> Quat:
-    """Hamilton product ``a * b`` (apply ``b`` first, then ``a``)."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    )
-
-
 def quat_conjugate(q: Quat) -> Quat:
     """Inverse of a unit quaternion."""
     return (-q[0], -q[1], -q[2], q[3])
-
-
-def quat_rotate(q: Quat, v: Sequence[float]) -> Vec3:
-    """Rotate the vector ``v`` by the unit quaternion ``q``."""
-    x, y, z, w = q
-    vx, vy, vz = float(v[0]), float(v[1]), float(v[2])
-    # t = 2 * cross(q.xyz, v); v' = v + w * t + cross(q.xyz, t)
-    tx = 2.0 * (y * vz - z * vy)
-    ty = 2.0 * (z * vx - x * vz)
-    tz = 2.0 * (x * vy - y * vx)
-    return (
-        vx + w * tx + (y * tz - z * ty),
-        vy + w * ty + (z * tx - x * tz),
-        vz + w * tz + (x * ty - y * tx),
-    )
 
 
 def quat_from_yaw(yaw: float) -> Quat:
