@@ -1,0 +1,268 @@
+"""Task creation (IMPERA Sections 7.3-7.4): a single-agent plan becomes a multi-agent ALICA plan.
+
+1. **Parallelise** (Algorithms 2-3): the plan's actions are taken in order;
+   an action opens a new task if its precondition holds for a *new* robot
+   (the team's state before the action, with the robot's own facts those of a
+   robot that has done nothing yet), else it joins the last task.
+2. **Role-task priorities** (Eq. 9): task ``i`` of ``n`` gets ``T_i = 1 - i/n``,
+   scaled for each role by the role's priority ``p`` for the planning
+   problem's entry point; a role that cannot take one of the task's skills
+   (a negative priority for that skill's task) gets -1.
+3. **Cardinalities**: min = the largest of the task's skills' minima, max =
+   the smallest of their maxima.
+4. **Utility** (Eq. 10-12): weights ``w_t = x/n``, ``w_p = x/(n+1)^2``,
+   ``w_s = x/(n+1)^3`` for task coverage, priorities and similarity; ``x``
+   cancels when the weights are normalised to sum to 1, and the threshold is
+   the normalised ``w_s``: the team switches only for a gain of more than that.
+
+The generated plan: one entry point per task, and per task a chain of
+states, each waiting until its step's precondition holds in the world model
+(another task may have to act first) and then running the step's skill plan
+with its variables bound; a failed step ends the task in a failure state (the
+runtime then replans).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, replace
+
+from alica.errors import PlannerError
+from alica.lang import literals
+from alica.model import (
+    Binding,
+    ChildRef,
+    Condition,
+    ConditionKind,
+    EntryPoint,
+    Plan,
+    PlanLibrary,
+    Priority,
+    RoleSet,
+    State,
+    StateKind,
+    Summand,
+    Task,
+    Transition,
+    UtilityFunction,
+)
+from prophet.planner import PlanStep
+
+Fact = tuple[str, tuple[str, ...]]
+#: The robot parameter of skill signatures: the agent that runs the skill.
+ROBOT = "?r"
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    """One action of the single-agent plan, with its skill plan and bindings."""
+
+    index: int
+    skill: Plan
+    bindings: tuple[tuple[str, str], ...]
+    pre: tuple[tuple[bool, Fact], ...]
+    effect: tuple[tuple[bool, Fact], ...]
+
+    @property
+    def label(self) -> str:
+        """``Pickup(a)``."""
+        args = ", ".join(v for k, v in self.bindings)
+        return f"{self.skill.name}({args})"
+
+
+@dataclass(frozen=True, slots=True)
+class CreatedTasks:
+    """The result of task creation.
+
+    Attributes:
+        tasks: the steps of each task, in order.
+        plan: the generated multi-agent plan.
+        task_defs: the new tasks of the task repository.
+        roleset: the role set with priorities for the new tasks.
+    """
+
+    tasks: tuple[tuple[Step, ...], ...]
+    plan: Plan
+    task_defs: tuple[Task, ...]
+    roleset: RoleSet
+
+
+def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[tuple[bool, Fact], ...]:
+    if not text:
+        return ()
+    out = []
+    for positive, name, args in literals(text):
+        out.append((positive, (name, tuple(subst.get(str(a), str(a)) for a in args))))
+    return tuple(out)
+
+
+def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robot: str) -> list[Step]:
+    """The plan's actions as steps of skill plans; ``robot`` is the object the planner used for ``?r``.
+
+    Raises:
+        PlannerError: an action names no skill plan with a signature, or has the wrong number of arguments.
+    """
+    by_name = {p.name.lower(): p for p in library.plans.values() if p.signature is not None}
+    out = []
+    for i, step in enumerate(plan_steps):
+        skill = by_name.get(step.action.lower())
+        if skill is None or skill.signature is None:
+            raise PlannerError(f"plan step {i + 1} '{step}' names no skill plan with a planning signature")
+        params = [v.name for v in skill.signature.parameters]
+        if len(params) != len(step.args):
+            raise PlannerError(f"plan step {i + 1} '{step}': skill plan '{skill.name}' takes {len(params)} parameters ({', '.join(params)})")
+        subst = dict(zip(params, step.args, strict=True))
+        bindings = tuple((p.lstrip("?"), a) for p, a in zip(params, step.args, strict=True) if p != ROBOT)
+        if ROBOT in subst and subst[ROBOT] != robot:
+            raise PlannerError(f"plan step {i + 1} '{step}' is for robot '{subst[ROBOT]}', but the plan is a single-agent plan of '{robot}'")
+        sig = skill.signature
+        pre = _ground(sig.precondition.text if sig.precondition else None, subst, skill.name)
+        eff = _ground(sig.effect.text if sig.effect else None, subst, skill.name)
+        out.append(Step(i, skill, bindings, pre, eff))
+    return out
+
+
+def _holds(pre: Iterable[tuple[bool, Fact]], state: set[Fact]) -> bool:
+    return all((fact in state) == positive for positive, fact in pre)
+
+
+def _apply(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
+    for positive, fact in effect:
+        if not positive:
+            state.discard(fact)
+    for positive, fact in effect:
+        if positive:
+            state.add(fact)
+
+
+def parallelise(steps: Sequence[Step], init: Iterable[Fact], robot: str) -> list[list[Step]]:
+    """Algorithms 2-3: split the steps into tasks.
+
+    A step opens a new task when its precondition holds for a robot that has
+    done nothing yet in the team's state before the step; else it joins the last task.
+    """
+    start = set(init)
+    fresh = {f for f in start if robot in f[1]}
+    state = set(start)
+    tasks: list[list[Step]] = []
+    for step in steps:
+        if not tasks:
+            tasks.append([step])
+        else:
+            shared = {f for f in state if robot not in f[1]}
+            if _holds(step.pre, shared | fresh):
+                tasks.append([step])
+            else:
+                tasks[-1].append(step)
+        _apply(state, step.effect)
+    return tasks
+
+
+def _cardinality(task: Sequence[Step]) -> tuple[int, float]:
+    lows, highs = [], []
+    for step in task:
+        ep = step.skill.entry_points[0]
+        lows.append(ep.min)
+        highs.append(ep.max)
+    low, high = max(lows), min(highs)
+    return max(1, low), max(high, float(max(1, low)))
+
+
+def generic_utility(n: int) -> UtilityFunction:
+    """Eq. 10-12, normalised: coverage w_t, priority w_p, similarity w_s; the threshold is w_s."""
+    n = max(1, n)
+    wt, wp, ws = 1.0 / n, 1.0 / (n + 1) ** 2, 1.0 / (n + 1) ** 3
+    total = wt + wp + ws
+    wt, wp, ws = wt / total, wp / total, ws / total
+    return UtilityFunction(priority_weight=wp, summands=(Summand("Coverage", wt, "1"),), similarity_weight=ws, threshold=ws)
+
+
+def _condition(pre: Sequence[tuple[bool, Fact]], robot: str) -> Condition | None:
+    if not pre:
+        return None
+    parts = []
+    for positive, (name, args) in pre:
+        shown = ", ".join("self" if a == robot else a for a in args)
+        atom = f"{name}({shown})" if args else name
+        parts.append(atom if positive else f"not {atom}")
+    return Condition(ConditionKind.TRANSITION, " and ".join(parts))
+
+
+def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str) -> tuple[Plan, tuple[Task, ...]]:
+    """The multi-agent plan of the tasks (see the module docstring)."""
+    entry_points, states, transitions, task_defs = [], [], [], []
+    for i, task in enumerate(tasks):
+        task_name = f"{name}_T{i}"
+        task_defs.append(Task(task_name, description=", ".join(s.label for s in task)))
+        low, high = _cardinality(task)
+        first = f"T{i}_Wait0"
+        entry_points.append(EntryPoint(task_name, task_name, first, min=low, max=high, success_required=True))
+        for k, step in enumerate(task):
+            wait, run = f"T{i}_Wait{k}", f"T{i}_S{k}_{step.skill.name}"
+            following = f"T{i}_Wait{k + 1}" if k + 1 < len(task) else f"T{i}_Done"
+            states.append(State(wait, description=f"wait until {step.label} can run"))
+            bind = tuple(Binding(var, value) for var, value in step.bindings)
+            states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
+            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot)))
+            transitions.append(Transition(f"{run}->{following}", run, following, Condition(ConditionKind.TRANSITION, "succeeded")))
+            transitions.append(Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed")))
+        states.append(State(f"T{i}_Done", StateKind.SUCCESS))
+        states.append(State(f"T{i}_Failed", StateKind.FAILURE))
+    plan = Plan(name, tuple(entry_points), tuple(states), tuple(transitions), utility=generic_utility(len(tasks)),
+                description=f"generated by pRoPhEt MAS from a plan of {sum(len(t) for t in tasks)} steps in {len(tasks)} task(s)")
+    return plan, tuple(task_defs)
+
+
+def role_priorities(roleset: RoleSet, tasks: Sequence[Sequence[Step]], task_defs: Sequence[Task], entry_task: str) -> RoleSet:
+    """Eq. 9: ``T_i = 1 - i/n`` scaled by each role's priority ``p`` for the problem's entry task; -1 if a skill is vetoed."""
+    n = len(tasks)
+    roles = []
+    for role in roleset.roles:
+        p = roleset.priority(role.name, entry_task)
+        extra = []
+        for i, (task, tdef) in enumerate(zip(tasks, task_defs, strict=True)):
+            vetoed = p < 0 or any(roleset.priority(role.name, s.skill.entry_points[0].task) < 0 for s in task)
+            extra.append(Priority(tdef.name, -1.0 if vetoed else round((1.0 - i / n) * p, 9)))
+        kept = tuple(q for q in role.priorities if q.task not in {t.name for t in task_defs})
+        roles.append(replace(role, priorities=kept + tuple(extra)))
+    return replace(roleset, roles=tuple(roles))
+
+
+def create_tasks(name: str, plan_steps: Sequence[PlanStep], library: PlanLibrary, init: Iterable[Fact], robot: str, roleset: RoleSet, entry_task: str) -> CreatedTasks:
+    """Turn a single-agent plan into tasks, a multi-agent plan and role-task priorities (the module docstring says how).
+
+    Args:
+        name: the generated plan's name.
+        plan_steps: the planner's single-agent plan.
+        library: holds the skill plans the steps name.
+        init: the world the plan starts from, as ``(predicate, args)`` facts.
+        robot: the object standing for the robot in the plan (``?r``).
+        roleset: the team's role set.
+        entry_task: the task through which the team runs the planning problem.
+
+    Raises:
+        PlannerError: the plan is empty or names unknown skills.
+    """
+    if not plan_steps:
+        raise PlannerError("an empty plan makes no tasks: the goal already holds")
+    steps = steps_of(plan_steps, library, robot)
+    tasks = parallelise(steps, init, robot)
+    plan, task_defs = build_plan(name, tasks, robot)
+    return CreatedTasks(tuple(tuple(t) for t in tasks), plan, task_defs, role_priorities(roleset, tasks, task_defs, entry_task))
+
+
+def emit_yaml(created: CreatedTasks, imports: Sequence[str] = ()) -> str:
+    """The generated plan and its tasks as a YAML plan file, for a person to read (``--emit-plan``).
+
+    Args:
+        created: the result of :func:`create_tasks`.
+        imports: plan files the generated plan needs (the skill plans), relative to where it is written.
+    """
+    from alica.io import dump_document
+    from alica.model import Document
+
+    document = Document(imports=tuple(imports), tasks=created.task_defs, plans=(created.plan,))
+    header = "# Generated by pRoPhEt MAS: " + "; ".join(
+        f"T{i}: " + ", ".join(s.label for s in task) for i, task in enumerate(created.tasks)
+    )
+    return header + "\n" + dump_document(document, "yaml")
