@@ -10,7 +10,6 @@ from alica.errors import PlannerError
 from alica.io import load_library
 from prophet.planner import PlanStep
 from prophet.tasks import create_tasks, emit_yaml, generic_utility, parallelise, steps_of
-
 from tests.conftest import PLANS
 
 SUSSMAN = [("on", ("c", "a")), ("ontable", ("a",)), ("ontable", ("b",)), ("clear", ("c",)), ("clear", ("b",)), ("handempty", ("r",))]
