@@ -1,0 +1,79 @@
+"""Eager A* with an admissible heuristic, pruned by a cost bound (the optimality pass).
+
+With a consistent admissible heuristic (h_max is one), the first goal state
+A* expands is reached by an optimal path; with ``g + h >= bound`` pruned, an
+exhausted open list proves that no plan cheaper than ``bound`` exists.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+from heapq import heappop, heappush
+
+from prophet.planner import Progress
+from prophet.search.encoding import CompiledTask
+from prophet.search.gbfs import Stats, trace
+from prophet.search.heuristics import INF, Evaluator
+
+
+def astar(
+    ct: CompiledTask,
+    evaluate: Evaluator,
+    stats: Stats,
+    *,
+    bound: float = INF,
+) -> Generator[Progress, None, list[int] | None]:
+    """A* on ``f = g + h`` (ties: lower h, then insertion order), pruning ``f >= bound``.
+
+    Args:
+        ct: the compiled task.
+        evaluate: an admissible heuristic (its preferred operators are ignored).
+        stats: shared counters.
+        bound: only plans cheaper than this are sought.
+
+    Returns:
+        An optimal plan cheaper than ``bound`` (compiled operator ids), or ``None``
+        if there is none.
+    """
+    successor = ct.successor
+    applicable = ct.applicable
+    op_cost = ct.cost
+    gm = ct.goal_mask
+    init = ct.init
+    h0 = evaluate(init)[0]
+    stats.evaluations += 1
+    if h0 >= bound:
+        return None
+    best_g: dict[int, int] = {init: 0}
+    parent: dict[int, tuple[int, int]] = {init: (-1, -1)}
+    hcache: dict[int, float] = {init: h0}
+    heap: list[tuple[float, float, int, int, int]] = [(h0, h0, 0, 0, init)]
+    count = 0
+    while heap:
+        _f, _h, _n, g, state = heappop(heap)
+        if best_g[state] < g:
+            continue
+        if state & gm == gm:
+            return trace(parent, state)
+        stats.expansions += 1
+        if stats.expansions >= stats.next_progress:
+            stats.next_progress += stats.progress_every
+            yield Progress(stats.expansions)
+        for o in applicable(state):
+            g2 = g + op_cost[o]
+            s2 = successor(state, o)
+            old = best_g.get(s2)
+            if old is not None and old <= g2:
+                continue
+            h2 = hcache.get(s2)
+            if h2 is None:
+                h2 = evaluate(s2)[0]
+                stats.evaluations += 1
+                hcache[s2] = h2
+            if g2 + h2 >= bound:
+                continue
+            best_g[s2] = g2
+            parent[s2] = (state, o)
+            count += 1
+            heappush(heap, (g2 + h2, h2, count, g2, s2))
+    return None

@@ -1,0 +1,263 @@
+"""A grounded task compiled for fast search: states as ``int`` bitsets.
+
+Fact ``i`` is bit ``i`` of a state. An operator becomes masks so that it is
+applicable in ``state`` when ``state & pre == pre`` and leads to
+``(state & ~delete) | add``. Static facts (never added or deleted) are
+compiled away: static true facts leave the preconditions, operators that need a
+static false fact are dropped, and so are operators a relaxed exploration from
+the initial state never reaches. Successors are generated through a watch
+index: every operator watches one of its (fluent) preconditions, so a state
+only tests the operators watching one of its true facts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+CondEffect = tuple[int, int, int]
+"""A compiled when-effect: (condition mask, add mask, delete mask)."""
+
+
+def bits(state: int) -> list[int]:
+    """The fact ids set in ``state``, in increasing order."""
+    out: list[int] = []
+    append = out.append
+    while state:
+        low = state & -state
+        append(low.bit_length() - 1)
+        state ^= low
+    return out
+
+
+def mask(ids: Sequence[int]) -> int:
+    """The bitset with the given fact ids set."""
+    m = 0
+    for i in ids:
+        m |= 1 << i
+    return m
+
+
+@dataclass(slots=True)
+class CompiledTask:
+    """A task ready for search (see the module docstring).
+
+    Attributes:
+        task: the grounded task it was compiled from.
+        n_facts: number of facts (bits).
+        init: the initial state (fluent facts only: states never hold static facts).
+        goal_mask: the fluent goal facts as a mask.
+        goal: the goal fact ids (fluent or not).
+        source: per compiled operator, its index in ``task.operators``.
+        pre: per operator, the fluent precondition fact ids.
+        pre_mask: per operator, ``pre`` as a mask.
+        add: per operator, the added fact ids.
+        add_mask: per operator, the add mask.
+        del_mask: per operator, the delete mask minus the add mask.
+        cost: per operator, its cost.
+        cond: per operator, its compiled when-effects (empty for most).
+        cond_raw: per operator, its when-effects as (condition ids, add ids, delete ids).
+        watch: per fact, the operators that watch it.
+        always: operators without fluent preconditions.
+        watch_mask: the facts some operator watches.
+        unit_cost: whether every operator costs 1.
+        solvable_relaxed: whether the relaxed task reaches the goal.
+    """
+
+    task: Any
+    n_facts: int
+    init: int
+    goal_mask: int
+    goal: tuple[int, ...]
+    source: list[int]
+    pre: list[tuple[int, ...]]
+    pre_mask: list[int]
+    add: list[tuple[int, ...]]
+    add_mask: list[int]
+    del_mask: list[int]
+    cost: list[int]
+    cond: list[tuple[CondEffect, ...]]
+    cond_raw: list[tuple[tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]], ...]]
+    watch: list[list[int]]
+    always: list[int]
+    watch_mask: int
+    unit_cost: bool
+    solvable_relaxed: bool
+
+    def applicable(self, state: int) -> list[int]:
+        """The operators applicable in ``state``, in a fixed order."""
+        pre_mask = self.pre_mask
+        watch = self.watch
+        out = [op for op in self.always if state & pre_mask[op] == pre_mask[op]]
+        append = out.append
+        s = state & self.watch_mask
+        while s:
+            low = s & -s
+            for op in watch[low.bit_length() - 1]:
+                m = pre_mask[op]
+                if state & m == m:
+                    append(op)
+            s ^= low
+        return out
+
+    def successor(self, state: int, op: int) -> int:
+        """The state after applying the (applicable) operator ``op`` in ``state``."""
+        conds = self.cond[op]
+        if not conds:
+            return (state & ~self.del_mask[op]) | self.add_mask[op]
+        add = self.add_mask[op]
+        delete = self.del_mask[op]
+        for cmask, cadd, cdel in conds:
+            if state & cmask == cmask:
+                add |= cadd
+                delete |= cdel
+        return (state & ~(delete & ~add)) | add
+
+    def is_goal(self, state: int) -> bool:
+        """Whether ``state`` satisfies the goal."""
+        return state & self.goal_mask == self.goal_mask
+
+    def plan_cost(self, ops: Sequence[int]) -> int:
+        """The summed cost of a sequence of compiled operators."""
+        cost = self.cost
+        return sum(cost[op] for op in ops)
+
+
+def _reachable(n_facts: int, init: set[int], pres: list[tuple[int, ...]], adds: list[tuple[int, ...]]) -> list[bool]:
+    """Which relaxed actions a relaxed exploration from ``init`` reaches."""
+    users: list[list[int]] = [[] for _ in range(n_facts)]
+    left = [len(p) for p in pres]
+    for a, p in enumerate(pres):
+        for f in p:
+            users[f].append(a)
+    reached = [False] * len(pres)
+    seen = [False] * n_facts
+    stack = sorted(init)
+    for f in stack:
+        seen[f] = True
+    for a, n in enumerate(left):
+        if n == 0:
+            reached[a] = True
+            for g in adds[a]:
+                if not seen[g]:
+                    seen[g] = True
+                    stack.append(g)
+    while stack:
+        f = stack.pop()
+        for a in users[f]:
+            left[a] -= 1
+            if left[a] == 0:
+                reached[a] = True
+                for g in adds[a]:
+                    if not seen[g]:
+                        seen[g] = True
+                        stack.append(g)
+    return reached
+
+
+def compile_task(task: Any) -> CompiledTask:
+    """Compile a grounded task (``GroundTask`` shape) for search."""
+    n = len(task.facts)
+    init_set = set(task.init)
+    fluent = [False] * n
+    for op in task.operators:
+        for f in (*op.add, *op.delete):
+            fluent[f] = True
+        for _cond, cadd, cdel in op.conditional:
+            for f in (*cadd, *cdel):
+                fluent[f] = True
+
+    def usable(ids: Sequence[int]) -> bool:
+        return all(fluent[f] or f in init_set for f in ids)
+
+    # Candidate operators: static preconditions hold; relaxed actions include when-effects.
+    cand: list[int] = []
+    for i, op in enumerate(task.operators):
+        if usable(op.pre):
+            cand.append(i)
+    r_pre: list[tuple[int, ...]] = []
+    r_add: list[tuple[int, ...]] = []
+    r_of: list[int] = []
+    main: list[int] = []
+    for k, i in enumerate(cand):
+        op = task.operators[i]
+        fpre = tuple(f for f in op.pre if fluent[f])
+        main.append(len(r_pre))
+        r_pre.append(fpre)
+        r_add.append(tuple(op.add))
+        r_of.append(k)
+        for cond, cadd, _cdel in op.conditional:
+            if usable(cond):
+                r_pre.append(tuple(sorted(set(fpre) | {f for f in cond if fluent[f]})))
+                r_add.append(tuple(cadd))
+                r_of.append(k)
+    reached = _reachable(n, init_set, r_pre, r_add)
+    keep_cand = [reached[a] for a in main]
+    relaxed_facts = set(init_set)
+    for a, ok in enumerate(reached):
+        if ok and keep_cand[r_of[a]]:
+            relaxed_facts.update(r_add[a])
+
+    source: list[int] = []
+    pre: list[tuple[int, ...]] = []
+    pre_mask: list[int] = []
+    add: list[tuple[int, ...]] = []
+    add_mask: list[int] = []
+    del_mask: list[int] = []
+    cost: list[int] = []
+    cond: list[tuple[CondEffect, ...]] = []
+    cond_raw: list[tuple[tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]], ...]] = []
+    for k, i in enumerate(cand):
+        if not keep_cand[k]:
+            continue
+        op = task.operators[i]
+        fpre = tuple(f for f in op.pre if fluent[f])
+        source.append(i)
+        pre.append(fpre)
+        pre_mask.append(mask(fpre))
+        add.append(tuple(op.add))
+        am = mask(op.add)
+        dm = mask(op.delete)
+        add_mask.append(am)
+        del_mask.append(dm & ~am)
+        cost.append(int(op.cost))
+        raw = tuple((tuple(f for f in c if fluent[f]), tuple(a), tuple(d)) for c, a, d in op.conditional if usable(c))
+        cond_raw.append(raw)
+        cond.append(tuple((mask(c), mask(a), mask(d)) for c, a, d in raw))
+
+    # Watch index: each operator watches its precondition used by the fewest operators.
+    uses = [0] * n
+    for p in pre:
+        for f in p:
+            uses[f] += 1
+    watch: list[list[int]] = [[] for _ in range(n)]
+    always: list[int] = []
+    for op, p in enumerate(pre):
+        if not p:
+            always.append(op)
+        else:
+            watch[min(p, key=lambda f: (uses[f], f))].append(op)
+    watch_mask = mask([f for f in range(n) if watch[f]])
+    goal = tuple(task.goal)
+    return CompiledTask(
+        task=task,
+        n_facts=n,
+        init=mask([f for f in sorted(init_set) if fluent[f]]),
+        goal_mask=mask([f for f in goal if fluent[f]]),
+        goal=goal,
+        source=source,
+        pre=pre,
+        pre_mask=pre_mask,
+        add=add,
+        add_mask=add_mask,
+        del_mask=del_mask,
+        cost=cost,
+        cond=cond,
+        cond_raw=cond_raw,
+        watch=watch,
+        always=always,
+        watch_mask=watch_mask,
+        unit_cost=all(c == 1 for c in cost),
+        solvable_relaxed=all(f in relaxed_facts for f in goal),
+    )

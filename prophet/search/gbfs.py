@@ -1,0 +1,149 @@
+"""Lazy best-first search with preferred operators: greedy (GBFS) or weighted A*.
+
+As in FF and LAMA, successors enter the open lists with their parent's
+estimate and are evaluated only when popped. Two open lists alternate: all
+successors, and the successors through preferred operators; each time the
+search finds a state with a lower estimate than before, the preferred list
+gets ``boost`` extra turns. Ties go to the earliest insertion, and states
+are plain ``int`` bitsets, so a run is deterministic.
+
+The searches are generators: they yield :class:`~prophet.planner.Progress`
+every ``progress_every`` expansions and *return* the plan (compiled operator
+ids) or ``None`` when the open lists run dry; use ``plan = yield from ...``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+from dataclasses import dataclass
+from heapq import heappop, heappush
+
+from prophet.planner import Progress
+from prophet.search.encoding import CompiledTask
+from prophet.search.heuristics import INF, Evaluator
+
+
+@dataclass(slots=True)
+class Stats:
+    """Counters shared by the searches of one planner run.
+
+    Attributes:
+        progress_every: expansions between two ``Progress`` events.
+        expansions: states expanded so far (all searches together).
+        evaluations: heuristic evaluations so far.
+        next_progress: the expansion count of the next ``Progress``.
+    """
+
+    progress_every: int = 1000
+    expansions: int = 0
+    evaluations: int = 0
+    next_progress: int = 0
+
+    def __post_init__(self) -> None:
+        self.progress_every = max(1, int(self.progress_every))
+        self.next_progress = self.progress_every
+
+
+def trace(parent: dict[int, tuple[int, int]], state: int) -> list[int]:
+    """The operators leading to ``state`` through the ``parent`` links (op -1 marks the start)."""
+    ops: list[int] = []
+    while True:
+        pstate, op = parent[state]
+        if op < 0:
+            break
+        ops.append(op)
+        state = pstate
+    ops.reverse()
+    return ops
+
+
+def lazy_search(
+    ct: CompiledTask,
+    evaluate: Evaluator,
+    stats: Stats,
+    *,
+    weight: float | None = None,
+    bound: float = INF,
+    boost: int = 1000,
+) -> Generator[Progress, None, list[int] | None]:
+    """Lazy GBFS (``weight=None``) or lazy weighted A* with preferred operators.
+
+    Args:
+        ct: the compiled task.
+        evaluate: the heuristic (its preferred operators fill the second list).
+        stats: shared counters (also sets how often ``Progress`` comes).
+        weight: ``None`` for greedy search on h, else the weight w of ``g + w*h``.
+        bound: successors with ``g >= bound`` are pruned.
+        boost: extra turns for the preferred list after progress.
+
+    Returns:
+        The plan as compiled operator ids, or ``None`` when the search space
+        under the bound is exhausted (with weighted A*, states are reopened on
+        a cheaper path, so ``None`` proves that no plan cheaper than ``bound`` exists).
+    """
+    successor = ct.successor
+    applicable = ct.applicable
+    op_cost = ct.cost
+    gm = ct.goal_mask
+    greedy = weight is None
+    w = 1.0 if weight is None else float(weight)
+    parent: dict[int, tuple[int, int]] = {}
+    closed_g: dict[int, int] = {}
+    cache: dict[int, tuple[float, list[int]]] = {}
+    regular: list[tuple[float, int, int, int, int]] = []
+    preferred: list[tuple[float, int, int, int, int]] = []
+    prio = [0, 0]
+    count = 0
+    best_h = INF
+    entry: tuple[float, int, int, int, int] | None = (0.0, 0, -1, -1, 0)
+    while True:
+        if entry is None:
+            if regular and preferred:
+                which = 0 if prio[0] <= prio[1] else 1
+            elif regular:
+                which = 0
+            elif preferred:
+                which = 1
+            else:
+                return None
+            prio[which] += 1
+            entry = heappop(preferred if which else regular)
+        _key, _n, pstate, op, g = entry
+        entry = None
+        state = ct.init if op < 0 else successor(pstate, op)
+        old = closed_g.get(state)
+        if old is not None and (greedy or old <= g):
+            continue
+        closed_g[state] = g
+        parent[state] = (pstate, op)
+        if state & gm == gm:
+            return trace(parent, state)
+        hp = cache.get(state)
+        if hp is None:
+            hp = evaluate(state)
+            stats.evaluations += 1
+            if not greedy:
+                cache[state] = hp
+        h, pref = hp
+        if h == INF:
+            continue
+        stats.expansions += 1
+        if stats.expansions >= stats.next_progress:
+            stats.next_progress += stats.progress_every
+            yield Progress(stats.expansions)
+        if h < best_h:
+            best_h = h
+            if pref:
+                prio[1] -= boost
+        for o in applicable(state):
+            g2 = g + op_cost[o]
+            if g2 >= bound:
+                continue
+            count += 1
+            heappush(regular, (h if greedy else g2 + w * h, count, state, o, g2))
+        for o in pref:
+            g2 = g + op_cost[o]
+            if g2 >= bound:
+                continue
+            count += 1
+            heappush(preferred, (h if greedy else g2 + w * h, count, state, o, g2))

@@ -1,0 +1,39 @@
+"""``BuiltinPlanner``: the pure-Python planner behind the :class:`~prophet.planner.Planner` interface."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+
+from prophet.planner import Feature, Planner, SearchEvent
+from prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+
+
+class BuiltinPlanner(Planner):
+    """Grounds the task, then runs :func:`~prophet.search.anytime.search_task`.
+
+    Args:
+        weights: the weighted A* weights of the anytime phase.
+        progress_every: expansions between two ``Progress`` events.
+    """
+
+    name = "builtin"
+    features = frozenset(
+        {
+            Feature.STRIPS,
+            Feature.TYPING,
+            Feature.NEGATIVE_PRECONDITIONS,
+            Feature.EQUALITY,
+            Feature.CONDITIONAL_EFFECTS,
+            Feature.ACTION_COSTS,
+        }
+    )
+
+    def __init__(self, *, weights: Sequence[float] = DEFAULT_WEIGHTS, progress_every: int = 1000) -> None:
+        self.weights = tuple(weights)
+        self.progress_every = progress_every
+
+    def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
+        from prophet.ground import ground  # lazy: the grounding is only needed here
+
+        task = ground(domain, problem)
+        yield from search_task(task, anytime=anytime, weights=self.weights, progress_every=self.progress_every)
