@@ -1,0 +1,23 @@
+"""PDDL: the lifted model, a reader with ``FILE:LINE:COL`` errors, and a writer.
+
+>>> domain = parse_domain("(define (domain d) (:predicates (p ?x)) (:action a :parameters (?x) :precondition (p ?x) :effect (not (p ?x))))")
+>>> domain.actions[0].name
+'a'
+"""
+
+from __future__ import annotations
+
+from prophet.pddl.errors import PddlError
+from prophet.pddl.model import (
+    OBJECT, Action, And, Atom, Domain, Effect, Equals, Exists, FluentTerm, FluentValue, Forall, Formula, Imply,
+    Increase, Metric, Not, Or, Predicate, Problem, TypedName, When,
+)
+from prophet.pddl.parser import SUPPORTED_REQUIREMENTS, parse_domain, parse_problem, read_domain, read_problem
+from prophet.pddl.writer import write_domain, write_formula, write_problem
+
+__all__ = [
+    "OBJECT", "SUPPORTED_REQUIREMENTS", "Action", "And", "Atom", "Domain", "Effect", "Equals", "Exists", "FluentTerm",
+    "FluentValue", "Forall", "Formula", "Imply", "Increase", "Metric", "Not", "Or", "PddlError", "Predicate",
+    "Problem", "TypedName", "When", "parse_domain", "parse_problem", "read_domain", "read_problem", "write_domain",
+    "write_formula", "write_problem",
+]

@@ -1,0 +1,268 @@
+"""The lifted PDDL model: domains, problems, formulas and effects as immutable values.
+
+Names are lower-cased (PDDL is case-insensitive). Variables keep their ``?``.
+A typed name is a ``(name, type)`` pair; untyped names have type ``object``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from prophet.planner import Feature
+
+OBJECT = "object"
+"""The root type."""
+
+TypedName = tuple[str, str]
+"""A ``(name, type)`` pair: a parameter, variable, constant or object."""
+
+
+@dataclass(frozen=True, slots=True)
+class Atom:
+    """``(predicate arg ...)``: args are variables (``?x``) or object names."""
+
+    predicate: str
+    args: tuple[str, ...] = ()
+
+    def __str__(self) -> str:
+        return f"({' '.join((self.predicate, *self.args))})"
+
+
+@dataclass(frozen=True, slots=True)
+class Equals:
+    """``(= left right)`` between two terms."""
+
+    left: str
+    right: str
+
+    def __str__(self) -> str:
+        return f"(= {self.left} {self.right})"
+
+
+@dataclass(frozen=True, slots=True)
+class Not:
+    """``(not formula)``; in effects the formula is an :class:`Atom` (a delete)."""
+
+    formula: Formula
+
+    def __str__(self) -> str:
+        return f"(not {self.formula})"
+
+
+@dataclass(frozen=True, slots=True)
+class And:
+    """``(and part ...)``; ``And(())`` is true (and the empty effect)."""
+
+    parts: tuple[Formula, ...] | tuple[Effect, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Or:
+    """``(or part ...)``; ``Or(())`` is false."""
+
+    parts: tuple[Formula, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class Imply:
+    """``(imply condition consequence)``."""
+
+    condition: Formula
+    consequence: Formula
+
+
+@dataclass(frozen=True, slots=True)
+class Exists:
+    """``(exists (?v - type ...) body)``."""
+
+    variables: tuple[TypedName, ...]
+    body: Formula
+
+
+@dataclass(frozen=True, slots=True)
+class Forall:
+    """``(forall (?v - type ...) body)``: a formula, or an effect over every binding."""
+
+    variables: tuple[TypedName, ...]
+    body: Formula | Effect
+
+
+@dataclass(frozen=True, slots=True)
+class FluentTerm:
+    """A numeric fluent (function application): ``(total-cost)``, ``(road-length ?a ?b)``."""
+
+    function: str
+    args: tuple[str, ...] = ()
+
+    def __str__(self) -> str:
+        return f"({' '.join((self.function, *self.args))})"
+
+
+@dataclass(frozen=True, slots=True)
+class When:
+    """``(when condition effect)``: a conditional effect."""
+
+    condition: Formula
+    effect: Effect
+
+
+@dataclass(frozen=True, slots=True)
+class Increase:
+    """``(increase (total-cost) value)``: value is a number or a fluent read from ``:init``."""
+
+    fluent: FluentTerm
+    value: int | float | FluentTerm
+
+
+Formula = Atom | Equals | Not | And | Or | Imply | Exists | Forall
+"""A precondition, goal or effect condition."""
+
+Effect = Atom | Not | And | Forall | When | Increase
+"""An action effect."""
+
+
+@dataclass(frozen=True, slots=True)
+class Predicate:
+    """A predicate or function declaration: name and typed parameters."""
+
+    name: str
+    parameters: tuple[TypedName, ...] = ()
+
+    @property
+    def arity(self) -> int:
+        """The number of parameters."""
+        return len(self.parameters)
+
+
+@dataclass(frozen=True, slots=True)
+class Action:
+    """An action schema.
+
+    Attributes:
+        name: the action name.
+        parameters: typed parameters, in order.
+        precondition: a formula (``And(())`` when absent).
+        effect: an effect tree (``And(())`` when absent).
+    """
+
+    name: str
+    parameters: tuple[TypedName, ...]
+    precondition: Formula = And(())
+    effect: Effect = And(())
+
+    @property
+    def cost(self) -> int | float | FluentTerm | None:
+        """The top-level ``(increase (total-cost) x)`` value (summed if numbers), None without one."""
+        values = [e.value for e in _top_level_effects(self.effect) if isinstance(e, Increase)]
+        if not values:
+            return None
+        if len(values) == 1:
+            return values[0]
+        if all(not isinstance(v, FluentTerm) for v in values):
+            return sum(v for v in values if not isinstance(v, FluentTerm))
+        return values[0]
+
+
+def _top_level_effects(effect: Effect) -> list[Effect]:
+    """The parts of an effect below top-level ``and``s."""
+    if isinstance(effect, And):
+        out: list[Effect] = []
+        for part in effect.parts:
+            out.extend(_top_level_effects(part))  # type: ignore[arg-type]
+        return out
+    return [effect]
+
+
+@dataclass(frozen=True, slots=True)
+class Metric:
+    """``(:metric minimize (total-cost))``."""
+
+    direction: str
+    expression: FluentTerm
+
+
+@dataclass(frozen=True, slots=True)
+class FluentValue:
+    """``(= (fluent args) value)`` in ``:init``."""
+
+    fluent: FluentTerm
+    value: int | float
+
+
+@dataclass(frozen=True, slots=True)
+class Domain:
+    """A PDDL domain.
+
+    Attributes:
+        name: the domain name.
+        requirements: the features it needs (declared, ``:adl`` expanded, and those found in use; always STRIPS).
+        types: child type -> parent type (``object`` is the implicit root and no key).
+        constants: typed constants.
+        predicates: predicate declarations.
+        functions: function (numeric fluent) declarations.
+        actions: action schemas.
+        extra_requirements: declared requirement names that are no :class:`Feature`
+            (``disjunctive-preconditions``, ``existential-preconditions``, ``universal-preconditions``).
+    """
+
+    name: str
+    requirements: frozenset[Feature]
+    types: dict[str, str] = field(default_factory=dict, hash=False)
+    constants: tuple[TypedName, ...] = ()
+    predicates: tuple[Predicate, ...] = ()
+    functions: tuple[Predicate, ...] = ()
+    actions: tuple[Action, ...] = ()
+    extra_requirements: frozenset[str] = frozenset()
+
+    def predicate(self, name: str) -> Predicate | None:
+        """The predicate called ``name``, or None."""
+        return next((p for p in self.predicates if p.name == name), None)
+
+    def action(self, name: str) -> Action | None:
+        """The action called ``name``, or None."""
+        return next((a for a in self.actions if a.name == name), None)
+
+    def is_subtype(self, child: str, parent: str) -> bool:
+        """Whether ``child`` is ``parent`` or below it."""
+        seen: set[str] = set()
+        while child != parent:
+            if child in seen or child == OBJECT:
+                return parent == OBJECT
+            seen.add(child)
+            child = self.types.get(child, OBJECT)
+        return True
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    """A PDDL problem.
+
+    Attributes:
+        name: the problem name.
+        domain_name: the ``(:domain ...)`` it is for.
+        objects: typed objects.
+        init: initial facts and fluent values, in file order.
+        goal: the goal formula.
+        metric: the metric, if any.
+        requirements: features declared in the problem or found in its goal.
+        extra_requirements: declared requirement names that are no :class:`Feature`.
+    """
+
+    name: str
+    domain_name: str
+    objects: tuple[TypedName, ...] = ()
+    init: tuple[Atom | FluentValue, ...] = ()
+    goal: Formula = And(())
+    metric: Metric | None = None
+    requirements: frozenset[Feature] = frozenset()
+    extra_requirements: frozenset[str] = frozenset()
+
+    @property
+    def facts(self) -> tuple[Atom, ...]:
+        """The initial facts (no fluent values)."""
+        return tuple(i for i in self.init if isinstance(i, Atom))
+
+    @property
+    def fluent_values(self) -> dict[FluentTerm, int | float]:
+        """The initial fluent values."""
+        return {i.fluent: i.value for i in self.init if isinstance(i, FluentValue)}

@@ -1,0 +1,385 @@
+"""Reading PDDL domains and problems (recursive descent over :mod:`prophet.pddl.sexpr`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from prophet.pddl.errors import PddlError
+from prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
+from prophet.pddl.model import (
+    OBJECT, Action, And, Atom, Domain, Effect, Equals, Exists, FluentTerm, FluentValue, Forall, Formula, Imply, Increase, Metric,
+    Not, Or, Predicate, Problem, TypedName, When,
+)
+from prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
+from prophet.planner import Feature
+
+_FEATURES = {f"{f.value}": frozenset({f}) for f in Feature}
+_EXTRA = {
+    "disjunctive-preconditions": frozenset({"disjunctive-preconditions"}),
+    "existential-preconditions": frozenset({"existential-preconditions"}),
+    "universal-preconditions": frozenset({"universal-preconditions"}),
+    "quantified-preconditions": frozenset({"existential-preconditions", "universal-preconditions"}),
+}
+_ADL = (
+    frozenset({Feature.STRIPS, Feature.TYPING, Feature.NEGATIVE_PRECONDITIONS, Feature.EQUALITY, Feature.CONDITIONAL_EFFECTS}),
+    frozenset({"disjunctive-preconditions", "existential-preconditions", "universal-preconditions"}),
+)
+_UNSUPPORTED = frozenset(
+    {
+        "numeric-fluents", "fluents", "object-fluents", "durative-actions", "duration-inequalities",
+        "continuous-effects", "derived-predicates", "timed-initial-literals", "preferences", "constraints",
+    }
+)
+SUPPORTED_REQUIREMENTS = tuple(sorted([*_FEATURES, *_EXTRA, "adl"]))
+"""The requirement names the reader accepts."""
+
+
+def _requirements(source: Source, section: SList) -> tuple[set[Feature], set[str]]:
+    features: set[Feature] = set()
+    extra: set[str] = set()
+    for item in section.items[1:]:
+        if not isinstance(item, Symbol) or not item.text.startswith(":"):
+            shown = item.text if isinstance(item, Symbol) else item.describe()
+            raise source.error(item.offset, f"expected a requirement ':name', found '{shown}'")
+        name = item.text[1:]
+        if name in _FEATURES:
+            features |= _FEATURES[name]
+        elif name in _EXTRA:
+            extra |= _EXTRA[name]
+        elif name == "adl":
+            features |= _ADL[0]
+            extra |= _ADL[1]
+        elif name in _UNSUPPORTED:
+            raise source.error(item.offset, f"unsupported requirement ':{name}'", "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS))
+        else:
+            raise source.error(item.offset, f"unknown requirement ':{name}'", "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS))
+    return features, extra
+
+
+def formula_features(formula: Formula | Effect, *, in_effect: bool = False) -> tuple[set[Feature], set[str]]:
+    """The features and extra requirement names a formula or effect uses.
+
+    Args:
+        formula: the formula or effect tree.
+        in_effect: whether ``formula`` is an effect (a ``not`` there is a delete).
+
+    Returns:
+        The features and the names such as ``disjunctive-preconditions``.
+    """
+    features: set[Feature] = set()
+    extra: set[str] = set()
+    stack: list[tuple[object, bool]] = [(formula, in_effect)]
+    while stack:
+        node, effect = stack.pop()
+        if isinstance(node, And):
+            stack.extend((p, effect) for p in node.parts)
+        elif isinstance(node, Not):
+            if not effect:
+                features.add(Feature.NEGATIVE_PRECONDITIONS)
+                stack.append((node.formula, False))
+        elif isinstance(node, Or | Imply):
+            extra.add("disjunctive-preconditions")
+            parts = node.parts if isinstance(node, Or) else (node.condition, node.consequence)
+            stack.extend((p, False) for p in parts)
+        elif isinstance(node, Exists):
+            extra.add("existential-preconditions")
+            stack.append((node.body, False))
+        elif isinstance(node, Forall):
+            if not effect:
+                extra.add("universal-preconditions")
+            stack.append((node.body, effect))
+        elif isinstance(node, When):
+            features.add(Feature.CONDITIONAL_EFFECTS)
+            stack.append((node.condition, False))
+            stack.append((node.effect, True))
+        elif isinstance(node, Equals):
+            features.add(Feature.EQUALITY)
+        elif isinstance(node, Increase):
+            features.add(Feature.ACTION_COSTS)
+    return features, extra
+
+
+def _check_header(source: Source, top: SList, kind: str) -> str:
+    if top.head() != "define":
+        raise source.error(top.offset, f"expected '(define ({kind} NAME) ...)', found '{top.describe()}'")
+    if len(top.items) < 2 or not isinstance(top.items[1], SList) or top.items[1].head() != kind:
+        place = top.items[1].offset if len(top.items) > 1 else top.offset
+        raise source.error(place, f"expected '({kind} NAME)' after 'define'")
+    header = top.items[1]
+    if len(header.items) != 2:
+        raise source.error(header.offset, f"expected '({kind} NAME)' with one name")
+    return expect_name(source, header.items[1], f"a {kind} name")
+
+
+def _sections(source: Source, top: SList, allowed: tuple[str, ...]) -> list[SList]:
+    sections = []
+    for item in top.items[2:]:
+        section = expect_list(source, item, "a section '(:keyword ...)'")
+        head = section.head()
+        if head in (":derived", ":durative-action", ":constraints"):
+            raise source.error(section.offset, f"unsupported construct '({head} ...)'")
+        if head not in allowed:
+            raise source.error(section.offset, f"expected one of {', '.join(allowed)}, found '{section.describe()}'")
+        sections.append(section)
+    return sections
+
+
+def _typed(source: Source, section: SList, variables: bool, types: dict[str, str] | None, what: str) -> list[tuple[TypedName, int]]:
+    return parse_typed_list(source, section.items[1:], variables=variables, types=types, what=what)
+
+
+def _declarations(source: Source, section: SList, types: dict[str, str], what: str, functions: bool) -> list[Predicate]:
+    out: list[Predicate] = []
+    items = section.items[1:]
+    index = 0
+    while index < len(items):
+        decl = expect_list(source, items[index], f"a {what} declaration '(name ?x ...)'")
+        name = expect_name(source, decl.items[0], f"a {what} name") if decl.items else ""
+        if not name:
+            raise source.error(decl.offset, f"expected a {what} name, found '()'")
+        params = parse_typed_list(source, decl.items[1:], variables=True, types=types, what=f"parameters of '{name}'")
+        if any(p.name == name for p in out):
+            raise source.error(decl.offset, f"duplicate {what} '{name}'")
+        out.append(Predicate(name, tuple(p for p, _ in params)))
+        index += 1
+        if functions and index < len(items) and isinstance(items[index], Symbol) and items[index].text == "-":
+            kind = items[index + 1] if index + 1 < len(items) else items[index]
+            if not isinstance(kind, Symbol) or kind.text != "number":
+                raise source.error(kind.offset, f"unsupported construct: function '{name}' must be '- number'")
+            index += 2
+    return out
+
+
+def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
+    if len(section.items) < 2:
+        raise source.error(section.offset, "expected an action name after ':action'")
+    name = expect_name(source, section.items[1], "an action name")
+    parameters: tuple[TypedName, ...] = ()
+    precondition: Formula = And(())
+    effect: Effect = And(())
+    items = section.items[2:]
+    seen: set[str] = set()
+    for index in range(0, len(items), 2):
+        key = items[index]
+        if not isinstance(key, Symbol) or key.text not in (":parameters", ":precondition", ":effect"):
+            shown = key.text if isinstance(key, Symbol) else key.describe() + " ...)"
+            raise source.error(key.offset, f"expected :parameters, :precondition or :effect in '(:action {name}', found '{shown}'")
+        if key.text in seen:
+            raise source.error(key.offset, f"duplicate {key.text} in '(:action {name}'")
+        seen.add(key.text)
+        if index + 1 >= len(items):
+            raise source.error(key.offset, f"expected a value after {key.text} in '(:action {name}'")
+        value = items[index + 1]
+        if key.text == ":parameters":
+            if index != 0:
+                raise source.error(key.offset, f"expected :parameters first in '(:action {name}'")
+            plist = expect_list(source, value, "a parameter list '(?x - type ...)'")
+            typed = parse_typed_list(source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'")
+            names = [n for (n, _), _ in typed]
+            for (pname, _), offset in typed:
+                if names.count(pname) > 1:
+                    raise source.error(offset, f"duplicate parameter '{pname}' in '(:action {name}'")
+            parameters = tuple(p for p, _ in typed)
+        elif key.text == ":precondition":
+            precondition = _empty_or(value, lambda v: reader.formula(v, dict(parameters)))
+        else:
+            effect = _empty_or(value, lambda v: reader.effect(v, dict(parameters)))
+    return Action(name, parameters, precondition, effect)
+
+
+def _empty_or(node: Node, read):  # type: ignore[no-untyped-def]
+    """``()`` is the empty conjunction, anything else is read by ``read``."""
+    if isinstance(node, SList) and not node.items:
+        return And(())
+    return read(node)
+
+
+def parse_domain(text: str, file: str = "<string>") -> Domain:
+    """Read a PDDL domain.
+
+    Args:
+        text: the domain text.
+        file: the file name for error messages.
+
+    Returns:
+        The domain.
+
+    Raises:
+        PddlError: the text is no valid domain (the message has ``FILE:LINE:COL``).
+    """
+    source = Source(text, file)
+    top = read_sexpr(source)
+    name = _check_header(source, top, "domain")
+    allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action")
+    features: set[Feature] = {Feature.STRIPS}
+    extra: set[str] = set()
+    types: dict[str, str] = {}
+    constants: list[TypedName] = []
+    predicates: list[Predicate] = []
+    functions: list[Predicate] = []
+    reader = FormulaReader(source, {}, {}, {}, types)
+    actions: list[Action] = []
+    for section in _sections(source, top, allowed):
+        head = section.head()
+        if head == ":requirements":
+            more, more_extra = _requirements(source, section)
+            features |= more
+            extra |= more_extra
+        elif head == ":types":
+            for (child, parent), offset in _typed(source, section, False, None, "type list"):
+                if child == OBJECT:
+                    continue
+                if child in types:
+                    raise source.error(offset, f"duplicate type '{child}'")
+                types[child] = parent
+            for (child, parent), offset in _typed(source, section, False, None, "type list"):
+                if parent != OBJECT and parent not in types:
+                    raise source.error(offset, f"unknown type '{parent}' (parent of '{child}')", "declare it in (:types ...)")
+            features.add(Feature.TYPING)
+        elif head == ":constants":
+            for (const, kind), offset in _typed(source, section, False, types, "constant list"):
+                if const in reader.objects:
+                    raise source.error(offset, f"duplicate constant '{const}'")
+                reader.objects[const] = kind
+                constants.append((const, kind))
+        elif head == ":predicates":
+            predicates.extend(_declarations(source, section, types, "predicate", functions=False))
+            reader.predicates.update((p.name, p) for p in predicates)
+        elif head == ":functions":
+            functions.extend(_declarations(source, section, types, "function", functions=True))
+            reader.functions.update((f.name, f) for f in functions)
+        else:
+            action = _action(source, section, reader)
+            if any(a.name == action.name for a in actions):
+                raise source.error(section.offset, f"duplicate action '{action.name}'")
+            actions.append(action)
+    for action in actions:
+        for part, in_effect in ((action.precondition, False), (action.effect, True)):
+            more, more_extra = formula_features(part, in_effect=in_effect)
+            features |= more
+            extra |= more_extra
+        if any(t != OBJECT for _, t in action.parameters):
+            features.add(Feature.TYPING)
+    if any(t != OBJECT for p in (*predicates, *functions) for _, t in p.parameters):
+        features.add(Feature.TYPING)
+    return Domain(name, frozenset(features), types, tuple(constants), tuple(predicates), tuple(functions), tuple(actions), frozenset(extra))
+
+
+def parse_problem(text: str, file: str = "<string>", domain: Domain | None = None) -> Problem:
+    """Read a PDDL problem, checked against ``domain`` when given.
+
+    Args:
+        text: the problem text.
+        file: the file name for error messages.
+        domain: the domain; with it, predicates, arities, objects, types and the domain name are checked.
+
+    Returns:
+        The problem.
+
+    Raises:
+        PddlError: the text is no valid problem (the message has ``FILE:LINE:COL``).
+    """
+    source = Source(text, file)
+    top = read_sexpr(source)
+    name = _check_header(source, top, "problem")
+    sections = _sections(source, top, (":domain", ":requirements", ":objects", ":init", ":goal", ":metric"))
+    if not sections or sections[0].head() != ":domain":
+        raise source.error(sections[0].offset if sections else top.offset, "expected '(:domain NAME)' first in the problem")
+    dom = sections[0]
+    if len(dom.items) != 2:
+        raise source.error(dom.offset, "expected '(:domain NAME)' with one name")
+    domain_name = expect_name(source, dom.items[1], "a domain name")
+    if domain is not None and domain_name != domain.name:
+        raise source.error(dom.items[1].offset, f"problem is for domain '{domain_name}', not '{domain.name}'")
+    strict = domain is not None
+    types = domain.types if domain is not None else None
+    reader = FormulaReader(
+        source,
+        {p.name: p for p in domain.predicates} if domain else {},
+        {f.name: f for f in domain.functions} if domain else {},
+        dict(domain.constants) if domain else {},
+        types,
+        strict,
+    )
+    features: set[Feature] = set()
+    extra: set[str] = set()
+    objects: list[TypedName] = []
+    init: list[Atom | FluentValue] = []
+    goal: Formula | None = None
+    metric: Metric | None = None
+    seen: set[str] = set()
+    for section in sections[1:]:
+        head = section.head()
+        if head in seen:
+            raise source.error(section.offset, f"duplicate section '({head}'")
+        seen.add(head)
+        if head == ":requirements":
+            features, extra = _requirements(source, section)
+        elif head == ":objects":
+            for (obj, kind), offset in _typed(source, section, False, types, "object list"):
+                if obj in reader.objects:
+                    raise source.error(offset, f"duplicate object '{obj}'")
+                objects.append((obj, kind))
+                reader.objects[obj] = kind
+        elif head == ":init":
+            init.extend(_init_item(source, item, reader) for item in section.items[1:])
+        elif head == ":goal":
+            if len(section.items) != 2:
+                raise source.error(section.offset, "expected '(:goal formula)' with one formula")
+            goal = _empty_or(section.items[1], lambda v: reader.formula(v, {}))
+        else:
+            metric = _metric(source, section, reader)
+    if goal is None:
+        raise source.error(top.offset, "expected a '(:goal ...)' section in the problem")
+    more, more_extra = formula_features(goal)
+    return Problem(
+        name, domain_name, tuple(objects), tuple(init), goal, metric, frozenset(features | more), frozenset(extra | more_extra)
+    )
+
+
+def _init_item(source: Source, node: Node, reader: FormulaReader) -> Atom | FluentValue:
+    item = expect_list(source, node, "an initial fact '(predicate ...)'")
+    head = item.head()
+    if head == "=":
+        if len(item.items) != 3:
+            raise source.error(item.offset, "expected '(= (fluent ...) number)'")
+        target = expect_list(source, item.items[1], "a fluent '(function ...)' after '='")
+        fluent = reader.fluent(target, {})
+        return FluentValue(fluent, parse_number(source, item.items[2], f"the value of {fluent}"))
+    if head in ("not", "and", "or", "forall", "exists", "when"):
+        raise source.error(item.offset, f"unsupported construct '({head} ...)' in :init", "list the true facts only")
+    return reader.atom(item, {})
+
+
+def _metric(source: Source, section: SList, reader: FormulaReader) -> Metric:
+    if len(section.items) != 3 or not isinstance(section.items[1], Symbol) or section.items[1].text not in ("minimize", "maximize"):
+        raise source.error(section.offset, "expected '(:metric minimize (total-cost))'")
+    expression = expect_list(source, section.items[2], "a fluent '(total-cost)' in the metric")
+    if expression.head() in ("+", "-", "*", "/"):
+        raise source.error(expression.offset, "unsupported construct: metric expressions other than one fluent")
+    return Metric(section.items[1].text, reader.fluent(expression, {}))
+
+
+def read_domain(path: str | Path) -> Domain:
+    """Read a domain file (see :func:`parse_domain`).
+
+    Raises:
+        PddlError: the file cannot be read or is no valid domain.
+    """
+    return parse_domain(_read(path), str(path))
+
+
+def read_problem(path: str | Path, domain: Domain | None = None) -> Problem:
+    """Read a problem file (see :func:`parse_problem`).
+
+    Raises:
+        PddlError: the file cannot be read or is no valid problem.
+    """
+    return parse_problem(_read(path), str(path), domain)
+
+
+def _read(path: str | Path) -> str:
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise PddlError(f"cannot read {path}: {error}") from error
