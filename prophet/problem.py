@@ -1,0 +1,117 @@
+"""A planning problem of a plan file as PDDL: the domain from its elements' signatures, the problem from World and Goal.
+
+Each problem element (a skill plan with a ``signature``) becomes a PDDL action
+of the same name: its parameters, its precondition and its effect (written in
+the plan language as conjunctions of literals, ``holding(?r, ?x) and not
+clear(?y)``). The robot parameter ``?r`` is the one agent of the
+single-agent plan (IMPERA 7.3); task creation spreads the plan over the team
+afterwards. World is the problem's ``world`` (offline use) or facts read from
+the world model; Goal is the problem's ``goal``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+
+from alica.errors import AlicaError, PlannerError
+from alica.lang import literals
+from alica.model import PlanLibrary, PlanningProblem
+
+Fact = tuple[str, tuple[str, ...]]
+
+
+def _symbol(name: str) -> str:
+    return name.lower()
+
+
+def _atom(name: str, args: Iterable[object]) -> str:
+    parts = [_symbol(name), *(_symbol(str(a)) for a in args)]
+    return f"({' '.join(parts)})"
+
+
+def _conjunction(text: str | None, what: str) -> tuple[list[str], list[tuple[bool, str, tuple[object, ...]]]]:
+    if not text:
+        return [], []
+    try:
+        found = literals(text)
+    except AlicaError as exc:
+        raise PlannerError(f"{what} must be a conjunction of literals to be planned with: {exc}") from None
+    out = [(_atom(n, a) if p else f"(not {_atom(n, a)})") for p, n, a in found]
+    return out, list(found)
+
+
+def _and(parts: list[str]) -> str:
+    return parts[0] if len(parts) == 1 else f"(and {' '.join(parts)})"
+
+
+def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
+    """The PDDL domain of a planning problem's elements.
+
+    Raises:
+        PlannerError: an element has no signature, or a signature is not a conjunction of literals.
+    """
+    actions, predicates, types = [], {}, {"object"}
+    for name in problem.elements:
+        plan = library.plans.get(name)
+        if plan is None or plan.signature is None:
+            raise PlannerError(f"planning problem '{problem.name}': element '{name}' is not a skill plan with a signature")
+        sig = plan.signature
+        typed = {v.name: (v.type if v.type != "any" else "object") for v in sig.parameters}
+        types.update(typed.values())
+        pre, pre_lits = _conjunction(sig.precondition.text if sig.precondition else None, f"the precondition of '{name}'")
+        eff, eff_lits = _conjunction(sig.effect.text if sig.effect else None, f"the effect of '{name}'")
+        for _, pred, args in pre_lits + eff_lits:
+            predicates.setdefault(_symbol(pred), tuple(typed.get(str(a), "object") for a in args))
+        params = " ".join(f"{_symbol(v)} - {_symbol(t)}" for v, t in typed.items())
+        cost = int(sig.cost) if float(sig.cost).is_integer() else sig.cost
+        effect_parts = eff + [f"(increase (total-cost) {cost})"]
+        actions.append(
+            f"  (:action {_symbol(name)}\n    :parameters ({params})\n"
+            f"    :precondition {_and(pre) if pre else '(and)'}\n    :effect {_and(effect_parts)})"
+        )
+    preds = " ".join(f"({p} {' '.join(f'?a{i} - {_symbol(t)}' for i, t in enumerate(ts))})".replace(" )", ")") for p, ts in sorted(predicates.items()))
+    type_list = " ".join(sorted(_symbol(t) for t in types if t != "object"))
+    return (
+        f"(define (domain {_symbol(problem.name)})\n  (:requirements :strips :typing :negative-preconditions :action-costs)\n"
+        f"  (:types {type_list} - object)\n  (:predicates {preds})\n  (:functions (total-cost) - number)\n"
+        + "\n".join(actions) + "\n)\n"
+    )
+
+
+def problem_text(problem: PlanningProblem, objects: Mapping[str, str], facts: Iterable[Fact]) -> str:
+    """The PDDL problem: typed ``objects`` (name -> type), the initial ``facts`` and the problem's goal.
+
+    Raises:
+        PlannerError: the goal is not a conjunction of literals.
+    """
+    goal, _ = _conjunction(problem.goal.text, f"the goal of '{problem.name}'")
+    objs = " ".join(f"{_symbol(o)} - {_symbol(t)}" for o, t in sorted(objects.items()))
+    init = " ".join(sorted(_atom(n, a) for n, a in facts))
+    return (
+        f"(define (problem {_symbol(problem.name)}-now) (:domain {_symbol(problem.name)})\n  (:objects {objs})\n"
+        f"  (:init {init} (= (total-cost) 0))\n  (:goal {_and(goal) if goal else '(and)'})\n  (:metric minimize (total-cost)))\n"
+    )
+
+
+def offline_world(problem: PlanningProblem) -> tuple[dict[str, str], list[Fact]]:
+    """The objects and facts a problem's own ``world`` and ``objects`` give (offline use).
+
+    Raises:
+        PlannerError: no world is given, or it is not a conjunction of positive literals.
+    """
+    if problem.world is None:
+        raise PlannerError(f"planning problem '{problem.name}' has no 'world': it is read from the world model at run time")
+    _, found = _conjunction(problem.world.text, f"the world of '{problem.name}'")
+    if any(not positive for positive, _, _ in found):
+        raise PlannerError(f"the world of '{problem.name}' lists facts that hold; leave out the ones that do not (closed world)")
+    objects = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
+    return objects, [(n, tuple(str(a) for a in args)) for _, n, args in found]
+
+
+def to_pddl(problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]) -> tuple[object, object]:
+    """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world."""
+    from prophet.pddl import parse_domain, parse_problem
+
+    domain = parse_domain(domain_text(problem, library), file=f"<{problem.name} domain>")
+    pddl_problem = parse_problem(problem_text(problem, objects, facts), file=f"<{problem.name} problem>")
+    return domain, pddl_problem
