@@ -9,7 +9,6 @@ from alica.io import load_library
 from prophet.planner import PlanStatus
 from prophet.problem import domain_text, offline_world, problem_text, to_pddl
 from prophet.tasks import create_tasks
-
 from tests.conftest import PLANS
 
 OBJECTS = {"a": "block", "b": "block", "c": "block", "r": "robot"}
