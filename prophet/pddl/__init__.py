@@ -9,8 +9,27 @@ from __future__ import annotations
 
 from prophet.pddl.errors import PddlError
 from prophet.pddl.model import (
-    OBJECT, Action, And, Atom, Domain, Effect, Equals, Exists, FluentTerm, FluentValue, Forall, Formula, Imply,
-    Increase, Metric, Not, Or, Predicate, Problem, TypedName, When,
+    OBJECT,
+    Action,
+    And,
+    Atom,
+    Domain,
+    Effect,
+    Equals,
+    Exists,
+    FluentTerm,
+    FluentValue,
+    Forall,
+    Formula,
+    Imply,
+    Increase,
+    Metric,
+    Not,
+    Or,
+    Predicate,
+    Problem,
+    TypedName,
+    When,
 )
 from prophet.pddl.parser import SUPPORTED_REQUIREMENTS, parse_domain, parse_problem, read_domain, read_problem
 from prophet.pddl.writer import write_domain, write_formula, write_problem

@@ -6,8 +6,22 @@ import re
 from dataclasses import dataclass, field
 
 from prophet.pddl.model import (
-    OBJECT, And, Atom, Effect, Equals, Exists, FluentTerm, Forall, Formula, Imply, Increase, Not, Or,
-    Predicate, TypedName, When,
+    OBJECT,
+    And,
+    Atom,
+    Effect,
+    Equals,
+    Exists,
+    FluentTerm,
+    Forall,
+    Formula,
+    Imply,
+    Increase,
+    Not,
+    Or,
+    Predicate,
+    TypedName,
+    When,
 )
 from prophet.pddl.sexpr import Node, SList, Source, Symbol
 from prophet.planner import Feature

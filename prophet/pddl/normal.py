@@ -12,7 +12,20 @@ from dataclasses import dataclass
 
 from prophet.pddl.errors import PddlError
 from prophet.pddl.model import (
-    And, Atom, Effect, Equals, Exists, FluentTerm, Forall, Formula, Imply, Increase, Not, Or, TypedName, When,
+    And,
+    Atom,
+    Effect,
+    Equals,
+    Exists,
+    FluentTerm,
+    Forall,
+    Formula,
+    Imply,
+    Increase,
+    Not,
+    Or,
+    TypedName,
+    When,
 )
 
 Literal = tuple[bool, Atom | Equals]

@@ -7,8 +7,26 @@ from pathlib import Path
 from prophet.pddl.errors import PddlError
 from prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
 from prophet.pddl.model import (
-    OBJECT, Action, And, Atom, Domain, Effect, Equals, Exists, FluentTerm, FluentValue, Forall, Formula, Imply, Increase, Metric,
-    Not, Or, Predicate, Problem, TypedName, When,
+    OBJECT,
+    Action,
+    And,
+    Atom,
+    Domain,
+    Effect,
+    Equals,
+    Exists,
+    FluentValue,
+    Forall,
+    Formula,
+    Imply,
+    Increase,
+    Metric,
+    Not,
+    Or,
+    Predicate,
+    Problem,
+    TypedName,
+    When,
 )
 from prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
 from prophet.planner import Feature

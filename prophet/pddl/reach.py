@@ -14,8 +14,8 @@ from __future__ import annotations
 import itertools
 from collections import deque
 from collections.abc import Callable, Sequence
-from operator import itemgetter
 from dataclasses import dataclass
+from operator import itemgetter
 
 from prophet.pddl.errors import PddlError
 from prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
@@ -83,6 +83,7 @@ class _Schema:
     effects: tuple[tuple[tuple[tuple[tuple[bool, str, tuple[Arg, ...]], ...], ...] | None, bool, CompiledAtom], ...]
     costs: tuple[int | float | tuple[str, tuple[Arg, ...]], ...]
     plans: tuple[tuple, ...] = ()
+    fast: tuple = ()
 
 
 class Fixpoint:
@@ -372,6 +373,23 @@ class Fixpoint:
                 full[slot] = value
             self._emit(schema, tuple(full))
 
+    def _fast(self, schema: _Schema) -> tuple:
+        """Atoms as (predicate, getter over args + constants) for :meth:`_emit`."""
+        if schema.fast:
+            return schema.fast
+        consts: dict[str, int] = {}
+        nparams = len(schema.params)
+
+        def compiled(pred: str, spec: tuple[Arg, ...]) -> tuple[str, Callable]:
+            idx = tuple(a if isinstance(a, int) else consts.setdefault(a, nparams + len(consts)) for a in spec)
+            return pred, _getter(idx)
+
+        pos = tuple(compiled(p, s) for p, s in schema.pos if p in self.fluent)
+        neg = tuple((p in self.fluent, *compiled(p, s)) for p, s in schema.neg)
+        plain = tuple((positive, *compiled(p, s)) for cond, positive, (p, s) in schema.effects if cond is None)
+        schema.fast = (tuple(consts), pos, neg, plain)
+        return schema.fast
+
     def _emit(self, schema: _Schema, args: tuple[str, ...]) -> None:
         def value(a: Arg) -> str:
             return args[a] if isinstance(a, int) else a
@@ -379,26 +397,31 @@ class Fixpoint:
         for positive, left, right in schema.eqs:
             if (value(left) == value(right)) != positive:
                 return
-        neg = []
-        for pred, spec in schema.neg:
-            fact = (pred, *(value(a) for a in spec))
-            if pred not in self.fluent:
-                if fact in self.init:
-                    return
-            else:
-                neg.append(fact)
         key = (id(schema), args)
         if key in self._seen:
             return
+        consts, fast_pos, fast_neg, plain = self._fast(schema)
+        ext = args + consts if consts else args
+        neg = []
+        for fluent, pred, getter in fast_neg:
+            fact = (pred, *getter(ext))
+            if fluent:
+                neg.append(fact)
+            elif fact in self.init:
+                return
         self._seen.add(key)
-        pos = [f for f in ((p, *(value(a) for a in s)) for p, s in schema.pos) if f[0] in self.fluent]
+        pos = [(pred, *getter(ext)) for pred, getter in fast_pos]
         add: list[Fact] = []
         delete: list[Fact] = []
+        for positive, pred, getter in plain:
+            (add if positive else delete).append((pred, *getter(ext)))
         conditional: dict[tuple[tuple[Fact, ...], tuple[Fact, ...]], tuple[list[Fact], list[Fact]]] = {}
         for cond, positive, (pred, spec) in schema.effects:
+            if cond is None:
+                continue
             fact = (pred, *(value(a) for a in spec))
-            for condition in ([None] if cond is None else self._ground_condition(cond, value)):
-                if condition is None or condition == ((), ()):
+            for condition in self._ground_condition(cond, value):
+                if condition == ((), ()):
                     (add if positive else delete).append(fact)
                 else:
                     entry = conditional.setdefault(condition, ([], []))

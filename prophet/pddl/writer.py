@@ -3,13 +3,30 @@
 from __future__ import annotations
 
 from prophet.pddl.model import (
-    OBJECT, Action, And, Atom, Domain, Effect, Equals, Exists, FluentTerm, FluentValue, Forall, Formula, Imply,
-    Increase, Not, Or, Problem, TypedName, When,
+    OBJECT,
+    Action,
+    And,
+    Atom,
+    Domain,
+    Effect,
+    Equals,
+    Exists,
+    FluentTerm,
+    FluentValue,
+    Forall,
+    Formula,
+    Imply,
+    Increase,
+    Not,
+    Or,
+    Problem,
+    TypedName,
+    When,
 )
 from prophet.planner import Feature
 
 
-def _number(value: int | float) -> str:
+def _number(value: float) -> str:
     return str(value) if isinstance(value, int) else repr(float(value))
 
 
