@@ -1,0 +1,131 @@
+"""``alica plan`` end to end with the builtin planner: exit codes, output, validation, errors."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+import prophet.planners
+from prophet.planner import Done, Feature, Improved, Plan, Planner, PlanStatus, PlanStep, SearchEvent
+from tests.prophet.planners.checks import JSON_KEYS, check_json, check_text
+
+
+def test_blocks_text(alica, blocks) -> None:
+    domain, problem = blocks("4-0")
+    run = alica("plan", domain, problem)
+    assert run.code == 0, run.err
+    assert check_text(run.out, domain, problem) >= 6  # 6 is optimal
+    assert "; planner: builtin" in run.out
+
+
+def test_blocks_json(alica, blocks) -> None:
+    domain, problem = blocks("4-0")
+    run = alica("plan", domain, problem, "--json")
+    assert run.code == 0, run.err
+    assert check_json(run.out, domain, problem)["cost"] >= 6
+
+
+def test_rovers_json(alica, rovers) -> None:
+    domain, problem = rovers("p01")
+    run = alica("plan", domain, problem, "--json", "--planner", "builtin")
+    assert run.code == 0, run.err
+    assert check_json(run.out, domain, problem)["cost"] >= 10  # 10 is optimal
+
+
+def test_anytime_reaches_the_optimum_on_a_small_task(alica, blocks) -> None:
+    domain, problem = blocks("5-2")
+    run = alica("plan", domain, problem, "--anytime", "--time-limit", "10", "--json")
+    assert run.code == 0, run.err
+    assert check_json(run.out, domain, problem)["cost"] == 16
+
+
+def test_unsolvable_exit_3(alica, unsolvable) -> None:
+    run = alica("plan", *unsolvable)
+    assert run.code == 3, run.err
+    assert "proven unsolvable" in run.out
+    run = alica("plan", *unsolvable, "--json")
+    assert run.code == 3
+    assert json.loads(run.out) == {k: v for k, v in json.loads(run.out).items() if k in JSON_KEYS}
+    assert json.loads(run.out)["solved"] is False and json.loads(run.out)["plan"] is None
+
+
+def test_timeout_exit_4(alica, rovers) -> None:
+    run = alica("plan", *rovers("p30"), "--time-limit", "0.01", "--json")  # ~1000 expansions to a first plan
+    assert run.code == 4, run.out
+    summary = json.loads(run.out)
+    assert set(summary) == JSON_KEYS and summary["solved"] is False and summary["cost"] is None
+
+
+def test_parse_error_exit_1(alica, tmp_path: Path, blocks) -> None:
+    bad = tmp_path / "bad-domain.pddl"
+    bad.write_text(
+        "(define (domain x)\n  (:predicates (p)\n  (:action a :parameters () :effect (p))\n", encoding="utf-8"
+    )
+    run = alica("plan", bad, blocks("4-0")[1])
+    assert run.code == 1
+    first = run.err.splitlines()[0]
+    assert first.startswith(f"{bad}:3:3: error: "), run.err
+    assert "Traceback" not in run.err and run.out == ""
+
+
+def test_parse_error_in_problem(alica, tmp_path: Path, blocks) -> None:
+    bad = tmp_path / "bad-problem.pddl"
+    bad.write_text(
+        "(define (problem p) (:domain blocks)\n  (:objects a)\n  (:init (clear a) (ontable a) (handempty))\n  (:goal (on a zz)))\n",
+        encoding="utf-8",
+    )
+    run = alica("plan", blocks("4-0")[0], bad)
+    assert run.code == 1
+    assert run.err.startswith(f"{bad}:4:"), run.err
+    assert ": error: " in run.err and "Traceback" not in run.err
+
+
+def test_missing_file(alica, tmp_path: Path, blocks) -> None:
+    missing = tmp_path / "nowhere.pddl"
+    run = alica("plan", blocks("4-0")[0], missing)
+    assert run.code == 1
+    assert str(missing) in run.err and "Traceback" not in run.err
+
+
+def test_unknown_planner(alica, blocks) -> None:
+    run = alica("plan", *blocks("4-0"), "--planner", "nope")
+    assert run.code == 2
+    assert "invalid choice: 'nope'" in run.err and "'builtin', 'fd'" in run.err
+
+
+def test_bad_time_limit(alica, blocks) -> None:
+    run = alica("plan", *blocks("4-0"), "--time-limit", "-1")
+    assert run.code == 2 and "positive" in run.err
+
+
+class _Scripted(Planner):
+    """A back-end that answers with a fixed plan or a fixed failure."""
+
+    name = "scripted"
+    features = frozenset(Feature)
+
+    def __init__(self, plan: Plan | None, status: PlanStatus, message: str = "") -> None:
+        self.plan, self.status, self.message = plan, status, message
+
+    def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
+        if self.plan is not None:
+            yield Improved(self.plan, 1)
+        yield Done(self.status, 1, self.message)
+
+
+def test_an_invalid_plan_from_a_back_end_is_an_error(alica, blocks, monkeypatch: pytest.MonkeyPatch) -> None:
+    wrong = Plan((PlanStep("stack", ("a", "b")),), 1.0)
+    monkeypatch.setattr(prophet.planners, "get_planner", lambda name: _Scripted(wrong, PlanStatus.SOLVED))
+    run = alica("plan", *blocks("4-0"))
+    assert run.code == 1 and run.out == ""
+    assert "planner 'scripted' returned an invalid plan: step 1" in run.err
+
+
+def test_a_failing_back_end_is_an_error(alica, blocks, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(prophet.planners, "get_planner", lambda name: _Scripted(None, PlanStatus.ERROR, "it broke"))
+    run = alica("plan", *blocks("4-0"), "--json")
+    assert run.code == 1 and run.out == ""
+    assert "planner 'scripted' failed: it broke" in run.err
