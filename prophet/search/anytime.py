@@ -1,30 +1,38 @@
 """The builtin planner's run on a grounded task: a first plan, then cheaper ones.
 
-1. Lazy GBFS with FF (plan length) and preferred operators finds a first plan
-   (or exhausts the reachable states: ``UNSOLVABLE``).
-2. Restarting lazy weighted A* with decreasing weights, FF on costs and
-   preferred operators, each pass pruning ``g >= best cost``; a pass that
-   exhausts proves the best plan optimal.
-3. Eager A* with h_max (admissible), pruning ``g + h >= best cost``: its
-   plan, or its exhaustion, proves optimality.
+1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
+   finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
+2. Rounds over a portfolio of bounded passes, each pruning ``g >= best cost``
+   and stopped after an expansion budget that doubles every round: lazy GBFS
+   with FF on h_add supporters, lazy weighted A* with decreasing weights
+   (FF with h_max and with h_add supporters, preferred operators), and
+   eager A* with h_max (admissible). Different heuristics and weights lead
+   to different plans; the bound makes every plan found cheaper.
+3. A pass that exhausts its space under the bound (rather than its budget)
+   proves the best plan optimal: ``Done(OPTIMAL)`` (not the greedy pass,
+   which does not reopen states).
 
-Every plan goes through loop removal and action elimination before it is
+Every plan goes through loop removal, action elimination and a small plan
+neighbourhood graph search (:mod:`prophet.search.neighbourhood`) before it is
 reported.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
+from collections.abc import Generator, Iterator, Sequence
 from typing import Any
 
 from prophet.planner import Done, Improved, Plan, PlanStatus, PlanStep, SearchEvent
 from prophet.search.astar import astar
 from prophet.search.encoding import CompiledTask, compile_task
 from prophet.search.gbfs import Stats, lazy_search
-from prophet.search.heuristics import Relaxed
+from prophet.search.heuristics import INF, Evaluator, Relaxed
+from prophet.search.neighbourhood import neighbourhood
 from prophet.search.postprocess import improve
 
 DEFAULT_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1.5, 1)
+NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
+"""The first and the largest state limit of the neighbourhood rounds after each plan."""
 
 
 def to_plan(ct: CompiledTask, ops: Sequence[int]) -> Plan:
@@ -32,6 +40,17 @@ def to_plan(ct: CompiledTask, ops: Sequence[int]) -> Plan:
     operators = ct.task.operators
     steps = tuple(PlanStep(operators[ct.source[o]].action, tuple(operators[ct.source[o]].args)) for o in ops)
     return Plan(steps, sum(operators[ct.source[o]].cost for o in ops))
+
+
+def _portfolio(ct: CompiledTask, relaxed: Relaxed, weights: Sequence[float]) -> list[tuple[Evaluator, float | None]]:
+    """The bounded passes of one improvement round: (heuristic, weight or None for greedy)."""
+    passes: list[tuple[Evaluator, float | None]] = [(relaxed.ff_add_unit, None)]
+    for w in weights:
+        if ct.unit_cost:
+            passes += [(relaxed.ff, w), (relaxed.ff_add_unit, w)]
+        else:
+            passes.append((relaxed.ff_cost, w))
+    return passes
 
 
 def search_task(
@@ -46,11 +65,12 @@ def search_task(
 
     Args:
         task: the grounded task.
-        anytime: go on after the first plan (weighted A* passes, then A*).
+        anytime: go on after the first plan (see the module docstring).
         weights: the weights of the weighted A* passes, in order.
         progress_every: expansions between two ``Progress`` events.
-        optimal_pass: end with the admissible A* pass (else ``Done(SOLVED)``
-            after the last weight).
+        optimal_pass: include the A* pass with h_max in the rounds; without it
+            (and with inadmissible passes only) the run ends with
+            ``Done(SOLVED)`` after one round.
 
     Yields:
         ``Progress``, ``Improved`` for each cheaper plan, one final ``Done``.
@@ -65,35 +85,70 @@ def search_task(
         yield Done(PlanStatus.UNSOLVABLE, 0, "the goal is unreachable even ignoring deletes")
         return
     relaxed = Relaxed(ct)
-    ops = yield from lazy_search(ct, relaxed.ff, stats)
+    ops, _exhausted = yield from lazy_search(ct, relaxed.ff, stats)
     if ops is None:
         yield Done(PlanStatus.UNSOLVABLE, stats.expansions, "every reachable state was expanded")
         return
+    first_expansions = stats.expansions
     best = improve(ct, ops)
-    best_cost = ct.plan_cost(best)
     yield Improved(to_plan(ct, best), stats.expansions)
     if not anytime:
         yield Done(PlanStatus.SOLVED, stats.expansions)
         return
-    if best_cost == 0:
-        yield Done(PlanStatus.OPTIMAL, stats.expansions, "a plan of cost 0")
+    best, proven = yield from _polish(ct, best, stats)
+    best_cost = ct.plan_cost(best)
+    if proven or best_cost == 0:
+        yield Done(PlanStatus.OPTIMAL, stats.expansions, "every reachable state was explored")
         return
-    evaluate = relaxed.ff if ct.unit_cost else relaxed.ff_cost
-    for w in weights:
-        ops = yield from lazy_search(ct, evaluate, stats, weight=w, bound=best_cost)
-        if ops is None:
-            yield Done(PlanStatus.OPTIMAL, stats.expansions, f"weighted A* (w={w}) found no cheaper plan")
+    passes = _portfolio(ct, relaxed, weights)
+    budget = max(500, 2 * first_expansions)
+    while True:
+        for evaluate, weight in passes:
+            ops, exhausted = yield from lazy_search(
+                ct, evaluate, stats, weight=weight, bound=best_cost, max_expansions=budget
+            )
+            if exhausted and weight is not None:  # greedy passes do not reopen: no proof
+                yield Done(PlanStatus.OPTIMAL, stats.expansions, "a bounded pass found no cheaper plan")
+                return
+            if ops is not None:
+                yield Improved(to_plan(ct, improve(ct, ops)), stats.expansions)
+                best, proven = yield from _polish(ct, improve(ct, ops), stats)
+                best_cost = ct.plan_cost(best)
+                if proven:
+                    yield Done(PlanStatus.OPTIMAL, stats.expansions, "every reachable state was explored")
+                    return
+        if not optimal_pass:
+            yield Done(PlanStatus.SOLVED, stats.expansions)
             return
+        ops, exhausted = yield from astar(ct, relaxed.h_max, stats, bound=best_cost, max_expansions=budget)
+        if ops is not None:
+            yield Improved(to_plan(ct, ops), stats.expansions)
+        if ops is not None or exhausted:
+            yield Done(PlanStatus.OPTIMAL, stats.expansions, "A* with h_max")
+            return
+        budget *= 2
+
+
+def _polish(ct: CompiledTask, plan: list[int], stats: Stats) -> Generator[SearchEvent, None, tuple[list[int], bool]]:
+    """Neighbourhood rounds around ``plan`` (the limit doubles after a round without gain).
+
+    Yields ``Improved`` for each cheaper plan; returns the best plan and whether
+    it is proven optimal (a round explored the whole reachable state space).
+    """
+    limit, cap = NEIGHBOURHOOD_LIMITS
+    cost = ct.plan_cost(plan)
+    while limit <= cap:
+        ops, exhausted = yield from neighbourhood(ct, plan, limit, stats)
         ops = improve(ct, ops)
-        cost = ct.plan_cost(ops)
-        if cost < best_cost:
-            best, best_cost = ops, cost
-            yield Improved(to_plan(ct, best), stats.expansions)
-    if not optimal_pass:
-        yield Done(PlanStatus.SOLVED, stats.expansions)
-        return
-    ops = yield from astar(ct, relaxed.h_max, stats, bound=best_cost)
-    if ops is not None:
-        best = ops
-        yield Improved(to_plan(ct, best), stats.expansions)
-    yield Done(PlanStatus.OPTIMAL, stats.expansions, "A* with h_max")
+        new_cost = ct.plan_cost(ops)
+        if new_cost < cost:
+            plan, cost = ops, new_cost
+            yield Improved(to_plan(ct, plan), stats.expansions)
+        elif not exhausted:
+            limit *= 2
+        if exhausted:
+            return plan, True
+    return plan, False
+
+
+__all__ = ["DEFAULT_WEIGHTS", "INF", "search_task", "to_plan"]

@@ -22,7 +22,8 @@ def astar(
     stats: Stats,
     *,
     bound: float = INF,
-) -> Generator[Progress, None, list[int] | None]:
+    max_expansions: float = INF,
+) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """A* on ``f = g + h`` (ties: lower h, then insertion order), pruning ``f >= bound``.
 
     Args:
@@ -30,10 +31,12 @@ def astar(
         evaluate: an admissible heuristic (its preferred operators are ignored).
         stats: shared counters.
         bound: only plans cheaper than this are sought.
+        max_expansions: give up after this many expansions.
 
     Returns:
-        An optimal plan cheaper than ``bound`` (compiled operator ids), or ``None``
-        if there is none.
+        ``(plan, exhausted)``: an optimal plan cheaper than ``bound`` (compiled
+        operator ids) or ``None``; ``exhausted`` when none exists (not when the
+        budget ran out).
     """
     successor = ct.successor
     applicable = ct.applicable
@@ -43,19 +46,23 @@ def astar(
     h0 = evaluate(init)[0]
     stats.evaluations += 1
     if h0 >= bound:
-        return None
+        return None, True
     best_g: dict[int, int] = {init: 0}
     parent: dict[int, tuple[int, int]] = {init: (-1, -1)}
     hcache: dict[int, float] = {init: h0}
     heap: list[tuple[float, float, int, int, int]] = [(h0, h0, 0, 0, init)]
     count = 0
+    expanded = 0
     while heap:
         _f, _h, _n, g, state = heappop(heap)
         if best_g[state] < g:
             continue
         if state & gm == gm:
-            return trace(parent, state)
+            return trace(parent, state), False
         stats.expansions += 1
+        expanded += 1
+        if expanded > max_expansions:
+            return None, False
         if stats.expansions >= stats.next_progress:
             stats.next_progress += stats.progress_every
             yield Progress(stats.expansions)
@@ -70,10 +77,12 @@ def astar(
                 h2 = evaluate(s2)[0]
                 stats.evaluations += 1
                 hcache[s2] = h2
+                if stats.evaluations % stats.progress_every == 0:  # evaluations dominate here
+                    yield Progress(stats.expansions)
             if g2 + h2 >= bound:
                 continue
             best_g[s2] = g2
             parent[s2] = (state, o)
             count += 1
             heappush(heap, (g2 + h2, h2, count, g2, s2))
-    return None
+    return None, True

@@ -156,17 +156,64 @@ def _reachable(n_facts: int, init: set[int], pres: list[tuple[int, ...]], adds: 
     return reached
 
 
+def _keep_relevant(task: Any, cand: list[int], keep: list[bool], fluent: list[bool]) -> None:
+    """Backward relevance from the goal (tasks without when-effects only).
+
+    Drops (in ``keep``) the operators that add no relevant fact, and turns the
+    irrelevant facts into non-fluent ones so that states never hold them: a
+    plan stays a plan without the dropped operators, whose only effects are
+    on facts no goal or kept precondition mentions.
+    """
+    n = len(fluent)
+    adders: list[list[int]] = [[] for _ in range(n)]
+    for k, i in enumerate(cand):
+        if keep[k]:
+            for f in task.operators[i].add:
+                if fluent[f]:
+                    adders[f].append(k)
+    relevant = [False] * n
+    stack = [f for f in task.goal if fluent[f]]
+    for f in stack:
+        relevant[f] = True
+    used = [False] * len(cand)
+    while stack:
+        f = stack.pop()
+        for k in adders[f]:
+            if used[k]:
+                continue
+            used[k] = True
+            for p in task.operators[cand[k]].pre:
+                if fluent[p] and not relevant[p]:
+                    relevant[p] = True
+                    stack.append(p)
+    for k in range(len(cand)):
+        keep[k] = keep[k] and used[k]
+    for f in range(n):
+        fluent[f] = fluent[f] and relevant[f]
+
+
 def compile_task(task: Any) -> CompiledTask:
     """Compile a grounded task (``GroundTask`` shape) for search."""
     n = len(task.facts)
     init_set = set(task.init)
+    # A fact is fluent if some operator really deletes it (a delete its own add
+    # does not override), or if it is false initially and some operator adds it.
     fluent = [False] * n
     for op in task.operators:
-        for f in (*op.add, *op.delete):
-            fluent[f] = True
-        for _cond, cadd, cdel in op.conditional:
-            for f in (*cadd, *cdel):
+        adds = set(op.add)
+        for f in op.delete:
+            if f not in adds:
                 fluent[f] = True
+        for f in op.add:
+            if f not in init_set:
+                fluent[f] = True
+        for _cond, cadd, cdel in op.conditional:
+            for f in cdel:
+                if f not in adds:
+                    fluent[f] = True
+            for f in cadd:
+                if f not in init_set:
+                    fluent[f] = True
 
     def usable(ids: Sequence[int]) -> bool:
         return all(fluent[f] or f in init_set for f in ids)
@@ -185,12 +232,12 @@ def compile_task(task: Any) -> CompiledTask:
         fpre = tuple(f for f in op.pre if fluent[f])
         main.append(len(r_pre))
         r_pre.append(fpre)
-        r_add.append(tuple(op.add))
+        r_add.append(tuple(f for f in op.add if fluent[f]))
         r_of.append(k)
         for cond, cadd, _cdel in op.conditional:
             if usable(cond):
                 r_pre.append(tuple(sorted(set(fpre) | {f for f in cond if fluent[f]})))
-                r_add.append(tuple(cadd))
+                r_add.append(tuple(f for f in cadd if fluent[f]))
                 r_of.append(k)
     reached = _reachable(n, init_set, r_pre, r_add)
     keep_cand = [reached[a] for a in main]
@@ -198,6 +245,8 @@ def compile_task(task: Any) -> CompiledTask:
     for a, ok in enumerate(reached):
         if ok and keep_cand[r_of[a]]:
             relaxed_facts.update(r_add[a])
+    if not any(task.operators[i].conditional for i in cand):
+        _keep_relevant(task, cand, keep_cand, fluent)
 
     source: list[int] = []
     pre: list[tuple[int, ...]] = []
@@ -216,13 +265,18 @@ def compile_task(task: Any) -> CompiledTask:
         source.append(i)
         pre.append(fpre)
         pre_mask.append(mask(fpre))
-        add.append(tuple(op.add))
-        am = mask(op.add)
-        dm = mask(op.delete)
+        fadd = tuple(f for f in op.add if fluent[f])
+        add.append(fadd)
+        am = mask(fadd)
+        dm = mask([f for f in op.delete if fluent[f]])
         add_mask.append(am)
         del_mask.append(dm & ~am)
         cost.append(int(op.cost))
-        raw = tuple((tuple(f for f in c if fluent[f]), tuple(a), tuple(d)) for c, a, d in op.conditional if usable(c))
+        raw = tuple(
+            (tuple(f for f in c if fluent[f]), tuple(f for f in a if fluent[f]), tuple(f for f in d if fluent[f]))
+            for c, a, d in op.conditional
+            if usable(c)
+        )
         cond_raw.append(raw)
         cond.append(tuple((mask(c), mask(a), mask(d)) for c, a, d in raw))
 

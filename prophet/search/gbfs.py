@@ -9,7 +9,8 @@ are plain ``int`` bitsets, so a run is deterministic.
 
 The searches are generators: they yield :class:`~prophet.planner.Progress`
 every ``progress_every`` expansions and *return* the plan (compiled operator
-ids) or ``None`` when the open lists run dry; use ``plan = yield from ...``.
+ids) or ``None``, and whether the open lists ran dry; use
+``plan, exhausted = yield from ...``.
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ def lazy_search(
     weight: float | None = None,
     bound: float = INF,
     boost: int = 1000,
-) -> Generator[Progress, None, list[int] | None]:
+    max_expansions: float = INF,
+) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """Lazy GBFS (``weight=None``) or lazy weighted A* with preferred operators.
 
     Args:
@@ -75,11 +77,14 @@ def lazy_search(
         weight: ``None`` for greedy search on h, else the weight w of ``g + w*h``.
         bound: successors with ``g >= bound`` are pruned.
         boost: extra turns for the preferred list after progress.
+        max_expansions: give up after this many expansions.
 
     Returns:
-        The plan as compiled operator ids, or ``None`` when the search space
-        under the bound is exhausted (with weighted A*, states are reopened on
-        a cheaper path, so ``None`` proves that no plan cheaper than ``bound`` exists).
+        ``(plan, exhausted)``: the plan as compiled operator ids, or ``None``;
+        ``exhausted`` when the search space under the bound ran out (with
+        weighted A*, states are reopened on a cheaper path, so this proves
+        that no plan cheaper than ``bound`` exists), not when the expansion
+        budget did.
     """
     successor = ct.successor
     applicable = ct.applicable
@@ -94,6 +99,7 @@ def lazy_search(
     preferred: list[tuple[float, int, int, int, int]] = []
     prio = [0, 0]
     count = 0
+    expanded = 0
     best_h = INF
     entry: tuple[float, int, int, int, int] | None = (0.0, 0, -1, -1, 0)
     while True:
@@ -105,7 +111,7 @@ def lazy_search(
             elif preferred:
                 which = 1
             else:
-                return None
+                return None, True
             prio[which] += 1
             entry = heappop(preferred if which else regular)
         _key, _n, pstate, op, g = entry
@@ -117,7 +123,7 @@ def lazy_search(
         closed_g[state] = g
         parent[state] = (pstate, op)
         if state & gm == gm:
-            return trace(parent, state)
+            return trace(parent, state), False
         hp = cache.get(state)
         if hp is None:
             hp = evaluate(state)
@@ -128,6 +134,9 @@ def lazy_search(
         if h == INF:
             continue
         stats.expansions += 1
+        expanded += 1
+        if expanded > max_expansions:
+            return None, False
         if stats.expansions >= stats.next_progress:
             stats.next_progress += stats.progress_every
             yield Progress(stats.expansions)

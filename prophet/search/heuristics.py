@@ -49,9 +49,17 @@ class Relaxed:
                 r_op.append(op)
         n = ct.n_facts
         pre_of: list[list[int]] = [[] for _ in range(n)]
+        multi_of: list[list[int]] = [[] for _ in range(n)]
+        unary_of: list[list[tuple[int, int]]] = [[] for _ in range(n)]
         for a, p in enumerate(r_pre):
             for f in p:
                 pre_of[f].append(a)
+                if len(p) > 1:
+                    multi_of[f].append(a)
+            if len(p) == 1:
+                unary_of[p[0]].extend((g, a) for g in r_add[a])
+        self.multi_of = multi_of
+        self.unary_of = unary_of
         self.goal_mask = ct.goal_mask
         self.r_pre = r_pre
         self.r_add = r_add
@@ -86,7 +94,8 @@ class Relaxed:
         gm = self.goal_mask
         if state & gm == gm:
             return 0, []
-        pre_of = self.pre_of
+        multi_of = self.multi_of
+        unary_of = self.unary_of
         r_add = self.r_add
         is_goal = self.is_goal
         level = self._neg[:]
@@ -104,14 +113,22 @@ class Relaxed:
         ready = list(self.zero)
         layer = 0
         while True:
+            layer += 1
+            nxt: list[int] = []
+            # Actions with one precondition fire straight from the frontier.
             for f in frontier:
-                for a in pre_of[f]:
+                for g, a in unary_of[f]:
+                    if level[g] < 0:
+                        level[g] = layer
+                        sup[g] = a
+                        nxt.append(g)
+                        if is_goal[g]:
+                            goals_left -= 1
+                for a in multi_of[f]:
                     c = unsat[a] - 1
                     unsat[a] = c
                     if not c:
                         ready.append(a)
-            layer += 1
-            nxt: list[int] = []
             for a in ready:
                 for g in r_add[a]:
                     if level[g] < 0:
