@@ -94,13 +94,31 @@ def blocks_task(stacks: list[list[str]], goal_on: list[tuple[str, str]], goal_ta
     blocks = sorted(b for s in stacks for b in s)
     tb = TaskBuilder("blocks")
     for x in blocks:
-        tb.op("pick-up", (x,), [f"clear {x}", f"ontable {x}", "handempty"], [f"holding {x}"], [f"ontable {x}", f"clear {x}", "handempty"])
+        tb.op(
+            "pick-up",
+            (x,),
+            [f"clear {x}", f"ontable {x}", "handempty"],
+            [f"holding {x}"],
+            [f"ontable {x}", f"clear {x}", "handempty"],
+        )
         tb.op("put-down", (x,), [f"holding {x}"], [f"clear {x}", "handempty", f"ontable {x}"], [f"holding {x}"])
         for y in blocks:
             if x == y:
                 continue
-            tb.op("stack", (x, y), [f"holding {x}", f"clear {y}"], [f"clear {x}", "handempty", f"on {x} {y}"], [f"holding {x}", f"clear {y}"])
-            tb.op("unstack", (x, y), [f"on {x} {y}", f"clear {x}", "handempty"], [f"holding {x}", f"clear {y}"], [f"on {x} {y}", f"clear {x}", "handempty"])
+            tb.op(
+                "stack",
+                (x, y),
+                [f"holding {x}", f"clear {y}"],
+                [f"clear {x}", "handempty", f"on {x} {y}"],
+                [f"holding {x}", f"clear {y}"],
+            )
+            tb.op(
+                "unstack",
+                (x, y),
+                [f"on {x} {y}", f"clear {x}", "handempty"],
+                [f"holding {x}", f"clear {y}"],
+                [f"on {x} {y}", f"clear {x}", "handempty"],
+            )
     init = ["handempty"]
     for s in stacks:
         init.append(f"ontable {s[0]}")

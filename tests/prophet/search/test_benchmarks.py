@@ -11,7 +11,12 @@ from tests.prophet.search.helpers import BENCHMARKS, check_plan
 pddl = pytest.importorskip("prophet.pddl")
 grounding = pytest.importorskip("prophet.ground")
 
-CASES = [("blocks", "probBLOCKS-4-0", 6), ("blocks", "probBLOCKS-6-0", 12), ("rovers", "p01", 10), ("rovers", "p03", 11)]
+CASES = [
+    ("blocks", "probBLOCKS-4-0", 6),
+    ("blocks", "probBLOCKS-6-0", 12),
+    ("rovers", "p01", 10),
+    ("rovers", "p03", 11),
+]
 
 
 def load(domain: str, problem: str):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import itertools
+
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -44,7 +46,7 @@ def test_anytime_agrees_with_uniform_cost(task: GroundTask) -> None:
     for plan in found:
         check_plan(task, plan)
     costs = [p.cost for p in found]
-    assert all(a > b for a, b in zip(costs, costs[1:], strict=False))
+    assert all(a > b for a, b in itertools.pairwise(costs))
     assert costs[-1] >= ref
     if done.status is PlanStatus.OPTIMAL:
         assert costs[-1] == ref

@@ -164,7 +164,7 @@ def test_heuristics_agree_on_a_small_task():
     hmax, hadd, ff = rel.h_max(s)[0], rel.h_add(s)[0], rel.ff(s)[0]
     assert 0 < hmax <= ff <= hadd
     assert rel.goal_count(s)[0] == len(task.goal) - len([g for g in task.goal if g in task.init])
-    h, pref = rel.ff(s)
+    _h, pref = rel.ff(s)
     assert pref and all(op in ct.applicable(s) for op in pref)
     assert rel.ff_cost(s)[0] == rel.ff_add_unit(s)[0]
     dead = ct.init & ~ct.init
@@ -186,4 +186,7 @@ def test_encoding_applicable_matches_brute_force():
 def test_planner_features_and_name():
     planner = BuiltinPlanner()
     assert planner.name == "builtin"
-    assert planner.missing({Feature.CONDITIONAL_EFFECTS, Feature.ACTION_COSTS, Feature.NEGATIVE_PRECONDITIONS}) == frozenset()
+    assert (
+        planner.missing({Feature.CONDITIONAL_EFFECTS, Feature.ACTION_COSTS, Feature.NEGATIVE_PRECONDITIONS})
+        == frozenset()
+    )
