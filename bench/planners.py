@@ -1,0 +1,480 @@
+"""Our planner (``alica plan``) beside Fast Downward lama-first and pyperplan gbf-hff on the shipped PDDL benchmarks.
+
+Every problem runs as a whole process, one at a time by default (the machine has 2
+cores; timings must not compete), with a wall limit (60 s):
+
+* ours: ``python -m alica.cli plan DOMAIN PROBLEM --json --time-limit 60``;
+* Fast Downward 26.6 from PyPI ``up-fast-downward``: its driver with ``--alias lama-first``;
+* pyperplan (PyPI ``pyperplan``, a peer only, installed for the bench):
+  ``python -m pyperplan -s gbf -H hff`` on copies of the files (it writes ``PROBLEM.soln``
+  next to the problem);
+* ours again after an anytime budget (``--anytime --time-limit 10``) on the blocks problems
+  with a proven optimum (``optimal_costs.tsv``).
+
+Every plan, ours and the peers', is validated with :func:`prophet.validate.validate_plan`;
+an invalid plan counts as unsolved. Times are whole-process wall seconds. The tables
+(markdown on standard output, TSV in ``build/bench/``): coverage per domain; Rovers
+p01-p20 total time, ours vs Fast Downward (goal: at most 2x); per-problem cost on Rovers
+p01-p20 vs the IMPERA paper's Table 1 (goal: ours at most that on each); blocks after the
+anytime budget vs the optimum (goal: total at most 1.15x).
+
+Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import importlib.util
+import json
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from prophet.pddl import Domain, read_domain, read_problem
+from prophet.planner import PlanStep
+from prophet.planners.fd import find_driver
+from prophet.planners.planfile import parse_plan
+from prophet.validate import validate_plan
+
+BENCHMARKS = ROOT.parent / "shared" / "benchmarks" / "pddl"
+OUT = ROOT / "build" / "bench"
+IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
+"""Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""
+GRACE_S = 5.0
+QUICK = {
+    "blocks": ("probBLOCKS-4-0", "probBLOCKS-5-2", "probBLOCKS-6-1", "probBLOCKS-8-0"),
+    "rovers": ("p01", "p03", "p05", "p10"),
+}
+OURS, FD, PYPERPLAN, ANYTIME = "ours", "fd lama-first", "pyperplan gbf-hff", "ours anytime 10 s"
+
+
+@dataclass(frozen=True, slots=True)
+class Job:
+    """One planner on one problem."""
+
+    planner: str
+    domain: str
+    problem: str
+    domain_file: Path
+    problem_file: Path
+
+
+@dataclass(slots=True)
+class Outcome:
+    """What a job gave: a plan (validated) or why not."""
+
+    job: Job
+    wall_s: float
+    status: str
+    steps: tuple[PlanStep, ...] | None = None
+    cost: float | None = None
+    valid: str = "-"
+    note: str = ""
+
+    @property
+    def solved(self) -> bool:
+        """Whether the job gave a valid plan."""
+        return self.valid == "VALID"
+
+
+@dataclass(frozen=True, slots=True)
+class Proc:
+    """A finished (or killed) process."""
+
+    code: int | None
+    wall_s: float
+    out: str
+    err: str
+    timed_out: bool
+
+
+@dataclass
+class Tasks:
+    """Parsed domains and problems, each read once, for validation."""
+
+    domains: dict[Path, Domain] = field(default_factory=dict)
+
+    def check(self, job: Job, steps: Sequence[PlanStep]) -> tuple[bool, float, str]:
+        """Validate ``steps`` on the job's task: (valid, cost, reason)."""
+        domain = self.domains.get(job.domain_file)
+        if domain is None:
+            domain = self.domains[job.domain_file] = read_domain(job.domain_file)
+        result = validate_plan((domain, read_problem(job.problem_file, domain)), tuple(steps))
+        return result.valid, result.cost, result.reason
+
+
+def run_process(command: Sequence[str], cwd: Path, timeout: float) -> Proc:
+    """Run ``command`` in its own process group; kill the whole group after ``timeout`` wall seconds."""
+    start = time.perf_counter()
+    with subprocess.Popen(
+        list(command),
+        cwd=cwd,
+        stdin=subprocess.DEVNULL,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    ) as process:
+        try:
+            out, err = process.communicate(timeout=timeout)
+            timed_out = False
+        except subprocess.TimeoutExpired:
+            with contextlib.suppress(ProcessLookupError):
+                os.killpg(process.pid, signal.SIGKILL)
+            out, err = process.communicate()
+            timed_out = True
+        wall = time.perf_counter() - start
+    return Proc(process.returncode, wall, out, err, timed_out)
+
+
+def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Outcome:
+    """``alica plan --json``: the plan it printed, validated again here."""
+    command = [
+        sys.executable,
+        "-m",
+        "alica.cli",
+        "plan",
+        str(job.domain_file),
+        str(job.problem_file),
+        "--json",
+        "--time-limit",
+        f"{limit:g}",
+    ]
+    if anytime:
+        command.append("--anytime")
+    proc = run_process(command, ROOT, limit + GRACE_S)
+    if proc.timed_out:
+        return Outcome(job, proc.wall_s, "killed")
+    if proc.code != 0:
+        status = {3: "unsolvable", 4: "timeout"}.get(proc.code or 0, f"exit {proc.code}")
+        return Outcome(job, proc.wall_s, status, note=_last_line(proc.err))
+    summary = json.loads(proc.out)
+    steps = parse_plan("\n".join(summary["plan"])).steps
+    return _validated(Outcome(job, proc.wall_s, "ok"), steps, tasks, claimed=summary["cost"])
+
+
+def run_fd(job: Job, limit: float, tasks: Tasks) -> Outcome:
+    """Fast Downward's driver with lama-first, in a temporary folder; the plan file, validated."""
+    driver = find_driver()
+    if driver is None:
+        return Outcome(job, 0.0, "not installed")
+    with tempfile.TemporaryDirectory(prefix="bench-fd-") as tmp:
+        command = [
+            sys.executable,
+            str(driver),
+            "--overall-time-limit",
+            f"{int(limit)}s",
+            "--alias",
+            "lama-first",
+            "--plan-file",
+            "sas_plan",
+            str(job.domain_file),
+            str(job.problem_file),
+        ]
+        proc = run_process(command, Path(tmp), limit + GRACE_S)
+        plan_file = Path(tmp) / "sas_plan"
+        if not plan_file.exists():
+            status = (
+                "killed"
+                if proc.timed_out
+                else {10: "unsolvable", 11: "unsolvable", 23: "timeout"}.get(proc.code or 0, f"exit {proc.code}")
+            )
+            return Outcome(job, proc.wall_s, status, note=_last_line(proc.err))
+        plan = parse_plan(plan_file.read_text(encoding="utf-8"), "sas_plan")
+    return _validated(Outcome(job, proc.wall_s, "ok"), plan.steps, tasks, claimed=plan.cost)
+
+
+def run_pyperplan(job: Job, limit: float, tasks: Tasks) -> Outcome:
+    """pyperplan gbf with hFF on copies of the files; its ``.soln`` file, validated."""
+    if importlib.util.find_spec("pyperplan") is None:
+        return Outcome(job, 0.0, "not installed")
+    with tempfile.TemporaryDirectory(prefix="bench-pyperplan-") as tmp:
+        folder = Path(tmp)
+        domain = shutil.copy(job.domain_file, folder / "domain.pddl")
+        problem = shutil.copy(job.problem_file, folder / job.problem_file.name)
+        command = [sys.executable, "-m", "pyperplan", "-s", "gbf", "-H", "hff", str(domain), str(problem)]
+        proc = run_process(command, folder, limit)
+        solution = Path(f"{problem}.soln")
+        if not solution.exists():
+            return Outcome(job, proc.wall_s, "killed" if proc.timed_out else "no plan", note=_last_line(proc.err))
+        plan = parse_plan(solution.read_text(encoding="utf-8"), solution.name)
+    return _validated(Outcome(job, proc.wall_s, "ok"), plan.steps, tasks, claimed=None)
+
+
+def _validated(outcome: Outcome, steps: tuple[PlanStep, ...], tasks: Tasks, claimed: float | None) -> Outcome:
+    valid, cost, reason = tasks.check(outcome.job, steps)
+    outcome.steps, outcome.cost = steps, cost
+    outcome.valid = "VALID" if valid else "INVALID"
+    if not valid:
+        outcome.note = reason
+    elif claimed is not None and abs(claimed - cost) > 1e-9:
+        outcome.note = f"claimed cost {claimed}, validated {cost}"
+    return outcome
+
+
+def _last_line(text: str) -> str:
+    lines = [line for line in text.strip().splitlines() if line.strip()]
+    return lines[-1][:160] if lines else ""
+
+
+def _order(name: str) -> tuple[int, ...]:
+    return tuple(int(n) for n in re.findall(r"\d+", name))
+
+
+def problems(domain: str, limit: int | None, quick: bool) -> list[Job]:
+    """The benchmark problems of ``domain`` (natural order), as planner-less jobs."""
+    folder = BENCHMARKS / domain
+    names = sorted((p.stem for p in folder.glob("*.pddl") if p.name != "domain.pddl"), key=_order)
+    if quick:
+        names = [n for n in names if n in QUICK.get(domain, ())]
+    if limit is not None:
+        names = names[:limit]
+    return [Job("", domain, n, folder / "domain.pddl", folder / f"{n}.pddl") for n in names]
+
+
+def optimal_costs(domain: str) -> dict[str, float]:
+    """The proven optimal costs of ``optimal_costs.tsv`` (problems without one are left out)."""
+    path = BENCHMARKS / domain / "optimal_costs.tsv"
+    costs: dict[str, float] = {}
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("#") or not line.strip():
+            continue
+        name, _, value = line.partition("\t")
+        with contextlib.suppress(ValueError):
+            costs[name.strip()] = float(value)
+    return costs
+
+
+def _fmt(value: float | None, digits: int = 2) -> str:
+    if value is None:
+        return "-"
+    return str(int(value)) if float(value).is_integer() and digits == 0 else f"{value:.{digits}f}"
+
+
+def markdown(header: Sequence[str], rows: Iterable[Sequence[object]]) -> str:
+    """A markdown table."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+def write_tsv(name: str, header: Sequence[str], rows: Iterable[Sequence[object]]) -> None:
+    """One table as ``build/bench/NAME.tsv``."""
+    OUT.mkdir(parents=True, exist_ok=True)
+    text = "\t".join(header) + "\n" + "".join("\t".join(str(c) for c in row) + "\n" for row in rows)
+    (OUT / f"{name}.tsv").write_text(text, encoding="utf-8")
+
+
+def table(name: str, title: str, header: Sequence[str], rows: list[list[object]], note: str = "") -> None:
+    """Print one table as markdown and write it as TSV."""
+    print(f"\n### {title}\n")
+    print(markdown(header, rows))
+    if note:
+        print(f"\n{note}")
+    write_tsv(name, header, rows)
+
+
+def report(outcomes: list[Outcome], limit: float, budget: float) -> None:
+    """Print the four tables (those the runs allow) and write them with every run as TSV."""
+    by = {(o.job.planner, o.job.domain, o.job.problem): o for o in outcomes}
+    domains = sorted({o.job.domain for o in outcomes})
+    planners = [p for p in (OURS, FD, PYPERPLAN) if any(o.job.planner == p for o in outcomes)]
+    write_tsv(
+        "planners_runs",
+        ["planner", "domain", "problem", "status", "valid", "cost", "wall_s", "note"],
+        [
+            [o.job.planner, o.job.domain, o.job.problem, o.status, o.valid, _fmt(o.cost, 0), f"{o.wall_s:.3f}", o.note]
+            for o in outcomes
+        ],
+    )
+
+    rows = []
+    for domain in domains:
+        total = len({o.job.problem for o in outcomes if o.job.domain == domain and o.job.planner == OURS})
+        rows.append(
+            [
+                domain,
+                *(
+                    f"{sum(1 for o in outcomes if o.job.planner == p and o.job.domain == domain and o.solved)}/{total}"
+                    for p in planners
+                ),
+            ]
+        )
+    if len(domains) > 1:
+        total = sum(1 for o in outcomes if o.job.planner == OURS)
+        rows.append(
+            ["all", *(f"{sum(1 for o in outcomes if o.job.planner == p and o.solved)}/{total}" for p in planners)]
+        )
+    table("planners_coverage", f"Coverage (valid plans within {limit:g} s)", ["domain", *planners], rows)
+
+    early = [f"p{i:02d}" for i in range(1, 21)]
+    present = [p for p in early if (OURS, "rovers", p) in by]
+    if present:
+        rows = []
+        for planner in planners:
+            runs = [by.get((planner, "rovers", p)) for p in present]
+            solved = [r for r in runs if r is not None and r.solved]
+            rows.append(
+                [planner, f"{len(solved)}/{len(present)}", f"{sum(r.wall_s for r in runs if r is not None):.2f}"]
+            )
+        ours = sum(by[(OURS, "rovers", p)].wall_s for p in present)
+        fd = (
+            sum(by[(FD, "rovers", p)].wall_s for p in present)
+            if all((FD, "rovers", p) in by for p in present)
+            else None
+        )
+        ratio = f"ours / fd = {ours / fd:.2f}x (goal: at most 2x)" if fd else ""
+        table(
+            "planners_rovers_time",
+            f"Rovers {present[0]}-{present[-1]}: total whole-process wall time (s)",
+            ["planner", "solved", "total wall s"],
+            rows,
+            ratio,
+        )
+
+        rows = []
+        met = 0
+        for p in present:
+            impera = IMPERA_TABLE1[int(p[1:]) - 1]
+            ours_run = by[(OURS, "rovers", p)]
+            ok = ours_run.solved and ours_run.cost is not None and ours_run.cost <= impera
+            met += ok
+            rows.append(
+                [
+                    p,
+                    impera,
+                    *(
+                        _fmt(
+                            by[(pl, "rovers", p)].cost
+                            if by.get((pl, "rovers", p)) and by[(pl, "rovers", p)].solved
+                            else None,
+                            0,
+                        )
+                        for pl in planners
+                    ),
+                    "yes" if ok else "NO",
+                ]
+            )
+        table(
+            "planners_rovers_cost",
+            "Rovers: plan cost vs the IMPERA paper's Table 1 (FDP)",
+            ["problem", "IMPERA", *planners, "ours <= IMPERA"],
+            rows,
+            f"ours at most IMPERA's cost on {met} of {len(present)}",
+        )
+
+    anytime = [o for o in outcomes if o.job.planner == ANYTIME]
+    if anytime:
+        optimum = optimal_costs("blocks")
+        rows = []
+        total_ours = total_opt = 0.0
+        for o in sorted(anytime, key=lambda o: _order(o.job.problem)):
+            best = optimum[o.job.problem]
+            first = by.get((OURS, "blocks", o.job.problem))
+            if o.solved and o.cost is not None:
+                total_ours += o.cost
+                total_opt += best
+            rows.append(
+                [
+                    o.job.problem,
+                    _fmt(best, 0),
+                    _fmt(first.cost if first and first.solved else None, 0),
+                    _fmt(o.cost if o.solved else None, 0),
+                    f"{o.cost / best:.2f}" if o.solved and o.cost else "-",
+                ]
+            )
+        solved = sum(1 for o in anytime if o.solved)
+        note = (
+            (
+                f"solved {solved}/{len(anytime)}; total cost {total_ours:g} vs optimum {total_opt:g} = "
+                f"{total_ours / total_opt:.3f}x on the solved ones (goal: at most 1.15x)"
+            )
+            if total_opt
+            else f"solved {solved}/{len(anytime)}"
+        )
+        table(
+            "planners_blocks_anytime",
+            f"Blocks with a proven optimum: ours after {budget:g} s anytime vs the optimum",
+            ["problem", "optimum", "ours first plan", f"ours anytime {budget:g} s", "ratio"],
+            rows,
+            note,
+        )
+
+
+def jobs_for(domains: Sequence[str], limit: int | None, quick: bool, planners: Sequence[str]) -> list[Job]:
+    """Every job of the run, in a fixed order: per problem ours, FD, pyperplan; then the anytime runs."""
+    jobs: list[Job] = []
+    anytime: list[Job] = []
+    for domain in domains:
+        known = optimal_costs(domain) if domain == "blocks" else {}
+        for base in problems(domain, limit, quick):
+            for planner in planners:
+                jobs.append(Job(planner, base.domain, base.problem, base.domain_file, base.problem_file))
+            if base.problem in known and OURS in planners:
+                anytime.append(Job(ANYTIME, base.domain, base.problem, base.domain_file, base.problem_file))
+    return jobs + anytime
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the bench; returns the exit code."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument(
+        "--domains", default="blocks,rovers", help="comma-separated benchmark domains (default blocks,rovers)"
+    )
+    parser.add_argument("--limit", type=int, help="the first N problems of each domain")
+    parser.add_argument("--jobs", type=int, default=1, help="processes at a time (default 1: timings must not compete)")
+    parser.add_argument("--quick", action="store_true", help="a few small problems per domain, for a smoke run")
+    parser.add_argument("--time-limit", type=float, default=60.0, metavar="S", help="wall seconds per run (default 60)")
+    parser.add_argument(
+        "--anytime-budget", type=float, default=10.0, metavar="S", help="ours --anytime on blocks (default 10)"
+    )
+    parser.add_argument("--planners", default=f"{OURS},fd,pyperplan", help="which of ours, fd, pyperplan (default all)")
+    args = parser.parse_args(argv)
+
+    names = {"ours": OURS, "fd": FD, "pyperplan": PYPERPLAN}
+    planners = [names[p.strip()] for p in args.planners.split(",") if p.strip()]
+    domains = [d.strip() for d in args.domains.split(",") if d.strip()]
+    jobs = jobs_for(domains, args.limit, args.quick, planners)
+    tasks = Tasks()
+    runners: dict[str, Callable[[Job], Outcome]] = {
+        OURS: lambda j: run_ours(j, args.time_limit, tasks),
+        FD: lambda j: run_fd(j, args.time_limit, tasks),
+        PYPERPLAN: lambda j: run_pyperplan(j, args.time_limit, tasks),
+        ANYTIME: lambda j: run_ours(j, args.anytime_budget, tasks, anytime=True),
+    }
+    print(f"{len(jobs)} runs, {args.jobs} at a time, {args.time_limit:g} s limit each", file=sys.stderr)
+
+    def one(job: Job) -> Outcome:
+        outcome = runners[job.planner](job)
+        print(
+            f"  {job.planner:<18} {job.domain}/{job.problem:<16} {outcome.status:<10} {outcome.valid:<7} "
+            f"cost {_fmt(outcome.cost, 0):>4}  {outcome.wall_s:7.2f} s {outcome.note}",
+            file=sys.stderr,
+            flush=True,
+        )
+        return outcome
+
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        outcomes = list(pool.map(one, jobs))
+    report(outcomes, args.time_limit, args.anytime_budget)
+    invalid = [o for o in outcomes if o.valid == "INVALID"]
+    if invalid:
+        print(f"\n{len(invalid)} INVALID plan(s): see build/bench/planners_runs.tsv", file=sys.stderr)
+    return 1 if any(o.job.planner in (OURS, ANYTIME) and o.valid == "INVALID" for o in outcomes) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
