@@ -1,15 +1,14 @@
-"""A few benchmark problems through the real parser and grounding (skipped until they are importable)."""
+"""A few benchmark problems through the real parser and grounding (the benchmark folder must be there)."""
 
 from __future__ import annotations
 
 import pytest
 
+from prophet import ground as grounding
+from prophet import pddl
 from prophet.planner import Done, Improved, PlanStatus
 from prophet.search import BuiltinPlanner, search_task
 from tests.prophet.search.helpers import BENCHMARKS, check_plan
-
-pddl = pytest.importorskip("prophet.pddl")
-grounding = pytest.importorskip("prophet.ground")
 
 CASES = [
     ("blocks", "probBLOCKS-4-0", 6),
@@ -20,11 +19,11 @@ CASES = [
 
 
 def load(domain: str, problem: str):
+    assert BENCHMARKS.is_dir(), f"the benchmark folder {BENCHMARKS} is missing"
     d = pddl.read_domain(BENCHMARKS / domain / "domain.pddl")
     return d, pddl.read_problem(BENCHMARKS / domain / f"{problem}.pddl", d)
 
 
-@pytest.mark.skipif(not BENCHMARKS.is_dir(), reason="benchmark folder not present")
 @pytest.mark.parametrize(("domain", "problem", "optimum"), CASES)
 def test_benchmark_problem(domain: str, problem: str, optimum: int) -> None:
     d, p = load(domain, problem)
@@ -43,7 +42,6 @@ def test_benchmark_problem(domain: str, problem: str, optimum: int) -> None:
         assert found[-1].cost == optimum
 
 
-@pytest.mark.skipif(not BENCHMARKS.is_dir(), reason="benchmark folder not present")
 def test_builtin_planner_solve() -> None:
     d, p = load("rovers", "p01")
     result = BuiltinPlanner().solve(d, p, time_limit=10)
