@@ -49,7 +49,7 @@ from prophet.planners.fd import find_driver
 from prophet.planners.planfile import parse_plan
 from prophet.validate import validate_plan
 
-BENCHMARKS = ROOT.parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = ROOT / "benchmarks" / "pddl"
 OUT = ROOT / "build" / "bench"
 IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""

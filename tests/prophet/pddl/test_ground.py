@@ -10,7 +10,7 @@ import pytest
 from prophet.ground import GroundTask, ground
 from prophet.pddl import PddlError, parse_domain, parse_problem, read_domain, read_problem
 
-BENCHMARKS = Path(__file__).resolve().parents[3].parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
 
 def _task(domain_text: str, problem_text: str) -> GroundTask:

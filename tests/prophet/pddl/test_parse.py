@@ -18,7 +18,7 @@ from prophet.pddl import (
 )
 from prophet.planner import Feature
 
-BENCHMARKS = Path(__file__).resolve().parents[3].parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
 
 def benchmark_sets() -> list[tuple[Path, list[Path]]]:

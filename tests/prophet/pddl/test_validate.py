@@ -11,7 +11,7 @@ from prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
 from prophet.planner import Plan, PlanStep
 from prophet.validate import validate_plan
 
-BENCHMARKS = Path(__file__).resolve().parents[3].parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
 GOOD = [("pick-up", "b"), ("stack", "b", "a"), ("pick-up", "c"), ("stack", "c", "b"), ("pick-up", "d"), ("stack", "d", "c")]
 

@@ -10,7 +10,7 @@ import pytest
 
 from alica.cli import main
 
-BENCHMARKS = Path(__file__).resolve().parents[3].parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
 UNSOLVABLE_DOMAIN = """\
 (define (domain switch)

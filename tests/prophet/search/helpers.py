@@ -10,7 +10,7 @@ from pathlib import Path
 
 from prophet.planner import Plan
 
-BENCHMARKS = Path(__file__).resolve().parents[3].parent / "shared" / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
 
 @dataclass(frozen=True, slots=True)
