@@ -251,23 +251,21 @@ class Relaxed:
     # ------------------------------------------------------- other estimates
     def h_add(self, state: int) -> tuple[float, list[int]]:
         """The additive heuristic (sum of the goals' relaxed costs)."""
-        gm = self.goal_mask
-        if state & gm == gm:
-            return 0, []
-        cost, _sup = self._explore_add(state, True)
-        if cost is None:
-            return INF, []
-        return sum(c for f, c in enumerate(cost) if self.is_goal[f]), []
+        return self._goal_costs(state, additive=True)
 
     def h_max(self, state: int) -> tuple[float, list[int]]:
         """The admissible max heuristic (the costliest goal's relaxed cost)."""
+        return self._goal_costs(state, additive=False)
+
+    def _goal_costs(self, state: int, additive: bool) -> tuple[float, list[int]]:
         gm = self.goal_mask
         if state & gm == gm:
             return 0, []
-        cost, _sup = self._explore_add(state, False)
+        cost, _sup = self._explore_add(state, additive)
         if cost is None:
             return INF, []
-        return max(c for f, c in enumerate(cost) if self.is_goal[f]), []
+        goals = (c for f, c in enumerate(cost) if self.is_goal[f])
+        return (sum(goals) if additive else max(goals)), []
 
     def goal_count(self, state: int) -> tuple[float, list[int]]:
         """The number of unsatisfied goals (INF on a relaxed dead end is not detected)."""
