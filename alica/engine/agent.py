@@ -105,6 +105,7 @@ class AgentEngine:
         for topic in (TEAM_TOPIC, SYNC_TOPIC, WORLD_TOPIC):
             transport.subscribe(topic)
         self._world_changed = False
+        self._refresh = getattr(world_model, "refresh", None)
         if hasattr(world_model, "on_change"):
             world_model.on_change(self._on_world_change)
 
@@ -158,9 +159,8 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self._invalidate_all()
-        refresh = getattr(self.world_model, "refresh", None)
-        if refresh is not None:
-            refresh()  # values whose time to live ran out
+        if self._refresh is not None:
+            self._refresh()  # values whose time to live ran out
         if self._world_changed:
             # utilities with summands read the world: allocate those plans again
             self._world_changed = False
@@ -444,9 +444,7 @@ class AgentEngine:
             agents.append(agent)
             current[agent] = entry[0] if entry is not None else None
         agents_t = tuple(agents)
-        plans: tuple[Plan, ...] = (plan,) if node.slot is None else tuple(
-            p for p in node.slot.candidates() if p is plan or self.formulas.holds(p.pre.text if p.pre else None, self.belief_for(node.slot.parent), node.env)
-        )
+        plans: tuple[Plan, ...] = (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan)
         if plan not in plans:
             plans = (plan, *plans)
         successes = {plan.name: node.successes()}

@@ -74,14 +74,19 @@ class Slot:
             return ()
         return tuple(library.plans[n] for n in names if n not in self.failed_plans)
 
+    def startable(self, plans: tuple[Plan, ...], keep: Plan | None = None) -> tuple[Plan, ...]:
+        """The plans whose pre-condition holds now (``keep`` is kept regardless: it already runs)."""
+        engine = self.parent.engine
+        belief = engine.belief_for(self.parent)
+        return tuple(p for p in plans if p is keep or engine.formulas.holds(p.pre.text if p.pre else None, belief, self.env))
+
     # -- life ----------------------------------------------------------
 
     def start(self, now: float, only: Plan | None = None) -> None:
         """Allocate the agents of the parent state to this plan child and start it."""
         engine = self.parent.engine
         candidates = (only,) if only is not None else self.candidates()
-        env = self.env
-        usable = tuple(p for p in candidates if engine.formulas.holds(p.pre.text if p.pre else None, engine.belief_for(self.parent), env))
+        usable = self.startable(candidates)
         if not usable:
             self._wait(now, "no plan whose pre-condition holds" if candidates else "no plan left")
             return
