@@ -389,7 +389,7 @@ def _plantype(node: Node, problems: Problems) -> PlanType:
 
 
 def _problem(node: Node, problems: Problems) -> PlanningProblem:
-    keys = ("name", "elements", "goal", "wait_plan", "alternative_plan", "update_time", "world", "objects", "planner", "description")
+    keys = ("name", "elements", "goal", "wait_plan", "alternative_plan", "update_time", "timeout", "world", "objects", "planner", "description")
     f = _element(node, "problems", problems, keys)
     if f is None:
         return PlanningProblem("", (), Condition(ConditionKind.POST, "true"), span=node.span)
@@ -400,6 +400,9 @@ def _problem(node: Node, problems: Problems) -> PlanningProblem:
     update_time = f.number("update_time", 1.0)
     if not math.isfinite(update_time) or update_time <= 0:
         problems.add(f.get("update_time").span, f"'update_time' of {f.what} must be a positive number of seconds", "use e.g. 1.0")  # type: ignore[union-attr]
+    timeout = f.number("timeout", 60.0)
+    if not math.isfinite(timeout) or timeout <= 0:
+        problems.add(f.get("timeout").span, f"'timeout' of {f.what} must be a positive number of seconds", "use e.g. 60")  # type: ignore[union-attr]
     return PlanningProblem(
         f.name(),
         tuple(n for n, _ in f.names("elements", required=True, hint="list the skill plans the planner may use")),
@@ -407,6 +410,7 @@ def _problem(node: Node, problems: Problems) -> PlanningProblem:
         f.text("wait_plan").strip() or None,
         f.text("alternative_plan").strip() or None,
         update_time,
+        timeout,
         _condition(f, "world", ConditionKind.PRE),
         _typed_list(f, "objects"),
         f.text("planner", default="builtin").strip(),

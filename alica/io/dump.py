@@ -209,6 +209,7 @@ def _problem(p: PlanningProblem) -> Data:
     _put(out, "wait_plan", p.wait_plan)
     _put(out, "alternative_plan", p.alternative_plan)
     _put(out, "update_time", _number(p.update_time), 1)
+    _put(out, "timeout", _number(p.timeout), 60)
     _put(out, "planner", p.planner, "builtin")
     _put(out, "objects", _typed(p.objects))
     _put(out, "world", _cond(p.world))

@@ -47,7 +47,7 @@ the shape the table below gives it. Tags and attributes are the YAML keys
                      fail_on_timeout
     <plantype>       name description                   plan -> plans (names)
     <problem>        name wait_plan alternative_plan    element -> elements (names), object -> objects
-                     update_time planner description    (list), world goal (text)
+                     update_time timeout planner description    (list), world goal (text)
     <variable>, <parameter>, <object>: name type  (a typed name, ``{name, type}`` in YAML)
 
 Shapes:

@@ -177,7 +177,7 @@ _SPECS: dict[str, _Spec] = {
     ),
     "plantype": _Spec(("name", "description"), (_DESCRIPTION, _Child("plan", "plans", NAMES))),
     "problem": _Spec(
-        ("name", "wait_plan", "alternative_plan", "update_time", "planner", "description"),
+        ("name", "wait_plan", "alternative_plan", "update_time", "timeout", "planner", "description"),
         (
             _DESCRIPTION,
             _Child("element", "elements", NAMES),

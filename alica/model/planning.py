@@ -19,6 +19,8 @@ class PlanningProblem:
         wait_plan: WaitPlan(O), run by the team until the first plan is ready.
         alternative_plan: AlternativePlan(O), run when planning fails.
         update_time: UpdateTime(O), seconds between plan updates.
+        timeout: seconds the leader may plan without a first plan before the
+            team gives up and runs the AlternativePlan.
         world: World(O) for offline use, a conjunction of facts; ``None`` reads
             the world model at run time.
         objects: typed objects for an offline world.
@@ -31,6 +33,7 @@ class PlanningProblem:
     wait_plan: str | None = None
     alternative_plan: str | None = None
     update_time: float = 1.0
+    timeout: float = 60.0
     world: Condition | None = None
     objects: tuple[Variable, ...] = ()
     planner: str = "builtin"

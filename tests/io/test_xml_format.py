@@ -147,6 +147,7 @@ problems:
     wait_plan: Wait
     alternative_plan: Empty
     update_time: 0.5
+    timeout: 30
     planner: builtin
     objects: ["a - sample", "g - location", r1]
     world: "onground(a) and handempty(r1)"
@@ -244,7 +245,7 @@ HANDWRITTEN_XML = """\
     </synchronisation>
   </plan>
   <plantype name="T"><plan>A</plan><plan>B</plan></plantype>
-  <problem name="GetObjects" wait_plan="Wait" alternative_plan="Alt" update_time="1" planner="builtin">
+  <problem name="GetObjects" wait_plan="Wait" alternative_plan="Alt" update_time="1" timeout="30" planner="builtin">
     <element>MoveToObject</element>
     <object name="a" type="sample"/>
     <world>onground(a)</world>
@@ -291,6 +292,7 @@ problems:
     elements: [MoveToObject]
     wait_plan: Wait
     alternative_plan: Alt
+    timeout: 30
     objects: [a - sample]
     world: onground(a)
     goal: On(a, g)
@@ -1116,7 +1118,7 @@ DOCUMENT_DATA = _optional(
     plans=st.lists(PLAN, max_size=2),
     plantypes=st.lists(_optional({"name": NAME, "plans": st.lists(NAME, min_size=1, max_size=3)}, description=TEXT), max_size=2),
     problems=st.lists(_optional({"name": NAME, "elements": st.lists(NAME, min_size=1, max_size=2), "goal": TEXT, "wait_plan": NAME},
-                                description=TEXT, alternative_plan=NAME, update_time=st.floats(1e-3, 1e3), planner=NAME,
+                                description=TEXT, alternative_plan=NAME, update_time=st.floats(1e-3, 1e3), timeout=st.floats(1e-3, 1e3), planner=NAME,
                                 objects=st.lists(TYPED, max_size=2), world=TEXT), max_size=2),
 )
 
