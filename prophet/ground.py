@@ -7,6 +7,10 @@ through indexes on the bound argument positions (never a cross product of all
 objects). Negative preconditions and negated goals become positive
 ``(not-p ...)`` facts that the effects keep up to date; equality is decided
 while grounding; static facts (changed by no action) leave the preconditions.
+Those ``not-`` facts and when-effects need a second, ground relaxed exploration
+(over local integer fact ids); a task without them (plain STRIPS, such as
+Rovers) skips it, since the fixpoint's exploration is then exact. The garbage
+collector is paused while grounding (many objects, no cycles).
 
 >>> from prophet.pddl import parse_domain, parse_problem
 >>> d = parse_domain("(define (domain d) (:predicates (p ?x) (q ?x)) (:action a :parameters (?x) :precondition (p ?x) :effect (q ?x)))")
@@ -17,7 +21,11 @@ while grounding; static facts (changed by no action) leave the preconditions.
 
 from __future__ import annotations
 
+import gc
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from operator import itemgetter
 
 from prophet.pddl import Domain, PddlError, Problem
 from prophet.pddl.model import Equals
@@ -134,6 +142,27 @@ def ground(domain: Domain, problem: Problem) -> GroundTask:
             not a non-negative integer, a goal is disjunctive, or conditional
             effects make a negative precondition impossible to compile.
     """
+    with _collector_paused():
+        return _ground(domain, problem)
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """The cyclic garbage collector off for a while (grounding makes many objects but no cycles).
+
+    Without this, the collector's full passes over every object of the process
+    take a good part of the grounding's time on large tasks.
+    """
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _ground(domain: Domain, problem: Problem) -> GroundTask:
     fix = Fixpoint(domain, problem)
     fix.run()
     goal_clauses = [c for c in dnf(expand(problem.goal, fix.objects_of)) if fix.clause_possible(c)]
@@ -159,52 +188,153 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     negated.update(goal_neg)
     for action in fix.actions:
         negated.update(action.neg)
-        for cond_pos, cond_neg, _, _ in action.conditional:
+        for _cond_pos, cond_neg, _, _ in action.conditional:
             negated.update(cond_neg)
+    init_fluent = {f for f in fix.init if f[0] in fluent}
+    if not negated and not any(action.conditional for action in fix.actions):
+        return _build_positive(problem, fix, init_fluent, goal_pos, reason)
     taken = {p.name for p in domain.predicates}
     not_names = {pred: _not_name(pred, taken) for pred in sorted({f[0] for f in negated})}
 
     def nf(fact: Fact) -> Fact:
         return (not_names[fact[0]], *fact[1:])
 
-    init_fluent = {f for f in fix.init if f[0] in fluent}
     init = init_fluent | {nf(f) for f in negated if f not in init_fluent}
-    compiled = [_compile(a, negated, nf) for a in fix.actions]
-    reached, kept = _reachable(init, compiled)
+    table = _Facts()
+    compiled = [_compile(a, negated, nf, table) for a in fix.actions]
+    init_ids = {table.id(f) for f in init}
     goal_facts = [*goal_pos, *(nf(f) for f in goal_neg)]
+    goal_ids = [table.id(f) for f in goal_facts]
+    reached, fired = _reachable(len(table.ids), init_ids, compiled)
+    missing = [f for f, i in zip(goal_facts, goal_ids, strict=True) if not reached[i]]
+    if reason is None and missing:
+        reason = f"goal fact {fact_text(missing[0])} is not reachable even ignoring deletes"
+    facts = table.facts
+    wanted = {i for i, ok in enumerate(reached) if ok} | set(goal_ids)
+    text_of = {i: fact_text(facts[i]) for i in wanted}
+    names = sorted(set(text_of.values()))
+    ids = {text: i for i, text in enumerate(names)}
+    final = [-1] * len(facts)  # -1: not reached (left out of the operators)
+    for i, text in text_of.items():
+        if reached[i]:
+            final[i] = ids[text]
+    goal_final = {ids[text_of[i]] for i in goal_ids}
+    operators = _operators([(fix.actions[k], compiled[k]) for k in fired], final)
+    return GroundTask(
+        problem.name, tuple(names), frozenset(final[i] for i in init_ids if final[i] >= 0),
+        tuple(sorted(goal_final)), operators, fix.has_costs, reason,
+    )
+
+
+def _build_positive(
+    problem: Problem, fix: Fixpoint, init: set[Fact], goal_facts: list[Fact], reason: str | None
+) -> GroundTask:
+    """The task when no action has a negative precondition or a when-effect and no goal is negated.
+
+    Then the fixpoint's relaxed exploration is exact: every action it found is reachable,
+    and the reached facts are the initial fluent facts and the actions' adds.
+    """
+    reached = set(init)
+    for action in fix.actions:
+        reached.update(action.add)
     missing = [f for f in goal_facts if f not in reached]
     if reason is None and missing:
         reason = f"goal fact {fact_text(missing[0])} is not reachable even ignoring deletes"
-    names = sorted({fact_text(f) for f in reached} | {fact_text(f) for f in goal_facts})
+    text_of = {f: fact_text(f) for f in reached}
+    text_of.update((f, fact_text(f)) for f in missing)
+    names = sorted(set(text_of.values()))
     ids = {text: i for i, text in enumerate(names)}
-    by_fact = {f: ids[fact_text(f)] for f in reached | set(goal_facts)}
+    final = {f: ids[text_of[f]] for f in reached}
+    operators: dict[tuple, GroundOperator] = {}
+    for action in fix.actions:
+        name = fact_text((action.action, *action.args))
+        add = {final[f] for f in action.add}
+        delete = {final[f] for f in action.delete if f in final}
+        delete -= add
+        pre_ids = tuple(sorted({final[f] for f in action.pos}))
+        add_ids = tuple(sorted(add))
+        del_ids = tuple(sorted(delete))
+        key = (name, pre_ids, add_ids, del_ids, action.cost, ())
+        if key not in operators:
+            operators[key] = GroundOperator(name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost)
+    return GroundTask(
+        problem.name, tuple(names), frozenset(final[f] for f in init), tuple(sorted({ids[text_of[f]] for f in goal_facts})),
+        _ordered(operators), fix.has_costs, reason,
+    )
 
-    def idset(facts: set[Fact] | frozenset[Fact]) -> tuple[int, ...]:
-        return tuple(sorted(by_fact[f] for f in facts if f in reached))
 
+def _ordered(operators: dict[tuple, GroundOperator]) -> tuple[GroundOperator, ...]:
+    """The operators by name, pre, add and delete (stable: ties in the order found)."""
+    return tuple(operators[k] for k in sorted(operators, key=_FIRST_FOUR))
+
+
+_FIRST_FOUR = itemgetter(slice(0, 4))
+
+
+class _Facts:
+    """Fact tuples numbered in the order first seen (ids local to one grounding)."""
+
+    __slots__ = ("ids",)
+
+    def __init__(self) -> None:
+        self.ids: dict[Fact, int] = {}
+
+    @property
+    def facts(self) -> list[Fact]:
+        """The facts by id."""
+        return list(self.ids)
+
+    def id(self, fact: Fact) -> int:
+        """The id of ``fact`` (a new one the first time)."""
+        ids = self.ids
+        return ids.setdefault(fact, len(ids))
+
+    def ids_of(self, facts: set[Fact] | frozenset[Fact]) -> frozenset[int]:
+        """The ids of ``facts``."""
+        ids = self.ids
+        new = ids.setdefault
+        return frozenset([new(f, len(ids)) for f in facts])
+
+
+Compiled = tuple[frozenset[int], frozenset[int], frozenset[int], tuple[tuple[frozenset[int], frozenset[int], frozenset[int]], ...]]
+"""Pre, add, delete (minus add) and the when-effects (condition, add, delete) of one action, over local fact ids."""
+
+
+def _operators(kept: list[tuple[GroundAction, Compiled]], final: list[int]) -> tuple[GroundOperator, ...]:
+    """The ground operators in their fixed order, duplicates dropped, over the final fact ids.
+
+    ``final`` maps a local fact id to its id in the task, -1 for a fact never reached; the
+    preconditions and adds of an action that fires are all reached.
+    """
     operators: dict[tuple, GroundOperator] = {}
     for action, (pre, add, delete, conditional) in kept:
         cond = []
         for c_pre, c_add, c_del in conditional:
-            if not all(f in reached for f in c_pre):
+            if any(final[f] < 0 for f in c_pre):
                 continue
-            entry = (idset(c_pre), idset(c_add), idset(c_del - c_add))
-            if entry[1] or entry[2]:
-                cond.append(entry)
-        op = GroundOperator(
-            fact_text((action.action, *action.args)), action.action, action.args, idset(pre), idset(add),
-            idset(delete - add), action.cost, tuple(sorted(set(cond))),
-        )
-        operators.setdefault((op.name, op.pre, op.add, op.delete, op.cost, op.conditional), op)
-    ordered = tuple(operators[k] for k in sorted(operators, key=lambda k: (k[0], k[1], k[2], k[3])))
-    return GroundTask(
-        problem.name, tuple(names), frozenset(by_fact[f] for f in init if f in reached),
-        tuple(sorted({by_fact[f] for f in goal_facts})), ordered, fix.has_costs, reason,
-    )
+            c_add_ids = tuple(sorted([final[i] for i in c_add if final[i] >= 0]))
+            c_del_ids = tuple(sorted([final[i] for i in c_del - c_add if final[i] >= 0]))
+            if c_add_ids or c_del_ids:
+                cond.append((tuple(sorted([final[i] for i in c_pre])), c_add_ids, c_del_ids))
+        name = fact_text((action.action, *action.args))
+        pre_ids = tuple(sorted([final[i] for i in pre]))
+        add_ids = tuple(sorted([final[i] for i in add]))
+        del_ids = tuple(sorted([final[i] for i in delete if final[i] >= 0]))
+        conds = tuple(sorted(set(cond))) if cond else ()
+        key = (name, pre_ids, add_ids, del_ids, action.cost, conds)
+        if key not in operators:
+            operators[key] = GroundOperator(name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost, conds)
+    return _ordered(operators)
 
 
-def _compile(action: GroundAction, negated: set[Fact], nf) -> tuple:  # type: ignore[no-untyped-def]
-    """Pre, add, delete and conditional effects with ``not-`` facts kept up to date."""
+def _compile(action: GroundAction, negated: set[Fact], nf: Callable[[Fact], Fact], table: _Facts) -> Compiled:
+    """Pre, add, delete and conditional effects with ``not-`` facts kept up to date, as local fact ids."""
+    if not negated and not action.conditional:  # the common case: nothing to keep up to date
+        ids = table.ids
+        new = ids.setdefault
+        add_ids = frozenset([new(f, len(ids)) for f in action.add])
+        pre_ids = frozenset([new(f, len(ids)) for f in action.pos])
+        return pre_ids, add_ids, frozenset([new(f, len(ids)) for f in action.delete]) - add_ids, ()
     pre = set(action.pos) | {nf(f) for f in action.neg}
     add = set(action.add)
     delete = set(action.delete) - add
@@ -222,48 +352,57 @@ def _compile(action: GroundAction, negated: set[Fact], nf) -> tuple:  # type: ig
                 clash |= ((set(other[2]) & c_del) | (set(other[3]) & c_add)) & negated
         if clash:
             raise PddlError(
-                f"cannot compile the negative precondition on {fact_text(sorted(clash)[0])}: "
+                f"cannot compile the negative precondition on {fact_text(min(clash))}: "
                 f"action {fact_text((action.action, *action.args))} both adds and deletes it under different conditions"
             )
         c_pre = set(c_pos) | {nf(f) for f in c_neg}
         extra_add = {nf(f) for f in c_del & negated}
         extra_del = {nf(f) for f in c_add & negated}
-        conditional.append((frozenset(c_pre), frozenset(c_add | extra_add), frozenset(c_del | extra_del)))
-    return action, (pre, add, delete, conditional)
+        conditional.append((table.ids_of(c_pre), table.ids_of(c_add | extra_add), table.ids_of(c_del | extra_del)))
+    return table.ids_of(pre), table.ids_of(add), table.ids_of(delete - add), tuple(conditional)
 
 
-def _reachable(init: set[Fact], compiled: list[tuple]) -> tuple[set[Fact], list[tuple]]:
-    """Relaxed reachability over the ground actions (counting unmet preconditions)."""
-    reached: set[Fact] = set()
-    waiting: dict[Fact, list[list]] = {}
-    records = []
-    for index, (_action, (pre, add, _delete, conditional)) in enumerate(compiled):
-        records.append([len(pre), add, index])
+def _reachable(n_facts: int, init: set[int], compiled: list[Compiled]) -> tuple[list[bool], list[int]]:
+    """Relaxed reachability over the ground actions (counting unmet preconditions).
+
+    Returns:
+        Per local fact id whether it is reached, and the indexes of the actions that fire (increasing).
+    """
+    reached = [False] * n_facts
+    fired = [False] * len(compiled)
+    # A record: [unmet count, facts it adds, action index or -1 for a when-effect].
+    waiting: list[list[list]] = [[] for _ in range(n_facts)]
+    effects_of: list[list[list]] = [[] for _ in compiled]
+    stack: list[int] = sorted(init)
+    ready: list[list] = []
+    for index, (pre, add, _delete, conditional) in enumerate(compiled):
+        record = [len(pre), add, index]
         for fact in pre:
-            waiting.setdefault(fact, []).append(records[-1])
+            waiting[fact].append(record)
+        if not pre:
+            ready.append(record)
         for c_pre, c_add, _ in conditional:
-            record = [len(c_pre) + 1, c_add, -1]
-            waiting.setdefault(("$op", str(index)), []).append(record)
+            effect = [len(c_pre) + 1, c_add, -1]  # + 1: the action itself must fire
+            effects_of[index].append(effect)
             for fact in c_pre:
-                waiting.setdefault(fact, []).append(record)
-    queue = sorted(init)
-    for record in records:
-        if record[0] == 0:
-            queue.extend(record[1])
-            queue.append(("$op", str(record[2])))
-    fired: set[int] = set()
-    while queue:
-        fact = queue.pop()
-        if fact in reached:
-            continue
-        reached.add(fact)
-        if fact[0] == "$op":
-            fired.add(int(fact[1]))
-        for record in waiting.get(fact, ()):
-            record[0] -= 1
-            if record[0] == 0:
-                queue.extend(record[1])
-                if record[2] >= 0:
-                    queue.append(("$op", str(record[2])))
-    reached = {f for f in reached if f[0] != "$op"}
-    return reached, [compiled[i] for i in sorted(fired)]
+                waiting[fact].append(effect)
+    while stack or ready:
+        while ready:
+            _, add, index = ready.pop()
+            stack.extend(add)
+            if index >= 0:
+                fired[index] = True
+                for effect in effects_of[index]:
+                    effect[0] -= 1
+                    if effect[0] == 0:
+                        ready.append(effect)
+        while stack:
+            fact = stack.pop()
+            if reached[fact]:
+                continue
+            reached[fact] = True
+            for record in waiting[fact]:
+                record[0] -= 1
+                if record[0] == 0:
+                    ready.append(record)
+    return reached, [i for i, ok in enumerate(fired) if ok]
