@@ -44,24 +44,42 @@ def _and(parts: list[str]) -> str:
     return parts[0] if len(parts) == 1 else f"(and {' '.join(parts)})"
 
 
-def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
-    """The PDDL domain of a planning problem's elements.
-
-    Raises:
-        PlannerError: an element has no signature, or a signature is not a conjunction of literals.
-    """
-    actions, predicates, types = [], {}, {"object"}
+def _signatures(problem: PlanningProblem, library: PlanLibrary):  # type: ignore[no-untyped-def]
+    """Per element: its name, typed parameters, precondition and effect (PDDL text and literals)."""
     for name in problem.elements:
         plan = library.plans.get(name)
         if plan is None or plan.signature is None:
             raise PlannerError(f"planning problem '{problem.name}': element '{name}' is not a skill plan with a signature")
         sig = plan.signature
         typed = {v.name: (v.type if v.type != "any" else "object") for v in sig.parameters}
-        types.update(typed.values())
-        pre, pre_lits = _conjunction(sig.precondition.text if sig.precondition else None, f"the precondition of '{name}'")
-        eff, eff_lits = _conjunction(sig.effect.text if sig.effect else None, f"the effect of '{name}'")
+        pre = _conjunction(sig.precondition.text if sig.precondition else None, f"the precondition of '{name}'")
+        eff = _conjunction(sig.effect.text if sig.effect else None, f"the effect of '{name}'")
+        yield name, sig, typed, pre, eff
+
+
+def predicate_types(problem: PlanningProblem, library: PlanLibrary) -> dict[str, tuple[str, ...]]:
+    """The predicates of a planning problem's domain with their argument types (lower-case names).
+
+    Raises:
+        PlannerError: as :func:`domain_text`.
+    """
+    predicates: dict[str, tuple[str, ...]] = {}
+    for _, _, typed, (_, pre_lits), (_, eff_lits) in _signatures(problem, library):
         for _, pred, args in pre_lits + eff_lits:
             predicates.setdefault(_symbol(pred), tuple(typed.get(str(a), "object") for a in args))
+    return predicates
+
+
+def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
+    """The PDDL domain of a planning problem's elements.
+
+    Raises:
+        PlannerError: an element has no signature, or a signature is not a conjunction of literals.
+    """
+    actions, types = [], {"object"}
+    predicates = predicate_types(problem, library)
+    for name, sig, typed, (pre, _), (eff, _) in _signatures(problem, library):
+        types.update(typed.values())
         params = " ".join(f"{_symbol(v)} - {_symbol(t)}" for v, t in typed.items())
         cost = int(sig.cost) if float(sig.cost).is_integer() else sig.cost
         effect_parts = eff + [f"(increase (total-cost) {cost})"]
@@ -73,7 +91,8 @@ def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
     type_list = " ".join(sorted(_symbol(t) for t in types if t != "object"))
     return (
         f"(define (domain {_symbol(problem.name)})\n  (:requirements :strips :typing :negative-preconditions :action-costs)\n"
-        f"  (:types {type_list} - object)\n  (:predicates {preds})\n  (:functions (total-cost) - number)\n"
+        + (f"  (:types {type_list} - object)\n" if type_list else "")
+        + f"  (:predicates {preds})\n  (:functions (total-cost) - number)\n"
         + "\n".join(actions) + "\n)\n"
     )
 

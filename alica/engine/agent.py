@@ -20,6 +20,7 @@ from alica.engine.belief import AgentBelief
 from alica.engine.conditions import Formulas
 from alica.engine.config import EngineConfig
 from alica.engine.node import PlanNode
+from alica.engine.shared import PLAN_TOPIC, PlanBoard
 from alica.engine.slot import Slot
 from alica.engine.status import ChildStatus
 from alica.engine.sync import SyncProcess, SyncTalk
@@ -79,7 +80,10 @@ class AgentEngine:
         self.role = roster[name]
         self.library = library
         self.root_plan = library.plans[plan]
+        self.base_roleset = roleset
         self.roleset = roleset
+        self.plan_board = PlanBoard()
+        self.problem_overrides: dict[str, dict[str, str]] = {}
         self.transport = transport
         self.world_model = world_model
         self.clock = clock
@@ -101,8 +105,8 @@ class AgentEngine:
         self._transitions: dict[tuple[str, str], tuple[Transition, ...]] = {}
         self._tree_changed = True
         self._last_broadcast = float("-inf")
-        self.stats = {"ticks": 0, "transitions": 0, "allocations": 0, "messages_in": 0, "messages_out": 0, "repairs": 0}
-        for topic in (TEAM_TOPIC, SYNC_TOPIC, WORLD_TOPIC):
+        self.stats = {"ticks": 0, "transitions": 0, "allocations": 0, "messages_in": 0, "messages_out": 0, "repairs": 0, "replans": 0}
+        for topic in (TEAM_TOPIC, SYNC_TOPIC, WORLD_TOPIC, PLAN_TOPIC):
             transport.subscribe(topic)
         self._world_changed = False
         self._refresh = getattr(world_model, "refresh", None)
@@ -147,6 +151,8 @@ class AgentEngine:
                 self._receive_sync(payload, now)
             elif topic == WORLD_TOPIC:
                 self.world_model.merge(payload)
+            elif topic == PLAN_TOPIC:
+                self.plan_board.receive(payload, now)
         if authority:
             self._apply_authority(now)
 
@@ -214,6 +220,42 @@ class AgentEngine:
                 self._tick_behaviours(slot.node, now)
 
     # -- services for plan nodes -------------------------------------------
+
+    def plan_named(self, name: str) -> Plan:
+        """A plan of the library, or one generated at run time by a planning problem."""
+        plan = self.library.plans.get(name)
+        return plan if plan is not None else self.plan_board.plans[name]
+
+    def register_generated(self, plan: Plan, roleset: RoleSet) -> None:
+        """Make a generated plan allocatable; ``roleset`` holds the priorities of its tasks."""
+        tasks = {ep.task for ep in plan.entry_points}
+        priorities = {role.name: tuple(p for p in role.priorities if p.task in tasks) for role in roleset.roles}
+        self.plan_board.register(plan, priorities)
+        self.roleset = self.plan_board.roleset(self.base_roleset)
+
+    def unregister_generated(self, name: str) -> None:
+        """Forget a generated plan that was replaced."""
+        self.plan_board.unregister(name)
+        self.roleset = self.plan_board.roleset(self.base_roleset)
+
+    def publish_plan(self, payload: object) -> None:
+        """Send a plan share or a replan request to the team (reliable)."""
+        self._publish(PLAN_TOPIC, payload, QoS.RELIABLE)
+
+    def set_problem(self, name: str, goal: str | None = None, world: str | None = None) -> None:
+        """The operator sets the goal and/or the world of planning problem ``name`` (the leader replans).
+
+        Raises:
+            AlicaError: no planning problem has that name.
+        """
+        if name not in self.library.problems:
+            raise AlicaError(f"no planning problem named '{name}'; problems: {', '.join(sorted(self.library.problems)) or 'none'}")
+        override = dict(self.problem_overrides.get(name, {}))
+        if goal is not None:
+            override["goal"] = goal
+        if world is not None:
+            override["world"] = world
+        self.problem_overrides[name] = override
 
     def belief_for(self, node: PlanNode) -> AgentBelief:
         """The belief base, looking at ``node``'s context."""
@@ -374,7 +416,7 @@ class AgentEngine:
             if slot is not None:
                 slot.reason = f"no valid assignment: {result.why}"
             return None
-        plan = self.library.plans[assignment.plan]
+        plan = self.plan_named(assignment.plan)
         node = PlanNode(self, key, slot, plan, env, now)
         self.index[key] = node
         for agent, entry in fixed.items():
@@ -469,7 +511,7 @@ class AgentEngine:
             slot = node.slot
             node.stop()
             slot.node = None
-            slot.start(now, only=self.library.plans[best.plan])
+            slot.start(now, only=self.plan_named(best.plan))
             return
         node.apply(best, now, "utility")
         self._check_conflicts(node, now)

@@ -25,6 +25,10 @@ class EngineConfig:
         authority_min: the first authority window, in seconds.
         authority_max: the longest authority window.
         authority_growth: the factor by which each new conflict grows the window.
+        planner_expansions: the planning leader's search budget per tick, in
+            expansions (deterministic: the same run plans the same way).
+        planner_seconds: a wall-time budget per tick instead (for real robots);
+            ``None`` uses ``planner_expansions``.
     """
 
     frequency: float = 30.0
@@ -39,6 +43,8 @@ class EngineConfig:
     authority_min: float = 1.0
     authority_max: float = 16.0
     authority_growth: float = 2.0
+    planner_expansions: int = 1000
+    planner_seconds: float | None = None
 
     def __post_init__(self) -> None:
         positive = ("frequency", "broadcast_interval", "team_timeout", "cycle_window", "authority_min")
@@ -48,6 +54,8 @@ class EngineConfig:
         for name in ("min_broadcast_gap", "assignment_protection"):
             if getattr(self, name) < 0:
                 raise ValueError(f"EngineConfig.{name} must be >= 0, got {getattr(self, name)}")
+        if self.planner_expansions < 1 or (self.planner_seconds is not None and self.planner_seconds <= 0):
+            raise ValueError("EngineConfig.planner_expansions must be at least 1 and planner_seconds > 0 (or None)")
         if self.max_rule_applications < 1 or self.cycle_count < 1:
             raise ValueError("EngineConfig.max_rule_applications and cycle_count must be at least 1")
         if self.authority_max < self.authority_min or self.authority_growth < 1:

@@ -21,6 +21,7 @@ from alica.model import Behaviour, ChildRef, Plan, PlanningProblem, PlanType
 if TYPE_CHECKING:
     from alica.engine.behaviours import BehaviourRunner
     from alica.engine.node import PlanNode
+    from prophet.runtime import ProblemRuntime
 
 
 class Slot:
@@ -32,7 +33,7 @@ class Slot:
         env: the child's variable bindings, evaluated when the state was entered.
     """
 
-    __slots__ = ("element", "env", "failed_plans", "failures", "next_try", "node", "parent", "reason", "ref", "runner", "status")
+    __slots__ = ("element", "env", "failed_plans", "failures", "next_try", "node", "parent", "reason", "ref", "revision", "runner", "runtime", "status")
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
         self.parent = parent
@@ -46,6 +47,12 @@ class Slot:
         self.failures: dict[str, int] = {}
         self.failed_plans: list[str] = []
         self.next_try = 0.0
+        self.runtime: ProblemRuntime | None = None
+        if isinstance(self.element, PlanningProblem):
+            from prophet.runtime import ProblemRuntime
+
+            self.runtime = ProblemRuntime(self)
+        self.revision = self.runtime.revision if self.runtime is not None else 0
 
     @property
     def name(self) -> str:
@@ -60,16 +67,17 @@ class Slot:
     def candidates(self) -> tuple[Plan, ...]:
         """The plans this child may run now, in preference order, failed ones left out.
 
-        A planning problem runs its WaitPlan here; the planner runtime fills it in later.
+        A planning problem runs what its runtime says: the WaitPlan, the
+        generated plan or the AlternativePlan (:mod:`prophet.runtime`).
         """
         library = self.parent.engine.library
         element = self.element
+        if self.runtime is not None:
+            return tuple(p for p in self.runtime.wanted() if p.name not in self.failed_plans)
         if isinstance(element, Plan):
             names: tuple[str, ...] = (element.name,)
         elif isinstance(element, PlanType):
             names = element.plans
-        elif isinstance(element, PlanningProblem):
-            names = (element.wait_plan,) if element.wait_plan else ()
         else:
             return ()
         return tuple(library.plans[n] for n in names if n not in self.failed_plans)
@@ -110,6 +118,9 @@ class Slot:
             self.status = self.runner.status
             self.reason = self.runner.reason
             return
+        runtime = self.runtime
+        if runtime is not None and self._follow(runtime, now):
+            return
         if self.status is ChildStatus.FAILURE:
             return
         if self.node is None:
@@ -118,10 +129,34 @@ class Slot:
             return
         node = self.node
         node.visit(now)
-        if node.status is ChildStatus.FAILURE:
-            self._repair(node, now)
+        if node.status is not ChildStatus.FAILURE:
+            self.status = runtime.child_status(node) if runtime is not None else node.status
+        elif runtime is not None and runtime.is_generated(node.plan):
+            # a step failed: back to the WaitPlan, the leader replans (not the generic repair)
+            node.stop()
+            self.node = None
+            runtime.execution_failed(node, now)
+            self.revision = runtime.revision
+            self.start(now)
         else:
-            self.status = node.status
+            self._repair(node, now)
+
+    def _follow(self, runtime: ProblemRuntime, now: float) -> bool:
+        """Let the planning problem's runtime decide what runs; ``True`` when the child is finished."""
+        runtime.update(now)
+        if runtime.revision != self.revision:
+            self.revision = runtime.revision
+            if self.node is not None:
+                self.node.stop()
+                self.node = None
+            self.status = ChildStatus.WAITING
+            self.start(now)
+        outcome = runtime.outcome()
+        if outcome is None:
+            return False
+        self.status = outcome
+        self.reason = runtime.reason
+        return True
 
     def _repair(self, node: PlanNode, now: float) -> None:
         engine = self.parent.engine
@@ -149,3 +184,5 @@ class Slot:
             self.runner.stop()
         if self.node is not None:
             self.node.stop()
+        if self.runtime is not None:
+            self.runtime.stop()

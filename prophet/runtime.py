@@ -1,0 +1,483 @@
+"""The runtime of a planning problem (IMPERA 7.1-7.2), inside each agent's engine.
+
+A state's child may be a planning problem. Each agent that enters the state
+gets a :class:`ProblemRuntime` for it, which says which plan the child runs:
+
+* **WaitPlan** until a plan is shared, and again while the leader replans;
+* the **generated plan** of the latest :class:`PlanShare`: every agent turns
+  the shared single-agent plan into the same multi-agent plan with
+  :func:`prophet.tasks.create_tasks`, and the team switches to it through the
+  normal allocation;
+* the **AlternativePlan** when the planner failed, proved the goal
+  unreachable, or found nothing within the problem's ``timeout``.
+
+The **leader** is the lowest alive agent in the state; when it crashes the
+next lowest takes over. The leader reads World (:func:`prophet.world.read_world`),
+runs the planner as an anytime search, a budget per tick
+(``EngineConfig.planner_expansions``), and shares:
+
+* a ``searching`` share when it starts (the team runs the WaitPlan);
+* the first plan as soon as it is found and validated;
+* every UpdateTime a better plan, while the world is still the one it planned from;
+* ``failed`` (AlternativePlan) or ``done`` (the goal holds already).
+
+Every UpdateTime it repeats its latest share (for agents that come late) and,
+while the team executes, checks that what is left of the plan still reaches
+the goal from the current world (:func:`prophet.world.remaining_fits`); twice
+in a row not, it replans. A step that fails sends its agent back to the
+WaitPlan and asks the leader to replan (:class:`ReplanRequest`); so does a
+change of goal or world by the operator (:meth:`AgentEngine.set_problem`).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+from alica.engine.status import ChildStatus
+from alica.engine.team import PlanKey, key_text
+from alica.errors import AlicaError, PlannerError
+from alica.model import Condition, ConditionKind, Plan, PlanningProblem
+from prophet.planner import Done, Improved, PlanStatus, PlanStep
+from prophet.planner import Plan as StepPlan
+from prophet.tasks import CreatedTasks, create_tasks, state_step
+from prophet.world import (
+    ROBOT_OBJECT,
+    PlanningWorld,
+    TaskProgress,
+    goal_literals,
+    holds_all,
+    read_world,
+    remaining_fits,
+)
+
+if TYPE_CHECKING:
+    from collections.abc import Iterator
+
+    from alica.engine.agent import AgentEngine
+    from alica.engine.node import PlanNode
+    from alica.engine.slot import Slot
+    from prophet.planner import SearchEvent
+
+Fact = tuple[str, tuple[str, ...]]
+
+SEARCHING, PLAN, FAILED, DONE = "searching", "plan", "failed", "done"
+
+
+@dataclass(frozen=True, slots=True)
+class PlanShare:
+    """What the leader tells the team about a planning problem.
+
+    Attributes:
+        key: the planning problem's instance (its plan key).
+        generation: counts the plannings of this instance (each replan starts a new one).
+        version: counts the plans shared within a generation (anytime improvements).
+        leader: who shares it.
+        status: ``searching``, ``plan``, ``failed`` or ``done``.
+        steps: the single-agent plan (status ``plan``).
+        cost: its cost.
+        world: the facts it was planned from (the robot is ``self``).
+        entry_task: the task through which the team runs the problem (for Eq. 9).
+        reason: why it failed, or why the leader replans.
+    """
+
+    key: PlanKey
+    generation: int
+    version: int
+    leader: str
+    status: str
+    steps: tuple[PlanStep, ...] = ()
+    cost: float = 0.0
+    world: tuple[Fact, ...] = ()
+    entry_task: str = ""
+    reason: str = ""
+
+    def supersedes(self, other: PlanShare) -> bool:
+        """Newer generation, then newer version; the lower leader wins a tie (a partition healed)."""
+        mine, theirs = (self.generation, self.version), (other.generation, other.version)
+        return mine > theirs or (mine == theirs and self.leader < other.leader)
+
+
+@dataclass(frozen=True, slots=True)
+class ReplanRequest:
+    """A teammate asks the leader to replan: a step of generation ``generation`` failed."""
+
+    key: PlanKey
+    generation: int
+    sender: str
+    reason: str
+    is_request: bool = True
+
+
+@dataclass
+class _Search:
+    """The leader's running search."""
+
+    generation: int
+    world: PlanningWorld
+    events: Iterator[SearchEvent]
+    domain: object
+    problem: object
+    started: float
+    names: dict[str, str]
+    expansions: int = 0
+    best: StepPlan | None = None
+    shared_cost: float | None = None
+    version: int = 0
+
+
+class ProblemRuntime:
+    """One agent's runtime of one planning problem child (see the module docstring).
+
+    Args:
+        slot: the child of the state that holds the planning problem.
+    """
+
+    def __init__(self, slot: Slot) -> None:
+        parent = slot.parent
+        self.slot = slot
+        self.engine: AgentEngine = parent.engine
+        element = slot.element
+        assert isinstance(element, PlanningProblem)
+        self.model = element
+        self.key: PlanKey = (*parent.key, parent.state or "", slot.name)
+        self.share: PlanShare | None = None
+        self.created: CreatedTasks | None = None
+        self.revision = 0
+        self.reason = ""
+        self.failed_generation = -1
+        self.search: _Search | None = None
+        self.next_update = -1.0
+        self.invalid_once = False
+        self.request: ReplanRequest | None = None
+        self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
+        now = self.engine.now()
+        board = self.engine.plan_board
+        known = board.shares.get(self.key)
+        fresh = known is not None and now - board.received_at[self.key] <= 2 * self.model.update_time
+        self.stale = None if fresh else known
+        if fresh:
+            self._adopt(known, now)
+
+    # -- what the slot runs --------------------------------------------------
+
+    @property
+    def problem(self) -> PlanningProblem:
+        """The planning problem with the operator's goal and world, if set."""
+        goal, world = self.overrides.get("goal"), self.overrides.get("world")
+        if goal is None and world is None:
+            return self.model
+        return replace(
+            self.model,
+            goal=Condition(ConditionKind.POST, goal) if goal is not None else self.model.goal,
+            world=Condition(ConditionKind.PRE, world) if world is not None else self.model.world,
+        )
+
+    def phase(self) -> str:
+        """``wait``, ``plan``, ``alternative``, ``done`` or ``failed``."""
+        share = self.share
+        if share is None or share.status == SEARCHING or share.generation <= self.failed_generation:
+            return "wait"
+        if share.status == PLAN:
+            return "plan"
+        if share.status == DONE:
+            return "done"
+        return "alternative" if self.model.alternative_plan else "failed"
+
+    def wanted(self) -> tuple[Plan, ...]:
+        """The plan the child runs now (none when done or failed)."""
+        phase = self.phase()
+        plans = self.engine.library.plans
+        if phase == "wait":
+            return (plans[self.model.wait_plan],) if self.model.wait_plan else ()
+        if phase == "plan":
+            assert self.created is not None
+            return (self.created.plan,)
+        if phase == "alternative":
+            return (plans[self.model.alternative_plan],)  # type: ignore[index]
+        return ()
+
+    def outcome(self) -> ChildStatus | None:
+        """The child's status when it no longer depends on a running plan."""
+        phase = self.phase()
+        if phase == "done":
+            return ChildStatus.SUCCESS
+        if phase == "failed":
+            return ChildStatus.FAILURE
+        return None
+
+    def is_generated(self, plan: Plan) -> bool:
+        """Whether ``plan`` is the generated plan this runtime made."""
+        return self.created is not None and plan is self.created.plan
+
+    def child_status(self, node: PlanNode) -> ChildStatus:
+        """The child's status from its running plan: the WaitPlan never ends it; the generated plan only with the goal."""
+        plan = node.plan
+        if self.is_generated(plan):
+            if node.status is ChildStatus.SUCCESS and not self._goal_believed(node):
+                return ChildStatus.RUNNING  # the leader's check replans
+            return node.status
+        if plan.name == self.model.wait_plan and self.phase() == "wait":
+            return ChildStatus.RUNNING
+        return node.status
+
+    def _goal_believed(self, node: PlanNode) -> bool:
+        engine = self.engine
+        return engine.formulas.holds(self.problem.goal.text, engine.belief_for(node), node.env)
+
+    # -- the tick --------------------------------------------------------------
+
+    def update(self, now: float) -> None:
+        """Take in shares, lead when this agent is the leader, repeat a pending replan request."""
+        engine = self.engine
+        latest = engine.plan_board.shares.get(self.key)
+        if (
+            latest is not None
+            and latest is not self.share
+            and latest is not self.stale
+            and latest.generation > self.failed_generation
+            and (self.share is None or latest.supersedes(self.share))
+        ):
+            self._adopt(latest, now)
+        overrides = engine.problem_overrides.get(self.model.name, {})
+        changed = overrides != self.overrides
+        if changed:
+            self.overrides = dict(overrides)
+        if self._is_leader():
+            if changed:
+                self._replan(now, "the operator changed the planning problem")
+            self._lead(now)
+        else:
+            if self.search is not None:
+                self.search = None
+                engine.emit("planner", key=key_text(self.key), what="handed over")
+            if self.request is not None and now >= self.next_update:
+                engine.publish_plan(self.request)
+                self.next_update = now + self.model.update_time
+        if self.request is not None and self.share is not None and self.share.generation > self.request.generation:
+            self.request = None
+
+    def stop(self) -> None:
+        """The agent leaves the state: stop planning, forget the generated plan."""
+        self.search = None
+        if self.created is not None:
+            self.engine.unregister_generated(self.created.plan.name)
+
+    def _is_leader(self) -> bool:
+        members = self.engine.members_of(self.slot.parent)
+        return bool(members) and members[0] == self.engine.name
+
+    # -- shares ---------------------------------------------------------------
+
+    def _adopt(self, share: PlanShare, now: float) -> None:
+        engine = self.engine
+        current = self.share
+        if current is not None and (current.generation, current.version) == (share.generation, share.version):
+            self.share = share  # the same plan, repeated by another leader
+            return
+        created = None
+        if share.status == PLAN:
+            name = f"{self.model.name}_g{share.generation}v{share.version}"
+            try:
+                created = create_tasks(name, share.steps, engine.library, share.world, ROBOT_OBJECT, engine.base_roleset, share.entry_task)
+            except (PlannerError, AlicaError) as exc:
+                engine.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
+                return
+        if self.created is not None:
+            engine.unregister_generated(self.created.plan.name)
+        self.created = created
+        if created is not None:
+            engine.register_generated(created.plan, created.roleset)
+        self.share = share
+        self.revision += 1
+        self.reason = share.reason
+        self.invalid_once = False
+        fields = {"generation": share.generation, "version": share.version, "leader": share.leader}
+        if created is not None:
+            fields.update(plan=created.plan.name, steps=len(share.steps), tasks=len(created.tasks), cost=share.cost)
+        if share.reason:
+            fields["reason"] = share.reason
+        engine.emit("problem", key=key_text(self.key), phase=self.phase(), **fields)
+
+    def _publish(self, share: PlanShare, now: float) -> None:
+        engine = self.engine
+        engine.plan_board.receive(share, now)
+        engine.publish_plan(share)
+        if share is not self.share and (self.share is None or share.supersedes(self.share)):
+            self._adopt(share, now)
+
+    def _entry_task(self) -> str:
+        parent = self.slot.parent
+        return parent.plan.entry_point(parent.ep).task if parent.ep is not None else ""
+
+    # -- failures --------------------------------------------------------------
+
+    def execution_failed(self, node: PlanNode, now: float) -> None:
+        """A step of the generated plan failed here: back to the WaitPlan; the leader replans."""
+        share = self.share
+        assert share is not None
+        reason = f"a step of {node.plan.name} failed: {node.reason}"
+        self.failed_generation = share.generation
+        self.revision += 1
+        self.engine.emit("problem", key=key_text(self.key), phase="wait", generation=share.generation, reason=reason)
+        if self._is_leader():
+            self._replan(now, reason)
+        else:
+            self.request = ReplanRequest(self.key, share.generation, self.engine.name, reason)
+            self.engine.publish_plan(self.request)
+            self.next_update = now + self.model.update_time
+
+    # -- the leader ----------------------------------------------------------
+
+    def _lead(self, now: float) -> None:
+        share = self.share
+        requests = [r for r in self.engine.plan_board.take_requests(self.key) if share is None or r.generation >= share.generation]
+        if requests and share is not None and share.status == PLAN:
+            self._replan(now, f"{requests[0].sender}: {requests[0].reason}")
+            return
+        if self.search is not None:
+            self._step_search(now)
+        elif share is None or share.status == SEARCHING or (share.status == PLAN and share.generation <= self.failed_generation):
+            self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
+        if now < self.next_update:
+            return
+        self.next_update = now + self.model.update_time
+        share = self.share
+        if share is None:
+            return
+        if self.search is None and share.status == PLAN:
+            self._check_execution(now, share)
+        if self.share is share:
+            self._publish(share if share.leader == self.engine.name else replace(share, leader=self.engine.name), now)
+
+    def _replan(self, now: float, reason: str) -> None:
+        self.engine.stats["replans"] += 1
+        self.engine.emit("replan", key=key_text(self.key), reason=reason)
+        self.search = None
+        self._start_search(now, reason)
+
+    def _start_search(self, now: float, reason: str) -> None:
+        from prophet.planners import get_planner
+        from prophet.problem import to_pddl
+
+        engine = self.engine
+        generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+        me = engine.name
+        task = self._entry_task()
+        problem = self.problem
+        try:
+            world = self._read_world(problem)
+            if holds_all(goal_literals(problem), set(world.facts)):
+                self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, entry_task=task, reason="the goal holds"), now)
+                return
+            domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
+            planner = get_planner(problem.planner, **({"progress_every": 100} if problem.planner == "builtin" else {}))
+            events = planner.search(domain, pddl, anytime=True)
+        except (PlannerError, AlicaError) as exc:
+            engine.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
+            self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
+            return
+        names = {name.lower(): name for name, _ in world.objects}
+        self.search = _Search(generation, world, events, domain, pddl, now, names)
+        engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts))
+        self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, entry_task=task, reason=reason), now)
+        self.next_update = now + self.model.update_time
+
+    def _read_world(self, problem: PlanningProblem) -> PlanningWorld:
+        engine = self.engine
+        world_model = engine.world_model
+        facts = world_model.facts() if hasattr(world_model, "facts") else ()
+        typed = {t: world_model.objects(t) for t in world_model.types()} if hasattr(world_model, "types") else {}
+        return read_world(problem, engine.library, facts, engine.name, engine.team.roles, typed)
+
+    def _step_search(self, now: float) -> None:
+        search = self.search
+        assert search is not None
+        config = self.engine.config
+        start_expansions = search.expansions
+        deadline = time.perf_counter() + config.planner_seconds if config.planner_seconds is not None else None
+        finished: Done | None = None
+        for event in search.events:
+            search.expansions = event.expansions
+            if isinstance(event, Improved):
+                search.best = event.plan
+                if search.shared_cost is None:
+                    break  # share the first plan at once
+            elif isinstance(event, Done):
+                finished = event
+                break
+            if deadline is not None:
+                if time.perf_counter() >= deadline:
+                    break
+            elif search.expansions - start_expansions >= config.planner_expansions:
+                break
+        else:
+            finished = Done(PlanStatus.SOLVED if search.best is not None else PlanStatus.UNSOLVABLE, search.expansions)
+        best = search.best
+        if best is not None and search.shared_cost is None:
+            self._share_plan(now, search, best)
+        elif search.shared_cost is not None and now >= self.next_update:
+            if set(self._read_world(self.problem).facts) != set(search.world.facts):
+                finished = finished or Done(PlanStatus.SOLVED, search.expansions, "the world changed: execution has begun")
+            elif best is not None and best.cost < search.shared_cost:
+                self._share_plan(now, search, best)
+        if self.search is not search:
+            return
+        if finished is not None:
+            self.search = None
+            self.engine.emit("planner", key=key_text(self.key), what="done", status=finished.status.value, expansions=search.expansions)
+            if search.shared_cost is None:
+                message = finished.message or f"the planner ended with '{finished.status.value}' and no plan"
+                self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)
+            return
+        if search.shared_cost is None:
+            if now - search.started > self.model.timeout:
+                self.search = None
+                reason = f"no plan within the timeout of {self.model.timeout:g} s"
+                self.engine.emit("planner", key=key_text(self.key), what="timeout", expansions=search.expansions)
+                self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=reason), now)
+            elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
+                self._replan(now, "the world changed while planning")
+
+    def _share_plan(self, now: float, search: _Search, plan: StepPlan) -> None:
+        from prophet.validate import validate_plan
+
+        result = validate_plan((search.domain, search.problem), plan)
+        if not result.valid:
+            self.engine.emit("warning", key=key_text(self.key), message=f"the planner's plan is invalid and not shared: {result.reason}")
+            return
+        steps = tuple(PlanStep(s.action, tuple(search.names.get(a, a) for a in s.args)) for s in plan.steps)
+        search.version += 1
+        search.shared_cost = plan.cost
+        self.engine.emit("planner", key=key_text(self.key), what="plan", generation=search.generation, version=search.version,
+                         cost=plan.cost, steps=len(steps), expansions=search.expansions, after_s=round(now - search.started, 6))
+        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, self._entry_task())
+        self._publish(share, now)
+
+    # -- execution monitoring --------------------------------------------------
+
+    def _check_execution(self, now: float, share: PlanShare) -> None:
+        node = self.slot.node
+        created = self.created
+        if node is None or created is None or node.plan is not created.plan:
+            return
+        progress = []
+        for ep, steps in zip(created.plan.entry_points, created.tasks, strict=True):
+            if node.succeeded.get(ep.name):
+                progress.append(TaskProgress(None, len(steps), done=True))
+                continue
+            holders = sorted((state_step(state, len(steps)), agent) for agent, (entry, state) in node.believed.items() if entry == ep.name and state)
+            progress.append(TaskProgress(holders[0][1], holders[0][0]) if holders else TaskProgress(None, 0))
+        from prophet.problem import predicate_types
+
+        predicates = predicate_types(self.problem, self.engine.library)
+        world_model = self.engine.world_model
+        facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
+        reason = remaining_fits(created.tasks, progress, facts, share.world, goal_literals(self.problem))
+        if reason is None:
+            self.invalid_once = False
+        elif not self.invalid_once:
+            self.invalid_once = True
+        else:
+            self._replan(now, f"the world changed under the plan: {reason}")

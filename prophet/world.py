@@ -1,0 +1,210 @@
+"""The world a planning problem is planned from, and the check that a running plan still fits the world.
+
+**World** (IMPERA 7.1) is read from first-order facts: the problem's own
+``world`` for offline use, else the facts of the shared world model. Only
+facts of the domain's predicates count. The single-agent plan is made for one
+robot, the stand-in :data:`ROBOT_OBJECT` (``self``): the planning agent's own
+facts (``handempty(r1)`` for agent ``r1``) become the stand-in's, and facts
+of other team members are left out, so the plan is one any fresh robot of the
+team could start. Objects get their types from the predicates they appear in
+(``clear(a)`` makes ``a`` a ``block``), from the problem's ``objects`` and
+from the world model's typed objects.
+
+While the team executes a generated plan, :func:`remaining_fits` simulates
+what is left of it (each task's remaining steps, run by the agent holding the
+task) from the current facts. A step whose precondition does not hold but
+whose effect already does counts as done (a teammate's message may lag
+behind the world); any other unmet precondition, or a goal not reached at the
+end, means the world changed under the plan.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+
+from alica.errors import AlicaError, PlannerError
+from alica.lang import literals
+from alica.model import PlanLibrary, PlanningProblem
+from prophet.problem import offline_world, predicate_types
+
+Fact = tuple[str, tuple[str, ...]]
+Literal = tuple[bool, Fact]
+
+#: The object standing for "the robot that runs the step" in single-agent plans.
+ROBOT_OBJECT = "self"
+
+
+@dataclass(frozen=True, slots=True)
+class PlanningWorld:
+    """A world to plan from.
+
+    Attributes:
+        objects: ``(name, type)`` pairs, sorted.
+        facts: the facts that hold, sorted; the planning robot is :data:`ROBOT_OBJECT`.
+    """
+
+    objects: tuple[tuple[str, str], ...]
+    facts: tuple[Fact, ...]
+
+    def object_types(self) -> dict[str, str]:
+        """Object name -> type."""
+        return dict(self.objects)
+
+
+def goal_literals(problem: PlanningProblem) -> tuple[Literal, ...]:
+    """The goal as ground literals.
+
+    Raises:
+        PlannerError: the goal is not a conjunction of literals.
+    """
+    try:
+        found = literals(problem.goal.text)
+    except AlicaError as exc:
+        raise PlannerError(f"the goal of '{problem.name}' must be a conjunction of literals to be planned with: {exc}") from None
+    return tuple((positive, (name, tuple(str(a) for a in args))) for positive, name, args in found if name != "=")
+
+
+def holds_all(wanted: Iterable[Literal], facts: set[Fact] | frozenset[Fact]) -> bool:
+    """Whether every literal holds in the closed world ``facts``."""
+    return all((fact in facts) == positive for positive, fact in wanted)
+
+
+def read_world(
+    problem: PlanningProblem,
+    library: PlanLibrary,
+    facts: Iterable[tuple[object, ...]],
+    agent: str,
+    team: Iterable[str],
+    typed_objects: Mapping[str, Iterable[object]] | None = None,
+) -> PlanningWorld:
+    """The world ``agent`` plans from (see the module docstring).
+
+    Args:
+        problem: the planning problem.
+        library: holds its elements' signatures.
+        facts: true facts as ``(predicate, *args)`` tuples (the world model's
+            :meth:`facts`); ignored when the problem has its own ``world``.
+        agent: the planning agent, whose facts become the stand-in's.
+        team: every team member (their facts are left out).
+        typed_objects: type -> objects, e.g. from the world model.
+
+    Raises:
+        PlannerError: the problem's elements or goal cannot be planned with.
+    """
+    predicates = predicate_types(problem, library)
+    declared: dict[str, str] = {}
+    if problem.world is not None:
+        declared, given = offline_world(problem)
+        source: Iterable[tuple[object, ...]] = ((name, *args) for name, args in given)
+    else:
+        source = facts
+    members = set(team) - {agent}
+    kept: set[Fact] = set()
+    for fact in source:
+        name = str(fact[0])
+        args = tuple(ROBOT_OBJECT if str(a) == agent else str(a) for a in fact[1:])
+        arity = predicates.get(name.lower())
+        if arity is None or len(args) != len(arity) or members.intersection(args):
+            continue
+        kept.add((name, args))
+    types: dict[str, str] = {}
+    for name, type_name in sorted(declared.items()):
+        types[ROBOT_OBJECT if name == agent else name] = type_name
+    for type_name, objects in sorted((typed_objects or {}).items()):
+        for obj in objects:
+            name = ROBOT_OBJECT if str(obj) == agent else str(obj)
+            if name not in members:
+                types.setdefault(name, type_name)
+    for _, (name, args) in goal_literals(problem):
+        kept_args = predicates.get(name.lower(), ())
+        for arg, type_name in zip(args, kept_args, strict=False):
+            types.setdefault(arg, type_name)
+    for name, args in sorted(kept):
+        for arg, type_name in zip(args, predicates[name.lower()], strict=True):
+            types.setdefault(arg, type_name)
+    if ROBOT_OBJECT not in types:
+        robot_type = _robot_type(problem, library)
+        if robot_type is not None:
+            types[ROBOT_OBJECT] = robot_type
+    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)))
+
+
+def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:
+    for name in problem.elements:
+        signature = library.plans[name].signature
+        if signature is not None:
+            for variable in signature.parameters:
+                if variable.name == "?r":
+                    return variable.type if variable.type != "any" else "object"
+    return None
+
+
+@dataclass(frozen=True, slots=True)
+class TaskProgress:
+    """How far one task of a generated plan is, as the team's claims say.
+
+    Attributes:
+        agent: the agent holding the task (None: nobody yet).
+        next_step: index into the task's steps of the first step not finished
+            (it may be running: its effects may hold already or not yet).
+        done: whether the task succeeded.
+    """
+
+    agent: str | None
+    next_step: int
+    done: bool = False
+
+
+def _ground(step_literals: Sequence[Literal], robot: str, who: str) -> list[Literal]:
+    return [(positive, (name, tuple(who if a == robot else a for a in args))) for positive, (name, args) in step_literals]
+
+
+def remaining_fits(
+    tasks: Sequence[Sequence[object]],
+    progress: Sequence[TaskProgress],
+    facts: Iterable[Fact],
+    start_world: Iterable[Fact],
+    goal: Sequence[Literal],
+    robot: str = ROBOT_OBJECT,
+) -> str | None:
+    """Whether what is left of a generated plan still reaches the goal from ``facts``.
+
+    Args:
+        tasks: the steps of each task (:class:`prophet.tasks.Step`).
+        progress: one entry per task.
+        facts: the facts that hold now, with the agents' real names.
+        start_world: the world the plan was made from (gives a fresh robot's facts).
+        goal: the goal literals.
+        robot: the stand-in the steps were planned with.
+
+    Returns:
+        ``None`` when it fits, else what does not.
+    """
+    state = set(facts)
+    fresh = [f for f in start_world if robot in f[1]]
+    remaining: list[tuple[int, object, str]] = []
+    for i, (task, where) in enumerate(zip(tasks, progress, strict=True)):
+        if where.done:
+            continue
+        who = where.agent
+        if who is None:
+            who = f"~T{i}"  # a robot that has done nothing yet
+            state.update((name, tuple(who if a == robot else a for a in args)) for name, args in fresh)
+        for k in range(where.next_step, len(task)):
+            remaining.append((task[k].index, task[k], who))  # type: ignore[attr-defined]
+    for _, step, who in sorted(remaining, key=lambda item: item[0]):
+        pre = _ground(step.pre, robot, who)  # type: ignore[attr-defined]
+        effect = _ground(step.effect, robot, who)  # type: ignore[attr-defined]
+        if holds_all(pre, state):
+            for positive, fact in effect:
+                if not positive:
+                    state.discard(fact)
+            state.update(fact for positive, fact in effect if positive)
+        elif not holds_all(effect, state):
+            unmet = next(f"{'' if p else 'not '}{n}({', '.join(a)})" for p, (n, a) in pre if ((n, a) in state) != p)
+            return f"step {step.label} of {who} cannot run: {unmet} does not hold"  # type: ignore[attr-defined]
+    if not holds_all(goal, state):
+        unmet = next(f"{'' if p else 'not '}{n}({', '.join(a)})" for p, (n, a) in goal if ((n, a) in state) != p)
+        return f"the plan no longer reaches the goal: {unmet} would not hold"
+    return None

@@ -1,0 +1,118 @@
+"""A blocks-world team with scripted skills that change the world model as the IPC blocks domain says."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import py_trees
+from py_trees.common import Status
+
+from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
+from alica.io import load_library
+from alica.model import PlanLibrary
+from tests.conftest import PLANS
+
+Literal = tuple[bool, str, tuple[str, ...]]
+
+
+def effects(skill: str, params: Mapping[str, object], me: str) -> list[Literal]:
+    """What the blocks-world skill ``skill`` changes when it succeeds (the signatures' effects)."""
+    x = str(params.get("object"))
+    if skill == "Pickup":
+        return [(False, "ontable", (x,)), (False, "clear", (x,)), (False, "handempty", (me,)), (True, "holding", (me, x))]
+    if skill == "Putdown":
+        return [(False, "holding", (me, x)), (True, "clear", (x,)), (True, "handempty", (me,)), (True, "ontable", (x,))]
+    if skill == "Stack":
+        y = str(params.get("target"))
+        return [(False, "holding", (me, x)), (False, "clear", (y,)), (True, "clear", (x,)), (True, "handempty", (me,)), (True, "on", (x, y))]
+    if skill == "Unstack":
+        y = str(params.get("from"))
+        return [(False, "on", (x, y)), (False, "clear", (x,)), (False, "handempty", (me,)), (True, "holding", (me, x)), (True, "clear", (y,))]
+    return []
+
+
+class BlockSkill(py_trees.behaviour.Behaviour):
+    """Runs for ``ticks`` ticks, then succeeds and writes its effects (or fails, when told to)."""
+
+    def __init__(self, name: str, skill: str, params: Mapping[str, object], context: Any, ticks: int | None, fail: bool) -> None:
+        super().__init__(name)
+        self.skill, self.params, self.context, self.ticks, self.fail = skill, dict(params), context, ticks, fail
+        self.count = 0
+
+    def initialise(self) -> None:
+        self.count = 0
+
+    def update(self) -> Status:
+        self.count += 1
+        if self.ticks is None or self.count < self.ticks:
+            return Status.RUNNING
+        if self.fail:
+            return Status.FAILURE
+        world = self.context.world_model
+        for positive, name, args in effects(self.skill, self.params, self.context.agent):
+            (world.assert_fact if positive else world.retract_fact)(name, *args)
+        return Status.SUCCESS
+
+
+class BlockSkills:
+    """Skill factories for the blocks-world plans; ``fail`` lists skill names whose next run fails (once each)."""
+
+    def __init__(self, fail: Iterable[str] = (), ticks: int = 3) -> None:
+        self.fail = list(fail)
+        self.ticks = ticks
+        self.runs: list[tuple[str, str, dict[str, object]]] = []
+
+    def factory(self, skill: str):  # type: ignore[no-untyped-def]
+        def make(name: str, params: Mapping[str, object], context: Any) -> BlockSkill:
+            fail = skill in self.fail
+            if fail:
+                self.fail.remove(skill)
+            self.runs.append((context.agent, skill, dict(params)))
+            ticks = None if skill == "Idle" else (1 if skill == "DriveToFreeSpace" else self.ticks)
+            return BlockSkill(name, skill, params, context, ticks, fail)
+
+        return make
+
+    def mapping(self) -> dict[str, Any]:
+        """Skill name -> factory, for :class:`SimulatedTeam`."""
+        names = ("MoveToPosition", "DriveToFreeSpace", "Idle", "Pickup", "Putdown", "Stack", "Unstack")
+        return {n: self.factory(n) for n in names}
+
+
+def blocks_library() -> PlanLibrary:
+    """The shipped blocks-world mission."""
+    return load_library(PLANS / "blocksworld" / "mission.yaml")
+
+
+def world_facts(stacks: Iterable[Iterable[str]], robots: Iterable[str]) -> list[Literal]:
+    """Facts of stacks (bottom first) and empty-handed robots."""
+    facts: list[Literal] = []
+    for stack in stacks:
+        blocks = list(stack)
+        facts.append((True, "ontable", (blocks[0],)))
+        facts.extend((True, "on", (upper, lower)) for lower, upper in zip(blocks, blocks[1:]))
+        facts.append((True, "clear", (blocks[-1],)))
+    facts.extend((True, "handempty", (r,)) for r in robots)
+    return facts
+
+
+SUSSMAN = [["a", "c"], ["b"]]
+"""c on a, b alone: the goal a on b on c takes 6 steps."""
+
+
+def blocks_team(agents: Iterable[str], skills: BlockSkills, stacks=SUSSMAN, seed: int = 0, **config: Any) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[no-untyped-def]
+    """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model."""
+    names = list(agents)
+    recorder = TraceRecorder()
+    settings = {"frequency": 10.0, "broadcast_interval": 0.1, "team_timeout": 0.5, "assignment_protection": 0.3, **config}
+    sim = SimulatedTeam(blocks_library(), "BlocksWorldMission", dict.fromkeys(names, "Manipulator"), seed=seed,
+                        config=EngineConfig(**settings), skills=skills.mapping(), observers=[recorder])
+    sim.set_facts(world_facts(stacks, names))
+    return sim, recorder
+
+
+def goal_holds(sim: SimulatedTeam, agent: str) -> bool:
+    """Whether a on b on c holds in ``agent``'s world model."""
+    world = sim.engines[agent].world_model
+    return world.holds("on", "a", "b") and world.holds("on", "b", "c") and world.holds("ontable", "c")
