@@ -29,10 +29,13 @@ from prophet.search.gbfs import Stats, lazy_search
 from prophet.search.heuristics import INF, Evaluator, Relaxed
 from prophet.search.neighbourhood import neighbourhood
 from prophet.search.postprocess import improve
+from prophet.search.windows import Windows
 
 DEFAULT_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1.5, 1)
 NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
 """The first and the largest state limit of the neighbourhood rounds after each plan."""
+RESTART_BUDGET = 20
+"""The expansion budget of each restart, in multiples of the first search's expansions."""
 
 
 def to_plan(ct: CompiledTask, ops: Sequence[int]) -> Plan:
@@ -95,6 +98,17 @@ def search_task(
     if not anytime:
         yield Done(PlanStatus.SOLVED, stats.expansions)
         return
+    windows = Windows(ct)
+    best = yield from _windows(ct, windows, best, ct.plan_cost(best), stats)
+    best_cost = ct.plan_cost(best)
+    for evaluate, weight in _restarts(ct, relaxed):
+        ops, _exhausted = yield from lazy_search(
+            ct, evaluate, stats, weight=weight, max_expansions=RESTART_BUDGET * max(100, first_expansions)
+        )
+        if ops is not None:
+            found = yield from _windows(ct, windows, improve(ct, ops), best_cost, stats)
+            if ct.plan_cost(found) < best_cost:
+                best, best_cost = found, ct.plan_cost(found)
     best, proven = yield from _polish(ct, best, stats)
     best_cost = ct.plan_cost(best)
     if proven or best_cost == 0:
@@ -111,8 +125,8 @@ def search_task(
                 yield Done(PlanStatus.OPTIMAL, stats.expansions, "a bounded pass found no cheaper plan")
                 return
             if ops is not None:
-                yield Improved(to_plan(ct, improve(ct, ops)), stats.expansions)
-                best, proven = yield from _polish(ct, improve(ct, ops), stats)
+                found = yield from _windows(ct, windows, improve(ct, ops), best_cost, stats)
+                best, proven = yield from _polish(ct, found, stats)
                 best_cost = ct.plan_cost(best)
                 if proven:
                     yield Done(PlanStatus.OPTIMAL, stats.expansions, "every reachable state was explored")
@@ -127,6 +141,35 @@ def search_task(
             yield Done(PlanStatus.OPTIMAL, stats.expansions, "A* with h_max")
             return
         budget *= 2
+
+
+def _restarts(ct: CompiledTask, relaxed: Relaxed) -> list[tuple[Evaluator, float | None]]:
+    """The unbounded searches after the first plan: other heuristics and weights give other plans."""
+    if ct.unit_cost:
+        return [(relaxed.ff_add_unit, None), (relaxed.ff, 3), (relaxed.ff_add_unit, 3)]
+    return [(relaxed.ff_cost, None), (relaxed.ff_cost, 3)]
+
+
+def _windows(
+    ct: CompiledTask, windows: Windows, plan: list[int], report_below: float, stats: Stats
+) -> Generator[SearchEvent, None, list[int]]:
+    """Window replanning on ``plan`` until a sweep finds nothing cheaper.
+
+    Yields ``Improved`` for each plan cheaper than ``report_below`` (the best so
+    far) and returns the last plan.
+    """
+    if ct.plan_cost(plan) < report_below:
+        report_below = ct.plan_cost(plan)
+        yield Improved(to_plan(ct, plan), stats.expansions)
+    while True:
+        found = yield from windows.improve_once(plan, stats)
+        if found is None:
+            return plan
+        plan = improve(ct, found)
+        cost = ct.plan_cost(plan)
+        if cost < report_below:
+            report_below = cost
+            yield Improved(to_plan(ct, plan), stats.expansions)
 
 
 def _polish(ct: CompiledTask, plan: list[int], stats: Stats) -> Generator[SearchEvent, None, tuple[list[int], bool]]:

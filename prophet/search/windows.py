@@ -1,0 +1,220 @@
+"""Window replanning: a cheaper stretch of the plan, searched among the window's own objects.
+
+For a window ``plan[i:j]``, the facts the rest of the plan needs are regressed
+from the goal through ``plan[j:]``; any state holding them lets the rest of
+the plan run to the goal (exactly so for STRIPS; every spliced plan is
+checked by simulation anyway). A uniform-cost search from the plan's state
+before ``i`` then looks for a cheaper way to reach those facts, using only
+the operators whose arguments are all objects the window's actions mention:
+a small space, searched exhaustively up to a state limit.
+
+Before the windows slide over it, the plan is reordered: deordered into the
+partial order of its interfering action pairs, then linearised so that an
+action follows one that shares the most objects with it. Stretches of one
+rover's (one agent's) work then come together, so a window holds a whole
+errand rather than pieces of several.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator, Sequence
+from heapq import heappop, heappush
+
+from prophet.planner import Progress
+from prophet.search.encoding import CompiledTask
+from prophet.search.gbfs import Stats, trace
+
+WINDOW_SIZES: tuple[int, ...] = (6, 10, 16, 24, 32)
+"""The window lengths tried, shortest first."""
+WINDOW_STATES = 3000
+"""The most states one window search expands."""
+
+
+class Windows:
+    """Window replanning on one compiled task (indexes built once).
+
+    Args:
+        ct: the compiled task.
+    """
+
+    def __init__(self, ct: CompiledTask) -> None:
+        self.ct = ct
+        operators = ct.task.operators
+        self.objects: list[frozenset[str]] = [frozenset(operators[s].args) for s in ct.source]
+        by_object: dict[str, list[int]] = {}
+        no_args: list[int] = []
+        for op, objs in enumerate(self.objects):
+            if not objs:
+                no_args.append(op)
+            for name in objs:
+                by_object.setdefault(name, []).append(op)
+        self.by_object = by_object
+        self.no_args = no_args
+        self.exact = not any(ct.cond)
+        self.failed: dict[tuple[int, int, frozenset[str]], int] = {}
+        """Window searches that found nothing: (start, needed facts, objects) -> the bound they had."""
+
+    def operators_among(self, objects: frozenset[str]) -> list[int]:
+        """The operators whose arguments are all in ``objects`` (increasing ids)."""
+        found = set(self.no_args)
+        own = self.objects
+        for name in objects:
+            for op in self.by_object.get(name, ()):
+                if op not in found and own[op] <= objects:
+                    found.add(op)
+        return sorted(found)
+
+    # ------------------------------------------------------------ reordering
+    def interferes(self, a: int, b: int) -> bool:
+        """Whether operators ``a`` and ``b`` may not swap places (one needs, adds or deletes what the other touches)."""
+        ct = self.ct
+        pa, aa, da = ct.pre_mask[a], ct.add_mask[a], ct.del_mask[a]
+        pb, ab, db = ct.pre_mask[b], ct.add_mask[b], ct.del_mask[b]
+        return bool(aa & pb or da & pb or pa & db or aa & db or da & ab or ct.cond[a] or ct.cond[b])
+
+    def regroup(self, plan: Sequence[int]) -> list[int]:
+        """The plan reordered so that actions sharing objects come together (a valid reordering).
+
+        Only pairs of non-interfering actions change their relative order, so the
+        result reaches the same final state. Ties go to the earlier action.
+        """
+        n = len(plan)
+        succ: list[list[int]] = [[] for _ in range(n)]
+        waiting = [0] * n
+        for j in range(n):
+            for i in range(j):
+                if self.interferes(plan[i], plan[j]):
+                    succ[i].append(j)
+                    waiting[j] += 1
+        ready = [j for j in range(n) if not waiting[j]]
+        order: list[int] = []
+        last: frozenset[str] = frozenset()
+        objects = self.objects
+        while ready:
+            best = max(ready, key=lambda k: (len(objects[plan[k]] & last), -k))
+            ready.remove(best)
+            order.append(plan[best])
+            last = objects[plan[best]]
+            for k in succ[best]:
+                waiting[k] -= 1
+                if not waiting[k]:
+                    ready.append(k)
+        return order
+
+    # ---------------------------------------------------------------- windows
+    def needs(self, plan: Sequence[int]) -> list[int]:
+        """Per position ``k``, the facts (mask) a state needs for ``plan[k:]`` to reach the goal."""
+        ct = self.ct
+        need = ct.goal_mask
+        out = [need]
+        for op in reversed(plan):
+            need = (need & ~ct.add_mask[op]) | ct.pre_mask[op]
+            out.append(need)
+        out.reverse()
+        return out
+
+    def valid(self, plan: Sequence[int]) -> bool:
+        """Whether ``plan`` is applicable from the initial state and reaches the goal."""
+        ct = self.ct
+        state = ct.init
+        for op in plan:
+            m = ct.pre_mask[op]
+            if state & m != m:
+                return False
+            state = ct.successor(state, op)
+        return ct.is_goal(state)
+
+    def search(
+        self, start: int, need: int, ops: Sequence[int], bound: int, limit: int, stats: Stats
+    ) -> Generator[Progress, None, list[int] | None]:
+        """A* from ``start`` to a state holding ``need``, cheaper than ``bound``, with ``ops`` only.
+
+        The estimate is the number of missing ``need`` facts over the most of them
+        one operator adds, times the cheapest operator cost (admissible).
+        """
+        ct = self.ct
+        pre = [ct.pre_mask[o] for o in ops]
+        cost = [ct.cost[o] for o in ops]
+        most = max([(ct.add_mask[o] & need).bit_count() for o in ops], default=0)
+        if not most:
+            return [] if start & need == need else None
+        cheapest = min(cost, default=0)
+        successor = ct.successor
+        dist = {start: 0}
+        parent: dict[int, tuple[int, int]] = {start: (-1, -1)}
+        heap = [(0, 0, 0, start)]
+        count = 0
+        expanded = 0
+        while heap:
+            _f, _n, g, state = heappop(heap)
+            if dist[state] < g:
+                continue
+            if state & need == need:
+                return trace(parent, state)
+            expanded += 1
+            if expanded > limit:
+                return None
+            stats.expansions += 1
+            if stats.expansions >= stats.next_progress:
+                stats.next_progress += stats.progress_every
+                yield Progress(stats.expansions)
+            for k, o in enumerate(ops):
+                m = pre[k]
+                if state & m != m:
+                    continue
+                g2 = g + cost[k]
+                if g2 >= bound:
+                    continue
+                nxt = successor(state, o)
+                old = dist.get(nxt)
+                if old is not None and old <= g2:
+                    continue
+                f2 = g2 + -(-(need & ~nxt).bit_count() // most) * cheapest
+                if f2 >= bound:
+                    continue
+                dist[nxt] = g2
+                parent[nxt] = (state, o)
+                count += 1
+                heappush(heap, (f2, count, g2, nxt))
+        return None
+
+    def improve_once(
+        self, plan: list[int], stats: Stats, sizes: Sequence[int] = WINDOW_SIZES, limit: int = WINDOW_STATES
+    ) -> Generator[Progress, None, list[int] | None]:
+        """The first cheaper plan one sweep of windows finds (shortest windows first), or ``None``."""
+        ct = self.ct
+        plan = self.regroup(plan) if self.exact else list(plan)
+        states = [ct.init]
+        for op in plan:
+            states.append(ct.successor(states[-1], op))
+        needs = self.needs(plan)
+        cost = ct.cost
+        tried: set[tuple[int, int]] = set()
+        n = len(plan)
+        for size in sizes:
+            size = min(size, n)
+            step = max(1, size // 3)
+            for i in range(0, max(1, n - size + step), step):
+                j = min(n, i + size)
+                if (i, j) in tried:
+                    continue
+                tried.add((i, j))
+                window = plan[i:j]
+                bound = sum(cost[o] for o in window)
+                if bound <= 0:
+                    continue
+                objects = frozenset().union(*(self.objects[o] for o in window))
+                key = (states[i], needs[j], objects)
+                if self.failed.get(key, -1) >= bound:
+                    continue  # the same search already failed with this bound or a looser one
+                ops = self.operators_among(objects)
+                found = yield from self.search(states[i], needs[j], ops, bound, limit, stats)
+                if found is None:
+                    self.failed[key] = bound
+                    continue
+                candidate = plan[:i] + found + plan[j:]
+                if self.valid(candidate):
+                    return candidate
+            if size == n:
+                break
+        return None
