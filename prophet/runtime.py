@@ -43,7 +43,6 @@ from prophet.planner import Done, Improved, PlanStatus, PlanStep
 from prophet.planner import Plan as StepPlan
 from prophet.tasks import CreatedTasks, create_tasks, state_step
 from prophet.world import (
-    ROBOT_OBJECT,
     PlanningWorld,
     TaskProgress,
     goal_literals,
@@ -77,7 +76,8 @@ class PlanShare:
         status: ``searching``, ``plan``, ``failed`` or ``done``.
         steps: the single-agent plan (status ``plan``).
         cost: its cost.
-        world: the facts it was planned from (the robot is ``self``).
+        world: the facts it was planned from.
+        robots: the robots it was planned with (the alive members in the state).
         entry_task: the task through which the team runs the problem (for Eq. 9).
         reason: why it failed, or why the leader replans.
     """
@@ -90,6 +90,7 @@ class PlanShare:
     steps: tuple[PlanStep, ...] = ()
     cost: float = 0.0
     world: tuple[Fact, ...] = ()
+    robots: tuple[str, ...] = ()
     entry_task: str = ""
     reason: str = ""
 
@@ -280,7 +281,7 @@ class ProblemRuntime:
         if share.status == PLAN:
             name = f"{self.model.name}_g{share.generation}v{share.version}"
             try:
-                created = create_tasks(name, share.steps, engine.library, share.world, ROBOT_OBJECT, engine.base_roleset, share.entry_task)
+                created = create_tasks(name, share.steps, engine.library, share.world, share.robots, engine.base_roleset, share.entry_task)
             except (PlannerError, AlicaError) as exc:
                 engine.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
                 return
@@ -288,7 +289,7 @@ class ProblemRuntime:
             engine.unregister_generated(self.created.plan.name)
         self.created = created
         if created is not None:
-            engine.register_generated(created.plan, created.roleset)
+            engine.register_generated(created.plan, created.roleset, created.pins())
         self.share = share
         self.revision += 1
         self.reason = share.reason
@@ -369,7 +370,7 @@ class ProblemRuntime:
         try:
             world = self._read_world(problem)
             if holds_all(goal_literals(problem), set(world.facts)):
-                self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, entry_task=task, reason="the goal holds"), now)
+                self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, robots=world.robots, entry_task=task, reason="the goal holds"), now)
                 return
             domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
             planner = get_planner(problem.planner, **({"progress_every": 100} if problem.planner == "builtin" else {}))
@@ -381,7 +382,7 @@ class ProblemRuntime:
         names = {name.lower(): name for name, _ in world.objects}
         self.search = _Search(generation, world, events, domain, pddl, now, names)
         engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts))
-        self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, entry_task=task, reason=reason), now)
+        self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, robots=world.robots, entry_task=task, reason=reason), now)
         self.next_update = now + self.model.update_time
 
     def _read_world(self, problem: PlanningProblem) -> PlanningWorld:
@@ -389,7 +390,7 @@ class ProblemRuntime:
         world_model = engine.world_model
         facts = world_model.facts() if hasattr(world_model, "facts") else ()
         typed = {t: world_model.objects(t) for t in world_model.types()} if hasattr(world_model, "types") else {}
-        return read_world(problem, engine.library, facts, engine.name, engine.team.roles, typed)
+        return read_world(problem, engine.library, facts, engine.members_of(self.slot.parent), typed)
 
     def _step_search(self, now: float) -> None:
         search = self.search
@@ -428,7 +429,7 @@ class ProblemRuntime:
             self.search = None
             self.engine.emit("planner", key=key_text(self.key), what="done", status=finished.status.value, expansions=search.expansions)
             if search.shared_cost is None:
-                message = finished.message or f"the planner ended with '{finished.status.value}' and no plan"
+                message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (f": {finished.message}" if finished.message else "")
                 self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)
             return
         if search.shared_cost is None:
@@ -452,7 +453,7 @@ class ProblemRuntime:
         search.shared_cost = plan.cost
         self.engine.emit("planner", key=key_text(self.key), what="plan", generation=search.generation, version=search.version,
                          cost=plan.cost, steps=len(steps), expansions=search.expansions, after_s=round(now - search.started, 6))
-        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, self._entry_task())
+        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, search.world.robots, self._entry_task())
         self._publish(share, now)
 
     # -- execution monitoring --------------------------------------------------

@@ -3,7 +3,12 @@
 1. **Parallelise** (Algorithms 2-3): the plan's actions are taken in order;
    an action opens a new task if its precondition holds for a *new* robot
    (the team's state before the action, with the robot's own facts those of a
-   robot that has done nothing yet), else it joins the last task.
+   robot that has done nothing yet), else it joins the task of the robot's
+   previous action (the last task, in a single-agent plan). The plan may name
+   several robots (when the world is planned with every team member, as the
+   runtime does, a robot may hold a block already): a task whose first action
+   only some robots could start now is *pinned* to them (``CreatedTasks.allowed``);
+   the engine vetoes every other agent for it.
 2. **Role-task priorities** (Eq. 9): task ``i`` of ``n`` gets ``T_i = 1 - i/n``,
    scaled for each role by the role's priority ``p`` for the planning
    problem's entry point; a role that cannot take one of the task's skills
@@ -67,6 +72,8 @@ class Step:
     bindings: tuple[tuple[str, str], ...]
     pre: tuple[tuple[bool, Fact], ...]
     effect: tuple[tuple[bool, Fact], ...]
+    robot: str = ""
+    """The robot the planner chose for the step (its ``?r``)."""
 
     @property
     def label(self) -> str:
@@ -84,12 +91,18 @@ class CreatedTasks:
         plan: the generated multi-agent plan.
         task_defs: the new tasks of the task repository.
         roleset: the role set with priorities for the new tasks.
+        allowed: per task, the robots that may take it (``None``: any).
     """
 
     tasks: tuple[tuple[Step, ...], ...]
     plan: Plan
     task_defs: tuple[Task, ...]
     roleset: RoleSet
+    allowed: tuple[tuple[str, ...] | None, ...] = ()
+
+    def pins(self) -> dict[str, tuple[str, ...]]:
+        """Entry point name -> the robots allowed to take it, for the pinned tasks."""
+        return {ep.name: allowed for ep, allowed in zip(self.plan.entry_points, self.allowed, strict=False) if allowed is not None}
 
 
 def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[tuple[bool, Fact], ...]:
@@ -101,12 +114,18 @@ def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[tup
     return tuple(out)
 
 
-def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robot: str) -> list[Step]:
-    """The plan's actions as steps of skill plans; ``robot`` is the object the planner used for ``?r``.
+def _robots(robots: str | Sequence[str]) -> tuple[str, ...]:
+    return (robots,) if isinstance(robots, str) else tuple(robots)
+
+
+def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robots: str | Sequence[str]) -> list[Step]:
+    """The plan's actions as steps of skill plans; ``robots`` are the objects the planner may use for ``?r``.
 
     Raises:
-        PlannerError: an action names no skill plan with a signature, or has the wrong number of arguments.
+        PlannerError: an action names no skill plan with a signature, has the
+            wrong number of arguments, or a robot that is not one of ``robots``.
     """
+    team = _robots(robots)
     by_name = {p.name.lower(): p for p in library.plans.values() if p.signature is not None}
     out = []
     for i, step in enumerate(plan_steps):
@@ -118,12 +137,13 @@ def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robot: str) -
             raise PlannerError(f"plan step {i + 1} '{step}': skill plan '{skill.name}' takes {len(params)} parameters ({', '.join(params)})")
         subst = dict(zip(params, step.args, strict=True))
         bindings = tuple((p.lstrip("?"), a) for p, a in zip(params, step.args, strict=True) if p != ROBOT)
-        if ROBOT in subst and subst[ROBOT] != robot:
-            raise PlannerError(f"plan step {i + 1} '{step}' is for robot '{subst[ROBOT]}', but the plan is a single-agent plan of '{robot}'")
+        robot = subst.get(ROBOT, team[0])
+        if robot not in team:
+            raise PlannerError(f"plan step {i + 1} '{step}' is for robot '{robot}', which is not one of the plan's robots ({', '.join(team)})")
         sig = skill.signature
         pre = _ground(sig.precondition.text if sig.precondition else None, subst, skill.name)
         eff = _ground(sig.effect.text if sig.effect else None, subst, skill.name)
-        out.append(Step(i, skill, bindings, pre, eff))
+        out.append(Step(i, skill, bindings, pre, eff, robot))
     return out
 
 
@@ -140,27 +160,44 @@ def _apply(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
             state.add(fact)
 
 
-def parallelise(steps: Sequence[Step], init: Iterable[Fact], robot: str) -> list[list[Step]]:
+def _as(literal_set: Iterable[tuple[bool, Fact]], robot: str, other: str) -> list[tuple[bool, Fact]]:
+    return [(positive, (name, tuple(other if a == robot else a for a in args))) for positive, (name, args) in literal_set]
+
+
+def parallelise(steps: Sequence[Step], init: Iterable[Fact], robots: str | Sequence[str]) -> list[list[Step]]:
     """Algorithms 2-3: split the steps into tasks.
 
     A step opens a new task when its precondition holds for a robot that has
-    done nothing yet in the team's state before the step; else it joins the last task.
+    done nothing yet (some robot with its initial facts) in the team's state
+    before the step; else it joins the task of the robot's previous step.
     """
+    return _parallelise(steps, init, _robots(robots))[0]
+
+
+def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, ...]) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
     start = set(init)
-    fresh = {f for f in start if robot in f[1]}
+    members = set(team)
+    fresh = {r: {f for f in start if r in f[1]} for r in team}
     state = set(start)
     tasks: list[list[Step]] = []
+    allowed: list[tuple[str, ...] | None] = []
+    task_of: dict[str, int] = {}
     for step in steps:
-        if not tasks:
+        shared = {f for f in state if not members.intersection(f[1])}
+        able = tuple(r for r in team if _holds(_as(step.pre, step.robot, r), shared | fresh[r]))
+        if not tasks or able:
             tasks.append([step])
+            allowed.append(able if _pinned(step) and able and set(able) != members else None)
+            task_of[step.robot] = len(tasks) - 1
         else:
-            shared = {f for f in state if robot not in f[1]}
-            if _holds(step.pre, shared | fresh):
-                tasks.append([step])
-            else:
-                tasks[-1].append(step)
+            tasks[task_of.get(step.robot, len(tasks) - 1)].append(step)
         _apply(state, step.effect)
-    return tasks
+    return tasks, allowed
+
+
+def _pinned(step: Step) -> bool:
+    """Whether the step needs the robot in a relation with an object (``holding(?r, ?x)``), not just a robot state."""
+    return any(positive and step.robot in args and len(args) > 1 for positive, (_, args) in step.pre)
 
 
 def _cardinality(task: Sequence[Step]) -> tuple[int, float]:
@@ -193,7 +230,7 @@ def _condition(pre: Sequence[tuple[bool, Fact]], robot: str) -> Condition | None
     return Condition(ConditionKind.TRANSITION, " and ".join(parts))
 
 
-def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str) -> tuple[Plan, tuple[Task, ...]]:
+def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None) -> tuple[Plan, tuple[Task, ...]]:
     """The multi-agent plan of the tasks (see the module docstring)."""
     entry_points, states, transitions, task_defs = [], [], [], []
     for i, task in enumerate(tasks):
@@ -208,7 +245,7 @@ def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str) -> tuple[
             states.append(State(wait, description=f"wait until {step.label} can run"))
             bind = tuple(Binding(var, value) for var, value in step.bindings)
             states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
-            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot)))
+            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot or step.robot)))
             transitions.append(Transition(f"{run}->{following}", run, following, Condition(ConditionKind.TRANSITION, "succeeded")))
             transitions.append(Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed")))
         states.append(State(f"T{i}_Done", StateKind.SUCCESS))
@@ -247,15 +284,18 @@ def role_priorities(roleset: RoleSet, tasks: Sequence[Sequence[Step]], task_defs
     return replace(roleset, roles=tuple(roles))
 
 
-def create_tasks(name: str, plan_steps: Sequence[PlanStep], library: PlanLibrary, init: Iterable[Fact], robot: str, roleset: RoleSet, entry_task: str) -> CreatedTasks:
+def create_tasks(
+    name: str, plan_steps: Sequence[PlanStep], library: PlanLibrary, init: Iterable[Fact], robots: str | Sequence[str], roleset: RoleSet, entry_task: str
+) -> CreatedTasks:
     """Turn a single-agent plan into tasks, a multi-agent plan and role-task priorities (the module docstring says how).
 
     Args:
         name: the generated plan's name.
-        plan_steps: the planner's single-agent plan.
+        plan_steps: the planner's plan.
         library: holds the skill plans the steps name.
         init: the world the plan starts from, as ``(predicate, args)`` facts.
-        robot: the object standing for the robot in the plan (``?r``).
+        robots: the robot objects of the plan (``?r``): one for a single-agent
+            plan, the team's members when the world was planned with all of them.
         roleset: the team's role set.
         entry_task: the task through which the team runs the planning problem.
 
@@ -264,10 +304,11 @@ def create_tasks(name: str, plan_steps: Sequence[PlanStep], library: PlanLibrary
     """
     if not plan_steps:
         raise PlannerError("an empty plan makes no tasks: the goal already holds")
-    steps = steps_of(plan_steps, library, robot)
-    tasks = parallelise(steps, init, robot)
-    plan, task_defs = build_plan(name, tasks, robot)
-    return CreatedTasks(tuple(tuple(t) for t in tasks), plan, task_defs, role_priorities(roleset, tasks, task_defs, entry_task))
+    team = _robots(robots)
+    steps = steps_of(plan_steps, library, team)
+    tasks, allowed = _parallelise(steps, init, team)
+    plan, task_defs = build_plan(name, tasks)
+    return CreatedTasks(tuple(tuple(t) for t in tasks), plan, task_defs, role_priorities(roleset, tasks, task_defs, entry_task), tuple(allowed))
 
 
 def emit_yaml(created: CreatedTasks, imports: Sequence[str] = ()) -> str:

@@ -2,13 +2,14 @@
 
 **World** (IMPERA 7.1) is read from first-order facts: the problem's own
 ``world`` for offline use, else the facts of the shared world model. Only
-facts of the domain's predicates count. The single-agent plan is made for one
-robot, the stand-in :data:`ROBOT_OBJECT` (``self``): the planning agent's own
-facts (``handempty(r1)`` for agent ``r1``) become the stand-in's, and facts
-of other team members are left out, so the plan is one any fresh robot of the
-team could start. Objects get their types from the predicates they appear in
-(``clear(a)`` makes ``a`` a ``block``), from the problem's ``objects`` and
-from the world model's typed objects.
+facts of the domain's predicates count. At run time the world is planned
+with every alive team member as a robot (the objects of the type of the
+skills' ``?r`` parameter), each with its own facts: a robot that holds a
+block when the team replans is part of the world, and the plan may use it.
+Facts of other robots (crashed members, opponents) are left out. Objects get
+their types from the predicates they appear in (``clear(a)`` makes ``a`` a
+``block``), from the problem's ``objects`` and from the world model's typed
+objects.
 
 While the team executes a generated plan, :func:`remaining_fits` simulates
 what is left of it (each task's remaining steps, run by the agent holding the
@@ -31,21 +32,19 @@ from prophet.problem import offline_world, predicate_types
 Fact = tuple[str, tuple[str, ...]]
 Literal = tuple[bool, Fact]
 
-#: The object standing for "the robot that runs the step" in single-agent plans.
-ROBOT_OBJECT = "self"
-
-
 @dataclass(frozen=True, slots=True)
 class PlanningWorld:
     """A world to plan from.
 
     Attributes:
         objects: ``(name, type)`` pairs, sorted.
-        facts: the facts that hold, sorted; the planning robot is :data:`ROBOT_OBJECT`.
+        facts: the facts that hold, sorted.
+        robots: the robots the plan may use, sorted.
     """
 
     objects: tuple[tuple[str, str], ...]
     facts: tuple[Fact, ...]
+    robots: tuple[str, ...] = ()
 
     def object_types(self) -> dict[str, str]:
         """Object name -> type."""
@@ -74,60 +73,57 @@ def read_world(
     problem: PlanningProblem,
     library: PlanLibrary,
     facts: Iterable[tuple[object, ...]],
-    agent: str,
     team: Iterable[str],
     typed_objects: Mapping[str, Iterable[object]] | None = None,
 ) -> PlanningWorld:
-    """The world ``agent`` plans from (see the module docstring).
+    """The world the team plans from (see the module docstring).
 
     Args:
         problem: the planning problem.
         library: holds its elements' signatures.
         facts: true facts as ``(predicate, *args)`` tuples (the world model's
             :meth:`facts`); ignored when the problem has its own ``world``.
-        agent: the planning agent, whose facts become the stand-in's.
-        team: every team member (their facts are left out).
+        team: the alive team members: the robots of the plan.
         typed_objects: type -> objects, e.g. from the world model.
 
     Raises:
         PlannerError: the problem's elements or goal cannot be planned with.
     """
     predicates = predicate_types(problem, library)
+    robot_type = _robot_type(problem, library)
+    offline = problem.world is not None
     declared: dict[str, str] = {}
-    if problem.world is not None:
+    if offline:
         declared, given = offline_world(problem)
         source: Iterable[tuple[object, ...]] = ((name, *args) for name, args in given)
     else:
         source = facts
-    members = set(team) - {agent}
+    members = tuple(sorted(set(team)))
     kept: set[Fact] = set()
     for fact in source:
         name = str(fact[0])
-        args = tuple(ROBOT_OBJECT if str(a) == agent else str(a) for a in fact[1:])
+        args = tuple(str(a) for a in fact[1:])
         arity = predicates.get(name.lower())
-        if arity is None or len(args) != len(arity) or members.intersection(args):
+        if arity is None or len(args) != len(arity):
             continue
+        if not offline and any(kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)):
+            continue  # a robot outside the team
         kept.add((name, args))
-    types: dict[str, str] = {}
-    for name, type_name in sorted(declared.items()):
-        types[ROBOT_OBJECT if name == agent else name] = type_name
+    types: dict[str, str] = dict(sorted(declared.items()))
+    if not offline and robot_type is not None:
+        types.update(dict.fromkeys(members, robot_type))
     for type_name, objects in sorted((typed_objects or {}).items()):
         for obj in objects:
-            name = ROBOT_OBJECT if str(obj) == agent else str(obj)
-            if name not in members:
-                types.setdefault(name, type_name)
+            if offline or type_name != robot_type:
+                types.setdefault(str(obj), type_name)
     for _, (name, args) in goal_literals(problem):
-        kept_args = predicates.get(name.lower(), ())
-        for arg, type_name in zip(args, kept_args, strict=False):
+        for arg, type_name in zip(args, predicates.get(name.lower(), ()), strict=False):
             types.setdefault(arg, type_name)
     for name, args in sorted(kept):
         for arg, type_name in zip(args, predicates[name.lower()], strict=True):
             types.setdefault(arg, type_name)
-    if ROBOT_OBJECT not in types:
-        robot_type = _robot_type(problem, library)
-        if robot_type is not None:
-            types[ROBOT_OBJECT] = robot_type
-    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)))
+    robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
+    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots)
 
 
 def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:
@@ -166,45 +162,48 @@ def remaining_fits(
     facts: Iterable[Fact],
     start_world: Iterable[Fact],
     goal: Sequence[Literal],
-    robot: str = ROBOT_OBJECT,
 ) -> str | None:
     """Whether what is left of a generated plan still reaches the goal from ``facts``.
 
     Args:
         tasks: the steps of each task (:class:`prophet.tasks.Step`).
         progress: one entry per task.
-        facts: the facts that hold now, with the agents' real names.
+        facts: the facts that hold now.
         start_world: the world the plan was made from (gives a fresh robot's facts).
         goal: the goal literals.
-        robot: the stand-in the steps were planned with.
 
     Returns:
         ``None`` when it fits, else what does not.
     """
     state = set(facts)
-    fresh = [f for f in start_world if robot in f[1]]
+    start = tuple(start_world)
     remaining: list[tuple[int, object, str]] = []
     for i, (task, where) in enumerate(zip(tasks, progress, strict=True)):
-        if where.done:
+        if where.done or where.next_step >= len(task):
             continue
         who = where.agent
         if who is None:
-            who = f"~T{i}"  # a robot that has done nothing yet
-            state.update((name, tuple(who if a == robot else a for a in args)) for name, args in fresh)
+            # nobody holds the task yet: a robot like the one planned for it, as it was at the start
+            who = f"~T{i}"
+            planned = task[where.next_step].robot  # type: ignore[attr-defined]
+            state.update((name, tuple(who if a == planned else a for a in args)) for name, args in start if planned in args)
         for k in range(where.next_step, len(task)):
             remaining.append((task[k].index, task[k], who))  # type: ignore[attr-defined]
     for _, step, who in sorted(remaining, key=lambda item: item[0]):
-        pre = _ground(step.pre, robot, who)  # type: ignore[attr-defined]
-        effect = _ground(step.effect, robot, who)  # type: ignore[attr-defined]
+        pre = _ground(step.pre, step.robot, who)  # type: ignore[attr-defined]
+        effect = _ground(step.effect, step.robot, who)  # type: ignore[attr-defined]
         if holds_all(pre, state):
             for positive, fact in effect:
                 if not positive:
                     state.discard(fact)
             state.update(fact for positive, fact in effect if positive)
         elif not holds_all(effect, state):
-            unmet = next(f"{'' if p else 'not '}{n}({', '.join(a)})" for p, (n, a) in pre if ((n, a) in state) != p)
-            return f"step {step.label} of {who} cannot run: {unmet} does not hold"  # type: ignore[attr-defined]
+            return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"  # type: ignore[attr-defined]
     if not holds_all(goal, state):
-        unmet = next(f"{'' if p else 'not '}{n}({', '.join(a)})" for p, (n, a) in goal if ((n, a) in state) != p)
-        return f"the plan no longer reaches the goal: {unmet} would not hold"
+        return f"the plan no longer reaches the goal: {_unmet(goal, state)} would not hold"
     return None
+
+
+def _unmet(wanted: Sequence[Literal], state: set[Fact]) -> str:
+    positive, (name, args) = next(item for item in wanted if (item[1] in state) != item[0])
+    return f"{'' if positive else 'not '}{name}({', '.join(args)})"

@@ -226,11 +226,17 @@ class AgentEngine:
         plan = self.library.plans.get(name)
         return plan if plan is not None else self.plan_board.plans[name]
 
-    def register_generated(self, plan: Plan, roleset: RoleSet) -> None:
-        """Make a generated plan allocatable; ``roleset`` holds the priorities of its tasks."""
+    def register_generated(self, plan: Plan, roleset: RoleSet, pins: Mapping[str, tuple[str, ...]] | None = None) -> None:
+        """Make a generated plan allocatable.
+
+        Args:
+            plan: the plan.
+            roleset: holds the priorities of its tasks.
+            pins: entry point -> the only agents that may take it (others are vetoed).
+        """
         tasks = {ep.task for ep in plan.entry_points}
         priorities = {role.name: tuple(p for p in role.priorities if p.task in tasks) for role in roleset.roles}
-        self.plan_board.register(plan, priorities)
+        self.plan_board.register(plan, priorities, pins or {})
         self.roleset = self.plan_board.roleset(self.base_roleset)
 
     def unregister_generated(self, name: str) -> None:
@@ -348,7 +354,12 @@ class AgentEngine:
     # -- allocation -----------------------------------------------------
 
     def _summand_fn(self, node_env: Mapping[str, object], context: PlanNode | None) -> Callable[[Plan, Summand, str, EntryPoint], float]:
+        pins = self.plan_board.pins
+
         def summand(plan: Plan, term: Summand, agent: str, ep: EntryPoint) -> float:
+            pinned = pins.get(plan.name)
+            if pinned and ep.name in pinned and agent not in pinned[ep.name]:
+                return -1.0  # a generated task only some robots can start (prophet.tasks)
             env = dict(node_env)
             env.update({"self": agent, "task": ep.task, "entry": ep.name})
             if context is not None:

@@ -42,6 +42,7 @@ class PlanBoard:
         self.requests: dict[PlanKey, list[Any]] = {}
         self.plans: dict[str, Plan] = {}
         self.priorities: dict[str, Mapping[str, tuple[Priority, ...]]] = {}
+        self.pins: dict[str, Mapping[str, tuple[str, ...]]] = {}
 
     def receive(self, payload: Any, now: float) -> None:
         """Take in a share (kept if it supersedes the one known) or a replan request."""
@@ -61,15 +62,18 @@ class PlanBoard:
         """The replan requests for ``key`` received since the last call."""
         return self.requests.pop(key, [])
 
-    def register(self, plan: Plan, priorities: Mapping[str, tuple[Priority, ...]]) -> None:
-        """Make a generated plan known, with its tasks' priorities per role."""
+    def register(self, plan: Plan, priorities: Mapping[str, tuple[Priority, ...]], pins: Mapping[str, tuple[str, ...]]) -> None:
+        """Make a generated plan known, with its tasks' priorities per role and its pinned entry points."""
         self.plans[plan.name] = plan
         self.priorities[plan.name] = priorities
+        if pins:
+            self.pins[plan.name] = pins
 
     def unregister(self, name: str) -> None:
         """Forget a generated plan."""
         self.plans.pop(name, None)
         self.priorities.pop(name, None)
+        self.pins.pop(name, None)
 
     def roleset(self, base: RoleSet) -> RoleSet:
         """``base`` with the priorities of every registered generated plan's tasks."""

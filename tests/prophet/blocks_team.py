@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import itertools
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 import py_trees
@@ -11,6 +12,7 @@ from py_trees.common import Status
 from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
 from alica.io import load_library
 from alica.model import PlanLibrary
+from prophet.planner import Feature, Planner, Progress, SearchEvent
 from tests.conftest import PLANS
 
 Literal = tuple[bool, str, tuple[str, ...]]
@@ -91,7 +93,7 @@ def world_facts(stacks: Iterable[Iterable[str]], robots: Iterable[str]) -> list[
     for stack in stacks:
         blocks = list(stack)
         facts.append((True, "ontable", (blocks[0],)))
-        facts.extend((True, "on", (upper, lower)) for lower, upper in zip(blocks, blocks[1:]))
+        facts.extend((True, "on", (upper, lower)) for lower, upper in itertools.pairwise(blocks))
         facts.append((True, "clear", (blocks[-1],)))
     facts.extend((True, "handempty", (r,)) for r in robots)
     return facts
@@ -116,3 +118,16 @@ def goal_holds(sim: SimulatedTeam, agent: str) -> bool:
     """Whether a on b on c holds in ``agent``'s world model."""
     world = sim.engines[agent].world_model
     return world.holds("on", "a", "b") and world.holds("on", "b", "c") and world.holds("ontable", "c")
+
+
+class StallingPlanner(Planner):
+    """A planner that never finds anything (for the planning timeout)."""
+
+    name = "stall"
+    features = frozenset(Feature)
+
+    def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
+        expansions = 0
+        while True:
+            expansions += 100
+            yield Progress(expansions)

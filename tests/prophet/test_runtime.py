@@ -1,0 +1,263 @@
+"""The runtime of planning problems (IMPERA 7.1-7.2) in simulated time, with scripted skills.
+
+The blocks-world team runs the shipped BlocksWorldMission: its state Stacking
+holds the planning problem StackBlocks (WaitPlan DriveToFreePosition, no
+AlternativePlan). The skills are scripted: each runs a few ticks and then
+changes the world model as the IPC blocks domain says.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from alica.engine import EngineConfig
+from alica.testing import scripted
+from prophet.planners import PLANNERS
+from tests.engine.helpers import library, team, where
+from tests.prophet.blocks_team import SUSSMAN, BlockSkills, blocks_team, goal_holds
+
+KEY = "BlocksWorldMission/Stacking/StackBlocks"
+
+
+def events(recorder, kind, **match):
+    return [e for e in recorder.events if e["event"] == kind and all(e.get(k) == v for k, v in match.items())]
+
+
+def child_plan(sim, agent):
+    node = sim.engines[agent].root.slots[0].node
+    return node.plan.name if node is not None else None
+
+
+def run_until(sim, condition, max_ticks=600):
+    for _ in range(max_ticks):
+        if condition():
+            return
+        sim.tick()
+    raise AssertionError("condition not reached")
+
+
+def test_wait_plan_while_planning_then_the_team_switches_to_the_first_plan():
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2"], skills, planner_expansions=1)
+    sim.tick()
+    assert [child_plan(sim, a) for a in ("r1", "r2")] == ["DriveToFreePosition"] * 2
+    started = events(rec, "planner", what="started")
+    assert [e["agent"] for e in started] == ["r1"]  # the lowest id leads
+    run_until(sim, lambda: all((child_plan(sim, a) or "").startswith("StackBlocks_g1v") for a in ("r1", "r2")))
+    first = events(rec, "planner", what="plan")[0]
+    assert first["agent"] == "r1" and first["steps"] == 6
+    adopted = events(rec, "problem", phase="plan")
+    assert {e["agent"] for e in adopted} == {"r1", "r2"}
+    summary = sim.run(until_done=True, max_time=60)
+    assert summary["success"] and goal_holds(sim, "r1") and goal_holds(sim, "r2")
+    # the plan was spread: both robots manipulated blocks
+    manipulators = {agent for agent, skill, _ in skills.runs if skill in ("Pickup", "Unstack", "Stack", "Putdown")}
+    assert manipulators == {"r1", "r2"}
+    assert events(rec, "replan") == []
+
+
+def test_one_robot_runs_every_task_in_turn():
+    skills = BlockSkills()
+    sim, _ = blocks_team(["r1"], skills)
+    summary = sim.run(until_done=True, max_time=60)
+    assert summary["success"] and goal_holds(sim, "r1")
+    assert [s for _, s, _ in skills.runs if s in ("Pickup", "Unstack", "Stack", "Putdown")] == ["Unstack", "Putdown", "Pickup", "Stack", "Pickup", "Stack"]
+
+
+def test_a_failed_step_sends_the_team_back_to_the_wait_plan_and_the_leader_replans():
+    skills = BlockSkills(fail=["Pickup"])
+    sim, rec = blocks_team(["r1", "r2"], skills)
+    summary = sim.run(until_done=True, max_time=60)
+    assert summary["success"] and goal_holds(sim, "r1")
+    replans = events(rec, "replan")
+    assert replans and all(e["agent"] == "r1" for e in replans)
+    assert "failed" in replans[0]["reason"]
+    # after the failure every agent ran the WaitPlan of generation 2, then its plan
+    for agent in ("r1", "r2"):
+        assert events(rec, "problem", agent=agent, phase="wait", generation=2)
+        assert events(rec, "problem", agent=agent, phase="plan", generation=2)
+    assert summary["agents"]["r1"]["replans"] >= 1
+
+
+def test_a_non_leader_step_failure_is_reported_to_the_leader():
+    skills = BlockSkills(fail=["Pickup"])
+    sim, rec = blocks_team(["r1", "r2"], skills)
+    sim.run(until_done=True, max_time=60)
+    failed_by = next(agent for agent, skill, _ in skills.runs if skill == "Pickup")
+    replan = events(rec, "replan")[0]
+    if failed_by != "r1":
+        assert replan["reason"].startswith(f"{failed_by}: ")
+
+
+def test_the_world_changing_under_the_plan_makes_the_leader_replan():
+    skills = BlockSkills(ticks=6)
+    stacks = [*SUSSMAN, ["d"]]
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=stacks)
+    run_until(sim, lambda: events(rec, "problem", agent="r2", phase="plan"))
+    # an opponent puts d on b before anyone picked b up: Pickup(b) cannot run any more
+    sim.set_facts([(False, "ontable", ("d",)), (False, "clear", ("b",)), (True, "on", ("d", "b"))])
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["success"] and goal_holds(sim, "r2")
+    replans = events(rec, "replan")
+    assert replans and "the world changed under the plan" in replans[0]["reason"]
+    assert "Pickup(b)" in replans[0]["reason"] or "Unstack" in replans[0]["reason"]
+
+
+def test_the_leader_crashes_while_planning_and_the_next_lowest_id_takes_over():
+    skills = BlockSkills()
+    # a budget of one progress event per tick keeps the first planning in flight for a few ticks
+    sim, rec = blocks_team(["r1", "r2", "r3"], skills, stacks=[["a", "b", "c", "d", "e", "f"]], planner_expansions=1)
+    sim.tick()
+    assert events(rec, "planner", agent="r1", what="started")
+    sim.crash("r1")
+    summary = sim.run(until_done=True, max_time=90)
+    takeover = events(rec, "planner", agent="r2", what="started")
+    assert takeover and takeover[0]["reason"] == "taking over from r1"
+    assert events(rec, "planner", agent="r3", what="started") == []
+    assert summary["agents"]["r2"]["status"] == "success" and summary["agents"]["r3"]["status"] == "success"
+    assert goal_holds(sim, "r2")
+
+
+def test_the_leader_crashes_during_execution_and_the_team_still_reaches_the_goal():
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2", "r3"], skills)
+    run_until(sim, lambda: any(a == "r1" and s in ("Unstack", "Pickup") for a, s, _ in skills.runs))
+    sim.crash("r1")
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["agents"]["r2"]["status"] == "success" and summary["agents"]["r3"]["status"] == "success"
+    assert goal_holds(sim, "r2")
+    # r1 held a block when it crashed or had just started: either the team replanned around it, or its task was taken over
+    assert events(rec, "replan") or any(a != "r1" for a, s, _ in skills.runs if s == "Stack")
+
+
+def test_the_same_seed_gives_the_same_trace():
+    def trace():
+        sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(fail=["Stack"]), seed=7)
+        sim.run(until_done=True, max_time=60)
+        return [e for e in rec.events]
+
+    assert trace() == trace()
+
+
+def test_the_operator_sets_a_new_goal_and_the_leader_replans():
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2"], skills)
+    run_until(sim, lambda: events(rec, "problem", agent="r2", phase="plan"))
+    for engine in sim.engines.values():
+        engine.set_problem("StackBlocks", goal="on(c, b) and on(b, a) and ontable(a)")
+    summary = sim.run(until_done=True, max_time=90)
+    assert events(rec, "replan", reason="the operator changed the planning problem")
+    world = sim.engines["r1"].world_model
+    assert summary["success"] and world.holds("on", "c", "b") and world.holds("on", "b", "a")
+
+
+# -- planner failure and timeout: the AlternativePlan -------------------------------
+
+PROBLEM = """
+behaviours:
+  - {name: Hold, skill: Wait}
+  - {name: GoHome, skill: Work}
+plans:
+  - name: Step
+    signature: {parameters: [], precondition: "ready and not done", effect: "done"}
+    entry_points: [{task: Work, state: Stepping, min: 1, max: 1}]
+    states:
+      - {name: Stepping, children: [Hold], transitions: [{to: Stepped, condition: succeeded}]}
+      - {name: Stepped, kind: success}
+  - name: Park
+    entry_points: [{task: Watch, state: Parked, min: 1, max: "*"}]
+    states:
+      - {name: Parked, children: [Hold]}
+  - name: Home
+    entry_points: [{task: Help, state: Going, min: 1, max: "*"}]
+    states:
+      - {name: Going, children: [GoHome], transitions: [{to: There, condition: succeeded}]}
+      - {name: There, kind: success}
+  - name: Top
+    entry_points: [{task: Default, state: Solve, min: 1, max: "*"}]
+    states:
+      - name: Solve
+        children: [Solve]
+        transitions:
+          - {to: Done, condition: "succeeded(Solve)"}
+          - {to: GaveUp, condition: "failed(Solve)"}
+      - {name: Done, kind: success}
+      - {name: GaveUp, kind: success}
+problems:
+  - name: Solve
+    elements: [Step]
+    wait_plan: Park
+    ALTERNATIVE
+    timeout: 2
+    planner: PLANNER
+    goal: "done"
+"""
+
+
+def problem_team(tmp_path, planner="builtin", alternative=True):
+    text = PROBLEM.replace("PLANNER", planner).replace("ALTERNATIVE", "alternative_plan: Home" if alternative else "")
+    lib = library(tmp_path, text)
+    config = EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    return team(lib, "Top", {"w": "Worker", "h": "Helper"}, {"Wait": scripted(["running"]), "Work": scripted(["running", "success"])}, config=config)
+
+
+def test_an_unsolvable_problem_runs_the_alternative_plan(tmp_path):
+    sim, rec = problem_team(tmp_path)
+    sim.run(ticks=3)  # the leader h plans in tick 2, w hears of it in tick 3
+    failed = events(rec, "problem", phase="alternative")
+    assert {e["agent"] for e in failed} == {"w", "h"}
+    assert "unsolvable" in failed[0]["reason"]
+    sim.run(ticks=5)
+    assert events(rec, "allocation", plan="Home")
+    summary = sim.run(until_done=True, max_time=10)
+    assert summary["success"] and where(sim, "w") == ("Default", "Done")  # the AlternativePlan's outcome is the child's
+
+
+def test_a_planner_timeout_runs_the_alternative_plan(tmp_path, monkeypatch):
+    monkeypatch.setitem(PLANNERS, "stall", "tests.prophet.blocks_team:StallingPlanner")
+    sim, rec = problem_team(tmp_path, planner="stall")
+    sim.run(ticks=15)
+    assert events(rec, "problem", phase="alternative") == []  # still planning within the 2 s timeout
+    assert child_plan(sim, "w") == "Park"
+    sim.run(ticks=10)
+    timeout = events(rec, "problem", agent="h", phase="alternative")
+    assert timeout and "timeout of 2 s" in timeout[0]["reason"]
+    summary = sim.run(until_done=True, max_time=10)
+    assert summary["success"]
+
+
+def test_without_an_alternative_plan_a_planning_failure_fails_the_child(tmp_path):
+    sim, rec = problem_team(tmp_path, alternative=False)
+    summary = sim.run(until_done=True, max_time=10)
+    assert summary["success"] and where(sim, "w") == ("Default", "GaveUp")
+    assert events(rec, "problem", phase="failed")
+
+
+def test_a_goal_that_holds_already_succeeds_at_once(tmp_path):
+    sim, rec = problem_team(tmp_path)
+    sim.set_facts([(True, "done", ())])
+    summary = sim.run(until_done=True, max_time=5)
+    assert summary["success"] and where(sim, "w") == ("Default", "Done")
+    assert events(rec, "problem", phase="done")
+    assert events(rec, "allocation", plan="Home") == []
+
+
+@pytest.mark.parametrize("planner", ["nonesuch"])
+def test_an_unknown_planner_is_a_planning_failure_with_its_reason(tmp_path, planner):
+    sim, rec = problem_team(tmp_path, planner=planner)
+    sim.run(ticks=2)
+    failed = events(rec, "problem", phase="alternative")
+    assert failed and "unknown planner 'nonesuch'" in failed[0]["reason"]
+
+
+def test_a_robot_holding_a_block_at_a_replan_is_part_of_the_new_plan():
+    skills = BlockSkills(fail=["Stack"])
+    sim, rec = blocks_team(["r1", "r2", "r3"], skills, seed=7)
+    summary = sim.run(until_done=True, max_time=60)
+    assert summary["success"] and goal_holds(sim, "r1")
+    stacks = [(agent, params["object"]) for agent, skill, params in skills.runs if skill == "Stack"]
+    failed_agent, block = stacks[0]
+    # the robot whose Stack failed still holds its block: the new plan has it stack that block (a pinned task)
+    assert (failed_agent, block) in stacks[1:]
+    replanned = events(rec, "planner", what="plan", generation=2)
+    assert replanned and replanned[0]["steps"] < 6
