@@ -1,5 +1,10 @@
 """``alica plan``: solve a PDDL problem with a planner back-end, validate the plan, print it.
 
+Given a plan file instead of a PDDL domain, it plans one of the file's
+planning problems offline (its ``world``, or ``--world``), prints the tasks
+pRoPhEt MAS makes of the plan and, with ``--emit-plan FILE``, writes the
+generated ALICA plan as a YAML plan file.
+
 Exit codes: 0 solved (the plan is valid), 1 input error or a failed planner
 (also: a back-end returned an invalid plan), 2 wrong usage, 3 proven
 unsolvable, 4 time limit reached without a plan.
@@ -9,13 +14,17 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from alica.errors import AlicaError
 from prophet.planner import Plan, PlanResult, PlanStatus
 
 EXIT_OK, EXIT_ERROR, EXIT_UNSOLVABLE, EXIT_TIMEOUT = 0, 1, 3, 4
+PLAN_FILE_SUFFIXES = (".yaml", ".yml", ".xml")
 
 
 def add_parser(sub: Any) -> None:
@@ -29,8 +38,12 @@ def add_parser(sub: Any) -> None:
         "(one action a line, then ';' lines with cost, times and expansions: the output is itself a plan file). "
         "Exit 0 solved, 1 input error or planner failure, 3 proven unsolvable, 4 time limit reached without a plan.",
     )
-    p.add_argument("domain", metavar="DOMAIN", help="a PDDL domain file")
-    p.add_argument("problem", metavar="PROBLEM", help="a PDDL problem file")
+    p.add_argument("domain", metavar="DOMAIN", help="a PDDL domain file, or a plan file with a planning problem")
+    p.add_argument("problem", metavar="PROBLEM", nargs="?", help="a PDDL problem file (not with a plan file)")
+    p.add_argument("--problem", dest="problem_name", metavar="NAME", help="with a plan file: the planning problem (default: its only one)")
+    p.add_argument("--world", metavar="FACTS", help="with a plan file: the world as facts, e.g. \"ontable(a) and clear(a) and handempty(r)\"")
+    p.add_argument("--goal", metavar="FORMULA", help="with a plan file: the goal instead of the problem's")
+    p.add_argument("--emit-plan", metavar="FILE", help="with a plan file: write the generated ALICA plan and its tasks as YAML")
     p.add_argument(
         "--planner",
         default="builtin",
@@ -66,6 +79,12 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from prophet.pddl import PddlError, read_domain, read_problem
     from prophet.planners import get_planner
 
+    if Path(args.domain).suffix.lower() in PLAN_FILE_SUFFIXES:
+        return _plan_file(args)
+    if args.problem is None:
+        raise AlicaError(f"{args.domain}: a PDDL domain needs a PROBLEM file (or give a plan file with a planning problem)")
+    if args.emit_plan or args.problem_name or args.world or args.goal:
+        raise AlicaError("--problem, --world, --goal and --emit-plan go with a plan file, not with PDDL files")
     try:
         domain = read_domain(args.domain)
         problem = read_problem(args.problem, domain)
@@ -78,20 +97,90 @@ def cmd_plan(args: argparse.Namespace) -> int:
         result = planner.solve(args.domain, args.problem, time_limit=args.time_limit, anytime=args.anytime)
     else:
         result = planner.solve(domain, problem, time_limit=args.time_limit, anytime=args.anytime)
+    return _report(args, planner.name, (domain, problem), result)
+
+
+def _report(args: argparse.Namespace, name: str, task: tuple[Any, Any], result: PlanResult, extra: Callable[[], dict[str, Any]] | None = None) -> int:
+    """Validate and print the result; ``extra`` adds fields (and lines) once the plan is valid."""
     if result.status is PlanStatus.ERROR and result.plan is None:
-        raise AlicaError(f"planner '{planner.name}' failed: {result.message or 'no reason given'}")
+        raise AlicaError(f"planner '{name}' failed: {result.message or 'no reason given'}")
     cost = None
+    more: dict[str, Any] = {}
     if result.plan is not None:
-        cost = _validated_cost(planner.name, (domain, problem), result.plan)
+        cost = _validated_cost(name, task, result.plan)
+        more = extra() if extra is not None else {}
     if args.json:
-        print(json.dumps(_summary(result, cost)))
+        print(json.dumps({**_summary(result, cost), **more}))
     else:
         _print_text(result, cost)
+        for key, value in more.items():
+            print(f"; {key}: {value}")
     if result.plan is not None:
         return EXIT_OK
     if result.status is PlanStatus.UNSOLVABLE:
         return EXIT_UNSOLVABLE
     return EXIT_TIMEOUT
+
+
+def _plan_file(args: argparse.Namespace) -> int:
+    """Plan a planning problem of a plan file offline; print the plan and its tasks, maybe emit the generated plan."""
+    from dataclasses import replace
+
+    from alica.io import load_library
+    from alica.model import Condition, ConditionKind
+    from prophet.planners import get_planner
+    from prophet.problem import to_pddl
+    from prophet.tasks import create_tasks, emit_yaml
+    from prophet.world import read_world
+
+    if args.problem is not None:
+        raise AlicaError(f"{args.domain} is a plan file: name its planning problem with --problem, not a PROBLEM file")
+    library = load_library(args.domain)
+    problems = library.problems
+    if args.problem_name is None:
+        if len(problems) != 1:
+            raise AlicaError(f"{args.domain}: choose a planning problem with --problem ({', '.join(sorted(problems)) or 'it has none'})")
+        name = next(iter(problems))
+    elif args.problem_name not in problems:
+        raise AlicaError(f"{args.domain}: no planning problem named '{args.problem_name}'; problems: {', '.join(sorted(problems)) or 'none'}")
+    else:
+        name = args.problem_name
+    problem = problems[name]
+    if args.world is not None:
+        problem = replace(problem, world=Condition(ConditionKind.PRE, args.world))
+    if args.goal is not None:
+        problem = replace(problem, goal=Condition(ConditionKind.POST, args.goal))
+    if problem.world is None:
+        raise AlicaError(f"planning problem '{name}' has no 'world' (it is read from the world model at run time): give one with --world")
+    world = read_world(problem, library, (), ())
+    domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
+    planner = get_planner(args.planner)
+    result = planner.solve(domain, pddl, time_limit=args.time_limit, anytime=args.anytime)
+
+    def tasks() -> dict[str, Any]:
+        assert result.plan is not None
+        if not result.plan.steps:
+            return {"tasks": []}
+        names = {o.lower(): o for o, _ in world.objects}
+        from prophet.planner import PlanStep
+
+        steps = [PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in result.plan.steps]
+        roleset = next(iter(sorted(library.rolesets.items())))[1] if library.rolesets else None
+        if roleset is None:
+            raise AlicaError(f"{args.domain}: the generated plan needs a role set for its task priorities; import one")
+        created = create_tasks(f"{name}Plan", steps, library, world.facts, world.robots or ("self",), roleset, "Default")
+        if args.emit_plan:
+            out = Path(args.emit_plan)
+            imports = sorted({_relative(Path(d.path), out) for d in library.documents if d.path})
+            out.parent.mkdir(parents=True, exist_ok=True)
+            out.write_text(emit_yaml(created, imports), encoding="utf-8")
+        return {"tasks": [[s.label for s in task] for task in created.tasks], **({"emitted": str(args.emit_plan)} if args.emit_plan else {})}
+
+    return _report(args, planner.name, (domain, pddl), result, tasks)
+
+
+def _relative(path: Path, out: Path) -> str:
+    return Path(os.path.relpath(path.resolve(), out.resolve().parent)).as_posix()
 
 
 def _check_features(planner: Any, domain: Any, problem: Any) -> None:
