@@ -47,3 +47,9 @@ def test_readme_skill_example(monkeypatch: pytest.MonkeyPatch, capfd: pytest.Cap
     monkeypatch.chdir(ROOT)
     exec(compile(_blocks("python")[1], "README.md", "exec"), {})
     assert capfd.readouterr().out.strip().splitlines()[-1] == "success"
+
+
+def test_readme_planning_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.chdir(ROOT)
+    exec(compile(_blocks("python")[3], "README.md", "exec"), {})
+    assert capsys.readouterr().out.splitlines() == ["Unstack(c, a), Putdown(c)", "Pickup(b), Stack(b, c)", "Pickup(a), Stack(a, b)"]
