@@ -245,15 +245,22 @@ def _build_positive(
     names = sorted(set(text_of.values()))
     ids = {text: i for i, text in enumerate(names)}
     final = {f: ids[text_of[f]] for f in reached}
+    def ids_of(facts: tuple[Fact, ...]) -> tuple[int, ...]:
+        if len(facts) == 1:
+            return (final[facts[0]],)
+        return tuple(sorted({final[f] for f in facts}))
+
     operators: dict[tuple, GroundOperator] = {}
     for action in fix.actions:
-        name = fact_text((action.action, *action.args))
-        add = {final[f] for f in action.add}
-        delete = {final[f] for f in action.delete if f in final}
-        delete -= add
-        pre_ids = tuple(sorted({final[f] for f in action.pos}))
-        add_ids = tuple(sorted(add))
-        del_ids = tuple(sorted(delete))
+        name = "(" + " ".join((action.action, *action.args)) + ")"
+        add_ids = ids_of(action.add)  # an action's adds are reached, and so are its preconditions
+        pre_ids = ids_of(action.pos)
+        delete = action.delete
+        if len(delete) == 1:
+            i = final.get(delete[0])
+            del_ids = () if i is None or i in add_ids else (i,)
+        else:
+            del_ids = tuple(sorted({final[f] for f in delete if f in final}.difference(add_ids)))
         key = (name, pre_ids, add_ids, del_ids, action.cost, ())
         if key not in operators:
             operators[key] = GroundOperator(name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost)
