@@ -41,7 +41,7 @@ from alica.errors import AlicaError, PlannerError
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from prophet.planner import Done, Improved, PlanStatus, PlanStep
 from prophet.planner import Plan as StepPlan
-from prophet.tasks import CreatedTasks, create_tasks, state_step
+from prophet.tasks import STEP_DONE, CreatedTasks, create_tasks, state_step, step_token
 from prophet.world import (
     PlanningWorld,
     TaskProgress,
@@ -152,6 +152,7 @@ class ProblemRuntime:
         self.next_update = -1.0
         self.invalid_once = False
         self.request: ReplanRequest | None = None
+        self.marked: set[str] = set()
         self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
         now = self.engine.now()
         board = self.engine.plan_board
@@ -258,6 +259,21 @@ class ProblemRuntime:
                 self.next_update = now + self.model.update_time
         if self.request is not None and self.share is not None and self.share.generation > self.request.generation:
             self.request = None
+        self._mark_done()
+
+    def _mark_done(self) -> None:
+        """Write ``step_done`` for the steps this agent finished in the generated plan (later steps wait for them)."""
+        node, created = self.slot.node, self.created
+        if node is None or created is None or node.plan is not created.plan or node.ep is None or node.state is None:
+            return
+        i = next(j for j, ep in enumerate(created.plan.entry_points) if ep.name == node.ep)
+        steps = created.tasks[i]
+        world_model = self.engine.world_model
+        for step in steps[: state_step(node.state, len(steps))]:
+            token = step_token(created.plan.name, step.index)
+            if token not in self.marked:
+                self.marked.add(token)
+                world_model.assert_fact(STEP_DONE, token)
 
     def stop(self) -> None:
         """The agent leaves the state: stop planning, forget the generated plan."""
@@ -468,17 +484,32 @@ class ProblemRuntime:
             if node.succeeded.get(ep.name):
                 progress.append(TaskProgress(None, len(steps), done=True))
                 continue
-            holders = sorted((state_step(state, len(steps)), agent) for agent, (entry, state) in node.believed.items() if entry == ep.name and state)
-            progress.append(TaskProgress(holders[0][1], holders[0][0]) if holders else TaskProgress(None, 0))
+            holders = sorted((state_step(state, len(steps)), agent, state) for agent, (entry, state) in node.believed.items() if entry == ep.name and state)
+            if holders:
+                k, agent, state = holders[0]
+                progress.append(TaskProgress(agent, k, running="_S" in state))
+            else:
+                progress.append(TaskProgress(None, 0))
         from prophet.problem import predicate_types
 
         predicates = predicate_types(self.problem, self.engine.library)
         world_model = self.engine.world_model
         facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
-        reason = remaining_fits(created.tasks, progress, facts, share.world, goal_literals(self.problem))
+        reason = remaining_fits(created.tasks, progress, facts, share.world, goal_literals(self.problem)) or _stalled(progress)
         if reason is None:
             self.invalid_once = False
         elif not self.invalid_once:
             self.invalid_once = True
+        elif reason.startswith("task T"):
+            self._replan(now, f"the plan is stuck: {reason}")
         else:
             self._replan(now, f"the world changed under the plan: {reason}")
+
+
+def _stalled(progress: list[TaskProgress]) -> str | None:
+    """A task nobody holds while an agent waits in a later one (tasks only wait for earlier tasks): replan."""
+    free = [i for i, p in enumerate(progress) if p.agent is None and not p.done]
+    waiting = [i for i, p in enumerate(progress) if p.agent is not None and not p.running and not p.done]
+    if free and waiting and min(free) < max(waiting):
+        return f"task T{min(free)} has nobody, and the agent of task T{max(waiting)} waits for it"
+    return None

@@ -27,9 +27,10 @@
 
 The generated plan: one entry point per task, and per task a chain of
 states, each waiting until its step's precondition holds in the world model
-(another task may have to act first) and then running the step's skill plan
-with its variables bound; a failed step ends the task in a failure state (the
-runtime then replans).
+(another task may have to act first) and until the earlier steps of other
+tasks on the same objects are done (``step_done`` facts, which the runtime
+writes), then running the step's skill plan with its variables bound; a
+failed step ends the task in a failure state (the runtime then replans).
 """
 
 from __future__ import annotations
@@ -219,20 +220,53 @@ def generic_utility(n: int) -> UtilityFunction:
     return UtilityFunction(priority_weight=wp, summands=(Summand("Coverage", wt, "1"),), similarity_weight=ws, threshold=ws)
 
 
-def _condition(pre: Sequence[tuple[bool, Fact]], robot: str) -> Condition | None:
-    if not pre:
-        return None
+#: The world-model predicate an agent asserts when it finished a step of a generated plan.
+STEP_DONE = "step_done"
+
+
+def step_token(plan: str, index: int) -> str:
+    """The argument of ``step_done`` for step ``index`` (0-based, in plan order) of generated plan ``plan``."""
+    return f"{plan}_s{index}"
+
+
+def _condition(pre: Sequence[tuple[bool, Fact]], robot: str, after: Sequence[str] = ()) -> Condition | None:
     parts = []
     for positive, (name, args) in pre:
         shown = ", ".join("self" if a == robot else a for a in args)
         atom = f"{name}({shown})" if args else name
         parts.append(atom if positive else f"not {atom}")
-    return Condition(ConditionKind.TRANSITION, " and ".join(parts))
+    parts.extend(f"{STEP_DONE}({token})" for token in after)
+    return Condition(ConditionKind.TRANSITION, " and ".join(parts)) if parts else None
+
+
+def _objects(step: Step) -> set[str]:
+    return {a for _, (_, args) in step.pre + step.effect for a in args if a != step.robot}
+
+
+def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
+    """Per step (plan index): the latest earlier step of another task touching each of its objects.
+
+    Steps on the same blocks run in plan order: two robots never work on the same stack at once.
+    """
+    task_of = {s.index: i for i, task in enumerate(tasks) for s in task}
+    ordered = sorted((s for task in tasks for s in task), key=lambda s: s.index)
+    last: dict[str, int] = {}
+    out: dict[int, list[int]] = {}
+    for step in ordered:
+        before = set()
+        for obj in _objects(step):
+            h = last.get(obj)
+            if h is not None and task_of[h] != task_of[step.index]:
+                before.add(h)
+            last[obj] = step.index
+        out[step.index] = sorted(before)
+    return out
 
 
 def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None) -> tuple[Plan, tuple[Task, ...]]:
     """The multi-agent plan of the tasks (see the module docstring)."""
     entry_points, states, transitions, task_defs = [], [], [], []
+    after = _predecessors(tasks)
     for i, task in enumerate(tasks):
         task_name = f"{name}_T{i}"
         task_defs.append(Task(task_name, description=", ".join(s.label for s in task)))
@@ -245,7 +279,7 @@ def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = N
             states.append(State(wait, description=f"wait until {step.label} can run"))
             bind = tuple(Binding(var, value) for var, value in step.bindings)
             states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
-            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot or step.robot)))
+            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot or step.robot, [step_token(name, h) for h in after[step.index]])))
             transitions.append(Transition(f"{run}->{following}", run, following, Condition(ConditionKind.TRANSITION, "succeeded")))
             transitions.append(Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed")))
         states.append(State(f"T{i}_Done", StateKind.SUCCESS))

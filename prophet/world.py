@@ -13,10 +13,11 @@ objects.
 
 While the team executes a generated plan, :func:`remaining_fits` simulates
 what is left of it (each task's remaining steps, run by the agent holding the
-task) from the current facts. A step whose precondition does not hold but
-whose effect already does counts as done (a teammate's message may lag
-behind the world); any other unmet precondition, or a goal not reached at the
-end, means the world changed under the plan.
+task) from the current facts. A running step whose precondition does not
+hold but whose effect already does counts as done (it has just finished, and
+the teammate's message lags behind the world); any other unmet precondition,
+or a goal not reached at the end, means the world changed under the plan
+(or a task's new holder cannot go on from where its last holder stopped).
 """
 
 from __future__ import annotations
@@ -142,13 +143,14 @@ class TaskProgress:
 
     Attributes:
         agent: the agent holding the task (None: nobody yet).
-        next_step: index into the task's steps of the first step not finished
-            (it may be running: its effects may hold already or not yet).
+        next_step: index into the task's steps of the first step not finished.
+        running: whether that step runs now (its effects may hold already or not yet).
         done: whether the task succeeded.
     """
 
     agent: str | None
     next_step: int
+    running: bool = False
     done: bool = False
 
 
@@ -177,7 +179,7 @@ def remaining_fits(
     """
     state = set(facts)
     start = tuple(start_world)
-    remaining: list[tuple[int, object, str]] = []
+    remaining: list[tuple[int, object, str, bool]] = []
     for i, (task, where) in enumerate(zip(tasks, progress, strict=True)):
         if where.done or where.next_step >= len(task):
             continue
@@ -188,8 +190,8 @@ def remaining_fits(
             planned = task[where.next_step].robot  # type: ignore[attr-defined]
             state.update((name, tuple(who if a == planned else a for a in args)) for name, args in start if planned in args)
         for k in range(where.next_step, len(task)):
-            remaining.append((task[k].index, task[k], who))  # type: ignore[attr-defined]
-    for _, step, who in sorted(remaining, key=lambda item: item[0]):
+            remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
+    for _, step, who, running in sorted(remaining, key=lambda item: item[0]):
         pre = _ground(step.pre, step.robot, who)  # type: ignore[attr-defined]
         effect = _ground(step.effect, step.robot, who)  # type: ignore[attr-defined]
         if holds_all(pre, state):
@@ -197,7 +199,7 @@ def remaining_fits(
                 if not positive:
                     state.discard(fact)
             state.update(fact for positive, fact in effect if positive)
-        elif not holds_all(effect, state):
+        elif not (running and holds_all(effect, state)):
             return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"  # type: ignore[attr-defined]
     if not holds_all(goal, state):
         return f"the plan no longer reaches the goal: {_unmet(goal, state)} would not hold"

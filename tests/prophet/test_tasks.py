@@ -73,8 +73,11 @@ def test_cardinalities_and_utility(blocks):
 def test_steps_wait_for_their_preconditions(blocks):
     created, _ = _created(blocks)
     waits = {t.source: t.condition.text for t in created.plan.transitions if "_Wait" in t.source}
-    assert waits["T1_Wait1"] == "holding(self, b) and clear(c)"
-    assert waits["T2_Wait0"] == "clear(a) and ontable(a) and handempty(self)"
+    # ... and for the earlier steps of other tasks on the same blocks (c put down, c off a, b on c)
+    assert waits["T1_Wait1"] == "holding(self, b) and clear(c) and step_done(StackBlocksPlan_s1)"
+    assert waits["T2_Wait0"] == "clear(a) and ontable(a) and handempty(self) and step_done(StackBlocksPlan_s0)"
+    assert waits["T2_Wait1"] == "holding(self, a) and clear(b) and step_done(StackBlocksPlan_s3)"
+    assert waits["T0_Wait0"] == "on(c, a) and clear(c) and handempty(self)"
 
 
 def test_emitted_plan_is_a_valid_plan_file(blocks, tmp_path):
