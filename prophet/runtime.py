@@ -153,6 +153,7 @@ class ProblemRuntime:
         self.invalid_once = False
         self.request: ReplanRequest | None = None
         self.marked: set[str] = set()
+        self.pending: tuple[float, str] | None = None
         self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
         now = self.engine.now()
         board = self.engine.plan_board
@@ -339,7 +340,7 @@ class ProblemRuntime:
         self.revision += 1
         self.engine.emit("problem", key=key_text(self.key), phase="wait", generation=share.generation, reason=reason)
         if self._is_leader():
-            self._replan(now, reason)
+            self._replan(now, reason, settle=True)
         else:
             self.request = ReplanRequest(self.key, share.generation, self.engine.name, reason)
             self.engine.publish_plan(self.request)
@@ -351,9 +352,15 @@ class ProblemRuntime:
         share = self.share
         requests = [r for r in self.engine.plan_board.take_requests(self.key) if share is None or r.generation >= share.generation]
         if requests and share is not None and share.status == PLAN:
-            self._replan(now, f"{requests[0].sender}: {requests[0].reason}")
+            self._replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
             return
-        if self.search is not None:
+        if self.pending is not None:
+            if now + 1e-9 < self.pending[0]:
+                return
+            reason = self.pending[1]
+            self.pending = None
+            self._start_search(now, reason, self.share.generation if self.share is not None else None)
+        elif self.search is not None:
             self._step_search(now)
         elif share is None or share.status == SEARCHING or (share.status == PLAN and share.generation <= self.failed_generation):
             self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
@@ -368,18 +375,26 @@ class ProblemRuntime:
         if self.share is share:
             self._publish(share if share.leader == self.engine.name else replace(share, leader=self.engine.name), now)
 
-    def _replan(self, now: float, reason: str) -> None:
+    def _replan(self, now: float, reason: str, settle: bool = False) -> None:
+        """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step)."""
         self.engine.stats["replans"] += 1
         self.engine.emit("replan", key=key_text(self.key), reason=reason)
         self.search = None
-        self._start_search(now, reason)
+        if not settle:
+            self._start_search(now, reason)
+            return
+        engine = self.engine
+        generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+        self.pending = (now + self.model.update_time, reason)
+        self._publish(PlanShare(self.key, generation, 0, engine.name, SEARCHING, entry_task=self._entry_task(), reason=reason), now)
 
-    def _start_search(self, now: float, reason: str) -> None:
+    def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         from prophet.planners import get_planner
         from prophet.problem import to_pddl
 
         engine = self.engine
-        generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+        if generation is None:
+            generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
         me = engine.name
         task = self._entry_task()
         problem = self.problem

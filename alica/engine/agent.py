@@ -8,6 +8,7 @@ is ticked in lock step) and the injected clock says what time it is.
 from __future__ import annotations
 
 import random
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
@@ -31,6 +32,17 @@ from alica.model import Behaviour, Plan, PlanLibrary, RoleSet, StateKind, Summan
 from alica.model.plan import EntryPoint
 
 Observer = Callable[[dict[str, Any]], None]
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
+def _substitute(text: str, env: Mapping[str, object]) -> str:
+    """``text`` with the names of ``env``'s string (and number) variables replaced by their values."""
+
+    def value(match: re.Match[str]) -> str:
+        found = env.get(match.group(0))
+        return str(found) if isinstance(found, (str, int, float)) and not isinstance(found, bool) else match.group(0)
+
+    return _NAME.sub(value, text)
 
 
 class AgentEngine:
@@ -290,7 +302,9 @@ class AgentEngine:
         """The variables of a child: its bindings evaluated in the parent's context.
 
         A binding whose value is not known yet (``pos(a)`` before ``a`` is seen)
-        is handed on as its text, for the skill to resolve later.
+        is handed on as its text, for the skill to resolve later, with the
+        parent's variables replaced by their values (``pos(x)`` with ``x = a``
+        becomes ``pos(a)``).
         """
         env: dict[str, object] = {"self": self.name}
         if not ref.bindings:
@@ -300,7 +314,7 @@ class AgentEngine:
             try:
                 env[binding.variable] = self.formulas.value(binding.value, belief, node.env)
             except AlicaError:
-                env[binding.variable] = binding.value
+                env[binding.variable] = _substitute(binding.value, node.env)
         return env
 
     def make_runner(self, slot: Slot) -> BehaviourRunner:

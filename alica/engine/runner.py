@@ -70,6 +70,12 @@ class SimulatedTeam:
         registry: predicates and functions of formulas.
         observers: trace observers.
         trace_messages: also trace every message sent and delivered.
+        world: the simulated world the skills act on (a :class:`worldsim.World`);
+            the team then runs on the world's clock and each tick steps it one period.
+        perception: called with the team before every tick, to write what the
+            robots sense into their world models.
+        step_world: whether :meth:`tick` steps the world (``False`` when a caller
+            runs several teams in one world and steps it itself).
     """
 
     def __init__(
@@ -90,6 +96,9 @@ class SimulatedTeam:
         registry: Registry | None = None,
         observers: Iterable[Observer] = (),
         trace_messages: bool = False,
+        world: Any = None,
+        perception: Callable[[SimulatedTeam], None] | None = None,
+        step_world: bool = True,
     ) -> None:
         if not agents:
             raise AlicaError("a team needs at least one agent")
@@ -102,7 +111,10 @@ class SimulatedTeam:
         self.config = config or EngineConfig()
         self.roleset = pick_roleset(library, (s.role for s in specs.values()), roleset)
         self.roles = assign_roles(specs, self.roleset)
-        self.clock = ManualClock()
+        self.world = world
+        self.perception = perception
+        self.step_world = step_world
+        self.clock = world.clock if world is not None and hasattr(world, "clock") else ManualClock()
         self.observers = list(observers)
         self.trace_messages = trace_messages
         self.network = SimNetwork(self.clock, seed=seed, loss=loss, delay=Delay(delay, jitter), lease=self.config.team_timeout, observer=self._network_event, trace_messages=trace_messages)
@@ -121,7 +133,7 @@ class SimulatedTeam:
         return AgentEngine(
             name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name, clock=self.clock, relay=False), self.clock,
             config=self.config, skills=self.binder, registry=self.registry, seed=self.seed, observers=tuple(self.observers),
-            listen_first=listen_first,
+            world=self.world, listen_first=listen_first,
         )
 
     # -- time -----------------------------------------------------------
@@ -131,15 +143,29 @@ class SimulatedTeam:
         return self.clock.now()
 
     def tick(self) -> None:
-        """One lock-step tick of every running agent, then time moves one period on."""
+        """One lock-step tick of every running agent, then time moves one period on (the world steps)."""
+        self.tick_agents()
+        if self.world is not None:
+            if self.step_world:
+                self.world.step(self.config.period)
+        else:
+            self.clock.advance(self.config.period)
+
+    def tick_agents(self) -> None:
+        """Timed events, perception, then one lock-step tick of every running agent; time stands still."""
         self._run_events()
-        running = [e for name, e in self.engines.items() if name not in self.crashed]
+        if self.perception is not None:
+            self.perception(self)
+        running = self.running()
         for engine in running:
             engine.receive()
         for engine in running:
             engine.step()
         self.ticks += 1
-        self.clock.advance(self.config.period)
+
+    def running(self) -> list[AgentEngine]:
+        """The engines of the agents that have not crashed, by name."""
+        return [e for name, e in self.engines.items() if name not in self.crashed]
 
     def run(self, ticks: int | None = None, *, until_done: bool = False, max_time: float | None = None) -> dict[str, Any]:
         """Tick ``ticks`` times, or until every running agent is done (or ``max_time`` passes).
@@ -192,6 +218,9 @@ class SimulatedTeam:
             return
         self.crashed.add(name)
         self.network.crash(name)
+        robot = getattr(self.world, "robots", {}).get(name)
+        if robot is not None:
+            robot.crash()  # the robot stops where it is (holding what it holds)
         self._fault("crash", agent=name)
 
     def recover(self, name: str, at: float | None = None) -> None:
