@@ -29,7 +29,7 @@ from prophet.search.gbfs import Stats, lazy_search
 from prophet.search.heuristics import INF, Evaluator, Relaxed
 from prophet.search.neighbourhood import neighbourhood
 from prophet.search.postprocess import improve
-from prophet.search.windows import Windows
+from prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
 
 DEFAULT_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1.5, 1)
 NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
@@ -99,16 +99,18 @@ def search_task(
         yield Done(PlanStatus.SOLVED, stats.expansions)
         return
     windows = Windows(ct)
-    best = yield from _windows(ct, windows, best, ct.plan_cost(best), stats)
+    best = yield from _windows(ct, windows, best, ct.plan_cost(best), stats, QUICK_WINDOW_STATES)
     best_cost = ct.plan_cost(best)
     for evaluate, weight in _restarts(ct, relaxed):
         ops, _exhausted = yield from lazy_search(
             ct, evaluate, stats, weight=weight, max_expansions=RESTART_BUDGET * max(100, first_expansions)
         )
         if ops is not None:
-            found = yield from _windows(ct, windows, improve(ct, ops), best_cost, stats)
+            found = yield from _windows(ct, windows, improve(ct, ops), best_cost, stats, QUICK_WINDOW_STATES)
+            found = yield from _windows(ct, windows, found, min(best_cost, ct.plan_cost(found)), stats)
             if ct.plan_cost(found) < best_cost:
                 best, best_cost = found, ct.plan_cost(found)
+    best = yield from _windows(ct, windows, best, best_cost, stats)
     best, proven = yield from _polish(ct, best, stats)
     best_cost = ct.plan_cost(best)
     if proven or best_cost == 0:
@@ -151,18 +153,24 @@ def _restarts(ct: CompiledTask, relaxed: Relaxed) -> list[tuple[Evaluator, float
 
 
 def _windows(
-    ct: CompiledTask, windows: Windows, plan: list[int], report_below: float, stats: Stats
+    ct: CompiledTask,
+    windows: Windows,
+    plan: list[int],
+    report_below: float,
+    stats: Stats,
+    limit: int = WINDOW_STATES,
 ) -> Generator[SearchEvent, None, list[int]]:
     """Window replanning on ``plan`` until a sweep finds nothing cheaper.
 
-    Yields ``Improved`` for each plan cheaper than ``report_below`` (the best so
-    far) and returns the last plan.
+    Yields ``Improved`` for each plan (``plan`` itself included) cheaper than
+    ``report_below`` (the best so far) and returns the last plan. ``limit``
+    caps the states of each window search.
     """
     if ct.plan_cost(plan) < report_below:
         report_below = ct.plan_cost(plan)
         yield Improved(to_plan(ct, plan), stats.expansions)
     while True:
-        found = yield from windows.improve_once(plan, stats)
+        found = yield from windows.improve_once(plan, stats, limit=limit)
         if found is None:
             return plan
         plan = improve(ct, found)

@@ -28,6 +28,8 @@ WINDOW_SIZES: tuple[int, ...] = (6, 10, 16, 24, 32)
 """The window lengths tried, shortest first."""
 WINDOW_STATES = 3000
 """The most states one window search expands."""
+QUICK_WINDOW_STATES = 300
+"""The state limit of the quick sweeps (on every new plan, before the full ones)."""
 
 
 class Windows:
@@ -51,8 +53,8 @@ class Windows:
         self.by_object = by_object
         self.no_args = no_args
         self.exact = not any(ct.cond)
-        self.failed: dict[tuple[int, int, frozenset[str]], int] = {}
-        """Window searches that found nothing: (start, needed facts, objects) -> the bound they had."""
+        self.failed: dict[tuple[int, int, frozenset[str]], tuple[int, int]] = {}
+        """Window searches that found nothing: (start, needed facts, objects) -> (bound, state limit)."""
 
     def operators_among(self, objects: frozenset[str]) -> list[int]:
         """The operators whose arguments are all in ``objects`` (increasing ids)."""
@@ -205,12 +207,13 @@ class Windows:
                     continue
                 objects = frozenset().union(*(self.objects[o] for o in window))
                 key = (states[i], needs[j], objects)
-                if self.failed.get(key, -1) >= bound:
-                    continue  # the same search already failed with this bound or a looser one
+                old_bound, old_limit = self.failed.get(key, (-1, -1))
+                if old_bound >= bound and old_limit >= limit:
+                    continue  # the same search already failed with a looser bound and as many states
                 ops = self.operators_among(objects)
                 found = yield from self.search(states[i], needs[j], ops, bound, limit, stats)
                 if found is None:
-                    self.failed[key] = bound
+                    self.failed[key] = (bound, limit)
                     continue
                 candidate = plan[:i] + found + plan[j:]
                 if self.valid(candidate):

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
-from prophet.planner import Done, Improved, PlanStatus
+from prophet import pddl
+from prophet.ground import ground
+from prophet.planner import Done, Improved, PlanStatus, Progress
 from prophet.search import search_task
 from prophet.search.encoding import CompiledTask, compile_task
 from prophet.search.gbfs import Stats
 from prophet.search.windows import Windows
-from tests.prophet.search.helpers import TaskBuilder, check_plan, optimal_cost
+from tests.prophet.search.helpers import BENCHMARKS, TaskBuilder, check_plan, optimal_cost
 
 ROAD = [("p0", "p1"), ("p1", "p2"), ("p2", "p3"), ("p0", "p3"), ("p3", "p4")]
 """A chain p0-p1-p2-p3-p4 with a shortcut p0-p3."""
@@ -132,3 +134,19 @@ def test_when_effects_skip_the_regrouping_and_plans_stay_valid() -> None:
     assert windows.regroup(plan) == plan
     better = drain(windows.improve_once(plan, Stats()))
     assert better is None or (windows.valid(better) and ct.plan_cost(better) < ct.plan_cost(plan))
+
+
+def test_rovers_anytime_plans_valid_and_strictly_cheaper() -> None:
+    domain = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
+    task = ground(domain, pddl.read_problem(BENCHMARKS / "rovers" / "p07.pddl", domain))
+    found = []
+    for event in search_task(task, progress_every=100):
+        if isinstance(event, Improved):
+            found.append(event.plan)
+        if isinstance(event, Progress) and event.expansions > 20_000:
+            break
+    for plan in found:
+        check_plan(task, plan)
+    costs = [p.cost for p in found]
+    assert costs == sorted(costs, reverse=True) and len(set(costs)) == len(costs)
+    assert costs[-1] == 18  # the optimum (benchmarks/pddl/rovers/optimal_costs.tsv)
