@@ -9,14 +9,17 @@ cores; timings must not compete), with a wall limit (60 s):
   ``python -m pyperplan -s gbf -H hff`` on copies of the files (it writes ``PROBLEM.soln``
   next to the problem);
 * ours again after an anytime budget (``--anytime --time-limit 10``) on the blocks problems
-  with a proven optimum (``optimal_costs.tsv``).
+  with a proven optimum (``optimal_costs.tsv``) and on Rovers p01-p20;
+* the grounding alone (:func:`prophet.ground.ground`, after parsing) on Rovers p18-p20 in a
+  fresh process each, the median of 3.
 
 Every plan, ours and the peers', is validated with :func:`prophet.validate.validate_plan`;
 an invalid plan counts as unsolved. Times are whole-process wall seconds. The tables
 (markdown on standard output, TSV in ``build/bench/``): coverage per domain; Rovers
 p01-p20 total time, ours vs Fast Downward (goal: at most 2x); per-problem cost on Rovers
-p01-p20 vs the IMPERA paper's Table 1 (goal: ours at most that on each); blocks after the
-anytime budget vs the optimum (goal: total at most 1.15x).
+p01-p20 vs the IMPERA paper's Table 1, our first plan and ours after the anytime budget (goal:
+ours at most that on each); blocks after the anytime budget vs the optimum (goal: total at
+most 1.15x); the grounding time of Rovers p18-p20 (goal: at most 0.1 s each).
 
 Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick]``
 """
@@ -53,6 +56,11 @@ BENCHMARKS = ROOT / "benchmarks" / "pddl"
 OUT = ROOT / "build" / "bench"
 IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""
+IMPERA_EARLY = tuple(f"p{i:02d}" for i in range(1, 21))
+"""The Rovers problems of that table (also the ones ours runs on with the anytime budget)."""
+GROUND_PROBLEMS = ("p18", "p19", "p20")
+"""The Rovers problems whose grounding is timed (goal: at most 0.1 s each)."""
+GROUND_REPEATS = 3
 GRACE_S = 5.0
 QUICK = {
     "blocks": ("probBLOCKS-4-0", "probBLOCKS-5-2", "probBLOCKS-6-1", "probBLOCKS-8-0"),
@@ -320,8 +328,7 @@ def report(outcomes: list[Outcome], limit: float, budget: float) -> None:
         )
     table("planners_coverage", f"Coverage (valid plans within {limit:g} s)", ["domain", *planners], rows)
 
-    early = [f"p{i:02d}" for i in range(1, 21)]
-    present = [p for p in early if (OURS, "rovers", p) in by]
+    present = [p for p in IMPERA_EARLY if (OURS, "rovers", p) in by]
     if present:
         rows = []
         for planner in planners:
@@ -345,38 +352,9 @@ def report(outcomes: list[Outcome], limit: float, budget: float) -> None:
             ratio,
         )
 
-        rows = []
-        met = 0
-        for p in present:
-            impera = IMPERA_TABLE1[int(p[1:]) - 1]
-            ours_run = by[(OURS, "rovers", p)]
-            ok = ours_run.solved and ours_run.cost is not None and ours_run.cost <= impera
-            met += ok
-            rows.append(
-                [
-                    p,
-                    impera,
-                    *(
-                        _fmt(
-                            by[(pl, "rovers", p)].cost
-                            if by.get((pl, "rovers", p)) and by[(pl, "rovers", p)].solved
-                            else None,
-                            0,
-                        )
-                        for pl in planners
-                    ),
-                    "yes" if ok else "NO",
-                ]
-            )
-        table(
-            "planners_rovers_cost",
-            "Rovers: plan cost vs the IMPERA paper's Table 1 (FDP)",
-            ["problem", "IMPERA", *planners, "ours <= IMPERA"],
-            rows,
-            f"ours at most IMPERA's cost on {met} of {len(present)}",
-        )
+        rovers_cost_table(by, present, planners, budget)
 
-    anytime = [o for o in outcomes if o.job.planner == ANYTIME]
+    anytime = [o for o in outcomes if o.job.planner == ANYTIME and o.job.domain == "blocks"]
     if anytime:
         optimum = optimal_costs("blocks")
         rows = []
@@ -414,6 +392,81 @@ def report(outcomes: list[Outcome], limit: float, budget: float) -> None:
         )
 
 
+def _solved_cost(by: dict[tuple[str, str, str], Outcome], planner: str, problem: str) -> float | None:
+    run = by.get((planner, "rovers", problem))
+    return run.cost if run is not None and run.solved else None
+
+
+def rovers_cost_table(
+    by: dict[tuple[str, str, str], Outcome], present: Sequence[str], planners: Sequence[str], budget: float
+) -> None:
+    """Rovers cost per problem vs IMPERA's Table 1: our first plan, ours after the anytime budget, the peers."""
+    anytime = f"ours anytime {budget:g} s"
+    with_anytime = any((ANYTIME, "rovers", p) in by for p in present)
+    peers = [p for p in planners if p != OURS]
+    header = ["problem", "IMPERA", "ours first plan", *([anytime] if with_anytime else []), *peers, "first <= IMPERA"]
+    header += [f"anytime {budget:g} s <= IMPERA"] if with_anytime else []
+    rows = []
+    met_first = met_anytime = 0
+    for p in present:
+        impera = IMPERA_TABLE1[int(p[1:]) - 1]
+        first = _solved_cost(by, OURS, p)
+        ok_first = first is not None and first <= impera
+        met_first += ok_first
+        row: list[object] = [p, impera, _fmt(first, 0)]
+        if with_anytime:
+            best = _solved_cost(by, ANYTIME, p)
+            ok_anytime = best is not None and best <= impera
+            met_anytime += ok_anytime
+            row.append(_fmt(best, 0))
+        row += [_fmt(_solved_cost(by, peer, p), 0) for peer in peers]
+        row.append("yes" if ok_first else "NO")
+        if with_anytime:
+            row.append("yes" if ok_anytime else "NO")
+        rows.append(row)
+    note = f"ours at most IMPERA's cost on {met_first} of {len(present)} with the first plan"
+    if with_anytime:
+        note += f", on {met_anytime} of {len(present)} after the {budget:g} s anytime budget"
+    table("planners_rovers_cost", "Rovers: plan cost vs the IMPERA paper's Table 1 (FDP)", header, rows, note)
+
+
+GROUND_SCRIPT = """
+import json, statistics, sys, time
+from prophet.ground import ground
+from prophet.pddl import read_domain, read_problem
+domain = read_domain(sys.argv[1])
+problem = read_problem(sys.argv[2], domain)
+times = []
+for _ in range(int(sys.argv[3])):
+    start = time.perf_counter()
+    task = ground(domain, problem)
+    times.append(time.perf_counter() - start)
+    del task
+print(json.dumps({"median_s": statistics.median(times), "times_s": times}))
+"""
+
+
+def grounding_table(names: Sequence[str] = GROUND_PROBLEMS, repeats: int = GROUND_REPEATS) -> None:
+    """Time the grounding alone (after parsing) of Rovers problems, each in a fresh process."""
+    folder = BENCHMARKS / "rovers"
+    rows = []
+    for name in names:
+        command = [sys.executable, "-c", GROUND_SCRIPT, str(folder / "domain.pddl"), str(folder / f"{name}.pddl")]
+        proc = run_process([*command, str(repeats)], ROOT, 120.0)
+        if proc.code != 0:
+            rows.append([name, "-", "-", _last_line(proc.err)])
+            continue
+        result = json.loads(proc.out)
+        each = " ".join(f"{t:.3f}" for t in result["times_s"])
+        rows.append([name, f"{result['median_s']:.3f}", each, "yes" if result["median_s"] <= 0.1 else "NO"])
+    table(
+        "planners_grounding",
+        f"Grounding time of Rovers {names[0]}-{names[-1]} (s, after parsing, median of {repeats})",
+        ["problem", "median s", "runs s", "<= 0.1 s"],
+        rows,
+    )
+
+
 def jobs_for(domains: Sequence[str], limit: int | None, quick: bool, planners: Sequence[str]) -> list[Job]:
     """Every job of the run, in a fixed order: per problem ours, FD, pyperplan; then the anytime runs."""
     jobs: list[Job] = []
@@ -423,7 +476,7 @@ def jobs_for(domains: Sequence[str], limit: int | None, quick: bool, planners: S
         for base in problems(domain, limit, quick):
             for planner in planners:
                 jobs.append(Job(planner, base.domain, base.problem, base.domain_file, base.problem_file))
-            if base.problem in known and OURS in planners:
+            if OURS in planners and (base.problem in known or (domain == "rovers" and base.problem in IMPERA_EARLY)):
                 anytime.append(Job(ANYTIME, base.domain, base.problem, base.domain_file, base.problem_file))
     return jobs + anytime
 
@@ -439,7 +492,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="a few small problems per domain, for a smoke run")
     parser.add_argument("--time-limit", type=float, default=60.0, metavar="S", help="wall seconds per run (default 60)")
     parser.add_argument(
-        "--anytime-budget", type=float, default=10.0, metavar="S", help="ours --anytime on blocks (default 10)"
+        "--anytime-budget",
+        type=float,
+        default=10.0,
+        metavar="S",
+        help="ours --anytime on blocks with an optimum and Rovers p01-p20 (default 10)",
     )
     parser.add_argument("--planners", default=f"{OURS},fd,pyperplan", help="which of ours, fd, pyperplan (default all)")
     args = parser.parse_args(argv)
@@ -470,6 +527,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         outcomes = list(pool.map(one, jobs))
     report(outcomes, args.time_limit, args.anytime_budget)
+    if "rovers" in domains and not args.quick:
+        grounding_table()
     invalid = [o for o in outcomes if o.valid == "INVALID"]
     if invalid:
         print(f"\n{len(invalid)} INVALID plan(s): see build/bench/planners_runs.tsv", file=sys.stderr)
