@@ -174,6 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("list-skills", help="list the registered skills and their parameters")
     p.set_defaults(run=_cmd_list_skills)
 
+    from alica.cli_demo import add_parser as add_demo_parser
     from alica.cli_plan import add_parser as add_plan_parser
     from alica.cli_run import add_parser as add_run_parser
     from alica.cli_skill import add_parser as add_skill_parser
@@ -181,6 +182,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_run_parser(sub)
     add_skill_parser(sub)
     add_plan_parser(sub)
+    add_demo_parser(sub)
     return parser
 
 

@@ -307,6 +307,7 @@ class ProblemRuntime:
         self.created = created
         if created is not None:
             engine.register_generated(created.plan, created.roleset, created.pins())
+            engine.plan_board.latest[self.key] = created
         self.share = share
         self.revision += 1
         self.reason = share.reason

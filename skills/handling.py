@@ -39,6 +39,14 @@ REACH = 0.55
 JOINT_SPEED = 1.5
 #: Seconds a released object gets to settle before the placement is checked.
 SETTLE = 0.5
+#: Turns (rad) from straight ahead tried for a free spot to put a block down.
+PUTDOWN_TURNS = (0.0, 0.6, -0.6, 1.2, -1.2, 1.8, -1.8, 3.14)
+#: Free room (m) a put-down spot needs around it.
+PUTDOWN_ROOM = 0.15
+#: Sides of a work site tried for the stand-off point (the nearest first).
+STANDOFF_TRIES = 12
+#: Room kept around the robot at its stand-off point, metres.
+STANDOFF_MARGIN = 0.1
 
 
 def _box(obj: Any) -> Any:
@@ -164,9 +172,9 @@ class ArmSkill(WorldSkill):
             if abs(gap - REACH) <= 0.12 and facing < 0.15:
                 self.phase = "plan"
                 return self._phase_plan()
-            heading = math.atan2(site[1] - y, site[0] - x)
-            standoff = REACH + _mount_ahead(robot)
-            goal = (site[0] - standoff * math.cos(heading), site[1] - standoff * math.sin(heading))
+            goal = self._standoff(site)
+            if goal is None:
+                return self.running("waiting: every side of the work site is taken by other robots")
             self.mover = MoveToPosition(f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context)
             self.mover.setup(context=self.context)
         if self.mover.status != Status.SUCCESS:
@@ -182,6 +190,29 @@ class ArmSkill(WorldSkill):
         robot.stop()
         self.phase = "plan"
         return self._phase_plan()
+
+    def _standoff(self, site: tuple[float, float]) -> tuple[float, float] | None:
+        """A free point facing ``site`` at the arm's reach: the nearest side first, then around it.
+
+        Points overlapping another robot or an object (with a margin) are skipped;
+        ``None`` when every side is taken (the skill waits and looks again).
+        """
+        from skills.navigation import planning_checker
+
+        robot = self.robot
+        x, y, _ = robot.pose
+        standoff = REACH + _mount_ahead(robot)
+        heading = math.atan2(site[1] - y, site[0] - x)
+        others = [(r.pose[0], r.pose[1], r.spec.radius + STANDOFF_MARGIN) for r in self.world.robots.values() if r is not robot]
+        # the motion planner's own check of a goal (static obstacles, blocks, other robots)
+        checker = planning_checker(self.world, robot.spec.radius).with_robots(others)
+        for k in range(STANDOFF_TRIES):
+            turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
+            angle = heading + turn
+            goal = (site[0] - standoff * math.cos(angle), site[1] - standoff * math.sin(angle))
+            if distance(goal, (x, y)) < 0.05 or checker.valid_xy(goal[0], goal[1]):
+                return goal
+        return None
 
     def _scene(self) -> Any:
         from skills.manipulation import ArmScene
@@ -356,13 +387,45 @@ class Putdown(ArmSkill):
         return None
 
     def site(self) -> tuple[float, float]:
-        """The target (a position, a place such as ``pos(g)``, or a block to put it on), or a spot in front of the robot."""
+        """The target (a position, a place such as ``pos(g)``, or a block to put it on), or a free spot near the robot.
+
+        The free spot lies at the arm's reach, straight ahead if nothing is there, else
+        turned to one side; a retry after a failed placement takes another spot.
+        """
         target = self.param("target")
         if target is not None:
             return self.resolve_position(target)
+        if getattr(self, "_spot", None) is None:
+            self._spot = self._free_spot()
+        return self._spot
+
+    def _free_spot(self) -> tuple[float, float]:
+        from worldsim.queries import blocker
+
         x, y, yaw = self.robot.pose
         ahead = REACH + _mount_ahead(self.robot)
-        return x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)
+        tried = getattr(self, "_tried", [])
+        first = None
+        for k in range(len(PUTDOWN_TURNS)):
+            angle = yaw + PUTDOWN_TURNS[k]
+            spot = (x + ahead * math.cos(angle), y + ahead * math.sin(angle))
+            first = first or spot
+            if any(distance(spot, old) < PUTDOWN_ROOM for old in tried):
+                continue
+            hit = blocker(self.world, spot[0], spot[1], PUTDOWN_ROOM)
+            if hit is None or hit == f"robot '{self.robot.name}'":
+                return spot
+        return first  # type: ignore[return-value]
+
+    def _retry(self, reason: str) -> Status:
+        """Try another spot on the next attempt (when no target was given)."""
+        status = super()._retry(reason)
+        if status == Status.RUNNING and self.param("target") is None:
+            self._tried = [*getattr(self, "_tried", []), self.site()]
+            self._spot = None
+            self.phase = "approach"
+            self.mover = None
+        return status
 
     def check_after(self) -> str | None:
         """Released, resting near the place."""

@@ -70,6 +70,10 @@ def planning_checker(world: Any, radius: float) -> Any:
     return checker
 
 
+#: Seconds to wait before planning again when another robot stands on the goal.
+GOAL_WAIT = 1.0
+
+
 class MoveToPosition(WorldSkill):
     """Drive to ``goal`` within ``tolerance`` metres, or fail with a reason after ``timeout`` seconds."""
 
@@ -85,6 +89,7 @@ class MoveToPosition(WorldSkill):
         self.escaping = False
         self.reason = ""
         self.path_length = 0.0
+        self.wait_until = 0.0
         self._plan(self.goal)
 
     def _others(self) -> list[tuple[float, float, float]]:
@@ -142,12 +147,22 @@ class MoveToPosition(WorldSkill):
     def _poll_plan(self, now: float) -> Status:
         from skills.motion import PathFollower
 
+        if self.job is None:
+            if now < self.wait_until:
+                return self.running(f"waiting for another robot to clear the goal ({self.reason})")
+            self._plan(self.goal)
         if not self.job.done():
             return self.running("planning")
         result = self.job.result()
         target = self.goal
         if result.status != "exact":
             self.reason = result.reason or result.status
+            if result.status == "invalid_goal" and "another robot" in self.reason:
+                # robots move: wait for this one to go, until the skill's timeout
+                self.robot.stop()
+                self.job = None
+                self.wait_until = now + GOAL_WAIT
+                return self.running(f"waiting for another robot to clear the goal ({self.reason})")
             if result.status in ("invalid_goal", "unreachable") and not self.escaping:
                 self.robot.stop()
                 return self.fail(f"cannot reach {self.goal}: {self.reason}")
@@ -217,7 +232,8 @@ class DriveToFreeSpace(MoveToPosition):
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
         grid = planning_grid(self.world)
-        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach)
+        others = [(r.pose[0], r.pose[1], r.spec.radius) for r in self.world.robots.values() if r is not self.robot]
+        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=others)
         self.spot = spot
         self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
         self.params.setdefault("tolerance", 0.2)

@@ -43,6 +43,8 @@ class PlanBoard:
         self.plans: dict[str, Plan] = {}
         self.priorities: dict[str, Mapping[str, tuple[Priority, ...]]] = {}
         self.pins: dict[str, Mapping[str, tuple[str, ...]]] = {}
+        self.latest: dict[PlanKey, Any] = {}
+        """The latest generated plan (``prophet.tasks.CreatedTasks``) per planning problem, kept after it ends."""
 
     def receive(self, payload: Any, now: float) -> None:
         """Take in a share (kept if it supersedes the one known) or a replan request."""

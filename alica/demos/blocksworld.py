@@ -1,0 +1,318 @@
+"""The blocks-world demo (IMPERA Section 8.2): a team plans at run time and stacks blocks in pybullet.
+
+The shipped mission ``plans/blocksworld/mission.yaml`` holds the planning
+problem StackBlocks. World comes from the simulated state: an overhead
+perception (:class:`worldsim.perception.FactPerception` with
+:func:`worldsim.scenarios.blocks_facts`) writes the IPC facts into every
+robot's world model. Goal is the goal configuration. The team robots
+``r1..rN`` plan, allocate and execute with the real skills (mobile
+manipulators driving with OMPL paths and grasping with the Panda arm).
+Opponents ``o1..oK`` are a second team on their own network, running
+BlocksWorldOpponent: each picks a random applicable skill on a stack that
+no other robot blocks.
+
+The run ends when the goal holds in the simulated world, or when the time
+limit passes.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from alica.errors import AlicaError
+
+Stacks = list[list[str]]
+PROBLEM = "StackBlocks"
+#: Simulated seconds the run goes on once the goal holds, for the team to notice it.
+SETTLE_S = 2.0
+#: The shipped mission plan.
+MISSION = Path(__file__).resolve().parents[2] / "plans" / "blocksworld" / "mission.yaml"
+
+
+@dataclass(frozen=True, slots=True)
+class DemoConfig:
+    """What to run.
+
+    Attributes:
+        agents: team robots (r1..rN).
+        opponents: opponent robots (o1..oK).
+        blocks: blocks in random configurations (ignored where ``start``/``goal`` are given).
+        seed: seeds the configurations, the world, the networks and the agents.
+        start: the initial stacks (bottom first); random from the seed when None.
+        goal: the goal stacks; random from the seed when None.
+        time_limit: simulated seconds before the run gives up.
+        frequency: engine ticks per simulated second.
+        planner: the planner back-end.
+    """
+
+    agents: int = 2
+    opponents: int = 0
+    blocks: int = 4
+    seed: int = 0
+    start: Stacks | None = None
+    goal: Stacks | None = None
+    time_limit: float = 600.0
+    frequency: float = 10.0
+    planner: str = "builtin"
+
+
+@dataclass(slots=True)
+class DemoResult:
+    """What a demo run gave (see :meth:`as_json` for the keys the CLI prints)."""
+
+    success: bool
+    sim_time_s: float
+    wall_time_s: float
+    plan_length: int
+    replans: int
+    messages: int
+    tasks: dict[str, int]
+    start: Stacks
+    goal: Stacks
+    goal_literals: int
+    satisfied: int
+    plan_yaml: str = ""
+    crashed: list[str] = field(default_factory=list)
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall second."""
+        return self.sim_time_s / self.wall_time_s if self.wall_time_s > 0 else float("inf")
+
+    def as_json(self) -> dict[str, Any]:
+        """The summary as plain data."""
+        return {
+            "success": self.success,
+            "sim_time_s": round(self.sim_time_s, 3),
+            "wall_time_s": round(self.wall_time_s, 3),
+            "real_time_factor": round(self.real_time_factor, 2),
+            "replans": self.replans,
+            "messages": self.messages,
+            "plan_length": self.plan_length,
+            "tasks": self.tasks,
+            "goal_literals": self.goal_literals,
+            "satisfied": self.satisfied,
+            "start": self.start,
+            "goal": self.goal,
+            "crashed": self.crashed,
+        }
+
+
+def goal_facts(stacks: Stacks) -> list[tuple[str, ...]]:
+    """The facts of a configuration: ``ontable`` for each bottom block, ``on`` for the others."""
+    out: list[tuple[str, ...]] = []
+    for stack in stacks:
+        out.append(("ontable", stack[0]))
+        out.extend(("on", upper, lower) for lower, upper in itertools.pairwise(stack))
+    return out
+
+
+def goal_text(stacks: Stacks) -> str:
+    """The goal formula of a configuration: ``ontable(a) and on(b, a) and ...``."""
+    return " and ".join(f"{f[0]}({', '.join(f[1:])})" for f in goal_facts(stacks))
+
+
+def check_stacks(stacks: object, what: str) -> Stacks:
+    """A configuration as lists of block names.
+
+    Raises:
+        AlicaError: not a list of non-empty lists of distinct names.
+    """
+    if not isinstance(stacks, list) or not stacks or not all(isinstance(s, list) and s for s in stacks):
+        raise AlicaError(f"{what} must be a list of stacks, each a non-empty list of block names (bottom first), e.g. [[a, b], [c]]")
+    names = [str(b) for s in stacks for b in s]
+    if len(set(names)) != len(names):
+        raise AlicaError(f"{what} names a block twice: {names}")
+    if not all(n.isidentifier() and n == n.lower() for n in names):
+        raise AlicaError(f"{what}: block names must be lower-case identifiers, got {names}")
+    return [[str(b) for b in s] for s in stacks]
+
+
+def configurations(config: DemoConfig) -> tuple[Stacks, Stacks]:
+    """The initial and goal stacks: given, or random from the seed (a goal different from the start).
+
+    Raises:
+        AlicaError: start and goal name different blocks.
+    """
+    if config.start is None or config.goal is None:
+        from worldsim.scenarios import random_stacks
+    start = config.start if config.start is not None else random_stacks(config.blocks, config.seed)
+    if config.goal is not None:
+        goal = config.goal
+    else:
+        blocks = sorted(b for s in start for b in s)
+        k = 1
+        while True:
+            candidate = _renamed(random_stacks(len(blocks), config.seed * 7919 + k), blocks)
+            if sorted(map(sorted, candidate)) != sorted(map(sorted, start)) or sorted(goal_facts(candidate)) != sorted(goal_facts(start)):
+                goal = candidate
+                break
+            k += 1
+    if sorted(b for s in start for b in s) != sorted(b for s in goal for b in s):
+        raise AlicaError(f"the start {start} and the goal {goal} must hold the same blocks")
+    return start, goal
+
+
+def _renamed(stacks: Stacks, names: Sequence[str]) -> Stacks:
+    """Random stacks of ``a, b, ...`` with the blocks named like ``names`` (sorted)."""
+    order = sorted(b for s in stacks for b in s)
+    mapping = dict(zip(order, names, strict=True))
+    return [[mapping[b] for b in s] for s in stacks]
+
+
+class _Counter:
+    """Counts what the trace says: tasks finished per agent, replans, the latest plan's length."""
+
+    def __init__(self) -> None:
+        self.tasks: dict[str, int] = {}
+        self.replans = 0
+        self.plan_length = 0
+
+    def __call__(self, event: dict[str, Any]) -> None:
+        kind = event["event"]
+        if kind == "transition" and str(event.get("plan", "")).startswith(f"{PROBLEM}_g") and str(event.get("target", "")).endswith("_Done"):
+            agent = str(event["agent"])
+            self.tasks[agent] = self.tasks.get(agent, 0) + 1
+        elif kind == "replan":
+            self.replans += 1
+        elif kind == "planner" and event.get("what") == "plan":
+            self.plan_length = int(event.get("steps", 0))
+
+
+def run_demo(
+    config: DemoConfig,
+    *,
+    observers: Iterable[Callable[[dict[str, Any]], None]] = (),
+    on_second: Callable[[float, int, int, int], None] | None = None,
+    actions: Iterable[tuple[float, Callable[[Any], None]]] = (),
+    out: Path | None = None,
+    gui: bool = False,
+) -> DemoResult:
+    """Run the demo in simulated time.
+
+    Args:
+        config: what to run.
+        observers: trace observers (every event of the team and the opponents).
+        on_second: called once per simulated second with (time, goal literals satisfied, of how many, replans).
+        actions: ``(time, action(team))`` to run at those simulated times (faults, say).
+        out: a folder for the trace (``trace.jsonl``), pictures (``initial.png``,
+            ``final.png``) and the generated plan (``plan.yaml``).
+        gui: show the pybullet window.
+
+    Raises:
+        AlicaError: a bad configuration.
+    """
+    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam
+    from alica.io import load_library
+    from skills.registry import default_registry
+    from worldsim.perception import FactPerception
+    from worldsim.scenarios import blocks_facts, blocksworld
+
+    if config.agents < 1 or config.opponents < 0:
+        raise AlicaError(f"the demo needs at least 1 agent and 0 or more opponents, got {config.agents} and {config.opponents}")
+    start, goal = configurations(config)
+    library = load_library(MISSION)
+    extra: dict[str, Any] = {"opponents": config.opponents} if config.opponents else {}
+    if gui:
+        extra["gui"] = True
+    world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
+    counter = _Counter()
+    trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
+    watchers = [counter, *observers, *([trace] if trace is not None else [])]
+    settings = EngineConfig(frequency=config.frequency)
+    perception = FactPerception(blocks_facts, every=0.2)
+    registry = default_registry()
+    team = SimulatedTeam(library, "BlocksWorldMission", {f"r{i + 1}": "Manipulator" for i in range(config.agents)}, seed=config.seed,
+                         config=settings, skill_registry=registry, observers=watchers, world=world, perception=perception, step_world=False)
+    text = goal_text(goal)
+    for engine in team.engines.values():
+        engine.set_problem(PROBLEM, goal=text)
+    rivals = None
+    if config.opponents:
+        rivals = SimulatedTeam(library, "BlocksWorldOpponent", {f"o{i + 1}": "Opponent" for i in range(config.opponents)}, seed=config.seed + 1,
+                               config=settings, skill_registry=registry, observers=watchers, world=world, step_world=False)
+    for when, action in actions:
+        team.at(when, "demo action", lambda action=action: action(team))
+    wanted = set(goal_facts(goal))
+    if out is not None:
+        _picture(world, out / "initial.png")
+    wall = time.perf_counter()
+    next_report = 0.0
+    satisfied = 0
+    reached: float | None = None
+    try:
+        while True:
+            team.tick_agents()
+            if rivals is not None:
+                rivals.tick_agents()
+            world.step(settings.period)
+            now = world.now()
+            facts = perception.facts
+            satisfied = len(wanted & facts)
+            if on_second is not None and now >= next_report:
+                next_report = now + 1.0
+                on_second(now, satisfied, len(wanted), counter.replans)
+            if satisfied == len(wanted) and facts:
+                if reached is None:
+                    reached = now
+                if team.done() or now - reached >= SETTLE_S:
+                    break  # the team has a moment to see the goal and finish its plan
+            else:
+                reached = None
+            if now >= config.time_limit:
+                break
+        wall = time.perf_counter() - wall
+        if on_second is not None:
+            on_second(world.now(), satisfied, len(wanted), counter.replans)
+        created = next(iter(e.plan_board.latest.values()), None) if (e := _leader(team)) is not None else None
+        plan_yaml = _plan_yaml(created, out) if created is not None else ""
+        if out is not None:
+            _picture(world, out / "final.png")
+            if plan_yaml:
+                (out / "plan.yaml").write_text(plan_yaml, encoding="utf-8")
+        return DemoResult(
+            success=satisfied == len(wanted),
+            sim_time_s=reached if reached is not None else world.now(),
+            wall_time_s=wall,
+            plan_length=counter.plan_length,
+            replans=counter.replans,
+            messages=team.network.stats.sent,
+            tasks={name: counter.tasks.get(name, 0) for name in team.engines},
+            start=start,
+            goal=goal,
+            goal_literals=len(wanted),
+            satisfied=satisfied,
+            plan_yaml=plan_yaml,
+            crashed=sorted(team.crashed),
+        )
+    finally:
+        if trace is not None:
+            trace.close()
+        world.close()
+
+
+def _leader(team: Any) -> Any:
+    running = [e for e in team.running() if e.plan_board.latest]
+    return running[0] if running else None
+
+
+def _plan_yaml(created: Any, out: Path | None) -> str:
+    """The generated plan as YAML, importing the mission from where it is written."""
+    import os
+
+    from prophet.tasks import emit_yaml
+
+    where = out.resolve() if out is not None else Path.cwd()
+    return emit_yaml(created, imports=(Path(os.path.relpath(MISSION, where)).as_posix(),))
+
+
+def _picture(world: Any, path: Path) -> None:
+    from worldsim.camera import snapshot
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    snapshot(world, path)
