@@ -163,6 +163,8 @@ class MoveToPosition(WorldSkill):
                 self.job = None
                 self.wait_until = now + GOAL_WAIT
                 return self.running(f"waiting for another robot to clear the goal ({self.reason})")
+            if result.status == "invalid_start" or self.reason.startswith("start "):
+                return self._stuck(now)  # too close to something (a block put down next to it): back off first
             if result.status in ("invalid_goal", "unreachable") and not self.escaping:
                 self.robot.stop()
                 return self.fail(f"cannot reach {self.goal}: {self.reason}")
