@@ -450,6 +450,8 @@ class ProblemRuntime:
         best = search.best
         if best is not None and search.shared_cost is None:
             self._share_plan(now, search, best)
+        elif search.shared_cost is not None and self._executing():
+            finished = finished or Done(PlanStatus.SOLVED, search.expansions, "execution has begun")
         elif search.shared_cost is not None and now >= self.next_update:
             if set(self._read_world(self.problem).facts) != set(search.world.facts):
                 finished = finished or Done(PlanStatus.SOLVED, search.expansions, "the world changed: execution has begun")
@@ -472,6 +474,13 @@ class ProblemRuntime:
                 self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=reason), now)
             elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
                 self._replan(now, "the world changed while planning")
+
+    def _executing(self) -> bool:
+        """Whether an agent runs a step of the shared plan (a better plan then no longer replaces it)."""
+        node, created = self.slot.node, self.created
+        if node is None or created is None or node.plan is not created.plan:
+            return False
+        return any(state is not None and "_S" in state for _, state in node.believed.values())
 
     def _share_plan(self, now: float, search: _Search, plan: StepPlan) -> None:
         from prophet.validate import validate_plan
