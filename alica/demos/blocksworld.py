@@ -213,6 +213,9 @@ def run_demo(
     from worldsim.perception import FactPerception
     from worldsim.scenarios import blocks_facts, blocksworld
 
+    from skills.motion import configure_ompl
+
+    configure_ompl(config.seed)  # OMPL's generator is per process: seed it before any planner exists
     if config.agents < 1 or config.opponents < 0:
         raise AlicaError(f"the demo needs at least 1 agent and 0 or more opponents, got {config.agents} and {config.opponents}")
     start, goal = configurations(config)
