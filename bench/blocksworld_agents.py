@@ -1,0 +1,121 @@
+"""The Fig. 22 experiment of the IMPERA paper: blocks-world execution time against the number of agents.
+
+For 1 to 5 agents, without and with opponents, over several seeds, this runs
+``alica demo blocksworld --json`` (each run in a fresh process, so each is
+repeatable on its own). It prints a markdown table of simulated execution
+time (mean, min, max over the successful runs), success count, replans and
+wall time. It writes the table as TSV and a PNG plot of simulated time
+against agents to ``build/bench/``.
+
+The paper's trends are the bar. Without opponents the time falls as agents
+are added. With opponents it is higher, because the team has to replan.
+
+Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 6] [--seeds 3] [--time-limit 900]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+OUT = ROOT / "build" / "bench"
+
+
+def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
+    """One demo run in a fresh process; its JSON summary (``error`` set when it did not run)."""
+    argv = [sys.executable, "-m", "alica.cli", "demo", "blocksworld", "--agents", str(agents), "--opponents", str(opponents),
+            "--blocks", str(blocks), "--seed", str(seed), "--time-limit", str(time_limit), "--json", "--no-progress"]
+    started = time.perf_counter()
+    done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=time_limit * 4 + 120)
+    line = next((row for row in reversed(done.stdout.splitlines()) if row.startswith("{")), None)
+    if line is None:
+        return {"error": done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}", "process_s": time.perf_counter() - started}
+    result = json.loads(line)
+    result["process_s"] = time.perf_counter() - started
+    return result
+
+
+def _range(text: str) -> list[int]:
+    low, _, high = text.partition("-")
+    return list(range(int(low), int(high or low) + 1))
+
+
+def main() -> int:
+    """Run the experiment and print the table."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--agents", default="1-5", help="range of team sizes (default 1-5)")
+    parser.add_argument("--opponents", type=int, default=2, help="opponents in the runs with opponents (default 2)")
+    parser.add_argument("--blocks", type=int, default=6, help="blocks (default 6)")
+    parser.add_argument("--seeds", type=int, default=3, help="seeds per cell (default 3)")
+    parser.add_argument("--time-limit", type=float, default=900.0, help="simulated seconds per run (default 900)")
+    args = parser.parse_args()
+    rows = []
+    for opponents in (0, args.opponents):
+        for agents in _range(args.agents):
+            runs = [run_one(agents, opponents, args.blocks, seed, args.time_limit) for seed in range(args.seeds)]
+            ok = [r for r in runs if r.get("success")]
+            times = [float(r["sim_time_s"]) for r in ok]  # type: ignore[arg-type]
+            rows.append({
+                "agents": agents,
+                "opponents": opponents,
+                "success": f"{len(ok)}/{len(runs)}",
+                "sim_mean": statistics.mean(times) if times else float("nan"),
+                "sim_min": min(times) if times else float("nan"),
+                "sim_max": max(times) if times else float("nan"),
+                "replans": statistics.mean(float(r.get("replans", 0)) for r in runs if "error" not in r) if any("error" not in r for r in runs) else float("nan"),  # type: ignore[arg-type]
+                "wall_mean": statistics.mean(float(r["wall_time_s"]) for r in runs if "wall_time_s" in r) if any("wall_time_s" in r for r in runs) else float("nan"),  # type: ignore[arg-type]
+                "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
+            })
+            last = rows[-1]
+            print(f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s", file=sys.stderr, flush=True)
+    header = ["agents", "opponents", "success", "sim time mean s", "min", "max", "replans mean", "wall mean s"]
+    print(f"Blocks world, {args.blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n")
+    print("| " + " | ".join(header) + " |")
+    print("|" + "---|" * len(header))
+    for r in rows:
+        print(f"| {r['agents']} | {r['opponents']} | {r['success']} | {r['sim_mean']:.1f} | {r['sim_min']:.1f} | {r['sim_max']:.1f} | {r['replans']:.1f} | {r['wall_mean']:.1f} |")
+    errors = [f"agents {r['agents']} opponents {r['opponents']}: {r['errors']}" for r in rows if r["errors"]]
+    if errors:
+        print("\nruns that did not finish: " + " | ".join(errors))
+    OUT.mkdir(parents=True, exist_ok=True)
+    with (OUT / "blocksworld_agents.tsv").open("w", encoding="utf-8") as f:
+        f.write("\t".join(["agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean"]) + "\n")
+        for r in rows:
+            f.write("\t".join(str(r[k]) for k in ("agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean")) + "\n")
+    _plot(rows, OUT / "blocksworld_agents.png", args)
+    print(f"\nwrote {OUT / 'blocksworld_agents.tsv'} and {OUT / 'blocksworld_agents.png'}")
+    return 0
+
+
+def _plot(rows: list[dict[str, object]], path: Path, args: argparse.Namespace) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for opponents, style in ((0, "o-"), (args.opponents, "s--")):
+        mine = [r for r in rows if r["opponents"] == opponents]
+        xs = [r["agents"] for r in mine]
+        ys = [r["sim_mean"] for r in mine]
+        low = [float(r["sim_mean"]) - float(r["sim_min"]) for r in mine]  # type: ignore[arg-type]
+        high = [float(r["sim_max"]) - float(r["sim_mean"]) for r in mine]  # type: ignore[arg-type]
+        ax.errorbar(xs, ys, yerr=[low, high], fmt=style, capsize=3, label=f"{opponents} opponents")
+    ax.set_xlabel("agents")
+    ax.set_ylabel("execution time (simulated s)")
+    ax.set_title(f"Blocks world, {args.blocks} blocks (cf. IMPERA Fig. 22)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
