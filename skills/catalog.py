@@ -175,9 +175,13 @@ def _manipulation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "RandomBlockSkill",
-        _p("blocking_radius", "float", "a stack with another robot closer than this many metres is left alone", default=0.5),
-        doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking",
+        _p("blocking_radius", "float", "a stack with another robot's centre closer than this many metres is left alone "
+           "(a robot working at a stack stands about 0.7 m from it)", default=1.0),
+        _p("pause", "float", "simulated seconds to wait after each action, and between looks when nothing is applicable", default=2.0),
+        _p("action_timeout", "float", "simulated seconds after which an action still running is stopped", default=120.0),
+        doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking, forever",
         capabilities=("base", "arm", "gripper"),
+        implementation="skills.opponent:RandomBlockSkill",
     )
 
 

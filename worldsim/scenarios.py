@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import logging
 import math
+import random
 import string
 
 import numpy as np
@@ -15,7 +16,7 @@ from worldsim.errors import WorldError
 from worldsim.objects import SAMPLE_KINDS
 from worldsim.world import World
 
-__all__ = ["blocks_facts", "blocksworld", "lunar", "sample_names"]
+__all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "random_stacks", "sample_names"]
 
 logger = logging.getLogger(__name__)
 
@@ -23,6 +24,14 @@ logger = logging.getLogger(__name__)
 STACK_SPACING = 0.8
 #: Distance from the line of stacks to the robots' centres.
 ROBOT_STANDOFF = 1.2
+#: Distance along x from the last stack of the row to the first opponent at that end.
+OPPONENT_GAP = 1.5
+#: Distance along x between opponents at the same end of the row.
+OPPONENT_SPACING = 0.8
+#: Free room (m) kept between the outermost opponent's centre and the field border.
+OPPONENT_ROOM = 1.5
+#: Extra room (m) behind both lines of team robots when there are opponents (more robots drive around).
+OPPONENT_EXTRA_Y = 1.0
 
 
 def blocksworld(
@@ -32,38 +41,43 @@ def blocksworld(
     block_size: float = 0.05,
     *,
     time_step: float = 1.0 / 240.0,
+    opponents: int = 0,
+    gui: bool = False,
 ) -> World:
-    """A blocks world: stacks of blocks on the ground in a row, and manipulators ``r1..rN`` around them.
+    """A blocks world: stacks of blocks on the ground in a row, manipulators ``r1..rN`` around them, opponents ``o1..oK``.
 
     Args:
         stacks: the stacks, each bottom block first (default ``[["a", "c"], ["b"]]``: c on a, b alone,
             the Sussman anomaly for the goal tower a on b on c).
-        agents: number of robots of kind ``manipulator``; they stand on both sides of the
+        agents: number of team robots of kind ``manipulator``; they stand on both sides of the
             row, facing it, :data:`ROBOT_STANDOFF` away.
         seed: the world seed.
         block_size: edge of the blocks in metres.
         time_step: the physics step.
+        opponents: number of opponent robots (kind ``manipulator``, named ``o1..oK``); they stand on
+            the line of the row beyond its ends, alternately left and right, facing the row,
+            :data:`OPPONENT_GAP` from the last stack and :data:`OPPONENT_SPACING` apart; the field
+            grows along x to leave :data:`OPPONENT_ROOM` behind the outermost ones, and by
+            :data:`OPPONENT_EXTRA_Y` in y, so that every robot can drive around the stacks.
+            Without opponents the field is unchanged.
+        gui: show the pybullet window (when a display is available).
 
     Raises:
-        WorldError: empty stacks, repeated block names, or fewer than 0 agents.
+        WorldError: empty stacks, repeated block names, or fewer than 0 agents or opponents.
     """
     if stacks is None:
         stacks = [["a", "c"], ["b"]]
-    names = [b for stack in stacks for b in stack]
-    if any(not stack for stack in stacks):
-        raise WorldError("blocksworld: every stack needs at least one block; drop empty stacks")
-    if len(set(names)) != len(names):
-        raise WorldError(f"blocksworld: block names must be unique, got {names}")
-    if int(agents) < 0:
-        raise WorldError(f"blocksworld: agents must be >= 0, got {agents}")
-    agents = int(agents)
+    _check_blocks_arguments(stacks, agents, opponents)
+    agents, opponents = int(agents), int(opponents)
     n = max(1, len(stacks))
     row = (n - 1) * STACK_SPACING
     per_side = max(1, math.ceil(agents / 2))
     robots_row = (per_side - 1) * 1.0
     half_x = max(2.5, 0.5 * max(row, robots_row) + 1.5)
-    half_y = ROBOT_STANDOFF + 1.5
-    world = World(seed, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y))
+    if opponents:
+        half_x = max(half_x, abs(_opponent_x(opponents - 1, row)) + OPPONENT_ROOM)  # the outermost opponent
+    half_y = ROBOT_STANDOFF + 1.5 + (OPPONENT_EXTRA_Y if opponents else 0.0)
+    world = World(seed, gui=gui, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y))
     for i, stack in enumerate(stacks):
         x = -0.5 * row + i * STACK_SPACING
         for level, name in enumerate(stack):
@@ -73,8 +87,91 @@ def blocksworld(
         slot = k // 2
         x = -0.5 * robots_row + slot * 1.0
         world.add_robot("manipulator", f"r{k + 1}", (x, side * ROBOT_STANDOFF, -side * 0.5 * math.pi))
+    for k in range(opponents):
+        x = _opponent_x(k, row)
+        world.add_robot("manipulator", f"o{k + 1}", (x, 0.0, 0.0 if x < 0 else math.pi))
     world.step(0.25)  # let the stacks settle
     return world
+
+
+def _check_blocks_arguments(stacks: list[list[str]], agents: int, opponents: int) -> None:
+    """Raise :class:`WorldError` for empty stacks, repeated names or negative robot counts."""
+    names = [b for stack in stacks for b in stack]
+    if any(not stack for stack in stacks):
+        raise WorldError("blocksworld: every stack needs at least one block; drop empty stacks")
+    if len(set(names)) != len(names):
+        raise WorldError(f"blocksworld: block names must be unique, got {names}")
+    if int(agents) < 0:
+        raise WorldError(f"blocksworld: agents must be >= 0, got {agents}")
+    if int(opponents) < 0:
+        raise WorldError(f"blocksworld: opponents must be >= 0, got {opponents}")
+
+
+def _opponent_x(k: int, row: float) -> float:
+    """The x of opponent ``k`` (0-based): even ones left of the row, odd ones right, outwards in pairs."""
+    side = -1.0 if k % 2 == 0 else 1.0
+    return side * (0.5 * row + OPPONENT_GAP + (k // 2) * OPPONENT_SPACING)
+
+
+def block_names(count: int) -> list[str]:
+    """Names of ``count`` blocks: ``a``, ``b``, ``c``, ... (no letter skipped).
+
+    Raises:
+        WorldError: ``count`` is below 1 or above 26.
+    """
+    if not 1 <= int(count) <= len(string.ascii_lowercase):
+        raise WorldError(f"blocks are named a..z: ask for 1 to {len(string.ascii_lowercase)} blocks, got {count}")
+    return list(string.ascii_lowercase[: int(count)])
+
+
+def random_stacks(blocks: int, seed: int, max_height: int | None = None) -> list[list[str]]:
+    """A random configuration of the blocks ``a, b, c, ...`` in stacks (each bottom first), the same for the same seed.
+
+    Every configuration (a set of stacks, each an ordered list, at most
+    ``max_height`` high) is equally likely: the stack holding the first
+    block not yet placed gets a size drawn with the number of configurations
+    each size leaves, then random members and a random order. Stacks come in
+    the order of their lowest block name.
+
+    Args:
+        blocks: how many blocks (1 to 26).
+        seed: seeds a ``random.Random``.
+        max_height: the highest stack allowed; no limit when None.
+
+    Raises:
+        WorldError: a block count out of range or a ``max_height`` below 1.
+    """
+    names = block_names(blocks)
+    if max_height is not None and int(max_height) < 1:
+        raise WorldError(f"random_stacks: max_height must be at least 1 (or None for no limit), got {max_height}")
+    height = len(names) if max_height is None else min(len(names), int(max_height))
+    rng = random.Random(int(seed))
+    counts = _configuration_counts(len(names), height)
+    left = list(names)
+    stacks: list[list[str]] = []
+    while left:
+        m = len(left)
+        pick = rng.randrange(counts[m])
+        size = 1
+        for size in range(1, min(height, m) + 1):
+            ways = math.comb(m - 1, size - 1) * math.factorial(size) * counts[m - size]
+            if pick < ways:
+                break
+            pick -= ways
+        first, rest = left[0], left[1:]
+        members = [first, *rng.sample(rest, size - 1)]
+        rng.shuffle(members)
+        stacks.append(members)
+        left = [b for b in rest if b not in members]
+    return stacks
+
+
+def _configuration_counts(n: int, height: int) -> list[int]:
+    """``counts[m]``: the configurations of ``m`` named blocks in stacks at most ``height`` high, for m = 0..n."""
+    counts = [1] + [0] * n
+    for m in range(1, n + 1):
+        counts[m] = sum(math.comb(m - 1, j - 1) * math.factorial(j) * counts[m - j] for j in range(1, min(height, m) + 1))
+    return counts
 
 
 def blocks_facts(world: World, tolerance: float | None = None) -> set[tuple[str, ...]]:
