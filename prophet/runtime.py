@@ -154,6 +154,7 @@ class ProblemRuntime:
         self.request: ReplanRequest | None = None
         self.marked: set[str] = set()
         self.pending: tuple[float, str] | None = None
+        self.blocked: set[Fact] | None = None
         self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
         now = self.engine.now()
         board = self.engine.plan_board
@@ -363,6 +364,10 @@ class ProblemRuntime:
             self._start_search(now, reason, self.share.generation if self.share is not None else None)
         elif self.search is not None:
             self._step_search(now)
+        elif self.blocked is not None:
+            if now >= self.next_update and set(self._read_world(self.problem).facts) != self.blocked:
+                self.blocked = None
+                self._start_search(now, "the world changed while planning was blocked")
         elif share is None or share.status == SEARCHING or (share.status == PLAN and share.generation <= self.failed_generation):
             self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
         if now < self.next_update:
@@ -464,6 +469,11 @@ class ProblemRuntime:
             self.engine.emit("planner", key=key_text(self.key), what="done", status=finished.status.value, expansions=search.expansions)
             if search.shared_cost is None:
                 message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (f": {finished.message}" if finished.message else "")
+                if search.world.left_out and finished.status is PlanStatus.UNSOLVABLE:
+                    # a robot outside the team holds something: wait in the WaitPlan until the world changes
+                    self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=f"{message}; robots outside the team hold objects")
+                    self.blocked = set(search.world.facts)
+                    return
                 self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)
             return
         if search.shared_cost is None:

@@ -41,11 +41,14 @@ class PlanningWorld:
         objects: ``(name, type)`` pairs, sorted.
         facts: the facts that hold, sorted.
         robots: the robots the plan may use, sorted.
+        left_out: facts about robots outside the team that were left out (a
+            block an opponent holds is missing from the world, say).
     """
 
     objects: tuple[tuple[str, str], ...]
     facts: tuple[Fact, ...]
     robots: tuple[str, ...] = ()
+    left_out: int = 0
 
     def object_types(self) -> dict[str, str]:
         """Object name -> type."""
@@ -101,6 +104,7 @@ def read_world(
         source = facts
     members = tuple(sorted(set(team)))
     kept: set[Fact] = set()
+    left_out = 0
     for fact in source:
         name = str(fact[0])
         args = tuple(str(a) for a in fact[1:])
@@ -108,7 +112,8 @@ def read_world(
         if arity is None or len(args) != len(arity):
             continue
         if not offline and any(kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)):
-            continue  # a robot outside the team
+            left_out += len(args) > 1  # a relation of an outside robot with an object (not just its own state)
+            continue
         kept.add((name, args))
     types: dict[str, str] = dict(sorted(declared.items()))
     if not offline and robot_type is not None:
@@ -124,7 +129,7 @@ def read_world(
         for arg, type_name in zip(args, predicates[name.lower()], strict=True):
             types.setdefault(arg, type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
-    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots)
+    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out)
 
 
 def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:
