@@ -261,3 +261,16 @@ def test_a_robot_holding_a_block_at_a_replan_is_part_of_the_new_plan():
     assert (failed_agent, block) in stacks[1:]
     replanned = events(rec, "planner", what="plan", generation=2)
     assert replanned and replanned[0]["steps"] < 6
+
+
+def test_a_block_held_by_a_robot_outside_the_team_makes_the_leader_wait_not_fail():
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
+    sim.set_facts([(True, "holding", ("o1", "b"))])  # an opponent holds b: it is missing from the team's world
+    sim.run(ticks=20)
+    assert events(rec, "planner", what="waiting")
+    assert events(rec, "problem", phase="failed") == [] and child_plan(sim, "r1") == "DriveToFreePosition"
+    sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])  # it puts b down
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["success"] and goal_holds(sim, "r1")
+    assert events(rec, "planner", what="started", reason="the world changed while planning was blocked")
