@@ -2,19 +2,25 @@
 
 1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
    finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
-2. Rounds over a portfolio of bounded passes, each pruning ``g >= best cost``
+2. Quick window sweeps on it (:mod:`prophet.search.windows`: stretches of the
+   plan replanned among their own objects).
+3. Restarts: unbounded lazy searches with other heuristics and weights, each
+   plan then cleaned up and window-swept (it may start worse than the best
+   and end better); full window sweeps on the best; the plan neighbourhood
+   graph search (:mod:`prophet.search.neighbourhood`).
+4. Rounds over a portfolio of bounded passes, each pruning ``g >= best cost``
    and stopped after an expansion budget that doubles every round: lazy GBFS
    with FF on h_add supporters, lazy weighted A* with decreasing weights
    (FF with h_max and with h_add supporters, preferred operators), and
    eager A* with h_max (admissible). Different heuristics and weights lead
    to different plans; the bound makes every plan found cheaper.
-3. A pass that exhausts its space under the bound (rather than its budget)
+5. A pass that exhausts its space under the bound (rather than its budget)
    proves the best plan optimal: ``Done(OPTIMAL)`` (not the greedy pass,
-   which does not reopen states).
+   which does not reopen states); so does a neighbourhood search that covers
+   the whole reachable state space.
 
-Every plan goes through loop removal, action elimination and a small plan
-neighbourhood graph search (:mod:`prophet.search.neighbourhood`) before it is
-reported.
+Every plan goes through loop removal and action elimination; ``Improved``
+comes only for a plan cheaper than every one before.
 """
 
 from __future__ import annotations
