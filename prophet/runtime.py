@@ -41,12 +41,11 @@ from alica.errors import AlicaError, PlannerError
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from prophet.planner import Done, Improved, PlanStatus, PlanStep
 from prophet.planner import Plan as StepPlan
-from prophet.tasks import STEP_DONE, CreatedTasks, create_tasks, state_step, step_token
+from prophet.tasks import STEP_DONE, CreatedTasks, create_tasks, holds, state_step, step_token
 from prophet.world import (
     PlanningWorld,
     TaskProgress,
     goal_literals,
-    holds_all,
     read_world,
     remaining_fits,
 )
@@ -155,6 +154,7 @@ class ProblemRuntime:
         self.marked: set[str] = set()
         self.pending: tuple[float, str] | None = None
         self.blocked: set[Fact] | None = None
+        self.predicates: dict[str, tuple[str, ...]] | None = None
         self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
         now = self.engine.now()
         board = self.engine.plan_board
@@ -390,9 +390,14 @@ class ProblemRuntime:
             self._start_search(now, reason)
             return
         engine = self.engine
-        generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+        generation = self._next_generation()
         self.pending = (now + self.model.update_time, reason)
         self._publish(PlanShare(self.key, generation, 0, engine.name, SEARCHING, entry_task=self._entry_task(), reason=reason), now)
+
+    def _next_generation(self) -> int:
+        """One more than any generation this agent has seen for the problem."""
+        board = self.engine.plan_board
+        return max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         from prophet.planners import get_planner
@@ -400,13 +405,13 @@ class ProblemRuntime:
 
         engine = self.engine
         if generation is None:
-            generation = max(engine.plan_board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+            generation = self._next_generation()
         me = engine.name
         task = self._entry_task()
         problem = self.problem
         try:
             world = self._read_world(problem)
-            if holds_all(goal_literals(problem), set(world.facts)):
+            if holds(goal_literals(problem), set(world.facts)):
                 self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, robots=world.robots, entry_task=task, reason="the goal holds"), now)
                 return
             domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
@@ -485,6 +490,14 @@ class ProblemRuntime:
             elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
                 self._replan(now, "the world changed while planning")
 
+    def _predicates(self) -> dict[str, tuple[str, ...]]:
+        """The domain's predicates (they depend on the problem's elements only), worked out once."""
+        if self.predicates is None:
+            from prophet.problem import predicate_types
+
+            self.predicates = predicate_types(self.model, self.engine.library)
+        return self.predicates
+
     def _executing(self) -> bool:
         """Whether an agent runs a step of the shared plan (a better plan then no longer replaces it)."""
         node, created = self.slot.node, self.created
@@ -525,9 +538,7 @@ class ProblemRuntime:
                 progress.append(TaskProgress(agent, k, running="_S" in state))
             else:
                 progress.append(TaskProgress(None, 0))
-        from prophet.problem import predicate_types
-
-        predicates = predicate_types(self.problem, self.engine.library)
+        predicates = self._predicates()
         world_model = self.engine.world_model
         facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
         reason = remaining_fits(created.tasks, progress, facts, share.world, goal_literals(self.problem)) or _stalled(progress)

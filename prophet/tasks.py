@@ -148,11 +148,13 @@ def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robots: str |
     return out
 
 
-def _holds(pre: Iterable[tuple[bool, Fact]], state: set[Fact]) -> bool:
-    return all((fact in state) == positive for positive, fact in pre)
+def holds(literals_: Iterable[tuple[bool, Fact]], state: set[Fact] | frozenset[Fact]) -> bool:
+    """Whether every literal holds in the closed world ``state``."""
+    return all((fact in state) == positive for positive, fact in literals_)
 
 
-def _apply(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
+def apply_effect(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
+    """Apply an effect to ``state``: deletes first, then adds."""
     for positive, fact in effect:
         if not positive:
             state.discard(fact)
@@ -161,7 +163,8 @@ def _apply(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
             state.add(fact)
 
 
-def _as(literal_set: Iterable[tuple[bool, Fact]], robot: str, other: str) -> list[tuple[bool, Fact]]:
+def for_robot(literal_set: Iterable[tuple[bool, Fact]], robot: str, other: str) -> list[tuple[bool, Fact]]:
+    """The literals with ``robot`` replaced by ``other``."""
     return [(positive, (name, tuple(other if a == robot else a for a in args))) for positive, (name, args) in literal_set]
 
 
@@ -185,14 +188,14 @@ def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, .
     task_of: dict[str, int] = {}
     for step in steps:
         shared = {f for f in state if not members.intersection(f[1])}
-        able = tuple(r for r in team if _holds(_as(step.pre, step.robot, r), shared | fresh[r]))
+        able = tuple(r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r]))
         if not tasks or able:
             tasks.append([step])
             allowed.append(able if _pinned(step) and able and set(able) != members else None)
             task_of[step.robot] = len(tasks) - 1
         else:
             tasks[task_of.get(step.robot, len(tasks) - 1)].append(step)
-        _apply(state, step.effect)
+        apply_effect(state, step.effect)
     return tasks, allowed
 
 

@@ -29,6 +29,7 @@ from alica.errors import AlicaError, PlannerError
 from alica.lang import literals
 from alica.model import PlanLibrary, PlanningProblem
 from prophet.problem import offline_world, predicate_types
+from prophet.tasks import apply_effect, for_robot, holds
 
 Fact = tuple[str, tuple[str, ...]]
 Literal = tuple[bool, Fact]
@@ -66,11 +67,6 @@ def goal_literals(problem: PlanningProblem) -> tuple[Literal, ...]:
     except AlicaError as exc:
         raise PlannerError(f"the goal of '{problem.name}' must be a conjunction of literals to be planned with: {exc}") from None
     return tuple((positive, (name, tuple(str(a) for a in args))) for positive, name, args in found if name != "=")
-
-
-def holds_all(wanted: Iterable[Literal], facts: set[Fact] | frozenset[Fact]) -> bool:
-    """Whether every literal holds in the closed world ``facts``."""
-    return all((fact in facts) == positive for positive, fact in wanted)
 
 
 def read_world(
@@ -159,10 +155,6 @@ class TaskProgress:
     done: bool = False
 
 
-def _ground(step_literals: Sequence[Literal], robot: str, who: str) -> list[Literal]:
-    return [(positive, (name, tuple(who if a == robot else a for a in args))) for positive, (name, args) in step_literals]
-
-
 def remaining_fits(
     tasks: Sequence[Sequence[object]],
     progress: Sequence[TaskProgress],
@@ -197,16 +189,13 @@ def remaining_fits(
         for k in range(where.next_step, len(task)):
             remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):
-        pre = _ground(step.pre, step.robot, who)  # type: ignore[attr-defined]
-        effect = _ground(step.effect, step.robot, who)  # type: ignore[attr-defined]
-        if holds_all(pre, state):
-            for positive, fact in effect:
-                if not positive:
-                    state.discard(fact)
-            state.update(fact for positive, fact in effect if positive)
-        elif not (running and holds_all(effect, state)):
+        pre = for_robot(step.pre, step.robot, who)  # type: ignore[attr-defined]
+        effect = for_robot(step.effect, step.robot, who)  # type: ignore[attr-defined]
+        if holds(pre, state):
+            apply_effect(state, effect)
+        elif not (running and holds(effect, state)):
             return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"  # type: ignore[attr-defined]
-    if not holds_all(goal, state):
+    if not holds(goal, state):
         return f"the plan no longer reaches the goal: {_unmet(goal, state)} would not hold"
     return None
 
