@@ -168,7 +168,7 @@ def _plan_file(args: argparse.Namespace) -> int:
         roleset = next(iter(sorted(library.rolesets.items())))[1] if library.rolesets else None
         if roleset is None:
             raise AlicaError(f"{args.domain}: the generated plan needs a role set for its task priorities; import one")
-        created = create_tasks(f"{name}Plan", steps, library, world.facts, world.robots or ("self",), roleset, "Default")
+        created = create_tasks(f"{name}Plan", steps, library, world.facts, world.robots or ("self",), roleset, "Default", standby=problem.wait_plan)
         if args.emit_plan:
             out = Path(args.emit_plan)
             imports = sorted({_relative(Path(d.path), out) for d in library.documents if d.path})

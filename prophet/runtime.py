@@ -46,6 +46,8 @@ from prophet.world import (
     PlanningWorld,
     TaskProgress,
     goal_literals,
+    goal_text,
+    reachable_goal,
     read_world,
     remaining_fits,
 )
@@ -59,6 +61,7 @@ if TYPE_CHECKING:
     from prophet.planner import SearchEvent
 
 Fact = tuple[str, tuple[str, ...]]
+Literal = tuple[bool, Fact]
 
 SEARCHING, PLAN, FAILED, DONE = "searching", "plan", "failed", "done"
 
@@ -79,6 +82,8 @@ class PlanShare:
         robots: the robots it was planned with (the alive members in the state).
         entry_task: the task through which the team runs the problem (for Eq. 9).
         reason: why it failed, or why the leader replans.
+        goal: the goal literals the plan reaches when robots outside the team hold
+            objects of the goal (the rest of the goal); empty: the whole goal.
     """
 
     key: PlanKey
@@ -92,6 +97,7 @@ class PlanShare:
     robots: tuple[str, ...] = ()
     entry_task: str = ""
     reason: str = ""
+    goal: tuple[Literal, ...] = ()
 
     def supersedes(self, other: PlanShare) -> bool:
         """Newer generation, then newer version; the lower leader wins a tie (a partition healed)."""
@@ -125,6 +131,7 @@ class _Search:
     best: StepPlan | None = None
     shared_cost: float | None = None
     version: int = 0
+    goal: tuple[Literal, ...] = ()
 
 
 class ProblemRuntime:
@@ -268,7 +275,9 @@ class ProblemRuntime:
         node, created = self.slot.node, self.created
         if node is None or created is None or node.plan is not created.plan or node.ep is None or node.state is None:
             return
-        i = next(j for j, ep in enumerate(created.plan.entry_points) if ep.name == node.ep)
+        i = next((j for j, ep in enumerate(created.task_entry_points) if ep.name == node.ep), None)
+        if i is None:
+            return  # standing by
         steps = created.tasks[i]
         world_model = self.engine.world_model
         for step in steps[: state_step(node.state, len(steps))]:
@@ -299,7 +308,8 @@ class ProblemRuntime:
         if share.status == PLAN:
             name = f"{self.model.name}_g{share.generation}v{share.version}"
             try:
-                created = create_tasks(name, share.steps, engine.library, share.world, share.robots, engine.base_roleset, share.entry_task)
+                created = create_tasks(name, share.steps, engine.library, share.world, share.robots, engine.base_roleset, share.entry_task,
+                                       standby=self.model.wait_plan)
             except (PlannerError, AlicaError) as exc:
                 engine.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
                 return
@@ -411,9 +421,16 @@ class ProblemRuntime:
         problem = self.problem
         try:
             world = self._read_world(problem)
-            if holds(goal_literals(problem), set(world.facts)):
+            goal = goal_literals(problem)
+            if holds(goal, set(world.facts)):
                 self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, robots=world.robots, entry_task=task, reason="the goal holds"), now)
                 return
+            partial = reachable_goal(goal, world.outside)
+            if partial != goal:
+                if not partial or holds(partial, set(world.facts)):
+                    self._wait_outside(now, world, generation)
+                    return
+                problem = replace(problem, goal=Condition(ConditionKind.POST, goal_text(partial)))
             domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
             planner = get_planner(problem.planner, **({"progress_every": 100} if problem.planner == "builtin" else {}))
             events = planner.search(domain, pddl, anytime=True)
@@ -422,10 +439,21 @@ class ProblemRuntime:
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
         names = {name.lower(): name for name, _ in world.objects}
-        self.search = _Search(generation, world, events, domain, pddl, now, names)
-        engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts))
+        self.search = _Search(generation, world, events, domain, pddl, now, names, goal=partial if partial != goal else ())
+        extra = {"goal": goal_text(partial), "outside": list(world.outside)} if partial != goal else {}
+        engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts), **extra)
         self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, robots=world.robots, entry_task=task, reason=reason), now)
         self.next_update = now + self.model.update_time
+
+    def _wait_outside(self, now: float, world: PlanningWorld, generation: int) -> None:
+        """Robots outside the team hold what is left to do: the team waits in the WaitPlan until the world changes."""
+        reason = f"robots outside the team hold {', '.join(world.outside)}, and the rest of the goal holds"
+        self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
+        self.blocked = set(world.facts)
+        self.next_update = now + self.model.update_time
+        if self.share is None or self.share.status != SEARCHING:
+            self._publish(PlanShare(self.key, generation, 0, self.engine.name, SEARCHING, world=world.facts, robots=world.robots,
+                                    entry_task=self._entry_task(), reason=reason), now)
 
     def _read_world(self, problem: PlanningProblem) -> PlanningWorld:
         engine = self.engine
@@ -517,7 +545,8 @@ class ProblemRuntime:
         search.shared_cost = plan.cost
         self.engine.emit("planner", key=key_text(self.key), what="plan", generation=search.generation, version=search.version,
                          cost=plan.cost, steps=len(steps), expansions=search.expansions, after_s=round(now - search.started, 6))
-        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, search.world.robots, self._entry_task())
+        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, search.world.robots,
+                          self._entry_task(), goal=search.goal)
         self._publish(share, now)
 
     # -- execution monitoring --------------------------------------------------
@@ -528,7 +557,7 @@ class ProblemRuntime:
         if node is None or created is None or node.plan is not created.plan:
             return
         progress = []
-        for ep, steps in zip(created.plan.entry_points, created.tasks, strict=True):
+        for ep, steps in zip(created.task_entry_points, created.tasks, strict=True):
             if node.succeeded.get(ep.name):
                 progress.append(TaskProgress(None, len(steps), done=True))
                 continue
@@ -541,7 +570,15 @@ class ProblemRuntime:
         predicates = self._predicates()
         world_model = self.engine.world_model
         facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
-        reason = remaining_fits(created.tasks, progress, facts, share.world, goal_literals(self.problem)) or _stalled(progress)
+        goal = goal_literals(self.problem)
+        reason = remaining_fits(created.tasks, progress, facts, share.world, share.goal or goal) or _stalled(progress)
+        if reason is None and share.goal:
+            world = self._read_world(self.problem)
+            if reachable_goal(goal, world.outside) != share.goal:
+                reason = f"the goal's objects held outside the team changed (now: {', '.join(world.outside) or 'none'})"
+            elif all(p.done for p in progress):
+                self._wait_outside(now, world, self._next_generation())  # the rest of the goal is reached
+                return
         if reason is None:
             self.invalid_once = False
         elif not self.invalid_once:

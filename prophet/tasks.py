@@ -31,6 +31,13 @@ states, each waiting until its step's precondition holds in the world model
 tasks on the same objects are done (``step_done`` facts, which the runtime
 writes), then running the step's skill plan with its variables bound; a
 failed step ends the task in a failure state (the runtime then replans).
+With a WaitPlan, one more entry point, :data:`STANDBY` (min 0, no maximum,
+not success-required), holds the agents no task needs: its one state runs
+the WaitPlan, so they keep out of the way of those who work (IMPERA 8.2: "in
+WaitPlan, every agent drives to a free position, so as not to disturb other
+tasks"). It counts nothing for coverage and has the smallest priority, so an
+agent stands by only when no task has room for it, and leaves it for a task
+that frees up just as an idle agent would.
 """
 
 from __future__ import annotations
@@ -100,6 +107,11 @@ class CreatedTasks:
     task_defs: tuple[Task, ...]
     roleset: RoleSet
     allowed: tuple[tuple[str, ...] | None, ...] = ()
+
+    @property
+    def task_entry_points(self) -> tuple[EntryPoint, ...]:
+        """The entry points of the tasks, in task order (the standby entry point left out)."""
+        return self.plan.entry_points[: len(self.tasks)]
 
     def pins(self) -> dict[str, tuple[str, ...]]:
         """Entry point name -> the robots allowed to take it, for the pinned tasks."""
@@ -191,17 +203,12 @@ def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, .
         able = tuple(r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r]))
         if not tasks or able:
             tasks.append([step])
-            allowed.append(able if _pinned(step) and able and set(able) != members else None)
+            allowed.append(able if set(able) != members else None)
             task_of[step.robot] = len(tasks) - 1
         else:
             tasks[task_of.get(step.robot, len(tasks) - 1)].append(step)
         apply_effect(state, step.effect)
     return tasks, allowed
-
-
-def _pinned(step: Step) -> bool:
-    """Whether the step needs the robot in a relation with an object (``holding(?r, ?x)``), not just a robot state."""
-    return any(positive and step.robot in args and len(args) > 1 for positive, (_, args) in step.pre)
 
 
 def _cardinality(task: Sequence[Step]) -> tuple[int, float]:
@@ -214,13 +221,21 @@ def _cardinality(task: Sequence[Step]) -> tuple[int, float]:
     return max(1, low), max(high, float(max(1, low)))
 
 
-def generic_utility(n: int) -> UtilityFunction:
-    """Eq. 10-12, normalised: coverage w_t, priority w_p, similarity w_s; the threshold is w_s."""
+#: The entry point (and state) of a generated plan for the agents no task needs.
+STANDBY = "Standby"
+
+
+def generic_utility(n: int, standby: bool = False) -> UtilityFunction:
+    """Eq. 10-12, normalised: coverage w_t, priority w_p, similarity w_s; the threshold is w_s.
+
+    With ``standby`` the coverage counts the agents of the tasks only (not those standing by).
+    """
     n = max(1, n)
     wt, wp, ws = 1.0 / n, 1.0 / (n + 1) ** 2, 1.0 / (n + 1) ** 3
     total = wt + wp + ws
     wt, wp, ws = wt / total, wp / total, ws / total
-    return UtilityFunction(priority_weight=wp, summands=(Summand("Coverage", wt, "1"),), similarity_weight=ws, threshold=ws)
+    coverage = f'entry != "{STANDBY}"' if standby else "1"
+    return UtilityFunction(priority_weight=wp, summands=(Summand("Coverage", wt, coverage),), similarity_weight=ws, threshold=ws)
 
 
 #: The world-model predicate an agent asserts when it finished a step of a generated plan.
@@ -266,8 +281,8 @@ def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
     return out
 
 
-def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None) -> tuple[Plan, tuple[Task, ...]]:
-    """The multi-agent plan of the tasks (see the module docstring)."""
+def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None, standby: str | None = None) -> tuple[Plan, tuple[Task, ...]]:
+    """The multi-agent plan of the tasks (see the module docstring); ``standby`` names the WaitPlan."""
     entry_points, states, transitions, task_defs = [], [], [], []
     after = _predecessors(tasks)
     for i, task in enumerate(tasks):
@@ -287,7 +302,12 @@ def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = N
             transitions.append(Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed")))
         states.append(State(f"T{i}_Done", StateKind.SUCCESS))
         states.append(State(f"T{i}_Failed", StateKind.FAILURE))
-    plan = Plan(name, tuple(entry_points), tuple(states), tuple(transitions), utility=generic_utility(len(tasks)),
+    if standby is not None:
+        task_name = f"{name}_{STANDBY}"
+        task_defs.append(Task(task_name, description=f"stand by in {standby} while no task needs the agent"))
+        entry_points.append(EntryPoint(STANDBY, task_name, STANDBY, min=0, success_required=False))
+        states.append(State(STANDBY, children=(ChildRef(standby),), description=f"keep out of the way ({standby})"))
+    plan = Plan(name, tuple(entry_points), tuple(states), tuple(transitions), utility=generic_utility(len(tasks), standby is not None),
                 description=f"generated by pRoPhEt MAS from a plan of {sum(len(t) for t in tasks)} steps in {len(tasks)} task(s)")
     return plan, tuple(task_defs)
 
@@ -313,16 +333,25 @@ def role_priorities(roleset: RoleSet, tasks: Sequence[Sequence[Step]], task_defs
     for role in roleset.roles:
         p = roleset.priority(role.name, entry_task)
         extra = []
-        for i, (task, tdef) in enumerate(zip(tasks, task_defs, strict=True)):
+        for i, (task, tdef) in enumerate(zip(tasks, task_defs[:n], strict=True)):
             vetoed = p < 0 or any(roleset.priority(role.name, s.skill.entry_points[0].task) < 0 for s in task)
             extra.append(Priority(tdef.name, -1.0 if vetoed else round((1.0 - i / n) * p, 9)))
+        for tdef in task_defs[n:]:  # the standby task: below every task
+            extra.append(Priority(tdef.name, -1.0 if p < 0 else round(p / (10 * n), 9)))
         kept = tuple(q for q in role.priorities if q.task not in {t.name for t in task_defs})
         roles.append(replace(role, priorities=kept + tuple(extra)))
     return replace(roleset, roles=tuple(roles))
 
 
 def create_tasks(
-    name: str, plan_steps: Sequence[PlanStep], library: PlanLibrary, init: Iterable[Fact], robots: str | Sequence[str], roleset: RoleSet, entry_task: str
+    name: str,
+    plan_steps: Sequence[PlanStep],
+    library: PlanLibrary,
+    init: Iterable[Fact],
+    robots: str | Sequence[str],
+    roleset: RoleSet,
+    entry_task: str,
+    standby: str | None = None,
 ) -> CreatedTasks:
     """Turn a single-agent plan into tasks, a multi-agent plan and role-task priorities (the module docstring says how).
 
@@ -335,6 +364,7 @@ def create_tasks(
             plan, the team's members when the world was planned with all of them.
         roleset: the team's role set.
         entry_task: the task through which the team runs the planning problem.
+        standby: the planning problem's WaitPlan, run by the agents no task needs (none: they idle).
 
     Raises:
         PlannerError: the plan is empty or names unknown skills.
@@ -344,7 +374,7 @@ def create_tasks(
     team = _robots(robots)
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _parallelise(steps, init, team)
-    plan, task_defs = build_plan(name, tasks)
+    plan, task_defs = build_plan(name, tasks, standby=standby)
     return CreatedTasks(tuple(tuple(t) for t in tasks), plan, task_defs, role_priorities(roleset, tasks, task_defs, entry_task), tuple(allowed))
 
 

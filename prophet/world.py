@@ -44,12 +44,14 @@ class PlanningWorld:
         robots: the robots the plan may use, sorted.
         left_out: facts about robots outside the team that were left out (a
             block an opponent holds is missing from the world, say).
+        outside: the objects in those facts (the blocks opponents hold), sorted.
     """
 
     objects: tuple[tuple[str, str], ...]
     facts: tuple[Fact, ...]
     robots: tuple[str, ...] = ()
     left_out: int = 0
+    outside: tuple[str, ...] = ()
 
     def object_types(self) -> dict[str, str]:
         """Object name -> type."""
@@ -101,6 +103,7 @@ def read_world(
     members = tuple(sorted(set(team)))
     kept: set[Fact] = set()
     left_out = 0
+    outside: set[str] = set()
     for fact in source:
         name = str(fact[0])
         args = tuple(str(a) for a in fact[1:])
@@ -108,7 +111,9 @@ def read_world(
         if arity is None or len(args) != len(arity):
             continue
         if not offline and any(kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)):
-            left_out += len(args) > 1  # a relation of an outside robot with an object (not just its own state)
+            if len(args) > 1:  # a relation of an outside robot with an object (not just its own state)
+                left_out += 1
+                outside.update(arg for arg, kind in zip(args, arity, strict=True) if kind != robot_type)
             continue
         kept.add((name, args))
     types: dict[str, str] = dict(sorted(declared.items()))
@@ -125,7 +130,22 @@ def read_world(
         for arg, type_name in zip(args, predicates[name.lower()], strict=True):
             types.setdefault(arg, type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
-    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out)
+    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out, tuple(sorted(outside)))
+
+
+def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Literal, ...]:
+    """The goal literals that name none of the ``outside`` objects (those robots outside the team hold).
+
+    The team cannot plan for a block an opponent holds; it plans for the
+    rest of the goal meanwhile and replans once the block is free again.
+    """
+    held = set(outside)
+    return tuple(literal for literal in goal if not held.intersection(literal[1][1]))
+
+
+def goal_text(goal: Iterable[Literal]) -> str:
+    """Ground literals as a conjunction: ``on(a, b) and not clear(c)``."""
+    return " and ".join(("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name) for positive, (name, args) in goal)
 
 
 def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:

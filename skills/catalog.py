@@ -96,6 +96,7 @@ def _navigation(registry: SkillRegistry) -> None:
         "DriveToFreeSpace",
         _p("clearance", "float", "distance in metres to keep from obstacles, robots and work sites", default=1.0),
         _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
+        _p("keep_away", "float", "distance in metres to keep from every block or sample lying in the world (0: none)", default=0.0),
         doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
         capabilities=("base",),
         implementation="skills.navigation:DriveToFreeSpace",

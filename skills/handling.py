@@ -47,6 +47,8 @@ PUTDOWN_ROOM = 0.15
 STANDOFF_TRIES = 12
 #: Room kept around the robot at its stand-off point, metres.
 STANDOFF_MARGIN = 0.1
+#: Simulated seconds a skill waits for a free side of its work site before it fails (the team then replans).
+STANDOFF_WAIT = 30.0
 
 
 def _box(obj: Any) -> Any:
@@ -144,6 +146,7 @@ class ArmSkill(WorldSkill):
         self.step_index = 0
         self.job: Any = None
         self.settle_until = 0.0
+        self.blocked_since: float | None = None
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
 
     def update(self) -> Status:
@@ -174,7 +177,12 @@ class ArmSkill(WorldSkill):
                 return self._phase_plan()
             goal = self._standoff(site)
             if goal is None:
+                if self.blocked_since is None:
+                    self.blocked_since = self.now()
+                elif self.now() - self.blocked_since >= STANDOFF_WAIT:
+                    return self.fail(f"every side of the work site {_xy_text(site)} was taken by other robots for {STANDOFF_WAIT:g} s")
                 return self.running("waiting: every side of the work site is taken by other robots")
+            self.blocked_since = None
             self.mover = MoveToPosition(f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context)
             self.mover.setup(context=self.context)
         if self.mover.status != Status.SUCCESS:
@@ -304,9 +312,32 @@ class ArmSkill(WorldSkill):
             self.robot.stop()
 
 
+def _xy_text(xy: tuple[float, float]) -> str:
+    return f"({float(xy[0]):.2f}, {float(xy[1]):.2f})"
+
+
 def _mount_ahead(robot: Any) -> float:
+    """How far ahead of the base centre the arm is mounted (metres)."""
     offset = getattr(robot.arm, "mount_offset", (0.0, 0.0, 0.0))
     return float(offset[0])
+
+
+def putdown_spots(world: Any, robot: Any) -> list[tuple[float, float]]:
+    """The spots at the arm's reach where ``robot`` could put a block down, straight ahead first, then turned.
+
+    Only spots with :data:`PUTDOWN_ROOM` free of objects and other robots are listed.
+    """
+    from worldsim.queries import blocker
+
+    x, y, yaw = robot.pose
+    ahead = REACH + _mount_ahead(robot)
+    spots = []
+    for turn in PUTDOWN_TURNS:
+        spot = (x + ahead * math.cos(yaw + turn), y + ahead * math.sin(yaw + turn))
+        hit = blocker(world, spot[0], spot[1], PUTDOWN_ROOM)
+        if hit is None or hit == f"robot '{robot.name}'":
+            spots.append(spot)
+    return spots
 
 
 def _near(obj: Any, xy: tuple[float, float], radius: float = 1.2) -> bool:
@@ -400,22 +431,13 @@ class Putdown(ArmSkill):
         return self._spot
 
     def _free_spot(self) -> tuple[float, float]:
-        from worldsim.queries import blocker
-
+        tried = getattr(self, "_tried", [])
+        for spot in putdown_spots(self.world, self.robot):
+            if not any(distance(spot, old) < PUTDOWN_ROOM for old in tried):
+                return spot
         x, y, yaw = self.robot.pose
         ahead = REACH + _mount_ahead(self.robot)
-        tried = getattr(self, "_tried", [])
-        first = None
-        for k in range(len(PUTDOWN_TURNS)):
-            angle = yaw + PUTDOWN_TURNS[k]
-            spot = (x + ahead * math.cos(angle), y + ahead * math.sin(angle))
-            first = first or spot
-            if any(distance(spot, old) < PUTDOWN_ROOM for old in tried):
-                continue
-            hit = blocker(self.world, spot[0], spot[1], PUTDOWN_ROOM)
-            if hit is None or hit == f"robot '{self.robot.name}'":
-                return spot
-        return first  # type: ignore[return-value]
+        return x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)  # nothing free: straight ahead (the placement check fails)
 
     def _retry(self, reason: str) -> Status:
         """Try another spot on the next attempt (when no target was given)."""

@@ -225,7 +225,12 @@ class MoveToPosition(WorldSkill):
 
 
 class DriveToFreeSpace(MoveToPosition):
-    """Drive to the nearest place with ``clearance`` metres of free space within ``max_distance``."""
+    """Drive to the nearest place with ``clearance`` metres of free space within ``max_distance``.
+
+    With ``keep_away`` > 0 the place is also at least that far (centre to
+    centre) from every movable object lying in the world (blocks, samples):
+    a robot waiting there does not crowd the stacks others work on.
+    """
 
     def initialise(self) -> None:
         """Find the free place, then drive there like MoveToPosition."""
@@ -233,13 +238,20 @@ class DriveToFreeSpace(MoveToPosition):
 
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
+        away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
         grid = planning_grid(self.world)
         others = [(r.pose[0], r.pose[1], r.spec.radius) for r in self.world.robots.values() if r is not self.robot]
-        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=others)
+        sites = [(*obj.position()[:2], away) for obj in self._lying_objects()] if away > 0 else []
+        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=others, keep_away=sites)
         self.spot = spot
         self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
         self.params.setdefault("tolerance", 0.2)
         super().initialise()
+
+    def _lying_objects(self) -> list[Any]:
+        """The blocks and samples no robot holds."""
+        held = {id(r.arm.held) for r in self.world.robots.values() if getattr(r, "arm", None) is not None and r.arm.held is not None}
+        return [obj for _, obj in sorted(self.world.objects.items()) if obj.kind in ("block", "sample") and id(obj) not in held]
 
     def update(self) -> Status:
         """Fail when there is no free place, else drive there."""

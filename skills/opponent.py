@@ -234,9 +234,10 @@ class RandomBlockSkill(WorldSkill):
         self.inner = prepared.get(action) or self._build(action)
         self.action_started = self.now()
 
-    def _build(self, action: BlockAction) -> Any:
+    def _build(self, action: BlockAction, **extra: object) -> Any:
         context = _silent_context(self.context)
-        inner = _skill_class(action.skill)(f"{self.name}/{action.label}", _catalog_params(action.skill, action.params()), context)
+        params = _catalog_params(action.skill, {**action.params(), **extra})
+        inner = _skill_class(action.skill)(f"{self.name}/{action.label}", params, context)
         inner.setup(context=context)
         return inner
 
@@ -267,10 +268,12 @@ class RandomBlockSkill(WorldSkill):
 
     def _blocked(self, action: BlockAction, facts: Facts) -> bool:
         """Whether another robot stands within the blocking radius of what ``action`` touches."""
-        others = [(r.pose[0], r.pose[1]) for r in self.world.robots.values() if r is not self.robot]
-        if not others:
-            return False
-        return any(math.hypot(x - ox, y - oy) < self.radius for x, y in self._touched(action, facts) for ox, oy in others)
+        return any(self._crowded(xy) for xy in self._touched(action, facts))
+
+    def _crowded(self, xy: tuple[float, float]) -> bool:
+        """Whether another robot's centre is within the blocking radius of ``xy``."""
+        x, y = xy
+        return any(math.hypot(x - r.pose[0], y - r.pose[1]) < self.radius for r in self.world.robots.values() if r is not self.robot)
 
     def _touched(self, action: BlockAction, facts: Facts) -> Iterable[tuple[float, float]]:
         """Where ``action`` works: the blocks of the stack it takes from or puts on, or the put-down spot."""
@@ -280,11 +283,23 @@ class RandomBlockSkill(WorldSkill):
         return [self._xy(b) for b in sorted(stack_of(block, facts))]
 
     def _putdown_spot(self, action: BlockAction) -> tuple[float, float]:
-        """Where Putdown would put the block; the inner skill is built now and kept, so the spot checked is the spot used."""
-        inner = self._prepared.get(action) or self._build(action)
-        self._prepared[action] = inner
+        """Where Putdown will put the block; the inner skill is built now and kept, so the spot checked is the spot used."""
+        inner = self._prepared.get(action)
+        if inner is None:
+            spot = self._free_spot()
+            inner = self._build(action, **({"target": list(spot)} if spot is not None else {}))
+            self._prepared[action] = inner
         spot = inner.site()
         return float(spot[0]), float(spot[1])
+
+    def _free_spot(self) -> tuple[float, float] | None:
+        """The first spot Putdown could use (:func:`skills.handling.putdown_spots`) that no other robot blocks.
+
+        ``None`` when there is none: Putdown then picks its own spot (and the action is blocked there).
+        """
+        from skills.handling import putdown_spots
+
+        return next((spot for spot in putdown_spots(self.world, self.robot) if not self._crowded(spot)), None)
 
     def _xy(self, block: str) -> tuple[float, float]:
         position = self.world.objects[block].position()

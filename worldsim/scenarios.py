@@ -77,7 +77,7 @@ def blocksworld(
     if opponents:
         half_x = max(half_x, abs(_opponent_x(opponents - 1, row)) + OPPONENT_ROOM)  # the outermost opponent
     half_y = ROBOT_STANDOFF + 1.5 + (OPPONENT_EXTRA_Y if opponents else 0.0)
-    world = World(seed, gui=gui, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y))
+    world = World(seed, gui=gui, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y), rest_when_still=True)
     for i, stack in enumerate(stacks):
         x = -0.5 * row + i * STACK_SPACING
         for level, name in enumerate(stack):

@@ -37,6 +37,12 @@ __all__ = ["Obstacle2D", "World", "WorldError", "WorldObject"]
 
 logger = logging.getLogger(__name__)
 
+#: Physics steps every free object must be still before a world with ``rest_when_still`` skips pybullet's step.
+SETTLE_STEPS = 120
+#: Speed (m/s) and spin (rad/s) below which a free object counts as still.
+STILL_SPEED = 1e-3
+STILL_SPIN = 1e-2
+
 
 class World:
     """A pybullet world with kinematic robots, objects, sensors' ground truth and faults.
@@ -50,6 +56,12 @@ class World:
         ground: add a flat ground plane named ``"ground"``.
         solver_iterations: pybullet's constraint solver iterations (its default when omitted).
         quiet: hide pybullet's C-level prints while connecting and loading models.
+        rest_when_still: skip pybullet's step while nothing can move a body: no arm follows a
+            path, nothing was added, removed, grasped or released, and every free object has
+            been still for :data:`SETTLE_STEPS` steps. Robots, arms and the clock go on as usual;
+            resting bodies stay where they are (as pybullet's own sleeping would keep them), and
+            the run stays deterministic. Off by default: code that pushes bodies through
+            :attr:`client` directly needs every step.
 
     Raises:
         WorldError: a non-positive time step or empty bounds.
@@ -66,6 +78,7 @@ class World:
         ground: bool = True,
         solver_iterations: int | None = None,
         quiet: bool = True,
+        rest_when_still: bool = False,
     ) -> None:
         if not (time_step > 0.0 and math.isfinite(time_step)) or time_step > 0.1:
             raise WorldError(f"time_step must be in (0, 0.1] seconds, got {time_step}; 1/240 is pybullet's default")
@@ -87,6 +100,10 @@ class World:
         self._version = 0
         self._steps = 0
         self._pending = 0.0
+        self.rest_when_still = bool(rest_when_still)
+        self._still = 0
+        self._seen_version = -1
+        self.physics_steps = 0
         self._states: dict[int, dict[str, Any]] = {}
         self._closed = False
         self._client = self._connect(gui)
@@ -171,8 +188,11 @@ class World:
         arms = [r.arm for r in robots if r.arm is not None]
         step_simulation = self._step_simulation
         t = self.clock.now()
+        rest = self.rest_when_still
         for _ in range(n):
-            step_simulation()
+            if not rest or self._physics_needed(arms):
+                step_simulation()
+                self.physics_steps += 1
             t += dt
             for robot in robots:
                 robot._advance(dt)
@@ -182,6 +202,27 @@ class World:
         if n:
             self.clock.advance(n * dt)
         return n
+
+    def _physics_needed(self, arms: list[Any]) -> bool:
+        """Whether the next physics step can change anything (see ``rest_when_still``)."""
+        if self._version != self._seen_version or any(arm._path is not None for arm in arms):
+            self._seen_version = self._version
+            self._still = 0
+            return True
+        if self._still >= SETTLE_STEPS:
+            return False
+        self._still = 0 if self._anything_moving() else self._still + 1
+        return True
+
+    def _anything_moving(self) -> bool:
+        held = self._held_bodies()
+        velocity = self._client.getBaseVelocity
+        for obj in self.objects.values():
+            if obj.mass > 0.0 and obj.body_id not in held:
+                (vx, vy, vz), (wx, wy, wz) = velocity(obj.body_id)
+                if vx * vx + vy * vy + vz * vz > STILL_SPEED**2 or wx * wx + wy * wy + wz * wz > STILL_SPIN**2:
+                    return True
+        return False
 
     # ------------------------------------------------------------- building
     def add_robot(self, kind: str | RobotSpec, name: str, pose: Sequence[float] = (0.0, 0.0, 0.0)) -> Robot:

@@ -275,6 +275,7 @@ def escape_goal(
     *,
     unknown_is_free: bool = False,
     other_robots: Iterable[Sequence[float]] = (),
+    keep_away: Iterable[Sequence[float]] = (),
 ) -> tuple[float, float] | None:
     """The nearest cell centre with ``clearance`` to every obstacle, for "drive into free space".
 
@@ -289,6 +290,8 @@ def escape_goal(
         max_distance: Search radius, metres.
         unknown_is_free: Count unknown cells as free.
         other_robots: Robots ``(x, y, radius)`` to keep ``clearance`` from as well.
+        keep_away: Points ``(x, y, distance)`` the cell centre must be at least ``distance`` from
+            (work sites such as stacks of blocks, which a waiting robot must not crowd).
 
     Returns:
         ``(x, y)`` or None when no such cell exists.
@@ -319,6 +322,8 @@ def escape_goal(
     dist = np.hypot(xs[None, :] - px, ys[:, None] - py)
     for rx, ry, rr in check_robots(other_robots):
         free &= np.hypot(xs[None, :] - rx, ys[:, None] - ry) >= clearance + rr
+    for kx, ky, kd in check_robots(keep_away):
+        free &= np.hypot(xs[None, :] - kx, ys[:, None] - ky) >= kd
     free &= dist <= max_distance
     cand_j, cand_i = np.nonzero(free)
     if cand_i.size == 0:

@@ -56,6 +56,25 @@ def test_wait_plan_while_planning_then_the_team_switches_to_the_first_plan():
     assert events(rec, "replan") == []
 
 
+def test_agents_no_task_needs_stand_by_in_the_wait_plan():
+    # the Sussman anomaly makes three tasks: two of five robots have none and keep out of the way
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2", "r3", "r4", "r5"], skills)
+    sim.tick()
+    run_until(sim, lambda: all((child_plan(sim, a) or "").startswith("StackBlocks_g1v") for a in sim.engines))
+    allocation = next(e for e in events(rec, "allocation", agent="r1") if e["plan"].startswith("StackBlocks_g1v"))
+    standing_by = sorted(a for a, entry in allocation["entries"].items() if entry == "Standby")
+    working = sorted(a for a, entry in allocation["entries"].items() if entry not in ("Standby", None))
+    assert len(standing_by) == 2 and len(working) == 3
+    # they run the WaitPlan inside the generated plan's Standby state
+    waiting = {e["agent"] for e in events(rec, "allocation", plan="DriveToFreePosition") if e["key"].endswith("/Standby/DriveToFreePosition")}
+    assert waiting == set(standing_by)
+    summary = sim.run(until_done=True, max_time=60)
+    assert summary["success"] and goal_holds(sim, "r1")
+    manipulators = {agent for agent, skill, _ in skills.runs if skill in ("Pickup", "Unstack", "Stack", "Putdown")}
+    assert manipulators == set(working)
+
+
 def test_one_robot_runs_every_task_in_turn():
     skills = BlockSkills()
     sim, _ = blocks_team(["r1"], skills)
@@ -263,14 +282,31 @@ def test_a_robot_holding_a_block_at_a_replan_is_part_of_the_new_plan():
     assert replanned and replanned[0]["steps"] < 6
 
 
-def test_a_block_held_by_a_robot_outside_the_team_makes_the_leader_wait_not_fail():
+def test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_waits():
     skills = BlockSkills()
     sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
     sim.set_facts([(True, "holding", ("o1", "b"))])  # an opponent holds b: it is missing from the team's world
-    sim.run(ticks=20)
-    assert events(rec, "planner", what="waiting")
-    assert events(rec, "problem", phase="failed") == [] and child_plan(sim, "r1") == "DriveToFreePosition"
+    sim.run(ticks=60)
+    # the leader plans for the part of the goal without b (c on the table), then waits for b
+    started = events(rec, "planner", what="started")[0]
+    assert started["goal"] == "ontable(c)" and started["outside"] == ["b"]
+    assert sim.engines["r1"].world_model.holds("ontable", "c")
+    assert any("robots outside the team hold b" in e["reason"] for e in events(rec, "planner", what="waiting"))
+    assert events(rec, "problem", phase="failed") == []
     sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])  # it puts b down
     summary = sim.run(until_done=True, max_time=90)
     assert summary["success"] and goal_holds(sim, "r1")
     assert events(rec, "planner", what="started", reason="the world changed while planning was blocked")
+
+
+def test_a_partial_plan_is_replaced_when_the_held_block_is_free_again():
+    # b is free before the team finished the rest of the goal: the leader replans for the whole goal
+    skills = BlockSkills(ticks=8)
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
+    sim.set_facts([(True, "holding", ("o1", "b"))])
+    run_until(sim, lambda: events(rec, "problem", agent="r2", phase="plan"))
+    sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["success"] and goal_holds(sim, "r1")
+    replans = events(rec, "replan")
+    assert replans and "held outside the team changed (now: none)" in replans[0]["reason"]

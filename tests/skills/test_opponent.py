@@ -116,7 +116,14 @@ def test_putdown_and_stack_targets_are_checked_too():
         world.robots["r1"].set_pose(-1.4, 0.6, 0.0)  # near the spot straight ahead of o1 where Putdown would go
         skill = RandomBlockSkill("opponent", {}, _context(world, "o1"))
         skill.setup()
-        assert [x.label for x in skill.free_actions()] == ["Stack(b, c)"]
+        # the opponent turns to another spot, out of r1's way
+        assert [x.label for x in skill.free_actions()] == ["Putdown(b)", "Stack(b, c)"]
+        spot = skill._putdown_spot(BlockAction("Putdown", "b"))
+        assert math.hypot(spot[0] + 1.4, spot[1] - 0.6) >= 1.0
+        # with r1 blocking every spot within reach, Putdown is left alone too
+        skill = RandomBlockSkill("opponent", {"blocking_radius": 3.0}, _context(world, "o1"))
+        skill.setup()
+        assert skill.free_actions() == []
 
 
 def _context(world, agent, seed=0):

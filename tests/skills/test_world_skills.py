@@ -160,3 +160,21 @@ def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run):
     assert dropped, "the rock was never dropped"
     assert run.ok, (run.reason, run.trace[-5:])
     assert any("replanning" in str(t["feedback"]) for t in run.trace)
+
+
+def test_drive_to_free_space_keeps_away_from_the_blocks(blocks_world, skill_run):
+    # r1 waits right next to the stacks; with keep_away it drives to a place at least that far from every block
+    blocks_world.robots["r1"].set_pose(0.0, -0.7, math.pi / 2)
+    blocks = [o.position()[:2] for o in blocks_world.objects.values() if o.kind == "block"]
+
+    def nearest_block():
+        x, y, _ = blocks_world.robots["r1"].pose
+        return min(math.hypot(x - bx, y - by) for bx, by in blocks)
+
+    assert nearest_block() < 1.0
+    plain = skill_run("DriveToFreeSpace", blocks_world, "r1", {"clearance": 0.4, "max_distance": 5.0})
+    assert plain.ok and nearest_block() < 1.0  # enough room from obstacles already: it stays in the way
+    run = skill_run("DriveToFreeSpace", blocks_world, "r1", {"clearance": 0.4, "max_distance": 5.0, "keep_away": 1.15})
+    assert run.ok, run.reason
+    assert nearest_block() >= 1.15 - 0.2  # the skill's goal tolerance
+    assert not blocks_world.robots["r1"].bumped
