@@ -22,6 +22,15 @@ def test_two_agents_reach_a_four_block_goal():
     assert result.messages > 0 and result.sim_time_s < 300
 
 
+def test_with_an_opponent_the_goal_is_still_reached_after_replanning():
+    replans = []
+    result = run_demo(DemoConfig(agents=2, opponents=1, blocks=4, seed=2, time_limit=300), observers=[lambda e: e["event"] == "replan" and replans.append(e)])
+    assert result.success, result.as_json()
+    assert result.replans >= 1 and len(replans) == result.replans
+    # the opponent acted in the world: it is not part of the team's summary
+    assert set(result.tasks) == {"r1", "r2"}
+
+
 def test_a_robot_crash_in_the_middle_the_team_still_reaches_the_goal():
     crashed = []
 
