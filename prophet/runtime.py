@@ -21,6 +21,13 @@ runs the planner as an anytime search, a budget per tick
 * every UpdateTime a better plan, while the world is still the one it planned from;
 * ``failed`` (AlternativePlan) or ``done`` (the goal holds already).
 
+While robots outside the team hold objects of the goal (an opponent holds a
+block), the leader plans for the rest of the goal (:func:`prophet.world.reachable_goal`),
+and the execution check leaves out the goal literals on objects held
+outside. A plan for part of the goal runs to its end; then the leader plans
+for what is left, or, with nothing left to plan for, the team waits in the
+WaitPlan until the world changes.
+
 Every UpdateTime it repeats its latest share (for agents that come late) and,
 while the team executes, checks that what is left of the plan still reaches
 the goal from the current world (:func:`prophet.world.remaining_fits`); twice
@@ -571,14 +578,16 @@ class ProblemRuntime:
         world_model = self.engine.world_model
         facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
         goal = goal_literals(self.problem)
-        reason = remaining_fits(created.tasks, progress, facts, share.world, share.goal or goal) or _stalled(progress)
-        if reason is None and share.goal:
-            world = self._read_world(self.problem)
-            if reachable_goal(goal, world.outside) != share.goal:
-                reason = f"the goal's objects held outside the team changed (now: {', '.join(world.outside) or 'none'})"
-            elif all(p.done for p in progress):
+        world = self._read_world(self.problem)
+        reachable = reachable_goal(goal, world.outside)
+        # what the plan was made for, less what robots outside the team hold now (they may put it back)
+        target = tuple(literal for literal in share.goal or goal if literal in reachable)
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target) or _stalled(progress)
+        if reason is None and all(p.done for p in progress):
+            if reachable != goal and holds(reachable, set(world.facts)):
                 self._wait_outside(now, world, self._next_generation())  # the rest of the goal is reached
                 return
+            reason = "the plan is done, but the goal does not hold: the part that robots outside the team held can be planned now"
         if reason is None:
             self.invalid_once = False
         elif not self.invalid_once:

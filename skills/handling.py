@@ -49,6 +49,8 @@ STANDOFF_TRIES = 12
 STANDOFF_MARGIN = 0.1
 #: Simulated seconds a skill waits for a free side of its work site before it fails (the team then replans).
 STANDOFF_WAIT = 30.0
+#: A stand-off point this close (m) to one from which the arm found no plan counts as tried.
+SIDE_TRIED = 0.2
 
 
 def _box(obj: Any) -> Any:
@@ -147,6 +149,7 @@ class ArmSkill(WorldSkill):
         self.job: Any = None
         self.settle_until = 0.0
         self.blocked_since: float | None = None
+        self.tried_sides: list[tuple[float, float]] = []
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
 
     def update(self) -> Status:
@@ -172,7 +175,7 @@ class ArmSkill(WorldSkill):
         if self.mover is None:
             gap = distance(self._arm_xy(), site)
             facing = abs(wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw))
-            if abs(gap - REACH) <= 0.12 and facing < 0.15:
+            if abs(gap - REACH) <= 0.12 and facing < 0.15 and not self._side_tried((x, y)):
                 self.phase = "plan"
                 return self._phase_plan()
             goal = self._standoff(site)
@@ -218,9 +221,15 @@ class ArmSkill(WorldSkill):
             turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
             angle = heading + turn
             goal = (site[0] - standoff * math.cos(angle), site[1] - standoff * math.sin(angle))
+            if self._side_tried(goal):
+                continue
             if distance(goal, (x, y)) < 0.05 or checker.valid_xy(goal[0], goal[1]):
                 return goal
         return None
+
+    def _side_tried(self, xy: tuple[float, float]) -> bool:
+        """Whether the arm found no plan from a stand-off point this close to ``xy`` already."""
+        return any(distance(xy, side) < SIDE_TRIED for side in self.tried_sides)
 
     def _scene(self) -> Any:
         from skills.manipulation import ArmScene
@@ -234,7 +243,29 @@ class ArmSkill(WorldSkill):
         target = self.target_object()
         boxes = [_box(o) for name, o in sorted(self.world.objects.items()) if name != target.name and _near(o, self._arm_xy()) and getattr(o, "kind", "") not in ("terrain", "collection_point")]
         scene.set_obstacles(boxes)
+        q = np.asarray(self.robot.arm.q(), dtype=float)
+        held = self._held_box(scene, q)
+        if boxes and scene.collides(q, held):
+            # the arm, or what it holds, touches an object already (pushed against it): no plan could
+            # leave a start in collision, so the objects it touches are left out of the scene
+            touching = []
+            for box in boxes:
+                scene.set_obstacles([box])
+                if scene.collides(q, held):
+                    touching.append(box)
+            scene.set_obstacles([b for b in boxes if b not in touching])
         return scene
+
+    def _held_box(self, scene: Any, q: np.ndarray) -> Any:
+        """What the arm holds, as a box in the tool's frame (None when grasping)."""
+        if self.grasps:
+            return None
+        from skills.manipulation import held_box
+
+        try:
+            return held_box(_box(self.target_object()), scene.fk(q))
+        except ValueError:
+            return None  # tilted in the hand: the planner says so itself
 
     def _phase_plan(self) -> Status:
         if self.job is None:
@@ -302,6 +333,11 @@ class ArmSkill(WorldSkill):
             arm.open()
         self.phase = "plan"
         self.job = None
+        if reason.startswith("no arm plan"):
+            # the arm found no way from here: the next attempt comes from another side of the work site
+            self.tried_sides.append((float(self.robot.pose[0]), float(self.robot.pose[1])))
+            self.phase = "approach"
+            self.mover = None
         return self.running(f"retrying ({reason})")
 
     def terminate(self, new_status: Status) -> None:

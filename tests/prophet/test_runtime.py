@@ -299,8 +299,8 @@ def test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_wa
     assert events(rec, "planner", what="started", reason="the world changed while planning was blocked")
 
 
-def test_a_partial_plan_is_replaced_when_the_held_block_is_free_again():
-    # b is free before the team finished the rest of the goal: the leader replans for the whole goal
+def test_a_plan_for_part_of_the_goal_runs_to_its_end_then_the_rest_is_planned():
+    # b is free before the team finished the rest of the goal: the plan goes on, then the leader plans for the whole goal
     skills = BlockSkills(ticks=8)
     sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
     sim.set_facts([(True, "holding", ("o1", "b"))])
@@ -309,4 +309,23 @@ def test_a_partial_plan_is_replaced_when_the_held_block_is_free_again():
     summary = sim.run(until_done=True, max_time=90)
     assert summary["success"] and goal_holds(sim, "r1")
     replans = events(rec, "replan")
-    assert replans and "held outside the team changed (now: none)" in replans[0]["reason"]
+    assert len(replans) == 1 and "the plan is done, but the goal does not hold" in replans[0]["reason"]
+    # the first plan (c onto the table) was not cut short
+    first = [(a, s, p["object"]) for a, s, p in skills.runs if s in ("Unstack", "Putdown")][:2]
+    assert [(s, o) for _, s, o in first] == [("Unstack", "c"), ("Putdown", "c")]
+
+
+def test_a_goal_block_taken_by_an_opponent_does_not_stop_the_rest_of_the_plan():
+    # the opponent picks up d, which only the goal names (on the table): the steps on a, b and c go on
+    skills = BlockSkills(ticks=8)
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[*SUSSMAN, ["d"]])
+    sim.engines["r1"].set_problem("StackBlocks", goal="on(a, b) and on(b, c) and ontable(c) and ontable(d)")
+    sim.engines["r2"].set_problem("StackBlocks", goal="on(a, b) and on(b, c) and ontable(c) and ontable(d)")
+    run_until(sim, lambda: events(rec, "problem", agent="r2", phase="plan"))
+    sim.set_facts([(False, "ontable", ("d",)), (False, "clear", ("d",)), (True, "holding", ("o1", "d"))])
+    sim.run(ticks=150)
+    assert goal_holds(sim, "r1")
+    assert events(rec, "replan") == []
+    sim.set_facts([(True, "ontable", ("d",)), (True, "clear", ("d",)), (False, "holding", ("o1", "d"))])
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["success"]
