@@ -10,7 +10,7 @@ against agents to ``build/bench/``.
 The paper's trends are the bar. Without opponents the time falls as agents
 are added. With opponents it is higher, because the team has to replan.
 
-Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 6] [--seeds 3] [--time-limit 900]``
+Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 6] [--seeds 3] [--time-limit 900] [--jobs 2]``
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import statistics
 import subprocess
 import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -54,26 +55,30 @@ def main() -> int:
     parser.add_argument("--blocks", type=int, default=6, help="blocks (default 6)")
     parser.add_argument("--seeds", type=int, default=3, help="seeds per cell (default 3)")
     parser.add_argument("--time-limit", type=float, default=900.0, help="simulated seconds per run (default 900)")
+    parser.add_argument("--jobs", type=int, default=1, help="runs at once, each in its own process (default 1; wall times are then shared-machine figures)")
     args = parser.parse_args()
+    cells = [(opponents, agents) for opponents in (0, args.opponents) for agents in _range(args.agents)]
+    with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
+        futures = {(o, a, seed): pool.submit(run_one, a, o, args.blocks, seed, args.time_limit) for o, a in cells for seed in range(args.seeds)}
+        results = {key: future.result() for key, future in futures.items()}
     rows = []
-    for opponents in (0, args.opponents):
-        for agents in _range(args.agents):
-            runs = [run_one(agents, opponents, args.blocks, seed, args.time_limit) for seed in range(args.seeds)]
-            ok = [r for r in runs if r.get("success")]
-            times = [float(r["sim_time_s"]) for r in ok]  # type: ignore[arg-type]
-            rows.append({
-                "agents": agents,
-                "opponents": opponents,
-                "success": f"{len(ok)}/{len(runs)}",
-                "sim_mean": statistics.mean(times) if times else float("nan"),
-                "sim_min": min(times) if times else float("nan"),
-                "sim_max": max(times) if times else float("nan"),
-                "replans": statistics.mean(float(r.get("replans", 0)) for r in runs if "error" not in r) if any("error" not in r for r in runs) else float("nan"),  # type: ignore[arg-type]
-                "wall_mean": statistics.mean(float(r["wall_time_s"]) for r in runs if "wall_time_s" in r) if any("wall_time_s" in r for r in runs) else float("nan"),  # type: ignore[arg-type]
-                "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
-            })
-            last = rows[-1]
-            print(f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s", file=sys.stderr, flush=True)
+    for opponents, agents in cells:
+        runs = [results[(opponents, agents, seed)] for seed in range(args.seeds)]
+        ok = [r for r in runs if r.get("success")]
+        times = [float(r["sim_time_s"]) for r in ok]  # type: ignore[arg-type]
+        rows.append({
+            "agents": agents,
+            "opponents": opponents,
+            "success": f"{len(ok)}/{len(runs)}",
+            "sim_mean": statistics.mean(times) if times else float("nan"),
+            "sim_min": min(times) if times else float("nan"),
+            "sim_max": max(times) if times else float("nan"),
+            "replans": statistics.mean(float(r.get("replans", 0)) for r in runs if "error" not in r) if any("error" not in r for r in runs) else float("nan"),  # type: ignore[arg-type]
+            "wall_mean": statistics.mean(float(r["wall_time_s"]) for r in runs if "wall_time_s" in r) if any("wall_time_s" in r for r in runs) else float("nan"),  # type: ignore[arg-type]
+            "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
+        })
+        last = rows[-1]
+        print(f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s", file=sys.stderr, flush=True)
     header = ["agents", "opponents", "success", "sim time mean s", "min", "max", "replans mean", "wall mean s"]
     print(f"Blocks world, {args.blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n")
     print("| " + " | ".join(header) + " |")
