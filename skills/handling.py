@@ -331,6 +331,10 @@ class ArmSkill(WorldSkill):
             arm.detach()
         if self.grasps:
             arm.open()
+        elif arm.held is not self.target_object():
+            # released, but it does not rest where it should: there is nothing left to place
+            x, y, z = (float(v) for v in self.target_object().position())
+            return self.fail(f"{reason}; {self.target_object().name} is no longer in the hand (it lies at ({x:.2f}, {y:.2f}, {z:.2f}))")
         self.phase = "plan"
         self.job = None
         if reason.startswith("no arm plan"):

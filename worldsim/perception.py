@@ -3,8 +3,12 @@
 The robots of a simulated team see the world through a reader such as
 :func:`worldsim.scenarios.blocks_facts` (an overhead camera, in effect). Every
 ``every`` simulated seconds :class:`FactPerception` reads the facts once and
-writes to each running agent's world model only what changed since it last
-wrote there, so the replicas send small deltas.
+brings each running agent's world model in line with the reading: for the
+predicates it senses, it asserts what is missing and retracts what is no
+longer seen. Only differences are written, so the replicas send small
+deltas; and a fact that a skill or a late message wrote wrongly (a robot
+said to hold nothing while it holds a block) is put right at the next
+reading, not only when the world changes again.
 """
 
 from __future__ import annotations
@@ -21,15 +25,17 @@ class FactPerception:
     Args:
         read: the facts of a world, as ``(predicate, *args)`` tuples.
         every: seconds of simulated time between two readings.
+        predicates: the predicates ``read`` senses (facts of other predicates are
+            never touched); by default every predicate it has returned so far.
     """
 
-    def __init__(self, read: Callable[[Any], Iterable[Fact]], every: float = 0.2) -> None:
+    def __init__(self, read: Callable[[Any], Iterable[Fact]], every: float = 0.2, predicates: Iterable[str] = ()) -> None:
         if every <= 0:
             raise ValueError(f"FactPerception: 'every' must be a positive number of seconds, got {every}")
         self.read = read
         self.every = every
         self.next_at = float("-inf")
-        self.seen: dict[str, set[Fact]] = {}
+        self.predicates: set[str] = set(predicates)
         self.facts: set[Fact] = set()
 
     def __call__(self, team: Any) -> None:
@@ -39,20 +45,19 @@ class FactPerception:
             return
         self.next_at = now + self.every
         self.facts = {tuple(f) for f in self.read(team.world)}
+        self.predicates.update(str(f[0]) for f in self.facts)
         for engine in team.running():
             self.write(engine.name, engine.world_model)
 
     def write(self, agent: str, world_model: Any) -> int:
-        """Bring ``world_model`` in line with the last reading; returns the number of writes."""
-        before = self.seen.get(agent, set())
+        """Bring ``world_model`` in line with the last reading (the sensed predicates only); returns the number of writes."""
+        sensed = self.predicates
+        believed = {tuple(f) for f in world_model.facts() if str(f[0]) in sensed}
         writes = 0
-        for fact in sorted(self.facts - before, key=repr):
-            if not world_model.holds(str(fact[0]), *fact[1:]):
-                world_model.assert_fact(str(fact[0]), *fact[1:])
-                writes += 1
-        for fact in sorted(before - self.facts, key=repr):
-            if world_model.holds(str(fact[0]), *fact[1:]):
-                world_model.retract_fact(str(fact[0]), *fact[1:])
-                writes += 1
-        self.seen[agent] = set(self.facts)
+        for fact in sorted(self.facts - believed, key=repr):
+            world_model.assert_fact(str(fact[0]), *fact[1:])
+            writes += 1
+        for fact in sorted(believed - self.facts, key=repr):
+            world_model.retract_fact(str(fact[0]), *fact[1:])
+            writes += 1
         return writes

@@ -228,7 +228,7 @@ def run_demo(
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
     watchers = [counter, *observers, *([trace] if trace is not None else [])]
     settings = EngineConfig(frequency=config.frequency)
-    perception = FactPerception(blocks_facts, every=0.2)
+    perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
     registry = default_registry()
     team = SimulatedTeam(library, "BlocksWorldMission", {f"r{i + 1}": "Manipulator" for i in range(config.agents)}, seed=config.seed,
                          config=settings, skill_registry=registry, observers=watchers, world=world, perception=perception, step_world=False)
