@@ -150,6 +150,7 @@ class ArmSkill(WorldSkill):
         self.settle_until = 0.0
         self.blocked_since: float | None = None
         self.tried_sides: list[tuple[float, float]] = []
+        self.followed: list[np.ndarray] = []
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
 
     def update(self) -> Status:
@@ -268,6 +269,8 @@ class ArmSkill(WorldSkill):
             return None  # tilted in the hand: the planner says so itself
 
     def _phase_plan(self) -> Status:
+        if self.job is None and self.robot.arm.busy:
+            return self.running("waiting for the arm to come back")
         if self.job is None:
             self.job = self.jobs.submit(self.plan, self._scene(), np.asarray(self.robot.arm.q(), dtype=float), self.np_rng)
             return self.running("planning the arm motion")
@@ -298,6 +301,7 @@ class ArmSkill(WorldSkill):
                 self._grip_or_release()
                 continue
             arm.follow(step, _duration(step))
+            self.followed.append(np.asarray(step, dtype=float))
             return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
         self.phase = "verify"
         self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
@@ -345,11 +349,32 @@ class ArmSkill(WorldSkill):
         return self.running(f"retrying ({reason})")
 
     def terminate(self, new_status: Status) -> None:
-        """Stop the base (and the inner approach) when the skill ends or is stopped."""
+        """Stop the base (and the inner approach) when the skill ends or is stopped.
+
+        A skill that fails or is stopped with the arm out backs the arm out the
+        way it came (:meth:`_back_out`): a hand left at a stack would push the
+        blocks others put there.
+        """
         if self.mover is not None and self.mover.status == Status.RUNNING:
             self.mover.stop(Status.INVALID)
         if self.robot is not None:
             self.robot.stop()
+            if new_status != Status.SUCCESS:
+                self._back_out()
+
+    def _back_out(self) -> None:
+        """Follow the arm paths of this skill backwards, from where the arm is now to where it started."""
+        followed = getattr(self, "followed", [])
+        arm = self.robot.arm
+        if not followed or arm is None or self.robot.crashed:
+            return
+        q = np.asarray(arm.q(), dtype=float)
+        last = followed[-1]
+        k = int(np.argmin(np.abs(last - q).max(axis=1)))  # how far along its last path the arm got
+        back = [last[: k + 1][::-1], *(path[::-1] for path in reversed(followed[:-1]))]
+        arm.stop()
+        arm.follow(np.vstack(back))
+        self.followed = []
 
 
 def _xy_text(xy: tuple[float, float]) -> str:

@@ -195,9 +195,11 @@ class World:
                 self.physics_steps += 1
             t += dt
             for robot in robots:
-                robot._advance(dt)
+                if robot._v != 0.0 or robot._w != 0.0:  # a robot without a command does not move
+                    robot._advance(dt)
             for arm in arms:
-                arm._update(dt, t)
+                if arm._path is not None or arm._moved or arm._base_dirty or arm._slip_at is not None:  # else nothing to do
+                    arm._update(dt, t)
         self._steps += n
         if n:
             self.clock.advance(n * dt)

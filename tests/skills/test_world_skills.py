@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 import pytest
 
 from alica.errors import SkillError
@@ -71,9 +73,15 @@ def test_pickup_fails_after_the_retry_budget(blocks_world, skill_run):
     from worldsim.faults import set_grasp_slip
 
     set_grasp_slip(blocks_world, 1.0)
+    arm = blocks_world.robots["r1"].arm
+    start = np.asarray(arm.q(), dtype=float)
     run = skill_run("Pickup", blocks_world, "r1", {"object": "c", "retries": 2})
     assert run.status == "failure"
     assert "gave up after 2 attempt(s)" in run.reason
+    # the arm does not stay at the block: it backs out the way it came
+    assert arm.busy
+    blocks_world.step(20.0)
+    assert not arm.busy and np.abs(np.asarray(arm.q()) - start).max() < 1e-6
 
 
 def test_putdown_on_the_ground_and_stack_on_a_block(blocks_world, skill_run):
