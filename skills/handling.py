@@ -151,6 +151,7 @@ class ArmSkill(WorldSkill):
         self.blocked_since: float | None = None
         self.tried_sides: list[tuple[float, float]] = []
         self.followed: list[np.ndarray] = []
+        self.released = False
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
 
     def update(self) -> Status:
@@ -315,6 +316,8 @@ class ArmSkill(WorldSkill):
         else:
             arm.detach()
             arm.open()
+            self.followed = []  # the way back would lead through what was just put down
+            self.released = True
 
     def _phase_verify(self) -> Status:
         if self.now() < self.settle_until:
@@ -351,9 +354,9 @@ class ArmSkill(WorldSkill):
     def terminate(self, new_status: Status) -> None:
         """Stop the base (and the inner approach) when the skill ends or is stopped.
 
-        A skill that fails or is stopped with the arm out backs the arm out the
-        way it came (:meth:`_back_out`): a hand left at a stack would push the
-        blocks others put there.
+        A skill that fails or is stopped with the arm out and an empty hand
+        gets its arm out of the way (:meth:`_back_out`): a hand left at a stack
+        would push the blocks others put there.
         """
         if self.mover is not None and self.mover.status == Status.RUNNING:
             self.mover.stop(Status.INVALID)
@@ -363,18 +366,37 @@ class ArmSkill(WorldSkill):
                 self._back_out()
 
     def _back_out(self) -> None:
-        """Follow the arm paths of this skill backwards, from where the arm is now to where it started."""
-        followed = getattr(self, "followed", [])
+        """Get an empty hand away from the work site.
+
+        Before anything was put down, the arm follows this skill's paths
+        backwards to where it started (nothing it passed has moved: a failed
+        grip lets go where it gripped). After a release it goes on with the
+        rest of the plan instead (the retreat and the way back to the
+        transport pose), since the way back leads through the object it put
+        down. An arm that holds something stays as it is.
+        """
         arm = self.robot.arm
-        if not followed or arm is None or self.robot.crashed:
+        if arm is None or self.robot.crashed or arm.held is not None:
             return
         q = np.asarray(arm.q(), dtype=float)
-        last = followed[-1]
-        k = int(np.argmin(np.abs(last - q).max(axis=1)))  # how far along its last path the arm got
-        back = [last[: k + 1][::-1], *(path[::-1] for path in reversed(followed[:-1]))]
-        arm.stop()
-        arm.follow(np.vstack(back))
+        followed = getattr(self, "followed", [])
+        if followed:
+            last = followed[-1]
+            k = int(np.argmin(np.abs(last - q).max(axis=1)))  # how far along its last path the arm got
+            way = [last[: k + 1][::-1], *(path[::-1] for path in reversed(followed[:-1]))]
+        elif getattr(self, "released", False):
+            steps, index = self.steps, self.step_index
+            way = [np.asarray(step, dtype=float) for step in steps[index:] if not isinstance(step, str)]
+            current = steps[index - 1] if 0 < index <= len(steps) and not isinstance(steps[index - 1], str) else None
+            if current is not None and arm.busy:
+                k = int(np.argmin(np.abs(np.asarray(current) - q).max(axis=1)))  # the rest of the path it was on
+                way.insert(0, np.asarray(current, dtype=float)[k:])
+        else:
+            way = []
         self.followed = []
+        if way:
+            arm.stop()
+            arm.follow(np.vstack(way))
 
 
 def _xy_text(xy: tuple[float, float]) -> str:
