@@ -180,6 +180,7 @@ def _manipulation(registry: SkillRegistry) -> None:
            "(a robot working at a stack stands about 0.7 m from it)", default=1.0),
         _p("pause", "float", "simulated seconds to wait after each action, and between looks when nothing is applicable", default=2.0),
         _p("action_timeout", "float", "simulated seconds after which an action still running is stopped", default=120.0),
+        _p("step_aside", "float", "after each action, drive to a free place at least this many metres from every block (0: stay)", default=1.15),
         doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking, forever",
         capabilities=("base", "arm", "gripper"),
         implementation="skills.opponent:RandomBlockSkill",

@@ -299,7 +299,9 @@ class ArmSkill(WorldSkill):
             step = self.steps[self.step_index]
             self.step_index += 1
             if isinstance(step, str):
-                self._grip_or_release()
+                taken = self._grip_or_release()
+                if taken is not None:
+                    return self.fail(taken)
                 continue
             arm.follow(step, _duration(step))
             self.followed.append(np.asarray(step, dtype=float))
@@ -308,16 +310,22 @@ class ArmSkill(WorldSkill):
         self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
         return self.running("checking the result")
 
-    def _grip_or_release(self) -> None:
+    def _grip_or_release(self) -> str | None:
+        """Close on the object or let it go; why not, when another robot has taken the object meanwhile."""
         arm = self.robot.arm
         if self.grasps:
+            obj = self.target_object()
+            holder = next((r.name for r in self.world.robots.values() if r.arm is not None and r.arm.held is obj and r is not self.robot), None)
+            if holder is not None:
+                return f"{obj.name} was taken by robot '{holder}' before the grip"
             arm.close()
-            arm.attach(self.target_object())
+            arm.attach(obj)
         else:
             arm.detach()
             arm.open()
             self.followed = []  # the way back would lead through what was just put down
             self.released = True
+        return None
 
     def _phase_verify(self) -> Status:
         if self.now() < self.settle_until:

@@ -23,6 +23,7 @@ from py_trees.common import Status
 
 from alica.errors import SkillError
 from skills.world_skill import WorldSkill
+from worldsim.errors import WorldError
 
 __all__ = ["BlockAction", "RandomBlockSkill", "applicable_actions", "stack_of"]
 
@@ -36,6 +37,9 @@ BLOCKING_RADIUS = 1.0
 PAUSE = 2.0
 #: Default of ``action_timeout``: simulated seconds an inner skill may run.
 ACTION_TIMEOUT = 120.0
+#: Default of ``step_aside``: after each action the opponent drives to a free place at least this far
+#: (metres) from every block, like the team's WaitPlan, instead of standing at the stack it worked on.
+STEP_ASIDE = 1.15
 
 Facts = set[tuple[str, ...]]
 
@@ -138,7 +142,9 @@ class RandomBlockSkill(WorldSkill):
     Parameters (see :mod:`skills.catalog`): ``blocking_radius`` (default
     :data:`BLOCKING_RADIUS`, 1.0 m: a robot working at a stack stands about
     0.7 m from it, so the catalog's earlier 0.5 m never blocked anything),
-    ``pause`` (:data:`PAUSE`) and ``action_timeout`` (:data:`ACTION_TIMEOUT`).
+    ``pause`` (:data:`PAUSE`), ``action_timeout`` (:data:`ACTION_TIMEOUT`) and
+    ``step_aside`` (:data:`STEP_ASIDE`: after each action the opponent drives to
+    a free place that far from every block, then pauses; 0 keeps it where it is).
 
     An action touches the stack of its block (Pickup, Unstack), the stack it
     puts the block on (Stack) or the spot where Putdown would place it; it
@@ -174,11 +180,13 @@ class RandomBlockSkill(WorldSkill):
         self.radius = self._positive("blocking_radius", BLOCKING_RADIUS)
         self.pause = self._positive("pause", PAUSE)
         self.action_timeout = self._positive("action_timeout", ACTION_TIMEOUT)
+        self.step_aside = self._positive("step_aside", STEP_ASIDE)
 
     def initialise(self) -> None:
         """Start idle: look at the world on this first tick."""
         self.inner = None
         self.action = None
+        self.aside: Any = None
         self._prepared = {}
         self.next_look = self.now()
         self.idle_message = "looking for an action"
@@ -195,6 +203,13 @@ class RandomBlockSkill(WorldSkill):
         """Tick the running action, or pause, or choose the next one."""
         if self.inner is not None:
             return self._tick_inner()
+        if self.aside is not None:
+            self.aside.tick_once()
+            if self.aside.status == Status.RUNNING:
+                return self.running(f"stepping aside: {self.aside.feedback_message}")
+            self.aside = None
+            self.robot.stop()
+            self.next_look = self.now() + self.pause
         now = self.now()
         if now < self.next_look:
             return self.running(self.idle_message)
@@ -247,7 +262,11 @@ class RandomBlockSkill(WorldSkill):
         if self.now() - self.action_started > self.action_timeout:
             self.inner.stop(Status.INVALID)
             return self._finished(label, "timeout", f"still running after {self.action_timeout:.0f} s")
-        self.inner.tick_once()
+        try:
+            self.inner.tick_once()
+        except (SkillError, WorldError) as exc:  # the world changed under the action (a block taken, say)
+            self.inner.stop(Status.INVALID)
+            return self._finished(label, "failure", str(exc))
         status = self.inner.status
         if status == Status.RUNNING:
             return self.running(f"{label}: {self.inner.feedback_message}")
@@ -260,6 +279,12 @@ class RandomBlockSkill(WorldSkill):
         self.action = None
         self.robot.stop()
         self.next_look = self.now() + self.pause
+        if self.step_aside > 0:
+            from skills.navigation import DriveToFreeSpace
+
+            context = _silent_context(self.context)
+            self.aside = DriveToFreeSpace(f"{self.name}/step aside", {"clearance": 0.4, "max_distance": 3.0, "keep_away": self.step_aside}, context)
+            self.aside.setup(context=context)
         why = f" ({reason})" if reason and outcome != "success" else ""
         self.idle_message = f"pausing after {label}: {outcome}{why}; next look at t = {self.next_look:.1f} s"
         return self.running(self.idle_message)
@@ -311,7 +336,10 @@ class RandomBlockSkill(WorldSkill):
         """Stop the running action (the inner skill stops its base and approach) and the base."""
         if self.inner is not None and self.inner.status == Status.RUNNING:
             self.inner.stop(Status.INVALID)
+        if getattr(self, "aside", None) is not None and self.aside.status == Status.RUNNING:
+            self.aside.stop(Status.INVALID)
         self.inner = None
+        self.aside = None
         self.action = None
         if self.robot is not None:
             self.robot.stop()
