@@ -454,7 +454,7 @@ class ProblemRuntime:
 
     def _wait_outside(self, now: float, world: PlanningWorld, generation: int) -> None:
         """Robots outside the team hold what is left to do: the team waits in the WaitPlan until the world changes."""
-        reason = f"robots outside the team hold {', '.join(world.outside)}, and the rest of the goal holds"
+        reason = f"robots outside the team hold, or nobody sees, {', '.join(world.outside)}; the rest of the goal holds"
         self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
         self.blocked = set(world.facts)
         self.next_update = now + self.model.update_time

@@ -44,7 +44,8 @@ class PlanningWorld:
         robots: the robots the plan may use, sorted.
         left_out: facts about robots outside the team that were left out (a
             block an opponent holds is missing from the world, say).
-        outside: the objects in those facts (the blocks opponents hold), sorted.
+        outside: the objects in those facts (the blocks opponents hold), and the goal's
+            objects that no fact mentions (a block falling), sorted: the team does not plan for them.
     """
 
     objects: tuple[tuple[str, str], ...]
@@ -130,6 +131,10 @@ def read_world(
         for arg, type_name in zip(args, predicates[name.lower()], strict=True):
             types.setdefault(arg, type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
+    if not offline:
+        # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
+        mentioned = {a for _, args in kept for a in args}
+        outside.update(a for _, (_, args) in goal_literals(problem) for a in args if a not in mentioned and a not in members)
     return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out, tuple(sorted(outside)))
 
 
