@@ -509,9 +509,12 @@ class ProblemRuntime:
             self.engine.emit("planner", key=key_text(self.key), what="done", status=finished.status.value, expansions=search.expansions)
             if search.shared_cost is None:
                 message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (f": {finished.message}" if finished.message else "")
-                if search.world.left_out and finished.status is PlanStatus.UNSOLVABLE:
-                    # a robot outside the team holds something: wait in the WaitPlan until the world changes
-                    self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=f"{message}; robots outside the team hold objects")
+                outsiders = search.world.left_out or (search.world.others and not self.model.alternative_plan)
+                if outsiders and finished.status is PlanStatus.UNSOLVABLE:
+                    # robots outside the team hold objects, or may change the world and there is no AlternativePlan:
+                    # wait in the WaitPlan until the world changes
+                    self.engine.emit("planner", key=key_text(self.key), what="waiting",
+                                     reason=f"{message}; robots outside the team ({', '.join(search.world.others)}) may change the world")
                     self.blocked = set(search.world.facts)
                     return
                 self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)

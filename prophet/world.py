@@ -46,6 +46,7 @@ class PlanningWorld:
             block an opponent holds is missing from the world, say).
         outside: the objects in those facts (the blocks opponents hold), and the goal's
             objects that no fact mentions (a block falling), sorted: the team does not plan for them.
+        others: the robots outside the team the facts name (opponents, crashed members), sorted.
     """
 
     objects: tuple[tuple[str, str], ...]
@@ -53,6 +54,7 @@ class PlanningWorld:
     robots: tuple[str, ...] = ()
     left_out: int = 0
     outside: tuple[str, ...] = ()
+    others: tuple[str, ...] = ()
 
     def object_types(self) -> dict[str, str]:
         """Object name -> type."""
@@ -105,6 +107,7 @@ def read_world(
     kept: set[Fact] = set()
     left_out = 0
     outside: set[str] = set()
+    others: set[str] = set()
     for fact in source:
         name = str(fact[0])
         args = tuple(str(a) for a in fact[1:])
@@ -112,6 +115,7 @@ def read_world(
         if arity is None or len(args) != len(arity):
             continue
         if not offline and any(kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)):
+            others.update(arg for arg, kind in zip(args, arity, strict=True) if kind == robot_type and arg not in members)
             if len(args) > 1:  # a relation of an outside robot with an object (not just its own state)
                 left_out += 1
                 outside.update(arg for arg, kind in zip(args, arity, strict=True) if kind != robot_type)
@@ -135,7 +139,7 @@ def read_world(
         # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
         mentioned = {a for _, args in kept for a in args}
         outside.update(a for _, (_, args) in goal_literals(problem) for a in args if a not in mentioned and a not in members)
-    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out, tuple(sorted(outside)))
+    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out, tuple(sorted(outside)), tuple(sorted(others)))
 
 
 def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Literal, ...]:

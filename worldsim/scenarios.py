@@ -9,7 +9,6 @@ import logging
 import math
 import random
 import string
-from collections.abc import Sequence
 
 import numpy as np
 
@@ -182,9 +181,7 @@ def blocks_facts(world: World, tolerance: float | None = None) -> set[tuple[str,
     and ``("handempty", robot)`` for every robot with an arm. A block is on another
     when its bottom lies within ``tolerance`` of the other's top and its centre
     over the other; on the table when its bottom is within ``tolerance`` of the
-    ground or a table top. A falling block is neither. A block is clear when no
-    block rests on it, not even partly (overlapping it by more than
-    :data:`OVERLAP` from above, as a block lying across two does).
+    ground or a table top. A falling block is neither.
 
     Args:
         world: the world to read.
@@ -227,22 +224,10 @@ def blocks_facts(world: World, tolerance: float | None = None) -> set[tuple[str,
                 floor = max(floor, hi_t[2])
         if abs(bottom - floor) <= tol:
             facts.add(("ontable", x))
-    for x, (lo_x, hi_x) in boxes.items():
-        # a block partly on x (resting across two blocks, say) covers x too: x cannot be taken
-        if x not in covered and not any(
-            y != x and abs(lo_y[2] - hi_x[2]) <= tol and _overlap(lo_x, hi_x, lo_y, hi_y) > OVERLAP for y, (lo_y, hi_y) in boxes.items()
-        ):
+    for x in boxes:
+        if x not in covered:
             facts.add(("clear", x))
     return facts
-
-
-#: Horizontal overlap (m) of two bounding boxes beyond which the upper block covers the lower one.
-OVERLAP = 0.005
-
-
-def _overlap(lo_a: Sequence[float], hi_a: Sequence[float], lo_b: Sequence[float], hi_b: Sequence[float]) -> float:
-    """The smaller of the x and y overlaps of two boxes (negative when apart)."""
-    return min(min(hi_a[0], hi_b[0]) - max(lo_a[0], lo_b[0]), min(hi_a[1], hi_b[1]) - max(lo_a[1], lo_b[1]))
 
 
 def sample_names(count: int) -> list[str]:

@@ -252,6 +252,21 @@ def test_without_an_alternative_plan_a_planning_failure_fails_the_child(tmp_path
     assert events(rec, "problem", phase="failed")
 
 
+def test_without_an_alternative_plan_an_unsolvable_problem_waits_while_robots_outside_the_team_may_change_the_world():
+    # c is seen on nothing and a is not clear, with nothing the planner knows on it (c lies across two blocks,
+    # say): unsolvable now, but an opponent is around and may move things
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1", "r2"], skills)
+    sim.set_facts([(True, "handempty", ("o1",)), (False, "on", ("c", "a"))])
+    sim.run(ticks=40)
+    waiting = events(rec, "planner", what="waiting")
+    assert waiting and "robots outside the team (o1) may change the world" in waiting[0]["reason"]
+    assert events(rec, "problem", phase="failed") == []
+    sim.set_facts([(True, "clear", ("a",)), (True, "on", ("c", "a"))])  # the world changes: solvable again
+    summary = sim.run(until_done=True, max_time=90)
+    assert summary["success"] and goal_holds(sim, "r1")
+
+
 def test_a_goal_that_holds_already_succeeds_at_once(tmp_path):
     sim, rec = problem_team(tmp_path)
     sim.set_facts([(True, "done", ())])

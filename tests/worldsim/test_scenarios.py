@@ -44,18 +44,6 @@ def test_blocks_facts_of_a_three_block_stack() -> None:
         }
 
 
-def test_a_block_lying_across_two_covers_both() -> None:
-    # a and b side by side, c across them with its centre over a: on(c, a), and neither a nor b is clear
-    with blocksworld([["a"], ["b"]], agents=0) as w:
-        w.remove("b")
-        w.add_block("b", (float(w.objects["a"].position()[0]) + 0.052, 0.0, 0.025), size=0.05)
-        w.add_block("c", (float(w.objects["a"].position()[0]) + 0.02, 0.0, 0.0765), size=0.05)
-        w.step(1.0)
-        facts = blocks_facts(w)
-        assert ("on", "c", "a") in facts and ("clear", "c") in facts
-        assert ("clear", "a") not in facts and ("clear", "b") not in facts
-
-
 def test_blocks_facts_while_holding() -> None:
     with blocksworld([["a", "b"]], agents=1) as w:
         arm = w.robots["r1"].arm
