@@ -585,7 +585,7 @@ class ProblemRuntime:
         reachable = reachable_goal(goal, world.outside)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
-        reason = remaining_fits(created.tasks, progress, facts, share.world, target) or _stalled(progress)
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target) or _stalled(progress, created.allowed, self.engine.members_of(self.slot.parent))
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):
                 self._wait_outside(now, world, self._next_generation())  # the rest of the goal is reached
@@ -601,10 +601,20 @@ class ProblemRuntime:
             self._replan(now, f"the world changed under the plan: {reason}")
 
 
-def _stalled(progress: list[TaskProgress]) -> str | None:
-    """A task nobody holds while an agent waits in a later one (tasks only wait for earlier tasks): replan."""
+def _stalled(progress: list[TaskProgress], allowed: tuple[tuple[str, ...] | None, ...] = (), members: tuple[str, ...] = ()) -> str | None:
+    """A task nobody holds while an agent waits in a later one (tasks only wait for earlier tasks): replan.
+
+    Not while an alive agent that may take the free task works on an earlier
+    task: that task does not wait for the free one, so the agent finishes it
+    and then takes the free task (the engine's reuse rule); a team smaller
+    than its tasks works that way.
+    """
     free = [i for i, p in enumerate(progress) if p.agent is None and not p.done]
     waiting = [i for i, p in enumerate(progress) if p.agent is not None and not p.running and not p.done]
-    if free and waiting and min(free) < max(waiting):
-        return f"task T{min(free)} has nobody, and the agent of task T{max(waiting)} waits for it"
-    return None
+    if not (free and waiting and min(free) < max(waiting)):
+        return None
+    first = min(free)
+    may = set(allowed[first] if first < len(allowed) and allowed[first] is not None else members) & set(members)
+    if any(p.agent in may and not p.done for p in progress[:first]):
+        return None
+    return f"task T{first} has nobody, and the agent of task T{max(waiting)} waits for it"

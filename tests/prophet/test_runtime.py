@@ -357,3 +357,17 @@ def test_a_goal_block_taken_by_an_opponent_does_not_stop_the_rest_of_the_plan():
     sim.set_facts([(True, "ontable", ("d",)), (True, "clear", ("d",)), (False, "holding", ("o1", "d"))])
     summary = sim.run(until_done=True, max_time=90)
     assert summary["success"]
+
+
+def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_earlier_one():
+    from prophet.runtime import _stalled
+    from prophet.world import TaskProgress
+
+    # T0 and T1 at work, T2 free, T3's agent waits for T2
+    progress = [TaskProgress("r1", 0, running=True), TaskProgress("r2", 1, running=True), TaskProgress(None, 0), TaskProgress("r4", 0)]
+    members = ("r1", "r2", "r4")
+    assert _stalled(progress, (None, None, ("r1", "r2"), ("r4",)), members) is None  # r1 or r2 takes T2 next
+    # only r4 may take T2, and it waits in T3: stuck
+    assert "task T2 has nobody" in _stalled(progress, (None, None, ("r4",), ("r4",)), members)
+    # the agents that may take it crashed (not members any more): stuck
+    assert "task T2 has nobody" in _stalled(progress, (None, None, ("r1", "r2"), ("r4",)), ("r4",))
