@@ -200,15 +200,33 @@ def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, .
     task_of: dict[str, int] = {}
     for step in steps:
         shared = {f for f in state if not members.intersection(f[1])}
-        able = tuple(r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r]))
+        able = tuple(r for r in team if holds(for_robot(step.pre, step.robot, r), shared | _own_facts(r, team, task_of, step.robot, fresh, state)))
         if not tasks or able:
             tasks.append([step])
-            allowed.append(able if set(able) != members else None)
+            # who may take the task: the robots whose initial facts let them start it, and the planner's own robot
+            may = {r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r])} | ({step.robot} & members)
+            allowed.append(tuple(sorted(may)) if may and may != members else None)
             task_of[step.robot] = len(tasks) - 1
         else:
             tasks[task_of.get(step.robot, len(tasks) - 1)].append(step)
         apply_effect(state, step.effect)
     return tasks, allowed
+
+
+def _own_facts(robot: str, team: tuple[str, ...], acted: Mapping[str, int], mover: str, fresh: Mapping[str, set[Fact]], state: set[Fact]) -> set[Fact]:
+    """The facts a robot could start the next step with, for Algorithms 2-3.
+
+    A robot that has done nothing yet has its initial facts. With one robot
+    (IMPERA's stand-in) every step is judged for a new robot with those facts.
+    In a world of several robots, one that has acted has the facts its steps
+    left it with (a block it held at the start and has put down is gone), and
+    the robot of the step itself is not new: its step continues its own task.
+    """
+    if len(team) == 1 or robot not in acted:
+        return fresh[robot]
+    if robot == mover:
+        return set()
+    return {f for f in state if robot in f[1]}
 
 
 def _cardinality(task: Sequence[Step]) -> tuple[int, float]:

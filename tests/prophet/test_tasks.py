@@ -43,6 +43,17 @@ def test_a_single_robot_chain_stays_one_task(blocks):
     assert len(tasks) == 1
 
 
+def test_a_robot_that_has_acted_is_no_longer_new(blocks):
+    # r5 holds f at the start and stacks it on g; r1 takes f off again and puts it back. r5's initial
+    # holding(r5, f) is used up: the second Stack(f, g) is not a new task for r5, it continues r1's task
+    init = [("holding", ("r5", "f")), ("ontable", ("g",)), ("clear", ("g",)), ("handempty", ("r1",))]
+    plan = [PlanStep("Stack", ("r5", "f", "g")), PlanStep("Unstack", ("r1", "f", "g")), PlanStep("Stack", ("r1", "f", "g"))]
+    created = create_tasks("P", plan, blocks, init, ("r1", "r5"), next(iter(blocks.rolesets.values())), "Default")
+    assert [[s.label for s in t] for t in created.tasks] == [["Stack(f, g)"], ["Unstack(f, g)", "Stack(f, g)"]]
+    # the first is pinned to the robot that holds f; the second to r1, whose initial empty hand can start it
+    assert created.allowed == (("r5",), ("r1",))
+
+
 def test_role_task_priorities_follow_eq_9(blocks):
     created, roleset = _created(blocks)
     n = len(created.tasks)
