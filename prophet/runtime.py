@@ -585,7 +585,7 @@ class ProblemRuntime:
         reachable = reachable_goal(goal, world.outside)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
-        reason = remaining_fits(created.tasks, progress, facts, share.world, target) or _stalled(progress, created.allowed, self.engine.members_of(self.slot.parent))
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(progress, created.allowed, self.engine.members_of(self.slot.parent))
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):
                 self._wait_outside(now, world, self._next_generation())  # the rest of the goal is reached

@@ -190,6 +190,7 @@ def remaining_fits(
     facts: Iterable[Fact],
     start_world: Iterable[Fact],
     goal: Sequence[Literal],
+    robots: Sequence[str] = (),
 ) -> str | None:
     """Whether what is left of a generated plan still reaches the goal from ``facts``.
 
@@ -199,6 +200,8 @@ def remaining_fits(
         facts: the facts that hold now.
         start_world: the world the plan was made from (gives a fresh robot's facts).
         goal: the goal literals.
+        robots: the robots of the plan; a task nobody holds yet is run by a stand-in with the
+            start facts of the first of them (the planned robot first) that could start it.
 
     Returns:
         ``None`` when it fits, else what does not.
@@ -211,10 +214,14 @@ def remaining_fits(
             continue
         who = where.agent
         if who is None:
-            # nobody holds the task yet: a robot like the one planned for it, as it was at the start
+            # nobody holds the task yet: a robot as it was at the start, the planned one if it could start the task
             who = f"~T{i}"
-            planned = task[where.next_step].robot  # type: ignore[attr-defined]
-            state.update((name, tuple(who if a == planned else a for a in args)) for name, args in start if planned in args)
+            first = task[where.next_step]
+            planned = first.robot  # type: ignore[attr-defined]
+            options = [planned, *(r for r in robots if r != planned)]
+            own = [{(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options]
+            pre = for_robot(first.pre, planned, who)  # type: ignore[attr-defined]
+            state.update(next((facts for facts in own if holds(pre, state | facts)), own[0]))
         for k in range(where.next_step, len(task)):
             remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):

@@ -110,3 +110,19 @@ def test_unknown_or_malformed_steps_are_refused(blocks):
         steps_of([PlanStep("Pickup", ("r",))], blocks, "r")
     with pytest.raises(PlannerError, match="empty plan"):
         create_tasks("P", [], blocks, SUSSMAN, "r", next(iter(blocks.rolesets.values())), "Default")
+
+
+def test_the_execution_check_runs_a_free_task_with_a_robot_that_could_start_it(blocks):
+    from prophet.world import TaskProgress, remaining_fits
+
+    # the planner gave Pickup(b) to r1, which held c at the start (it put c down in T0); r2 had an empty hand
+    init = [("holding", ("r1", "c")), ("handempty", ("r2",)), ("ontable", ("b",)), ("clear", ("b",)), ("ontable", ("a",)), ("clear", ("a",))]
+    plan = [PlanStep("Putdown", ("r1", "c")), PlanStep("Pickup", ("r1", "b"))]
+    tasks = [[s] for s in steps_of(plan, blocks, ("r1", "r2"))]
+    now = [("ontable", ("c",)), ("clear", ("c",)), ("handempty", ("r1",)), ("handempty", ("r2",)), ("ontable", ("b",)), ("clear", ("b",)),
+           ("ontable", ("a",)), ("clear", ("a",))]
+    progress = [TaskProgress(None, 1, done=True), TaskProgress(None, 0)]
+    goal = [(True, ("holding", ("~T1", "b")))]
+    assert remaining_fits(tasks, progress, now, init, goal, ("r1", "r2")) is None
+    # without the team's robots the stand-in is r1 as it was at the start, hand full: a false alarm
+    assert "handempty" in remaining_fits(tasks, progress, now, init, goal)
