@@ -220,8 +220,8 @@ def remaining_fits(
             planned = first.robot  # type: ignore[attr-defined]
             options = [planned, *(r for r in robots if r != planned)]
             own = [{(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options]
-            pre = for_robot(first.pre, planned, who)  # type: ignore[attr-defined]
-            state.update(next((facts for facts in own if holds(pre, state | facts)), own[0]))
+            mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]  # type: ignore[attr-defined]
+            state.update(next((facts for facts in own if holds(mine, facts)), own[0]))
         for k in range(where.next_step, len(task)):
             remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):
