@@ -304,7 +304,8 @@ class ArmSkill(WorldSkill):
                     return self.fail(taken)
                 continue
             arm.follow(step, _duration(step))
-            self.followed.append(np.asarray(step, dtype=float))
+            if not self.released:  # after a release the way back would lead through what was put down
+                self.followed.append(np.asarray(step, dtype=float))
             return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
         self.phase = "verify"
         self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
@@ -323,7 +324,7 @@ class ArmSkill(WorldSkill):
         else:
             arm.detach()
             arm.open()
-            self.followed = []  # the way back would lead through what was just put down
+            self.followed = []
             self.released = True
         return None
 
