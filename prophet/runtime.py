@@ -48,12 +48,11 @@ from alica.errors import AlicaError, PlannerError
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from prophet.planner import Done, Improved, PlanStatus, PlanStep
 from prophet.planner import Plan as StepPlan
-from prophet.tasks import STEP_DONE, CreatedTasks, create_tasks, holds, state_step, step_token
+from prophet.tasks import STEP_DONE, CreatedTasks, conjunction, create_tasks, holds, state_step, step_token
 from prophet.world import (
     PlanningWorld,
     TaskProgress,
     goal_literals,
-    goal_text,
     reachable_goal,
     read_world,
     remaining_fits,
@@ -435,9 +434,10 @@ class ProblemRuntime:
             partial = reachable_goal(goal, world.outside)
             if partial != goal:
                 if not partial or holds(partial, set(world.facts)):
-                    self._wait_outside(now, world, generation)
+                    self._wait_for_world(now, world, generation, _rest_holds(world))
+                    self.next_update = now + self.model.update_time
                     return
-                problem = replace(problem, goal=Condition(ConditionKind.POST, goal_text(partial)))
+                problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
             domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
             planner = get_planner(problem.planner, **({"progress_every": 100} if problem.planner == "builtin" else {}))
             events = planner.search(domain, pddl, anytime=True)
@@ -447,17 +447,15 @@ class ProblemRuntime:
             return
         names = {name.lower(): name for name, _ in world.objects}
         self.search = _Search(generation, world, events, domain, pddl, now, names, goal=partial if partial != goal else ())
-        extra = {"goal": goal_text(partial), "outside": list(world.outside)} if partial != goal else {}
+        extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
         engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts), **extra)
         self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, robots=world.robots, entry_task=task, reason=reason), now)
         self.next_update = now + self.model.update_time
 
-    def _wait_outside(self, now: float, world: PlanningWorld, generation: int) -> None:
-        """Robots outside the team hold what is left to do: the team waits in the WaitPlan until the world changes."""
-        reason = f"robots outside the team hold, or nobody sees, {', '.join(world.outside)}; the rest of the goal holds"
+    def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
+        """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
         self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
         self.blocked = set(world.facts)
-        self.next_update = now + self.model.update_time
         if self.share is None or self.share.status != SEARCHING:
             self._publish(PlanShare(self.key, generation, 0, self.engine.name, SEARCHING, world=world.facts, robots=world.robots,
                                     entry_task=self._entry_task(), reason=reason), now)
@@ -511,11 +509,9 @@ class ProblemRuntime:
                 message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (f": {finished.message}" if finished.message else "")
                 outsiders = search.world.left_out or (search.world.others and not self.model.alternative_plan)
                 if outsiders and finished.status is PlanStatus.UNSOLVABLE:
-                    # robots outside the team hold objects, or may change the world and there is no AlternativePlan:
-                    # wait in the WaitPlan until the world changes
-                    self.engine.emit("planner", key=key_text(self.key), what="waiting",
-                                     reason=f"{message}; robots outside the team ({', '.join(search.world.others)}) may change the world")
-                    self.blocked = set(search.world.facts)
+                    # robots outside the team hold objects, or may change the world and there is no AlternativePlan
+                    reason = f"{message}; robots outside the team ({', '.join(search.world.others)}) may change the world"
+                    self._wait_for_world(now, search.world, search.generation, reason)
                     return
                 self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)
             return
@@ -587,8 +583,8 @@ class ProblemRuntime:
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(progress, created.allowed, self.engine.members_of(self.slot.parent))
         if reason is None and all(p.done for p in progress):
-            if reachable != goal and holds(reachable, set(world.facts)):
-                self._wait_outside(now, world, self._next_generation())  # the rest of the goal is reached
+            if reachable != goal and holds(reachable, set(world.facts)):  # the rest of the goal is reached
+                self._wait_for_world(now, world, self._next_generation(), _rest_holds(world))
                 return
             reason = "the plan is done, but the goal does not hold: the part that robots outside the team held can be planned now"
         if reason is None:
@@ -599,6 +595,10 @@ class ProblemRuntime:
             self._replan(now, f"the plan is stuck: {reason}")
         else:
             self._replan(now, f"the world changed under the plan: {reason}")
+
+
+def _rest_holds(world: PlanningWorld) -> str:
+    return f"robots outside the team hold, or nobody sees, {', '.join(world.outside)}; the rest of the goal holds"
 
 
 def _stalled(progress: list[TaskProgress], allowed: tuple[tuple[str, ...] | None, ...] = (), members: tuple[str, ...] = ()) -> str | None:

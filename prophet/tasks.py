@@ -265,12 +265,13 @@ def step_token(plan: str, index: int) -> str:
     return f"{plan}_s{index}"
 
 
+def conjunction(literal_set: Iterable[tuple[bool, Fact]]) -> str:
+    """Ground literals as a formula: ``on(a, b) and not clear(c)``."""
+    return " and ".join(("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name) for positive, (name, args) in literal_set)
+
+
 def _condition(pre: Sequence[tuple[bool, Fact]], robot: str, after: Sequence[str] = ()) -> Condition | None:
-    parts = []
-    for positive, (name, args) in pre:
-        shown = ", ".join("self" if a == robot else a for a in args)
-        atom = f"{name}({shown})" if args else name
-        parts.append(atom if positive else f"not {atom}")
+    parts = [conjunction(for_robot(pre, robot, "self"))] if pre else []
     parts.extend(f"{STEP_DONE}({token})" for token in after)
     return Condition(ConditionKind.TRANSITION, " and ".join(parts)) if parts else None
 

@@ -152,11 +152,6 @@ def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Lit
     return tuple(literal for literal in goal if not held.intersection(literal[1][1]))
 
 
-def goal_text(goal: Iterable[Literal]) -> str:
-    """Ground literals as a conjunction: ``on(a, b) and not clear(c)``."""
-    return " and ".join(("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name) for positive, (name, args) in goal)
-
-
 def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:
     for name in problem.elements:
         signature = library.plans[name].signature

@@ -241,17 +241,13 @@ class DriveToFreeSpace(MoveToPosition):
         away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
         grid = planning_grid(self.world)
         others = [(r.pose[0], r.pose[1], r.spec.radius) for r in self.world.robots.values() if r is not self.robot]
-        sites = [(*obj.position()[:2], away) for obj in self._lying_objects()] if away > 0 else []
+        lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
+        sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
         spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=others, keep_away=sites)
         self.spot = spot
         self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
         self.params.setdefault("tolerance", 0.2)
         super().initialise()
-
-    def _lying_objects(self) -> list[Any]:
-        """The blocks and samples no robot holds."""
-        held = {id(r.arm.held) for r in self.world.robots.values() if getattr(r, "arm", None) is not None and r.arm.held is not None}
-        return [obj for _, obj in sorted(self.world.objects.items()) if obj.kind in ("block", "sample") and id(obj) not in held]
 
     def update(self) -> Status:
         """Fail when there is no free place, else drive there."""
