@@ -143,13 +143,27 @@ def read_world(
 
 
 def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Literal, ...]:
-    """The goal literals that name none of the ``outside`` objects (those robots outside the team hold).
+    """The goal literals not tied to any of the ``outside`` objects (those robots outside the team hold).
 
     The team cannot plan for a block an opponent holds; it plans for the
-    rest of the goal meanwhile and replans once the block is free again.
+    rest of the goal meanwhile and replans once the block is free again. A
+    literal is tied to an outside object when it names it, or names an
+    object of a literal tied to it: with ``on(d, f)`` and ``on(g, d)`` in
+    the goal and ``f`` held, both are left out. Building ``g`` on ``d`` now
+    would put up a stack that has to come down again once ``d`` can go onto
+    ``f``.
     """
-    held = set(outside)
-    return tuple(literal for literal in goal if not held.intersection(literal[1][1]))
+    tied = set(outside)
+    left = list(goal)
+    grew = True
+    while grew:
+        grew = False
+        for literal in left:
+            names = set(literal[1][1])
+            if names & tied and not names <= tied:
+                tied |= names
+                grew = True
+    return tuple(literal for literal in goal if not tied.intersection(literal[1][1]))
 
 
 def _robot_type(problem: PlanningProblem, library: PlanLibrary) -> str | None:

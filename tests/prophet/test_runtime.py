@@ -299,13 +299,17 @@ def test_a_robot_holding_a_block_at_a_replan_is_part_of_the_new_plan():
 
 def test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_waits():
     skills = BlockSkills()
-    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"], ["d", "e"]])
+    for agent in ("r1", "r2"):
+        sim.engines[agent].set_problem("StackBlocks", goal="on(a, b) and on(b, c) and ontable(c) and ontable(e)")
     sim.set_facts([(True, "holding", ("o1", "b"))])  # an opponent holds b: it is missing from the team's world
     sim.run(ticks=60)
-    # the leader plans for the part of the goal without b (c on the table), then waits for b
+    # the leader plans for the part of the goal not tied to b (e on the table), then waits for b; a on b on c
+    # is left out as a whole: c on the table would only be a base for b, whose place is not known yet
     started = events(rec, "planner", what="started")[0]
-    assert started["goal"] == "ontable(c)" and started["outside"] == ["b"]
-    assert sim.engines["r1"].world_model.holds("ontable", "c")
+    assert started["goal"] == "ontable(e)" and started["outside"] == ["b"]
+    assert sim.engines["r1"].world_model.holds("ontable", "e")
+    assert sim.engines["r1"].world_model.holds("on", "c", "a")
     assert any("robots outside the team hold, or nobody sees, b" in e["reason"] for e in events(rec, "planner", what="waiting"))
     assert events(rec, "problem", phase="failed") == []
     sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])  # it puts b down
@@ -320,8 +324,10 @@ def test_a_goal_block_nobody_sees_is_left_out_of_the_plan_not_a_failure():
     sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"], ["b"]])
     sim.set_facts([(False, "ontable", ("b",)), (False, "clear", ("b",))])
     sim.run(ticks=60)
-    started = events(rec, "planner", what="started")[0]
-    assert started["outside"] == ["b"] and events(rec, "problem", phase="failed") == []
+    # every goal literal is tied to b (a on b on c): the team waits for b instead of planning
+    waiting = events(rec, "planner", what="waiting")
+    assert waiting and "nobody sees, b" in waiting[0]["reason"]
+    assert events(rec, "problem", phase="failed") == []
     sim.set_facts([(True, "ontable", ("b",)), (True, "clear", ("b",))])  # it is seen again
     summary = sim.run(until_done=True, max_time=90)
     assert summary["success"] and goal_holds(sim, "r1")
@@ -330,7 +336,9 @@ def test_a_goal_block_nobody_sees_is_left_out_of_the_plan_not_a_failure():
 def test_a_plan_for_part_of_the_goal_runs_to_its_end_then_the_rest_is_planned():
     # b is free before the team finished the rest of the goal: the plan goes on, then the leader plans for the whole goal
     skills = BlockSkills(ticks=8)
-    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"]])
+    sim, rec = blocks_team(["r1", "r2"], skills, stacks=[["a", "c"], ["d", "e"]])
+    for agent in ("r1", "r2"):
+        sim.engines[agent].set_problem("StackBlocks", goal="on(a, b) and on(b, c) and ontable(c) and ontable(e)")
     sim.set_facts([(True, "holding", ("o1", "b"))])
     run_until(sim, lambda: events(rec, "problem", agent="r2", phase="plan"))
     sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])
@@ -338,9 +346,9 @@ def test_a_plan_for_part_of_the_goal_runs_to_its_end_then_the_rest_is_planned():
     assert summary["success"] and goal_holds(sim, "r1")
     replans = events(rec, "replan")
     assert len(replans) == 1 and "the plan is done, but the goal does not hold" in replans[0]["reason"]
-    # the first plan (c onto the table) was not cut short
+    # the first plan (e onto the table) was not cut short
     first = [(a, s, p["object"]) for a, s, p in skills.runs if s in ("Unstack", "Putdown")][:2]
-    assert [(s, o) for _, s, o in first] == [("Unstack", "c"), ("Putdown", "c")]
+    assert [(s, o) for _, s, o in first] == [("Unstack", "e"), ("Putdown", "e")]
 
 
 def test_a_goal_block_taken_by_an_opponent_does_not_stop_the_rest_of_the_plan():
