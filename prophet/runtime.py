@@ -38,6 +38,7 @@ change of goal or world by the operator (:meth:`AgentEngine.set_problem`).
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -59,7 +60,7 @@ from prophet.world import (
 )
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator
+    from collections.abc import Iterator, Sequence
 
     from alica.engine.agent import AgentEngine
     from alica.engine.node import PlanNode
@@ -581,7 +582,9 @@ class ProblemRuntime:
         reachable = reachable_goal(goal, world.outside)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
-        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(progress, created.allowed, self.engine.members_of(self.slot.parent))
+        order = [[step.index for step in steps] for steps in created.tasks]
+        members = self.engine.members_of(self.slot.parent)
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(progress, order, created.allowed, members)
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):  # the rest of the goal is reached
                 self._wait_for_world(now, world, self._next_generation(), _rest_holds(world))
@@ -601,20 +604,38 @@ def _rest_holds(world: PlanningWorld) -> str:
     return f"robots outside the team hold, or nobody sees, {', '.join(world.outside)}; the rest of the goal holds"
 
 
-def _stalled(progress: list[TaskProgress], allowed: tuple[tuple[str, ...] | None, ...] = (), members: tuple[str, ...] = ()) -> str | None:
-    """A task nobody holds while an agent waits in a later one (tasks only wait for earlier tasks): replan.
+def _stalled(
+    progress: list[TaskProgress],
+    order: Sequence[Sequence[int]],
+    allowed: tuple[tuple[str, ...] | None, ...] = (),
+    members: tuple[str, ...] = (),
+) -> str | None:
+    """A task nobody holds while an agent waits in a step that comes after it in the plan: replan.
 
-    Not while an alive agent that may take the free task works on an earlier
-    task: that task does not wait for the free one, so the agent finishes it
-    and then takes the free task (the engine's reuse rule); a team smaller
-    than its tasks works that way.
+    ``order[i]`` holds the plan positions of task ``i``'s steps. A step waits
+    only for steps before it in the plan, so an agent whose next step comes
+    after the free task's first step may wait for the free task; that is not
+    stuck while an alive agent that may take the free task will be free for
+    it: one that runs a step now, or whose next step comes before the free
+    task's (its task does not wait for the free one; it finishes it and then
+    takes the free task by the engine's reuse rule, as a team smaller than
+    its tasks works). An agent that may take the free task but waits in a
+    step after it never will: with the free task pinned to it alone, that is
+    a deadlock.
     """
+    def position(i: int) -> float:  # where the task's next step is in the plan (its last steps finished: after all)
+        steps, k = order[i], progress[i].next_step
+        return steps[k] if k < len(steps) else math.inf
+
     free = [i for i, p in enumerate(progress) if p.agent is None and not p.done]
-    waiting = [i for i, p in enumerate(progress) if p.agent is not None and not p.running and not p.done]
-    if not (free and waiting and min(free) < max(waiting)):
+    if not free:
         return None
-    first = min(free)
+    first = min(free, key=position)
+    start = position(first)
+    waiting = [i for i, p in enumerate(progress) if p.agent is not None and not p.running and not p.done and position(i) > start]
+    if not waiting:
+        return None
     may = set(allowed[first] if first < len(allowed) and allowed[first] is not None else members) & set(members)
-    if any(p.agent in may and not p.done for p in progress[:first]):
+    if any(p.agent in may and not p.done and (p.running or position(i) < start) for i, p in enumerate(progress)):
         return None
     return f"task T{first} has nobody, and the agent of task T{max(waiting)} waits for it"

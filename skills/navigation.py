@@ -187,7 +187,8 @@ class MoveToPosition(WorldSkill):
         self.replans += 1
         if self.replans > MAX_REPLANS:
             return self.fail(f"stuck on the way to {self.goal} after {MAX_REPLANS} escapes")
-        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0)
+        # free space away from the other robots too: the robot it bumped into is often one of them
+        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0, other_robots=self._others())
         if spot is None:
             return self.fail(f"stuck at {robot.pose[:2]} and no free space within 3 m to drive to")
         x, y, yaw = robot.pose

@@ -123,6 +123,11 @@ class Arm(GripperMixin):
         for link in range(-1, n):
             c.changeDynamics(self.body_id, link, mass=0.0)
             c.setCollisionFilterGroupMask(self.body_id, link, ARM_GROUP, MOVABLE_GROUP)
+        # Asleep, pybullet skips the arm's articulated-body dynamics (about 26 us per arm and step, most of
+        # a step with several arms), which a re-posed massless arm does not need; a re-pose still moves its
+        # collision shapes, so it pushes blocks exactly as when awake.
+        c.changeDynamics(self.body_id, -1, activationState=c.ACTIVATION_STATE_ENABLE_SLEEPING)
+        c.changeDynamics(self.body_id, -1, activationState=c.ACTIVATION_STATE_SLEEP)
         self._reset_joints = c.resetJointStatesMultiDof
         self._reset_pose = c.resetBasePositionAndOrientation
         self._all_joints = list(_ARM_JOINTS + _FINGER_JOINTS)

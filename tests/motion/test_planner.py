@@ -44,7 +44,7 @@ def test_corner_to_corner_exact_and_valid(seed: int) -> None:
     assert np.allclose(path[0], start)
     assert math.dist(path[-1, :2], CORNER_B) <= 0.1 + 1e-9
     straight = math.dist(CORNER_A, CORNER_B)
-    assert result.length >= straight - 1e-9
+    assert result.length >= straight - 0.1 - 1e-9  # the path ends within the goal tolerance (0.1 m) of the corner
     assert result.length == pytest.approx(np.hypot(*np.diff(path[:, :2], axis=0).T).sum())
     assert_path_valid(path, grid, obstacles)
 

@@ -371,11 +371,30 @@ def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_ea
     from prophet.runtime import _stalled
     from prophet.world import TaskProgress
 
-    # T0 and T1 at work, T2 free, T3's agent waits for T2
+    # T0 and T1 at work, T2 free, T3's agent waits for T2 (the plan: T0 step 0, T1 steps 1 and 2, T2 step 3, T3 step 4)
+    order = [[0], [1, 2], [3], [4]]
     progress = [TaskProgress("r1", 0, running=True), TaskProgress("r2", 1, running=True), TaskProgress(None, 0), TaskProgress("r4", 0)]
     members = ("r1", "r2", "r4")
-    assert _stalled(progress, (None, None, ("r1", "r2"), ("r4",)), members) is None  # r1 or r2 takes T2 next
+    assert _stalled(progress, order, (None, None, ("r1", "r2"), ("r4",)), members) is None  # r1 or r2 takes T2 next
     # only r4 may take T2, and it waits in T3: stuck
-    assert "task T2 has nobody" in _stalled(progress, (None, None, ("r4",), ("r4",)), members)
+    assert "task T2 has nobody" in _stalled(progress, order, (None, None, ("r4",), ("r4",)), members)
     # the agents that may take it crashed (not members any more): stuck
-    assert "task T2 has nobody" in _stalled(progress, (None, None, ("r1", "r2"), ("r4",)), ("r4",))
+    assert "task T2 has nobody" in _stalled(progress, order, (None, None, ("r1", "r2"), ("r4",)), ("r4",))
+
+
+def test_a_free_task_pinned_to_an_agent_that_waits_for_it_in_an_earlier_task_is_stuck():
+    from prophet.runtime import _stalled
+    from prophet.world import TaskProgress
+
+    # seed 10 of the 5-agent demo: T1 = Unstack(d, g) (step 1) and Stack(d, g) (step 4); T2 = Pickup(g), Stack(g, h)
+    # (steps 2, 3), pinned to r5. r5 took T1 and waits before step 4, which comes after T2: nobody will ever take T2
+    order = [[0], [1, 4], [2, 3], [5]]
+    progress = [TaskProgress(None, 1, done=True), TaskProgress("r5", 1), TaskProgress(None, 0), TaskProgress("r3", 0)]
+    members = ("r1", "r3", "r5")
+    assert "task T2 has nobody, and the agent of task T3 waits for it" in _stalled(progress, order, (None, ("r1", "r5"), ("r5",), ("r3",)), members)
+    # r3 may take it as well, and runs its step now: it takes T2 when that step is done
+    at_work = [*progress[:3], TaskProgress("r3", 0, running=True)]
+    assert _stalled(at_work, order, (None, ("r1", "r5"), ("r3", "r5"), ("r3",)), members) is None
+    # r5 still before step 1 (it comes before T2): it finishes that step and T1 waits for T2 only then
+    before = [TaskProgress(None, 1, done=True), TaskProgress("r5", 0), TaskProgress(None, 0), TaskProgress("r3", 0)]
+    assert _stalled(before, order, (None, ("r1", "r5"), ("r5",), ("r3",)), members) is None
