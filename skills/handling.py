@@ -56,6 +56,7 @@ SIDE_TRIED = 0.2
 def _box(obj: Any) -> Any:
     """An object as a box for arm planning: its own extents and yaw for boxes, else its bounding box."""
     from skills.manipulation import Box
+    from skills.manipulation.geometry import upright_box
 
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
     half = tuple(getattr(obj, "half_extents", (0.0, 0.0, 0.0)))
@@ -64,9 +65,22 @@ def _box(obj: Any) -> Any:
         r = float(obj.radius)
         half = (r, r, 0.5 * float(obj.size))
     if half and half[0] > 0.0:
-        center = tuple(float(v) for v in obj.position())
-        return Box(obj.name, center, half, float(obj.yaw()))
+        center, quat = obj.pose()
+        yaw, upright = upright_box(quat, half)  # a block that fell onto a side has its faces turned another way
+        return Box(obj.name, tuple(float(v) for v in center), upright, yaw)
     return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
+
+
+def _crowds(box: Any, target: Any) -> bool:
+    """Whether ``box`` stands beside ``target`` closer than the fingers need to close around it.
+
+    Beside: its top is above the target's bottom (not the block the target stands on), and its centre
+    is within 1.6 times the sum of the two boxes' largest horizontal half extents.
+    """
+    if box.center[2] + box.half_extents[2] <= target.center[2] - target.half_extents[2] + 0.01:
+        return False
+    reach = 1.6 * (max(box.half_extents[:2]) + max(target.half_extents[:2]))
+    return math.dist(box.center[:2], target.center[:2]) < reach
 
 
 def _duration(path: np.ndarray) -> float:
@@ -256,6 +270,13 @@ class ArmSkill(WorldSkill):
                 if scene.collides(q, held):
                     touching.append(box)
             scene.set_obstacles([b for b in boxes if b not in touching])
+        elif self.grasps and self.attempts == self.retries - 1:
+            # the last attempt: blocks pressed against the target (one fell right beside it) are left out of
+            # the scene, and the closing fingers push them aside; else no grasp of the target ever works
+            near = _box(target)
+            crowding = [b for b in boxes if _crowds(b, near)]
+            if crowding:
+                scene.set_obstacles([b for b in boxes if b not in crowding])
         return scene
 
     def _held_box(self, scene: Any, q: np.ndarray) -> Any:

@@ -94,6 +94,22 @@ def vertical_yaw(q: Quat, tol: float = 1e-3) -> float:
     return math.atan2(r10, r00)
 
 
+def upright_box(q: Sequence[float], half_extents: Sequence[float]) -> tuple[float, Vec3]:
+    """The yaw and half extents of a box turned by ``q``, seen with its most vertical axis as up.
+
+    A box that fell over onto a side (a quarter turn about a horizontal axis)
+    is again a box turned about z alone, with its extents swapped; its Euler
+    yaw says nothing about its faces then (the pitch is at the gimbal lock).
+    A box left leaning gets the nearest upright box.
+    """
+    axes = [quat_rotate(q, e) for e in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))]
+    up = max(range(3), key=lambda k: abs(axes[k][2]))
+    first, second = (k for k in range(3) if k != up)
+    yaw = math.atan2(axes[first][1], axes[first][0])
+    half = (float(half_extents[first]), float(half_extents[second]), float(half_extents[up]))
+    return yaw, half
+
+
 def pose_multiply(a: Pose, b: Pose) -> Pose:
     """Compose two poses: ``b`` expressed in frame ``a`` -> world."""
     pa, qa = a

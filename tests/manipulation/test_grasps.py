@@ -71,3 +71,23 @@ def test_bad_arguments_raise_value_errors() -> None:
     tilted = ((0.0, 0.0, 0.5), (0.0, math.sin(0.3), 0.0, math.cos(0.3)))
     with pytest.raises(ValueError, match="tilts"):
         held_box(Box("cube", (0, 0, 0.1), (0.02, 0.02, 0.02)), tilted)
+
+
+def test_a_box_fallen_onto_a_side_is_seen_upright_with_its_faces_turned() -> None:
+    from skills.manipulation.geometry import quat_multiply, upright_box
+    from worldsim.geometry import quat_to_yaw, yaw_to_quat
+
+    half = (0.01, 0.02, 0.03)
+    tip = (math.sin(math.pi / 4), 0.0, 0.0, math.cos(math.pi / 4))  # a quarter turn about x: the box lies on its side
+    for turn in (0.0, 0.5, -2.0):
+        q = quat_multiply(yaw_to_quat(turn), tip)
+        yaw, upright = upright_box(q, half)
+        assert upright == pytest.approx((0.01, 0.03, 0.02))  # its y axis points up now
+        assert math.cos(2 * (yaw - turn)) == pytest.approx(1.0)  # its faces are turned like before the fall
+    # upright boxes keep their yaw and extents
+    assert upright_box(yaw_to_quat(0.7), half) == (pytest.approx(0.7), half)
+    # the Euler yaw of a block that fell about y (at the gimbal lock) is not its faces' yaw
+    fallen = quat_multiply(yaw_to_quat(0.3), (0.0, math.sin(math.pi / 4), 0.0, math.cos(math.pi / 4)))
+    yaw, _ = upright_box(fallen, (0.025,) * 3)
+    assert math.cos(4 * (yaw - 0.3)) == pytest.approx(1.0)
+    assert math.cos(4 * (quat_to_yaw(fallen) - 0.3)) < 0.9  # the Euler yaw: 0.17 rad

@@ -51,6 +51,22 @@ def test_pickup_succeeds(blocks_world, skill_run):
     assert ("holding", "r1", "c") in facts and ("ontable", "c") not in facts
 
 
+def test_pickup_of_a_block_hemmed_in_by_others_pushes_them_aside_on_its_last_attempt(blocks_world, skill_run):
+    # blocks fell right beside c on all four sides: every grasp's fingers would touch one of them
+    from worldsim.scenarios import blocks_facts
+
+    cx, cy, _ = blocks_world.objects["c"].position()
+    for name, (dx, dy) in zip("dfhi", [(0.056, 0), (0, 0.056), (-0.056, 0), (0, -0.056)], strict=True):
+        blocks_world.add_block(name, (cx + dx, cy + dy))
+    blocks_world.step(1.0)
+    run = skill_run("Pickup", blocks_world, "r1", {"object": "c"})
+    assert run.ok, (run.reason, run.trace[-6:])
+    retries = [t["feedback"] for t in run.trace if t["feedback"].startswith("retrying")]
+    assert len(retries) == 2 and all("no grasp of 'c' worked" in r for r in retries)
+    assert run.reason == "done after 3 attempt(s)"
+    assert ("holding", "r1", "c") in blocks_facts(blocks_world)
+
+
 def test_pickup_retries_after_a_slip(blocks_world, skill_run):
     from worldsim.faults import set_grasp_slip
 
