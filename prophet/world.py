@@ -210,7 +210,8 @@ def remaining_fits(
         start_world: the world the plan was made from (gives a fresh robot's facts).
         goal: the goal literals.
         robots: the robots of the plan; a task nobody holds yet is run by a stand-in with the
-            start facts of the first of them (the planned robot first) that could start it.
+            start facts of the first of them (the planned robot first) that could start it, or
+            when none could, by the planned robot itself after its earlier steps.
 
     Returns:
         ``None`` when it fits, else what does not.
@@ -230,7 +231,13 @@ def remaining_fits(
             options = [planned, *(r for r in robots if r != planned)]
             own = [{(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options]
             mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]  # type: ignore[attr-defined]
-            state.update(next((facts for facts in own if holds(mine, facts)), own[0]))
+            fresh = next((facts for facts in own if holds(mine, facts)), None)
+            if fresh is None:
+                # no robot as it was at the start could: the planned robot will, once its earlier steps are done
+                # (it put its block down first, say), and takes the task then
+                who = planned
+            else:
+                state.update(fresh)
         for k in range(where.next_step, len(task)):
             remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):

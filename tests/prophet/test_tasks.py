@@ -124,5 +124,21 @@ def test_the_execution_check_runs_a_free_task_with_a_robot_that_could_start_it(b
     progress = [TaskProgress(None, 1, done=True), TaskProgress(None, 0)]
     goal = [(True, ("holding", ("~T1", "b")))]
     assert remaining_fits(tasks, progress, now, init, goal, ("r1", "r2")) is None
-    # without the team's robots the stand-in is r1 as it was at the start, hand full: a false alarm
-    assert "handempty" in remaining_fits(tasks, progress, now, init, goal)
+    # without the team's robots no robot as it was at the start could start T1: r1 does, after its put-down
+    assert remaining_fits(tasks, progress, now, init, [(True, ("holding", ("r1", "b")))]) is None
+
+
+def test_a_free_task_no_robot_could_start_at_the_start_is_run_by_its_planned_robot_after_its_earlier_steps(blocks):
+    from prophet.world import TaskProgress, remaining_fits
+
+    # r1 puts c down (T0, running now), then picks b up (T1, free); r2 holds e all along (seed 18 of the demo:
+    # a stand-in with r1's start facts, hand full, made the check replan eleven times)
+    init = [("holding", ("r1", "c")), ("holding", ("r2", "e")), ("ontable", ("b",)), ("clear", ("b",))]
+    plan = [PlanStep("Putdown", ("r1", "c")), PlanStep("Pickup", ("r1", "b"))]
+    tasks = [[s] for s in steps_of(plan, blocks, ("r1", "r2"))]
+    progress = [TaskProgress("r1", 0, running=True), TaskProgress(None, 0)]
+    goal = [(True, ("ontable", ("c",))), (True, ("holding", ("r1", "b")))]
+    assert remaining_fits(tasks, progress, init, init, goal, ("r1", "r2")) is None
+    # b taken meanwhile: the step cannot run, whoever does it
+    taken = [f for f in init if f[1] != ("b",)]
+    assert "Pickup(b) of r1 cannot run" in remaining_fits(tasks, progress, taken, init, goal, ("r1", "r2"))
