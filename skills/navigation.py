@@ -195,7 +195,9 @@ class MoveToPosition(WorldSkill):
         heading = math.atan2(spot[1] - y, spot[0] - x)
         path = np.array([[x, y, yaw], [spot[0], spot[1], heading]])
         spec = robot.spec
-        self.follower = PathFollower(path, lookahead=0.3, max_speed=spec.max_speed * 0.5, max_yaw_rate=spec.max_yaw_rate, tolerance=0.1)
+        # turn on the spot first: driving an arc while touching something pushes into it, and the base refuses
+        self.follower = PathFollower(path, lookahead=0.3, max_speed=spec.max_speed * 0.5, max_yaw_rate=spec.max_yaw_rate, tolerance=0.1,
+                                     turn_in_place=math.radians(15.0))
         self.escaping = True
         if hasattr(robot, "bumped"):
             robot.bumped = False

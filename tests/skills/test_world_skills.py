@@ -202,3 +202,26 @@ def test_drive_to_free_space_keeps_away_from_the_blocks(blocks_world, skill_run)
     assert run.ok, run.reason
     assert nearest_block() >= 1.15 - 0.2  # the skill's goal tolerance
     assert not blocks_world.robots["r1"].bumped
+
+
+def test_an_escape_turns_on_the_spot_before_it_drives(blocks_world, skill_run):
+    # a robot pressed against something refuses any move deeper into it, turning included, so an escape that
+    # drove an arc towards free space 40 degrees off its heading stayed where it was (seed 7 of the 5-agent demo)
+    robot = blocks_world.robots["r1"]
+    cx, cy, _ = blocks_world.objects["c"].position()
+    robot.set_pose(cx - 0.3, cy, 0.0)  # right next to c
+    escapes = []
+
+    def stuck_once_then_watch(world, behaviour):
+        if getattr(behaviour, "follower", None) is None or escapes:
+            return
+        behaviour._stuck(world.now())  # as if the base had just bumped
+        x, y, _ = robot.pose
+        spot = behaviour.follower.path[-1]
+        robot.set_pose(x, y, math.atan2(spot[1] - y, spot[0] - x) + math.radians(40.0))  # free space 40 degrees to the right
+        escapes.append(behaviour.follower.command(robot.pose, 0.1))
+
+    run = skill_run("MoveToPosition", blocks_world, "r1", {"goal": [cx - 1.2, cy - 0.6]}, on_tick=stuck_once_then_watch)
+    assert run.ok, (run.reason, run.trace[-4:])
+    v, w, done = escapes[0]
+    assert v == 0.0 and w < 0.0 and not done  # it turns right on the spot first
