@@ -154,11 +154,10 @@ def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Lit
     ``f``.
     """
     tied = set(outside)
-    left = list(goal)
     grew = True
     while grew:
         grew = False
-        for literal in left:
+        for literal in goal:
             names = set(literal[1][1])
             if names & tied and not names <= tied:
                 tied |= names

@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from alica.errors import PlannerError
 from alica.io import load_library
@@ -142,3 +144,32 @@ def test_a_free_task_no_robot_could_start_at_the_start_is_run_by_its_planned_rob
     # b taken meanwhile: the step cannot run, whoever does it
     taken = [f for f in init if f[1] != ("b",)]
     assert "Pickup(b) of r1 cannot run" in remaining_fits(tasks, progress, taken, init, goal, ("r1", "r2"))
+
+
+def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
+    from prophet.world import reachable_goal
+
+    # the tower b f d g, and e alone; an opponent holds f
+    tower = [(True, ("ontable", ("b",))), (True, ("on", ("f", "b"))), (True, ("on", ("d", "f"))), (True, ("on", ("g", "d")))]
+    alone = [(True, ("ontable", ("e",)))]
+    assert reachable_goal(tower + alone, ["f"]) == tuple(alone)
+    assert reachable_goal(tower + alone, ["e"]) == tuple(tower)
+    assert reachable_goal(tower + alone, []) == tuple(tower + alone)
+    # the order of the literals does not matter
+    assert reachable_goal(list(reversed(tower)) + alone, ["g"]) == tuple(alone)
+
+
+@given(
+    st.lists(st.tuples(st.sampled_from(["on", "ontable"]), st.lists(st.sampled_from("abcdefg"), min_size=1, max_size=2)), max_size=8),
+    st.sets(st.sampled_from("abcdefg"), max_size=3),
+)
+def test_the_kept_part_of_the_goal_shares_no_object_with_the_left_out_part(raw, outside):
+    from prophet.world import reachable_goal
+
+    goal = [(True, (name, tuple(args))) for name, args in raw]
+    kept = reachable_goal(goal, outside)
+    dropped = [literal for literal in goal if literal not in kept]
+    kept_names = {a for _, (_, args) in kept for a in args}
+    assert not kept_names & set(outside)
+    assert not kept_names & {a for _, (_, args) in dropped for a in args}
+    assert [literal for literal in goal if literal in kept] == list(kept)  # in the goal's order
