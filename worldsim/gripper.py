@@ -169,8 +169,11 @@ class GripperMixin:
         c = self._client
         c.changeDynamics(obj.body_id, -1, mass=0.0 if held else obj.mass)
         c.resetBaseVelocity(obj.body_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-        if not held:
-            c.changeDynamics(obj.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
+        # Wake every resting object: one asleep on a block that is lifted away (grasped) would float in
+        # mid-air, as pybullet does not wake bodies for a kinematic re-pose of what they rest on.
+        for other in self.robot.world.objects.values():
+            if other.movable and other.mass > 0.0 and not (held and other is obj):
+                c.changeDynamics(other.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
 
 
 def _half_width(obj: WorldObject) -> float:

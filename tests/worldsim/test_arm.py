@@ -181,6 +181,21 @@ def test_a_block_put_on_another_rests_on_it(world: World, manipulator: Robot) ->
     assert ("clear", "low") not in facts
 
 
+def test_a_block_lifted_from_under_another_lets_it_fall(world: World, manipulator: Robot) -> None:
+    # the upper block has rested long enough to sleep in pybullet; lifting the lower one away must wake it
+    arm = manipulator.arm
+    x0 = arm.mount_offset[0] + 0.5
+    world.add_block("low", (x0, 0.0))
+    upper = world.add_block("upper", (x0, 0.0, 0.075))
+    world.step(5.0)
+    assert ("on", "upper", "low") in blocks_facts(world)
+    _grasp(world, manipulator, "low")
+    arm.follow(arm.home_q[None, :], 2.0)
+    world.step(3.0)
+    assert upper.position()[2] == pytest.approx(0.025, abs=3e-3)  # it fell to the ground, not floating where it was
+    assert ("ontable", "upper") in blocks_facts(world)
+
+
 def test_attach_needs_the_object_between_the_fingers(world: World, manipulator: Robot) -> None:
     arm = manipulator.arm
     world.add_block("b", (arm.mount_offset[0] + 0.5, 0.0))
