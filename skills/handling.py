@@ -333,13 +333,15 @@ class ArmSkill(WorldSkill):
         return self.running("checking the result")
 
     def _grip_or_release(self) -> str | None:
-        """Close on the object or let it go; why not, when another robot has taken the object meanwhile."""
+        """Close on the object or let it go; why not, when another robot has taken the object or put one on it meanwhile."""
         arm = self.robot.arm
         if self.grasps:
             obj = self.target_object()
             holder = next((r.name for r in self.world.robots.values() if r.arm is not None and r.arm.held is obj and r is not self.robot), None)
             if holder is not None:
                 return f"{obj.name} was taken by robot '{holder}' before the grip"
+            if getattr(obj, "kind", "") == "block" and ("clear", obj.name) not in blocks_state(self.world):
+                return f"something was put on {obj.name} before the grip"  # lifting it would throw that off
             arm.close()
             arm.attach(obj)
         else:

@@ -67,6 +67,21 @@ def test_pickup_of_a_block_hemmed_in_by_others_pushes_them_aside_on_its_last_att
     assert ("holding", "r1", "c") in blocks_facts(blocks_world)
 
 
+def test_pickup_fails_when_a_block_is_put_on_its_object_before_the_grip(blocks_world, skill_run):
+    # another robot stacks a block on c while r1's arm is on its way down: r1 does not lift c from under it
+    cx, cy, _ = blocks_world.objects["c"].position()
+    put = []
+
+    def stack_on_c(world, behaviour):
+        if getattr(behaviour, "phase", "") == "execute" and not put:
+            put.append(world.add_block("d", (cx, cy, 0.075)))
+
+    run = skill_run("Pickup", blocks_world, "r1", {"object": "c"}, on_tick=stack_on_c)
+    assert put and not run.ok
+    assert "something was put on c before the grip" in run.reason
+    assert blocks_world.robots["r1"].arm.held is None
+
+
 def test_pickup_retries_after_a_slip(blocks_world, skill_run):
     from worldsim.faults import set_grasp_slip
 
