@@ -37,6 +37,11 @@ BLOCKING_RADIUS = 1.0
 PAUSE = 2.0
 #: Default of ``action_timeout``: simulated seconds an inner skill may run.
 ACTION_TIMEOUT = 120.0
+#: Looks in a row with every applicable action blocked after which the opponent drives elsewhere for room.
+RELOCATE_AFTER = 3
+#: Free space (metres, beyond the robots' radii) around the place it then drives to: its put-down spots
+#: (about 0.65 m ahead) are then outside the other robots' blocking radius.
+RELOCATE_CLEARANCE = 1.0
 #: Default of ``step_aside``: after each action the opponent drives to a free place at least this far
 #: (metres) from every block, like the team's WaitPlan, instead of standing at the stack it worked on.
 STEP_ASIDE = 1.15
@@ -152,7 +157,11 @@ class RandomBlockSkill(WorldSkill):
     crashed or not) is within ``blocking_radius`` of one of those blocks or
     of that spot, horizontally. The choice is uniform, with
     ``context.rng``. A failed inner skill is fine: the opponent pauses and
-    chooses again. The skill never ends by itself (always RUNNING).
+    chooses again. After :data:`RELOCATE_AFTER` looks in a row with every
+    applicable action blocked, it drives to a place with
+    :data:`RELOCATE_CLEARANCE` of room (two opponents waiting side by side
+    would otherwise block each other for good, one of them holding a block).
+    The skill never ends by itself (always RUNNING).
 
     Attributes:
         chosen: the actions chosen so far, in order.
@@ -187,6 +196,7 @@ class RandomBlockSkill(WorldSkill):
         self.inner = None
         self.action = None
         self.aside: Any = None
+        self.blocked_looks = 0
         self._prepared = {}
         self.next_look = self.now()
         self.idle_message = "looking for an action"
@@ -218,9 +228,17 @@ class RandomBlockSkill(WorldSkill):
         free = self.free_actions(facts, possible)
         if not free:
             self.next_look = now + self.pause
+            self.blocked_looks = self.blocked_looks + 1 if possible else 0
+            if self.blocked_looks >= RELOCATE_AFTER and self.step_aside > 0:
+                # other robots crowd every stack and put-down spot within reach (another opponent waiting
+                # next to this one, say, each blocking the other for good): look for room elsewhere
+                self.blocked_looks = 0
+                self.aside = self._drive_aside(RELOCATE_CLEARANCE)
+                return self.running(f"all {len(possible)} applicable actions are blocked by other robots: looking for room")
             why = f"all {len(possible)} applicable actions are blocked by other robots" if possible else "no action is applicable"
             self.idle_message = f"waiting: {why}; looking again at t = {self.next_look:.1f} s"
             return self.running(self.idle_message)
+        self.blocked_looks = 0
         self.action = self.context.rng.choice(free)
         self.chosen.append(self.action)
         self._start(self.action)
@@ -280,14 +298,19 @@ class RandomBlockSkill(WorldSkill):
         self.robot.stop()
         self.next_look = self.now() + self.pause
         if self.step_aside > 0:
-            from skills.navigation import DriveToFreeSpace
-
-            context = _silent_context(self.context)
-            self.aside = DriveToFreeSpace(f"{self.name}/step aside", {"clearance": 0.4, "max_distance": 3.0, "keep_away": self.step_aside}, context)
-            self.aside.setup(context=context)
+            self.aside = self._drive_aside(0.4)
         why = f" ({reason})" if reason and outcome != "success" else ""
         self.idle_message = f"pausing after {label}: {outcome}{why}; next look at t = {self.next_look:.1f} s"
         return self.running(self.idle_message)
+
+    def _drive_aside(self, clearance: float) -> Any:
+        """A drive to a free place ``clearance`` metres from obstacles and robots, ``step_aside`` from every block."""
+        from skills.navigation import DriveToFreeSpace
+
+        context = _silent_context(self.context)
+        aside = DriveToFreeSpace(f"{self.name}/step aside", {"clearance": clearance, "max_distance": 3.0, "keep_away": self.step_aside}, context)
+        aside.setup(context=context)
+        return aside
 
     # -- blocking ---------------------------------------------------------------
 

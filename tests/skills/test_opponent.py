@@ -126,6 +126,21 @@ def test_putdown_and_stack_targets_are_checked_too():
         assert skill.free_actions() == []
 
 
+def test_an_opponent_blocked_everywhere_it_stands_drives_elsewhere_for_room():
+    # o1 holds b with r1 right beside it: every put-down spot of its reach and the stack c on a are within the
+    # blocking radius of r1; waiting there would hold b for good, so it looks for room and acts from there
+    with blocksworld(stacks=STACKS, agents=1, opponents=1) as world:
+        assert run_skill("Pickup", world, "o1", {"object": "b"}).ok
+        arm = world.robots["o1"].arm
+        x, y, _ = world.robots["o1"].pose
+        world.robots["r1"].set_pose(x + 0.55, y, 0.0)
+        run, behaviour, _ = _run(world, params={"blocking_radius": 1.6}, timeout=90.0)
+        feedback = [t["feedback"] for t in run.trace]
+        assert any("looking for room" in f for f in feedback)
+        assert behaviour.chosen and arm.held is None  # it put b somewhere at last
+        assert math.dist(world.robots["o1"].pose[:2], (x, y)) > 0.5
+
+
 def _context(world, agent, seed=0):
     import random
 
