@@ -8,6 +8,7 @@ re-posed with the end-effector by the arm every step, dynamic again after
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -31,6 +32,8 @@ GRIP_FORCE = 20.0
 #: The opening of each finger (m) when the gripper is open.
 FINGER_OPEN = 0.04
 _RELEASE_GAP = 0.005
+#: Objects within this horizontal distance (m) of one grasped or released are woken in pybullet.
+WAKE_RADIUS = 0.3
 
 
 class GripperMixin:
@@ -169,11 +172,15 @@ class GripperMixin:
         c = self._client
         c.changeDynamics(obj.body_id, -1, mass=0.0 if held else obj.mass)
         c.resetBaseVelocity(obj.body_id, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-        # Wake every resting object: one asleep on a block that is lifted away (grasped) would float in
-        # mid-air, as pybullet does not wake bodies for a kinematic re-pose of what they rest on.
+        # Wake the resting objects around it: one asleep on a block that is lifted away (grasped) would float
+        # in mid-air, as pybullet does not wake bodies for a kinematic re-pose of what they rest on. Only
+        # those within WAKE_RADIUS: woken ones stay awake for 2 s, and contacts of awake blocks cost steps.
+        x, y, _ = obj.position()
         for other in self.robot.world.objects.values():
             if other.movable and other.mass > 0.0 and not (held and other is obj):
-                c.changeDynamics(other.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
+                ox, oy, _ = other.position()
+                if other is obj or math.hypot(ox - x, oy - y) <= WAKE_RADIUS:
+                    c.changeDynamics(other.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
 
 
 def _half_width(obj: WorldObject) -> float:
