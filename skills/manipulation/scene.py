@@ -38,6 +38,7 @@ from skills.manipulation.geometry import (
     quat_from_yaw,
 )
 from skills.manipulation.robot_model import ArmModel, read_arm_model
+from worldsim._quiet import quiet_stdout
 
 log = logging.getLogger(__name__)
 
@@ -124,7 +125,8 @@ class ArmScene:
         position, orientation = as_pose(base_pose, "base_pose")
         self._margin = float(margin)
         self.rng = np.random.default_rng(seed)
-        self._c = BulletClient(connection_mode=pybullet.DIRECT)
+        with quiet_stdout():  # pybullet prints 'argv[0]=' for every client it connects
+            self._c = BulletClient(connection_mode=pybullet.DIRECT)
         try:
             self._build(path, position, orientation, obstacles, rest_q, home_q)
         except BaseException:
