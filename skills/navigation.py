@@ -188,7 +188,8 @@ class MoveToPosition(WorldSkill):
         if self.replans > MAX_REPLANS:
             return self.fail(f"stuck on the way to {self.goal} after {MAX_REPLANS} escapes")
         # free space away from the other robots too: the robot it bumped into is often one of them
-        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0, other_robots=self._others())
+        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0, other_robots=self._others(),
+                           body_radius=robot.spec.radius)
         if spot is None:
             return self.fail(f"stuck at {robot.pose[:2]} and no free space within 3 m to drive to")
         x, y, yaw = robot.pose

@@ -267,6 +267,10 @@ def _disk_hits(grid: OccupancyGrid, pts: np.ndarray, radius: float) -> bool:
     return bool((near & inside & (vals == OCCUPIED)).any())
 
 
+#: What counts as touching for :func:`escape_goal` ``body_radius``: within the radius plus this (m).
+TOUCH_MARGIN = 0.02
+
+
 def escape_goal(
     grid: OccupancyGrid,
     pose: Sequence[float],
@@ -276,6 +280,7 @@ def escape_goal(
     unknown_is_free: bool = False,
     other_robots: Iterable[Sequence[float]] = (),
     keep_away: Iterable[Sequence[float]] = (),
+    body_radius: float = 0.0,
 ) -> tuple[float, float] | None:
     """The nearest cell centre with ``clearance`` to every obstacle, for "drive into free space".
 
@@ -292,6 +297,11 @@ def escape_goal(
         other_robots: Robots ``(x, y, radius)`` to keep ``clearance`` from as well.
         keep_away: Points ``(x, y, distance)`` the cell centre must be at least ``distance`` from
             (work sites such as stacks of blocks, which a waiting robot must not crowd).
+        body_radius: The robot's radius, when it may touch something now: occupied cells and
+            other robots within this distance (plus 2 cm) of the pose are what it touches, and
+            the spots whose straight way out leads away from each of them come first (a robot
+            base refuses to push deeper into what it touches, so a straight line past it would
+            not get out); the others only when none of those can be reached.
 
     Returns:
         ``(x, y)`` or None when no such cell exists.
@@ -328,8 +338,20 @@ def escape_goal(
     cand_j, cand_i = np.nonzero(free)
     if cand_i.size == 0:
         return None
-    order = np.argsort(dist[cand_j, cand_i], kind="stable")
     occupied = window == OCCUPIED
+    rank = dist[cand_j, cand_i]
+    if body_radius > 0.0:
+        # the spots that lead away from everything the robot touches come first, the others after them
+        touch = body_radius + TOUCH_MARGIN
+        near_j, near_i = np.nonzero(occupied & (dist <= touch + 0.5 * res))
+        touched = [(float(xs[i]) - px, float(ys[j]) - py) for j, i in zip(near_j, near_i, strict=True)]
+        touched += [(rx - px, ry - py) for rx, ry, rr in check_robots(other_robots) if math.hypot(rx - px, ry - py) <= touch + rr]
+        dx, dy = xs[cand_i] - px, ys[cand_j] - py
+        towards = np.zeros(cand_i.size, dtype=bool)
+        for tx, ty in touched:
+            towards |= dx * tx + dy * ty > 0.0
+        rank = rank + towards * (2.0 * max_distance + 1.0)
+    order = np.argsort(rank, kind="stable")
     samples = math.ceil(2.0 * max_distance / res) + 2
     t = np.linspace(0.0, 1.0, samples)[None, :]
     for start in range(0, order.size, 256):

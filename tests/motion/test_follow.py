@@ -106,6 +106,30 @@ def test_escape_goal_out_of_a_corner() -> None:
     assert edge is not None and edge[0] <= 3.5 + 1e-9 and edge[1] <= 3.5 + 1e-9
 
 
+def test_escape_goal_leads_away_from_what_the_robot_touches() -> None:
+    # a base refuses any move deeper into what it touches: a robot touching a block (seed 15 of the 5-agent demo)
+    # could not take a straight line past the block to the nearest free spot, and gave up after 5 escapes
+    block = Obstacle2D("box", -0.4, 0.0, half_x=0.025, half_y=0.025)
+    rocks = [Obstacle2D("circle", x, y, radius=0.1) for x, y in [(-0.85, -0.2), (0.14, -0.75), (-0.69, 0.09)]]
+    grid = OccupancyGrid.from_obstacles([block, *rocks], (-3.0, -3.0, 3.0, 3.0), 0.05)
+    pose = (-0.3, -0.26, math.pi)  # 0.28 m from the block's centre: a base of radius 0.25 touches it
+
+    def towards_block(spot):
+        return (spot[0] - pose[0]) * (-0.4 - pose[0]) + (spot[1] - pose[1]) * (0.0 - pose[1])
+
+    nearest = escape_goal(grid, pose, 0.55, max_distance=3.0)
+    out = escape_goal(grid, pose, 0.55, max_distance=3.0, body_radius=0.25)
+    assert nearest is not None and towards_block(nearest) > -0.01  # sideways past the block
+    assert out is not None and towards_block(out) < -0.05  # away from it
+    assert math.dist(out, pose[:2]) > math.dist(nearest, pose[:2])
+    assert GridChecker(grid, 0.55, margin=0.0).valid_xy(*out)
+    # with nothing leading away, the nearest free spot still (a wall right behind the robot)
+    wall = Obstacle2D("box", -0.3, -0.6, half_x=3.0, half_y=0.05)
+    boxed = OccupancyGrid.from_obstacles([block, wall], (-3.0, -3.0, 3.0, 3.0), 0.05)
+    fallback = escape_goal(boxed, pose, 0.55, max_distance=3.0, body_radius=0.25)
+    assert fallback is not None and fallback == escape_goal(boxed, pose, 0.55, max_distance=3.0)
+
+
 def test_follower_bad_arguments() -> None:
     with pytest.raises(ValueError, match="path"):
         PathFollower(np.zeros((0, 2)))
