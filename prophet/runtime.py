@@ -60,7 +60,7 @@ from prophet.world import (
 )
 
 if TYPE_CHECKING:
-    from collections.abc import Iterator, Sequence
+    from collections.abc import Iterable, Iterator, Sequence
 
     from alica.engine.agent import AgentEngine
     from alica.engine.node import PlanNode
@@ -461,10 +461,12 @@ class ProblemRuntime:
             self._publish(PlanShare(self.key, generation, 0, self.engine.name, SEARCHING, world=world.facts, robots=world.robots,
                                     entry_task=self._entry_task(), reason=reason), now)
 
-    def _read_world(self, problem: PlanningProblem) -> PlanningWorld:
+    def _read_world(self, problem: PlanningProblem, facts: Iterable[object] | None = None) -> PlanningWorld:
+        """The planning world from the world model (``facts``: its facts, when the caller read them already)."""
         engine = self.engine
         world_model = engine.world_model
-        facts = world_model.facts() if hasattr(world_model, "facts") else ()
+        if facts is None:
+            facts = world_model.facts() if hasattr(world_model, "facts") else ()
         typed = {t: world_model.objects(t) for t in world_model.types()} if hasattr(world_model, "types") else {}
         return read_world(problem, engine.library, facts, engine.members_of(self.slot.parent), typed)
 
@@ -576,9 +578,10 @@ class ProblemRuntime:
                 progress.append(TaskProgress(None, 0))
         predicates = self._predicates()
         world_model = self.engine.world_model
-        facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in world_model.facts() if str(f[0]).lower() in predicates]
+        believed = list(world_model.facts())
+        facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in believed if str(f[0]).lower() in predicates]
         goal = goal_literals(self.problem)
-        world = self._read_world(self.problem)
+        world = self._read_world(self.problem, believed)
         reachable = reachable_goal(goal, world.outside)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)

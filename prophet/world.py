@@ -228,7 +228,7 @@ def remaining_fits(
             first = task[where.next_step]
             planned = first.robot  # type: ignore[attr-defined]
             options = [planned, *(r for r in robots if r != planned)]
-            own = [{(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options]
+            own = ({(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options)
             mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]  # type: ignore[attr-defined]
             fresh = next((facts for facts in own if holds(mine, facts)), None)
             if fresh is None:

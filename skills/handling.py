@@ -414,21 +414,25 @@ class ArmSkill(WorldSkill):
         followed = getattr(self, "followed", [])
         if followed:
             last = followed[-1]
-            k = int(np.argmin(np.abs(last - q).max(axis=1)))  # how far along its last path the arm got
+            k = _reached(last, q)
             way = [last[: k + 1][::-1], *(path[::-1] for path in reversed(followed[:-1]))]
         elif getattr(self, "released", False):
             steps, index = self.steps, self.step_index
             way = [np.asarray(step, dtype=float) for step in steps[index:] if not isinstance(step, str)]
             current = steps[index - 1] if 0 < index <= len(steps) and not isinstance(steps[index - 1], str) else None
             if current is not None and arm.busy:
-                k = int(np.argmin(np.abs(np.asarray(current) - q).max(axis=1)))  # the rest of the path it was on
-                way.insert(0, np.asarray(current, dtype=float)[k:])
+                way.insert(0, np.asarray(current, dtype=float)[_reached(current, q):])  # the rest of the path it was on
         else:
             way = []
         self.followed = []
         if way:
             arm.stop()
             arm.follow(np.vstack(way))
+
+
+def _reached(path: Any, q: np.ndarray) -> int:
+    """The waypoint of ``path`` closest to the configuration ``q``: how far along the path the arm got."""
+    return int(np.argmin(np.abs(np.asarray(path, dtype=float) - q).max(axis=1)))
 
 
 def _xy_text(xy: tuple[float, float]) -> str:

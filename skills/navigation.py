@@ -244,10 +244,9 @@ class DriveToFreeSpace(MoveToPosition):
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
         away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
         grid = planning_grid(self.world)
-        others = [(r.pose[0], r.pose[1], r.spec.radius) for r in self.world.robots.values() if r is not self.robot]
         lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
         sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
-        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=others, keep_away=sites)
+        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=self._others(), keep_away=sites)
         self.spot = spot
         self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
         self.params.setdefault("tolerance", 0.2)

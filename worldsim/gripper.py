@@ -179,7 +179,7 @@ class GripperMixin:
         for other in self.robot.world.objects.values():
             if other.movable and other.mass > 0.0 and not (held and other is obj):
                 ox, oy, _ = other.position()
-                if other is obj or math.hypot(ox - x, oy - y) <= WAKE_RADIUS:
+                if math.hypot(ox - x, oy - y) <= WAKE_RADIUS:
                     c.changeDynamics(other.body_id, -1, activationState=c.ACTIVATION_STATE_WAKE_UP)
 
 
