@@ -30,7 +30,7 @@ OUT = ROOT / "build" / "bench"
 
 def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
     """One demo run in a fresh process; its JSON summary (``error`` set when it did not run)."""
-    argv = [sys.executable, "-m", "alica.cli", "demo", "blocksworld", "--agents", str(agents), "--opponents", str(opponents),
+    argv = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", str(agents), "--opponents", str(opponents),
             "--blocks", str(blocks), "--seed", str(seed), "--time-limit", str(time_limit), "--json", "--no-progress"]
     started = time.perf_counter()
     done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=time_limit * 4 + 120)

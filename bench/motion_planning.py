@@ -5,7 +5,7 @@
 apart in free space, the same queries for every planner. Goals for ours: median first
 solution at most 1 ms (60 rocks) and 15 ms (150 rocks).
 
-* ours: :func:`skills.motion.plan_path` on a prepared :class:`GridChecker` (grid inflated
+* ours: :func:`alica.skills.motion.plan_path` on a prepared :class:`GridChecker` (grid inflated
   by radius + margin), SE2 RRTConnect with the numpy :class:`SegmentValidator`;
   ``first`` is its RRTConnect search alone, ``total`` the whole call with simplification.
 * peer: the same RRTConnect set-up with an :class:`FclChecker` as the state validity
@@ -31,8 +31,8 @@ import numpy as np
 from ompl import base as ob
 from ompl import geometric as og
 
-from skills.motion import FclChecker, GridChecker, configure_ompl, plan_path
-from worldsim.grid import Obstacle2D, OccupancyGrid
+from alica.skills.motion import FclChecker, GridChecker, configure_ompl, plan_path
+from alica.worldsim.grid import Obstacle2D, OccupancyGrid
 
 BOUNDS = (-20.0, -20.0, 20.0, 20.0)
 RADIUS = 0.5

@@ -3,17 +3,17 @@
 Every problem runs as a whole process, one at a time by default (the machine has 2
 cores; timings must not compete), with a wall limit (60 s):
 
-* ours: ``python -m alica.cli plan DOMAIN PROBLEM --json --time-limit 60``;
+* ours: ``python -m alica.app.cli plan DOMAIN PROBLEM --json --time-limit 60``;
 * Fast Downward 26.6 from PyPI ``up-fast-downward``: its driver with ``--alias lama-first``;
 * pyperplan (PyPI ``pyperplan``, a peer only, installed for the bench):
   ``python -m pyperplan -s gbf -H hff`` on copies of the files (it writes ``PROBLEM.soln``
   next to the problem);
 * ours again after an anytime budget (``--anytime --time-limit 10``) on the blocks problems
   with a proven optimum (``optimal_costs.tsv``) and on Rovers p01-p20;
-* the grounding alone (:func:`prophet.ground.ground`, after parsing) on Rovers p18-p20 in a
+* the grounding alone (:func:`alica.prophet.ground.ground`, after parsing) on Rovers p18-p20 in a
   fresh process each, the median of 3.
 
-Every plan, ours and the peers', is validated with :func:`prophet.validate.validate_plan`;
+Every plan, ours and the peers', is validated with :func:`alica.prophet.validate.validate_plan`;
 an invalid plan counts as unsolved. Times are whole-process wall seconds. The tables
 (markdown on standard output, TSV in ``build/bench/``): coverage per domain; Rovers
 p01-p20 total time, ours vs Fast Downward (goal: at most 2x); per-problem cost on Rovers
@@ -46,11 +46,11 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from prophet.pddl import Domain, read_domain, read_problem
-from prophet.planner import PlanStep
-from prophet.planners.fd import find_driver
-from prophet.planners.planfile import parse_plan
-from prophet.validate import validate_plan
+from alica.prophet.pddl import Domain, read_domain, read_problem
+from alica.prophet.planner import PlanStep
+from alica.prophet.planners.fd import find_driver
+from alica.prophet.planners.planfile import parse_plan
+from alica.prophet.validate import validate_plan
 
 BENCHMARKS = ROOT / "benchmarks" / "pddl"
 OUT = ROOT / "build" / "bench"
@@ -153,7 +153,7 @@ def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Out
     command = [
         sys.executable,
         "-m",
-        "alica.cli",
+        "alica.app.cli",
         "plan",
         str(job.domain_file),
         str(job.problem_file),
@@ -432,8 +432,8 @@ def rovers_cost_table(
 
 GROUND_SCRIPT = """
 import json, statistics, sys, time
-from prophet.ground import ground
-from prophet.pddl import read_domain, read_problem
+from alica.prophet.ground import ground
+from alica.prophet.pddl import read_domain, read_problem
 domain = read_domain(sys.argv[1])
 problem = read_problem(sys.argv[2], domain)
 times = []

@@ -1,6 +1,6 @@
 """Simulation speed of the lunar scenario: real-time factor with 3 robots driving and one arm moving (goal: >= 20x).
 
-Each setting builds ``worldsim.scenarios.lunar`` (60 rocks, 2 samples, seed 0),
+Each setting builds ``alica.worldsim.scenarios.lunar`` (60 rocks, 2 samples, seed 0),
 then simulates ``--seconds`` seconds in 0.1 s chunks (as a 10 Hz skill loop
 would): scout, stummel and amparo drive circles of 1 m radius in the start
 area (commands re-sent every chunk) while stummel's Panda follows a 7-joint
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet_data
 
-from worldsim._quiet import quiet_stdout
-from worldsim.scenarios import lunar
-from worldsim.world import World
+from alica.worldsim._quiet import quiet_stdout
+from alica.worldsim.scenarios import lunar
+from alica.worldsim.world import World
 
 CHUNK = 0.1
 V, W = 0.4, 0.4  # 1 m turning circles

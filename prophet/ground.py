@@ -12,7 +12,7 @@ Those ``not-`` facts and when-effects need a second, ground relaxed exploration
 Rovers) skips it, since the fixpoint's exploration is then exact. The garbage
 collector is paused while grounding (many objects, no cycles).
 
->>> from prophet.pddl import parse_domain, parse_problem
+>>> from alica.prophet.pddl import parse_domain, parse_problem
 >>> d = parse_domain("(define (domain d) (:predicates (p ?x) (q ?x)) (:action a :parameters (?x) :precondition (p ?x) :effect (q ?x)))")
 >>> task = ground(d, parse_problem("(define (problem x) (:domain d) (:objects o) (:init (p o)) (:goal (q o)))", domain=d))
 >>> [op.name for op in task.operators], task.facts
@@ -27,10 +27,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from operator import itemgetter
 
-from prophet.pddl import Domain, PddlError, Problem
-from prophet.pddl.model import Equals
-from prophet.pddl.normal import dnf, expand
-from prophet.pddl.reach import Fixpoint, GroundAction, fact_text
+from alica.prophet.pddl import Domain, PddlError, Problem
+from alica.prophet.pddl.model import Equals
+from alica.prophet.pddl.normal import dnf, expand
+from alica.prophet.pddl.reach import Fixpoint, GroundAction, fact_text
 
 Fact = tuple[str, ...]
 

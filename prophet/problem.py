@@ -129,7 +129,7 @@ def offline_world(problem: PlanningProblem) -> tuple[dict[str, str], list[Fact]]
 
 def to_pddl(problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]) -> tuple[object, object]:
     """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world."""
-    from prophet.pddl import parse_domain, parse_problem
+    from alica.prophet.pddl import parse_domain, parse_problem
 
     domain = parse_domain(domain_text(problem, library), file=f"<{problem.name} domain>")
     pddl_problem = parse_problem(problem_text(problem, objects, facts), file=f"<{problem.name} problem>")

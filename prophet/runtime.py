@@ -6,13 +6,13 @@ gets a :class:`ProblemRuntime` for it, which says which plan the child runs:
 * **WaitPlan** until a plan is shared, and again while the leader replans;
 * the **generated plan** of the latest :class:`PlanShare`: every agent turns
   the shared single-agent plan into the same multi-agent plan with
-  :func:`prophet.tasks.create_tasks`, and the team switches to it through the
+  :func:`alica.prophet.tasks.create_tasks`, and the team switches to it through the
   normal allocation;
 * the **AlternativePlan** when the planner failed, proved the goal
   unreachable, or found nothing within the problem's ``timeout``.
 
 The **leader** is the lowest alive agent in the state; when it crashes the
-next lowest takes over. The leader reads World (:func:`prophet.world.read_world`),
+next lowest takes over. The leader reads World (:func:`alica.prophet.world.read_world`),
 runs the planner as an anytime search, a budget per tick
 (``EngineConfig.planner_expansions``), and shares:
 
@@ -22,7 +22,7 @@ runs the planner as an anytime search, a budget per tick
 * ``failed`` (AlternativePlan) or ``done`` (the goal holds already).
 
 While robots outside the team hold objects of the goal (an opponent holds a
-block), the leader plans for the rest of the goal (:func:`prophet.world.reachable_goal`),
+block), the leader plans for the rest of the goal (:func:`alica.prophet.world.reachable_goal`),
 and the execution check leaves out the goal literals on objects held
 outside. A plan for part of the goal runs to its end; then the leader plans
 for what is left, or, with nothing left to plan for, the team waits in the
@@ -30,7 +30,7 @@ WaitPlan until the world changes.
 
 Every UpdateTime it repeats its latest share (for agents that come late) and,
 while the team executes, checks that what is left of the plan still reaches
-the goal from the current world (:func:`prophet.world.remaining_fits`); twice
+the goal from the current world (:func:`alica.prophet.world.remaining_fits`); twice
 in a row not, it replans. A step that fails sends its agent back to the
 WaitPlan and asks the leader to replan (:class:`ReplanRequest`); so does a
 change of goal or world by the operator (:meth:`AgentEngine.set_problem`).
@@ -47,10 +47,10 @@ from alica.engine.status import ChildStatus
 from alica.engine.team import PlanKey, key_text
 from alica.errors import AlicaError, PlannerError
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
-from prophet.planner import Done, Improved, PlanStatus, PlanStep
-from prophet.planner import Plan as StepPlan
-from prophet.tasks import STEP_DONE, CreatedTasks, conjunction, create_tasks, holds, state_step, step_token
-from prophet.world import (
+from alica.prophet.planner import Done, Improved, PlanStatus, PlanStep
+from alica.prophet.planner import Plan as StepPlan
+from alica.prophet.tasks import STEP_DONE, CreatedTasks, conjunction, create_tasks, holds, state_step, step_token
+from alica.prophet.world import (
     PlanningWorld,
     TaskProgress,
     goal_literals,
@@ -65,7 +65,7 @@ if TYPE_CHECKING:
     from alica.engine.agent import AgentEngine
     from alica.engine.node import PlanNode
     from alica.engine.slot import Slot
-    from prophet.planner import SearchEvent
+    from alica.prophet.planner import SearchEvent
 
 Fact = tuple[str, tuple[str, ...]]
 Literal = tuple[bool, Fact]
@@ -417,8 +417,8 @@ class ProblemRuntime:
         return max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
-        from prophet.planners import get_planner
-        from prophet.problem import to_pddl
+        from alica.prophet.planners import get_planner
+        from alica.prophet.problem import to_pddl
 
         engine = self.engine
         if generation is None:
@@ -530,7 +530,7 @@ class ProblemRuntime:
     def _predicates(self) -> dict[str, tuple[str, ...]]:
         """The domain's predicates (they depend on the problem's elements only), worked out once."""
         if self.predicates is None:
-            from prophet.problem import predicate_types
+            from alica.prophet.problem import predicate_types
 
             self.predicates = predicate_types(self.model, self.engine.library)
         return self.predicates
@@ -543,7 +543,7 @@ class ProblemRuntime:
         return any(state is not None and "_S" in state for _, state in node.believed.values())
 
     def _share_plan(self, now: float, search: _Search, plan: StepPlan) -> None:
-        from prophet.validate import validate_plan
+        from alica.prophet.validate import validate_plan
 
         result = validate_plan((search.domain, search.problem), plan)
         if not result.valid:

@@ -64,7 +64,7 @@ from alica.model import (
     Transition,
     UtilityFunction,
 )
-from prophet.planner import PlanStep
+from alica.prophet.planner import PlanStep
 
 Fact = tuple[str, tuple[str, ...]]
 #: The robot parameter of skill signatures: the agent that runs the skill.

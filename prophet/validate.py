@@ -2,7 +2,7 @@
 
 On a (domain, problem) pair the plan is checked at the lifted level (action
 names, argument types, preconditions as formulas, conditional effects, costs
-read from ``:init``); on a :class:`prophet.ground.GroundTask` it is checked on
+read from ``:init``); on a :class:`alica.prophet.ground.GroundTask` it is checked on
 the ground operators.
 """
 
@@ -12,8 +12,8 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from prophet.ground import GroundTask
-from prophet.pddl.model import (
+from alica.prophet.ground import GroundTask
+from alica.prophet.pddl.model import (
     OBJECT,
     And,
     Atom,
@@ -31,8 +31,8 @@ from prophet.pddl.model import (
     Problem,
     When,
 )
-from prophet.pddl.normal import substitute
-from prophet.planner import Plan, PlanStep
+from alica.prophet.pddl.normal import substitute
+from alica.prophet.planner import Plan, PlanStep
 
 
 @dataclass(frozen=True, slots=True)

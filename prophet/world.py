@@ -28,8 +28,8 @@ from dataclasses import dataclass
 from alica.errors import AlicaError, PlannerError
 from alica.lang import literals
 from alica.model import PlanLibrary, PlanningProblem
-from prophet.problem import offline_world, predicate_types
-from prophet.tasks import apply_effect, for_robot, holds
+from alica.prophet.problem import offline_world, predicate_types
+from alica.prophet.tasks import apply_effect, for_robot, holds
 
 Fact = tuple[str, tuple[str, ...]]
 Literal = tuple[bool, Fact]
@@ -203,7 +203,7 @@ def remaining_fits(
     """Whether what is left of a generated plan still reaches the goal from ``facts``.
 
     Args:
-        tasks: the steps of each task (:class:`prophet.tasks.Step`).
+        tasks: the steps of each task (:class:`alica.prophet.tasks.Step`).
         progress: one entry per task.
         facts: the facts that hold now.
         start_world: the world the plan was made from (gives a fresh robot's facts).

@@ -1,10 +1,10 @@
 """Robot skills as py_trees behaviours.
 
 Importing this package loads only the skill *declarations* (names and
-parameters, :mod:`skills.catalog`), never pybullet or OMPL; implementations
+parameters, :mod:`alica.skills.catalog`), never pybullet or OMPL; implementations
 are imported by name when a skill is instantiated.
 """
 
-from skills.registry import ParamSpec, SkillRegistry, SkillSpec, default_registry
+from alica.skills.registry import ParamSpec, SkillRegistry, SkillSpec, default_registry
 
 __all__ = ["ParamSpec", "SkillRegistry", "SkillSpec", "default_registry"]

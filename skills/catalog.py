@@ -21,7 +21,7 @@ words under ``requires`` (``base``, ``arm``, ``gripper``, ``lidar2d``,
 
 from __future__ import annotations
 
-from skills.registry import ParamSpec, SkillRegistry
+from alica.skills.registry import ParamSpec, SkillRegistry
 
 
 def _p(name: str, type: str, doc: str, *, default: object = None, required: bool | None = None) -> ParamSpec:
@@ -39,7 +39,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("timeout", "float", "seconds before the skill gives up", default=60.0),
         doc="drive to a goal position, escaping into free space when stuck (Fig. 8)",
         capabilities=("base",),
-        implementation="skills.navigation:MoveToPosition",
+        implementation="alica.skills.navigation:MoveToPosition",
     )
     registry.declare(
         "Pickup",
@@ -47,7 +47,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("retries", "int", "grasp attempts before the skill fails", default=3),
         doc="align with an object, grasp it, lift it to the transport pose and check the grip (Fig. 15)",
         capabilities=("base", "arm", "gripper"),
-        implementation="skills.handling:Pickup",
+        implementation="alica.skills.handling:Pickup",
     )
     registry.declare(
         "Putdown",
@@ -55,7 +55,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("target", "position", "where to place it: a position or a term such as pos(g); by default in front of the robot", required=False),
         doc="place the held object, open the gripper, stow the arm and check the placement (Fig. 16)",
         capabilities=("arm", "gripper"),
-        implementation="skills.handling:Putdown",
+        implementation="alica.skills.handling:Putdown",
     )
     registry.declare(
         "Stack",
@@ -63,7 +63,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("target", "object", "the block to place it on"),
         doc="put the held block on top of another block",
         capabilities=("base", "arm", "gripper"),
-        implementation="skills.handling:Stack",
+        implementation="alica.skills.handling:Stack",
     )
     registry.declare(
         "Unstack",
@@ -71,7 +71,7 @@ def _composite(registry: SkillRegistry) -> None:
         _p("from", "object", "the block it currently lies on"),
         doc="take the top block off a stack and hold it",
         capabilities=("base", "arm", "gripper"),
-        implementation="skills.handling:Unstack",
+        implementation="alica.skills.handling:Unstack",
     )
     registry.declare(
         "Explore",
@@ -90,7 +90,7 @@ def _navigation(registry: SkillRegistry) -> None:
         _p("timeout", "float", "seconds without progress before the skill fails", default=60.0),
         doc="follow a collision-free path to a goal; fails when stuck",
         capabilities=("base",),
-        implementation="skills.navigation:MoveToPosition",
+        implementation="alica.skills.navigation:MoveToPosition",
     )
     registry.declare(
         "DriveToFreeSpace",
@@ -99,7 +99,7 @@ def _navigation(registry: SkillRegistry) -> None:
         _p("keep_away", "float", "distance in metres to keep from every block or sample lying in the world (0: none)", default=0.0),
         doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
         capabilities=("base",),
-        implementation="skills.navigation:DriveToFreeSpace",
+        implementation="alica.skills.navigation:DriveToFreeSpace",
     )
     registry.declare(
         "Localize",
@@ -125,7 +125,7 @@ def _navigation(registry: SkillRegistry) -> None:
         "Idle",
         _p("duration", "float", "seconds to wait before succeeding; 0 waits until the state is left", default=0.0),
         doc="stand still",
-        implementation="skills.navigation:Idle",
+        implementation="alica.skills.navigation:Idle",
     )
 
 
@@ -183,7 +183,7 @@ def _manipulation(registry: SkillRegistry) -> None:
         _p("step_aside", "float", "after each action, drive to a free place at least this many metres from every block (0: stay)", default=1.15),
         doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking, forever",
         capabilities=("base", "arm", "gripper"),
-        implementation="skills.opponent:RandomBlockSkill",
+        implementation="alica.skills.opponent:RandomBlockSkill",
     )
 
 

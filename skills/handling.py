@@ -5,7 +5,7 @@ Each skill runs the same phases, polled tick by tick:
 1. **approach**: if the work site is out of the arm's reach, drive to a
    stand-off point facing it (an inner :class:`MoveToPosition`), then turn to it;
 2. **plan**: a job plans the arm motion on the robot's own planning scene
-   (:mod:`skills.manipulation`: IK with joint-limit checks and random
+   (:mod:`alica.skills.manipulation`: IK with joint-limit checks and random
    restarts, OMPL joint-space paths with collision checks, the held object
    included);
 3. **execute**: the arm follows the paths in simulated time; the gripper
@@ -29,9 +29,9 @@ from typing import Any
 import numpy as np
 from py_trees.common import Status
 
-from skills.navigation import MoveToPosition
-from skills.world_skill import WorldSkill, distance, world_cache
-from worldsim.geometry import wrap_angle
+from alica.skills.navigation import MoveToPosition
+from alica.skills.world_skill import WorldSkill, distance, world_cache
+from alica.worldsim.geometry import wrap_angle
 
 #: Horizontal distance from the arm's base at which the arm works best.
 REACH = 0.55
@@ -55,8 +55,8 @@ SIDE_TRIED = 0.2
 
 def _box(obj: Any) -> Any:
     """An object as a box for arm planning: its own extents and yaw for boxes, else its bounding box."""
-    from skills.manipulation import Box
-    from skills.manipulation.geometry import upright_box
+    from alica.skills.manipulation import Box
+    from alica.skills.manipulation.geometry import upright_box
 
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
     half = tuple(getattr(obj, "half_extents", (0.0, 0.0, 0.0)))
@@ -90,7 +90,7 @@ def _duration(path: np.ndarray) -> float:
 
 def blocks_state(world: Any) -> set[tuple[object, ...]]:
     """The IPC blocks facts of the simulated state."""
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     return set(blocks_facts(world))
 
@@ -125,13 +125,13 @@ class ArmSkill(WorldSkill):
 
     def plan(self, scene: Any, q: np.ndarray, rng: np.random.Generator) -> Any:
         """The arm plan, run as a job: grasp and lift, or place at :meth:`place_top` and retreat."""
-        from skills.manipulation import plan_pickup, plan_place
+        from alica.skills.manipulation import plan_pickup, plan_place
 
         if self.grasps:
             obj = self.target_object()
             shape = "cylinder" if getattr(obj, "kind", "") == "sample" else "box"
             return plan_pickup(scene, _box(obj), q, rng=rng, kind=shape)
-        from skills.manipulation import held_box
+        from alica.skills.manipulation import held_box
 
         held = held_box(_box(self.target_object()), scene.fk(q))  # the object in the tool's frame
         return plan_place(scene, held, self.place_top(), q, rng=rng)
@@ -224,7 +224,7 @@ class ArmSkill(WorldSkill):
         Points overlapping another robot or an object (with a margin) are skipped;
         ``None`` when every side is taken (the skill waits and looks again).
         """
-        from skills.navigation import planning_checker
+        from alica.skills.navigation import planning_checker
 
         robot = self.robot
         x, y, _ = robot.pose
@@ -248,7 +248,7 @@ class ArmSkill(WorldSkill):
         return any(distance(xy, side) < SIDE_TRIED for side in self.tried_sides)
 
     def _scene(self) -> Any:
-        from skills.manipulation import ArmScene
+        from alica.skills.manipulation import ArmScene
 
         cache = world_cache(self.world)
         key = f"arm-scene:{self.robot.name}"
@@ -283,7 +283,7 @@ class ArmSkill(WorldSkill):
         """What the arm holds, as a box in the tool's frame (None when grasping)."""
         if self.grasps:
             return None
-        from skills.manipulation import held_box
+        from alica.skills.manipulation import held_box
 
         try:
             return held_box(_box(self.target_object()), scene.fk(q))
@@ -450,7 +450,7 @@ def putdown_spots(world: Any, robot: Any) -> list[tuple[float, float]]:
 
     Only spots with :data:`PUTDOWN_ROOM` free of objects and other robots are listed.
     """
-    from worldsim.queries import blocker
+    from alica.worldsim.queries import blocker
 
     x, y, yaw = robot.pose
     ahead = REACH + _mount_ahead(robot)

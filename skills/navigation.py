@@ -1,7 +1,7 @@
 """Driving skills: MoveToPosition (and its primitive DriveTo), DriveToFreeSpace, Idle.
 
 MoveToPosition plans in SE2 with OMPL on the world's occupancy grid, inflated
-by the robot's radius (:func:`skills.motion.plan_path`), checks the path
+by the robot's radius (:func:`alica.skills.motion.plan_path`), checks the path
 exactly with FCL against the rocks' meshes and the other robots, follows it,
 replans when another robot or a new obstacle blocks it, and when the robot is
 stuck (bumped, or no progress) drives into free space first. Planning runs as
@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from py_trees.common import Status
 
-from skills.world_skill import WorldSkill, distance, world_cache
+from alica.skills.world_skill import WorldSkill, distance, world_cache
 
 #: Replans (after being stuck or blocked) before MoveToPosition gives up.
 MAX_REPLANS = 5
@@ -24,7 +24,7 @@ MAX_REPLANS = 5
 
 def planning_grid(world: Any) -> Any:
     """The world's static obstacles as an occupancy grid (5 cm cells), built once per world layout."""
-    from worldsim.grid import OccupancyGrid
+    from alica.worldsim.grid import OccupancyGrid
 
     cache = world_cache(world)
     obstacles = tuple(world.ground_truth_obstacles())
@@ -41,7 +41,7 @@ def exact_checker(world: Any, radius: float) -> Any:
 
     The final exact check of a path; movable objects (blocks, samples, held or not) are left to the grid.
     """
-    from skills.motion import FclChecker
+    from alica.skills.motion import FclChecker
 
     planning_grid(world)  # drops stale checkers when the layout changed
     checkers = world_cache(world).setdefault("exact", {})
@@ -59,8 +59,8 @@ def exact_checker(world: Any, radius: float) -> Any:
 
 
 def planning_checker(world: Any, radius: float) -> Any:
-    """The grid inflated for a robot of ``radius`` (a :class:`skills.motion.GridChecker`), built once per radius."""
-    from skills.motion import GridChecker
+    """The grid inflated for a robot of ``radius`` (a :class:`alica.skills.motion.GridChecker`), built once per radius."""
+    from alica.skills.motion import GridChecker
 
     grid = planning_grid(world)
     checkers = world_cache(world).setdefault("checkers", {})
@@ -96,7 +96,7 @@ class MoveToPosition(WorldSkill):
         return [(r.pose[0], r.pose[1], r.spec.radius) for name, r in sorted(self.world.robots.items()) if r is not self.robot]
 
     def _plan(self, goal: tuple[float, float]) -> None:
-        from skills.motion import plan_path
+        from alica.skills.motion import plan_path
 
         checker = planning_checker(self.world, self.robot.spec.radius)
         exact = exact_checker(self.world, self.robot.spec.radius)
@@ -145,7 +145,7 @@ class MoveToPosition(WorldSkill):
         return self.running(f"driving to {self.goal}")
 
     def _poll_plan(self, now: float) -> Status:
-        from skills.motion import PathFollower
+        from alica.skills.motion import PathFollower
 
         if self.job is None:
             if now < self.wait_until:
@@ -180,7 +180,7 @@ class MoveToPosition(WorldSkill):
         return self.running("path found")
 
     def _stuck(self, now: float) -> Status:
-        from skills.motion import PathFollower, escape_goal
+        from alica.skills.motion import PathFollower, escape_goal
 
         robot = self.robot
         robot.stop()
@@ -238,7 +238,7 @@ class DriveToFreeSpace(MoveToPosition):
 
     def initialise(self) -> None:
         """Find the free place, then drive there like MoveToPosition."""
-        from skills.motion import escape_goal
+        from alica.skills.motion import escape_goal
 
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]

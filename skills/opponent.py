@@ -1,10 +1,10 @@
 """The opponents' skill of the blocks-world demo (IMPERA Section 8.2, Fig. 22): disturb the stacks at random.
 
 :class:`RandomBlockSkill` runs forever. Whenever it is idle it reads the
-simulated state (:func:`worldsim.scenarios.blocks_facts`), lists the IPC
+simulated state (:func:`alica.worldsim.scenarios.blocks_facts`), lists the IPC
 actions its robot could do now, drops those touching a stack that another
 robot stands near, draws one with the agent's seeded generator and runs the
-matching skill of :mod:`skills.handling` as an inner behaviour, then pauses.
+matching skill of :mod:`alica.skills.handling` as an inner behaviour, then pauses.
 Opponents write nothing to the world model: what they do shows in the
 simulated state only.
 """
@@ -22,8 +22,8 @@ from typing import Any
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from skills.world_skill import WorldSkill
-from worldsim.errors import WorldError
+from alica.skills.world_skill import WorldSkill
+from alica.worldsim.errors import WorldError
 
 __all__ = ["BlockAction", "RandomBlockSkill", "applicable_actions", "stack_of"]
 
@@ -85,7 +85,7 @@ def applicable_actions(facts: Facts, robot: str) -> list[BlockAction]:
     clear block.
 
     Args:
-        facts: IPC facts as :func:`worldsim.scenarios.blocks_facts` gives them.
+        facts: IPC facts as :func:`alica.worldsim.scenarios.blocks_facts` gives them.
         robot: the robot's name.
     """
     clear = {f[1] for f in facts if f[0] == "clear"}
@@ -123,7 +123,7 @@ def _silent_context(context: Any) -> Any:
 
 
 def _skill_class(name: str) -> Any:
-    from skills import handling
+    from alica.skills import handling
 
     return {"Pickup": handling.Pickup, "Unstack": handling.Unstack, "Putdown": handling.Putdown, "Stack": handling.Stack}[name]
 
@@ -131,7 +131,7 @@ def _skill_class(name: str) -> Any:
 @functools.cache
 def _catalog_defaults(skill: str) -> tuple[tuple[str, object], ...]:
     """The optional parameters of ``skill`` in the catalog, with their defaults."""
-    from skills.registry import default_registry
+    from alica.skills.registry import default_registry
 
     return tuple((p.name, p.default) for p in default_registry().get(skill).params if not p.required)
 
@@ -144,7 +144,7 @@ def _catalog_params(skill: str, given: Mapping[str, object]) -> dict[str, object
 class RandomBlockSkill(WorldSkill):
     """An opponent: forever picks a random applicable blocks-world action no other robot blocks, and runs it.
 
-    Parameters (see :mod:`skills.catalog`): ``blocking_radius`` (default
+    Parameters (see :mod:`alica.skills.catalog`): ``blocking_radius`` (default
     :data:`BLOCKING_RADIUS`, 1.0 m: a robot working at a stack stands about
     0.7 m from it, so the catalog's earlier 0.5 m never blocked anything),
     ``pause`` (:data:`PAUSE`), ``action_timeout`` (:data:`ACTION_TIMEOUT`) and
@@ -257,7 +257,7 @@ class RandomBlockSkill(WorldSkill):
         return sorted(a for a in candidates if not self._blocked(a, facts))
 
     def _facts(self) -> Facts:
-        from worldsim.scenarios import blocks_facts
+        from alica.worldsim.scenarios import blocks_facts
 
         return set(blocks_facts(self.world))
 
@@ -305,7 +305,7 @@ class RandomBlockSkill(WorldSkill):
 
     def _drive_aside(self, clearance: float) -> Any:
         """A drive to a free place ``clearance`` metres from obstacles and robots, ``step_aside`` from every block."""
-        from skills.navigation import DriveToFreeSpace
+        from alica.skills.navigation import DriveToFreeSpace
 
         context = _silent_context(self.context)
         aside = DriveToFreeSpace(f"{self.name}/step aside", {"clearance": clearance, "max_distance": 3.0, "keep_away": self.step_aside}, context)
@@ -341,11 +341,11 @@ class RandomBlockSkill(WorldSkill):
         return float(spot[0]), float(spot[1])
 
     def _free_spot(self) -> tuple[float, float] | None:
-        """The first spot Putdown could use (:func:`skills.handling.putdown_spots`) that no other robot blocks.
+        """The first spot Putdown could use (:func:`alica.skills.handling.putdown_spots`) that no other robot blocks.
 
         ``None`` when there is none: Putdown then picks its own spot (and the action is blocked there).
         """
-        from skills.handling import putdown_spots
+        from alica.skills.handling import putdown_spots
 
         return next((spot for spot in putdown_spots(self.world, self.robot) if not self._crowded(spot)), None)
 

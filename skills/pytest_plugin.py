@@ -2,7 +2,7 @@
 
 * ``lunar_world``: a small lunar field (seed 0, 20 rocks) with scout, stummel and amparo;
 * ``blocks_world``: a blocks world with the stacks ``[["a", "b"], ["c"]]`` and two manipulators;
-* ``skill_run``: :func:`skills.testing.run_skill`.
+* ``skill_run``: :func:`alica.skills.testing.run_skill`.
 
 Worlds are closed after each test.
 """
@@ -18,7 +18,7 @@ import pytest
 @pytest.fixture
 def lunar_world() -> Iterator[Any]:
     """A small lunar world (needs pybullet)."""
-    from worldsim.scenarios import lunar
+    from alica.worldsim.scenarios import lunar
 
     world = lunar(seed=0, rocks=20)
     try:
@@ -30,7 +30,7 @@ def lunar_world() -> Iterator[Any]:
 @pytest.fixture
 def blocks_world() -> Iterator[Any]:
     """A blocks world: b on a, c alone, robots r1 and r2 (needs pybullet)."""
-    from worldsim.scenarios import blocksworld
+    from alica.worldsim.scenarios import blocksworld
 
     world = blocksworld([["a", "b"], ["c"]], agents=2, seed=0)
     try:
@@ -41,7 +41,7 @@ def blocks_world() -> Iterator[Any]:
 
 @pytest.fixture
 def skill_run() -> Callable[..., Any]:
-    """:func:`skills.testing.run_skill`."""
-    from skills.testing import run_skill
+    """:func:`alica.skills.testing.run_skill`."""
+    from alica.skills.testing import run_skill
 
     return run_skill

@@ -185,7 +185,7 @@ class SkillRegistry:
 
 def default_registry() -> SkillRegistry:
     """A fresh registry holding every skill the library declares."""
-    from skills.catalog import declare_all
+    from alica.skills.catalog import declare_all
 
     registry = SkillRegistry()
     declare_all(registry)

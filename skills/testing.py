@@ -2,14 +2,14 @@
 
 Example::
 
-    from worldsim.scenarios import lunar
-    from skills.testing import run_skill
+    from alica.worldsim.scenarios import lunar
+    from alica.skills.testing import run_skill
 
     with lunar(seed=1, rocks=20) as world:
         run = run_skill("MoveToPosition", world, "scout", {"goal": [5.0, 5.0]})
         assert run.status == "success", run.reason
 
-With pytest, the fixtures of :mod:`skills.pytest_plugin` (``lunar_world``,
+With pytest, the fixtures of :mod:`alica.skills.pytest_plugin` (``lunar_world``,
 ``blocks_world``, ``skill_run``) are available in every test.
 """
 
@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from alica.errors import SkillError
-from skills.registry import SkillRegistry, default_registry
+from alica.skills.registry import SkillRegistry, default_registry
 
 
 @dataclass(slots=True)

@@ -4,7 +4,7 @@ A skill class is its own factory: the engine calls ``Skill(name, params,
 context)``, then ``setup(context=...)``; ``context.world`` is a
 :class:`worldsim.World` (or a real robot interface with the same methods) and
 the robot is the one named like the agent. ``update`` only polls: planning runs
-as a job (:mod:`skills.jobs`).
+as a job (:mod:`alica.skills.jobs`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import py_trees
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from skills.jobs import DeferredJobs, Jobs
+from alica.skills.jobs import DeferredJobs, Jobs
 
 _TERM = re.compile(r"^\s*(?:pos|pose)\s*\(\s*([A-Za-z_][A-Za-z0-9_\-]*)\s*\)\s*$")
 #: Per-world caches (planning grids, arm scenes); entries go with their world.
@@ -39,7 +39,7 @@ class WorldSkill(py_trees.behaviour.Behaviour):
 
     Args:
         name: the behaviour's name.
-        params: the skill's parameters (declared in :mod:`skills.catalog`).
+        params: the skill's parameters (declared in :mod:`alica.skills.catalog`).
         context: the engine's :class:`~alica.engine.SkillContext` (or any object with
             ``agent``, ``world``, ``world_model``, ``now`` and ``rng``).
     """

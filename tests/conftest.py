@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, settings
 
-from skills.motion import configure_ompl
+from alica.skills.motion import configure_ompl
 
 settings.register_profile(
     "deterministic",

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from alica import render
-from alica.cli import main
+from alica.app import render
+from alica.app.cli import main
 from alica.io import load_document
 from tests.conftest import PLANS
 
@@ -122,10 +122,17 @@ def test_list_skills(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "list-skills")
     assert code == 0
     assert "MoveToPosition:" in out and "goal (position, required)" in out
-    assert "(runs skills.navigation:MoveToPosition)" in out and "(no implementation yet" in out
+    assert "(runs alica.skills.navigation:MoveToPosition)" in out and "(no implementation yet" in out
 
 
 def test_shipped_plans_are_found_from_the_package() -> None:
     from alica.io import plans_dir
 
     assert (plans_dir() / "roles.yaml").is_file()
+
+
+def test_version(capsys: pytest.CaptureFixture[str]) -> None:
+    from alica import __version__
+
+    code, out, _ = run(capsys, "--version")
+    assert code == 0 and out.strip() == f"alica {__version__}"

@@ -1,11 +1,11 @@
 """The simulated world (pybullet): robots, objects, terrain, sensors, faults.
 
 Nothing here is imported by :mod:`alica`. Importing this package is cheap: the
-names below are loaded on first use, so ``import worldsim.grid`` does not load
+names below are loaded on first use, so ``import alica.worldsim.grid`` does not load
 pybullet.
 
 Example:
-    >>> from worldsim import lunar
+    >>> from alica.worldsim import lunar
     >>> with lunar(seed=1, rocks=10) as world:
     ...     world.robots["scout"].drive(0.5, 0.0)
     ...     world.step(1.0)
@@ -18,26 +18,26 @@ import importlib
 from typing import Any
 
 _EXPORTS = {
-    "World": "worldsim.world",
-    "WorldError": "worldsim.errors",
-    "Obstacle2D": "worldsim.grid",
-    "OccupancyGrid": "worldsim.grid",
-    "Robot": "worldsim.robots",
-    "RobotSpec": "worldsim.robots",
-    "ROBOT_KINDS": "worldsim.robots",
-    "Arm": "worldsim.arm",
-    "WorldObject": "worldsim.objects",
-    "SAMPLE_KINDS": "worldsim.objects",
-    "Detection": "worldsim.sensors",
-    "lidar_scan": "worldsim.sensors",
-    "perceive": "worldsim.sensors",
-    "scan_to_grid": "worldsim.sensors",
-    "crash": "worldsim.faults",
-    "set_grasp_slip": "worldsim.faults",
-    "set_sensor_noise": "worldsim.faults",
-    "blocksworld": "worldsim.scenarios",
-    "blocks_facts": "worldsim.scenarios",
-    "lunar": "worldsim.scenarios",
+    "World": "alica.worldsim.world",
+    "WorldError": "alica.worldsim.errors",
+    "Obstacle2D": "alica.worldsim.grid",
+    "OccupancyGrid": "alica.worldsim.grid",
+    "Robot": "alica.worldsim.robots",
+    "RobotSpec": "alica.worldsim.robots",
+    "ROBOT_KINDS": "alica.worldsim.robots",
+    "Arm": "alica.worldsim.arm",
+    "WorldObject": "alica.worldsim.objects",
+    "SAMPLE_KINDS": "alica.worldsim.objects",
+    "Detection": "alica.worldsim.sensors",
+    "lidar_scan": "alica.worldsim.sensors",
+    "perceive": "alica.worldsim.sensors",
+    "scan_to_grid": "alica.worldsim.sensors",
+    "crash": "alica.worldsim.faults",
+    "set_grasp_slip": "alica.worldsim.faults",
+    "set_sensor_noise": "alica.worldsim.faults",
+    "blocksworld": "alica.worldsim.scenarios",
+    "blocks_facts": "alica.worldsim.scenarios",
+    "lunar": "alica.worldsim.scenarios",
 }
 
 __all__ = [

@@ -19,14 +19,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pybullet_data
 
-from worldsim._quiet import quiet_stdout
-from worldsim.errors import WorldError
-from worldsim.geometry import pose_multiply, quat_multiply, yaw_to_quat
-from worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, GripperMixin
-from worldsim.objects import ARM_GROUP, MOVABLE_GROUP, WorldObject
+from alica.worldsim._quiet import quiet_stdout
+from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import pose_multiply, quat_multiply, yaw_to_quat
+from alica.worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, GripperMixin
+from alica.worldsim.objects import ARM_GROUP, MOVABLE_GROUP, WorldObject
 
 if TYPE_CHECKING:
-    from worldsim.robots import Robot
+    from alica.worldsim.robots import Robot
 
 __all__ = ["GRASP_TOLERANCE", "GRIP_FORCE", "PANDA_URDF", "Arm"]
 

@@ -1,8 +1,8 @@
-"""Building the bodies of :mod:`worldsim.objects` in code (no mesh files).
+"""Building the bodies of :mod:`alica.worldsim.objects` in code (no mesh files).
 
 Boxes and cylinders from pybullet primitives; rocks as convex hulls of
 perturbed, flattened icospheres made with trimesh. Each builder takes the
-:class:`~worldsim.world.World` it adds to; use the world's ``add_*`` methods,
+:class:`~alica.worldsim.world.World` it adds to; use the world's ``add_*`` methods,
 which call them and register the result.
 """
 
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import trimesh
 
-from worldsim.errors import WorldError
-from worldsim.geometry import yaw_to_quat
-from worldsim.objects import BLOCK_PALETTE, COLOURS, MOVABLE_GROUP, WorldObject, parse_colour, sample_sections
+from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import yaw_to_quat
+from alica.worldsim.objects import BLOCK_PALETTE, COLOURS, MOVABLE_GROUP, WorldObject, parse_colour, sample_sections
 
 if TYPE_CHECKING:
-    from worldsim.world import World
+    from alica.worldsim.world import World
 
 __all__ = ["make_block", "make_collection_point", "make_rock", "make_sample", "make_table", "make_terrain", "rock_mesh"]
 

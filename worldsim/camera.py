@@ -7,8 +7,8 @@ the picture.
 
 Example::
 
-    from worldsim.camera import snapshot
-    from worldsim.scenarios import blocksworld
+    from alica.worldsim.camera import snapshot
+    from alica.worldsim.scenarios import blocksworld
 
     with blocksworld(agents=2, opponents=1) as world:
         snapshot(world, "build/blocks.png")
@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from worldsim.errors import WorldError
+from alica.worldsim.errors import WorldError
 
 __all__ = ["DEFAULT_PITCH", "DEFAULT_YAW", "FOV", "render", "snapshot"]
 
@@ -94,7 +94,7 @@ def render(
     Raises:
         WorldError: as :func:`snapshot`.
     """
-    from worldsim.world import pybullet
+    from alica.worldsim.world import pybullet
 
     if getattr(world, "closed", False):
         raise WorldError("snapshot: the world is closed; take pictures before world.close()")

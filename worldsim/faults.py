@@ -1,7 +1,7 @@
 """Faults and sensor noise: crashed robots, slipping grasps, noisier sensors.
 
 All settings are per world (``world.faults``, ``world.noise``) and every random
-draw comes from the world's seeded :attr:`~worldsim.world.World.rng`, so a run
+draw comes from the world's seeded :attr:`~alica.worldsim.world.World.rng`, so a run
 with faults is as repeatable as one without.
 """
 
@@ -13,11 +13,11 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from worldsim.errors import WorldError
+from alica.worldsim.errors import WorldError
 
 if TYPE_CHECKING:
-    from worldsim.robots import Robot
-    from worldsim.world import World
+    from alica.worldsim.robots import Robot
+    from alica.worldsim.world import World
 
 __all__ = ["Faults", "SensorNoise", "crash", "set_grasp_slip", "set_sensor_noise"]
 

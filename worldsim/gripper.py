@@ -2,7 +2,7 @@
 
 A held object is an *attachment*: massless (kinematic) in physics while held,
 re-posed with the end-effector by the arm every step, dynamic again after
-:meth:`GripperMixin.detach`. :class:`~worldsim.arm.Arm` inherits these methods.
+:meth:`GripperMixin.detach`. :class:`~alica.worldsim.arm.Arm` inherits these methods.
 """
 
 from __future__ import annotations
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from worldsim.errors import WorldError
-from worldsim.geometry import pose_inverse, pose_multiply
-from worldsim.objects import WorldObject
+from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import pose_inverse, pose_multiply
+from alica.worldsim.objects import WorldObject
 
 if TYPE_CHECKING:
-    from worldsim.robots import Robot
+    from alica.worldsim.robots import Robot
 
 __all__ = ["FINGER_OPEN", "GRASP_TOLERANCE", "GRIP_FORCE", "GripperMixin"]
 
@@ -37,7 +37,7 @@ WAKE_RADIUS = 0.3
 
 
 class GripperMixin:
-    """Gripper methods of :class:`~worldsim.arm.Arm` (which holds the state they use)."""
+    """Gripper methods of :class:`~alica.worldsim.arm.Arm` (which holds the state they use)."""
 
     __slots__ = ()
 
@@ -98,7 +98,7 @@ class GripperMixin:
 
         On success the object moves with the end-effector (kinematic, massless
         in physics) and the fingers close on it. With a grasp slip set (see
-        :mod:`worldsim.faults`) the grasp may fail a short time later.
+        :mod:`alica.worldsim.faults`) the grasp may fail a short time later.
 
         Returns:
             Whether the object is now held (``False`` when it is out of the gripper's

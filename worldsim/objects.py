@@ -2,7 +2,7 @@
 
 Blocks and samples are *movable* (dynamic, graspable); rocks and tables are
 static obstacles; the collection point is a flat marker without collision.
-The bodies are built by :mod:`worldsim.bodies` (through the world's ``add_*``
+The bodies are built by :mod:`alica.worldsim.bodies` (through the world's ``add_*``
 methods); this module holds :class:`WorldObject` and the vocabularies.
 """
 
@@ -14,9 +14,9 @@ from typing import Any
 import numpy as np
 import trimesh
 
-from worldsim.errors import WorldError
-from worldsim.geometry import quat_rotate, quat_to_yaw
-from worldsim.grid import Obstacle2D
+from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import quat_rotate, quat_to_yaw
+from alica.worldsim.grid import Obstacle2D
 
 __all__ = ["COLOURS", "OBJECT_KINDS", "SAMPLE_KINDS", "WorldObject", "parse_colour", "sample_sections"]
 

@@ -1,7 +1,7 @@
 """Perception for team runs: facts read from the simulated world, written into each agent's world model.
 
 The robots of a simulated team see the world through a reader such as
-:func:`worldsim.scenarios.blocks_facts` (an overhead camera, in effect). Every
+:func:`alica.worldsim.scenarios.blocks_facts` (an overhead camera, in effect). Every
 ``every`` simulated seconds :class:`FactPerception` reads the facts once and
 brings each running agent's world model in line with the reading: for the
 predicates it senses, it asserts what is missing and retracts what is no

@@ -1,6 +1,6 @@
 """Geometric questions about a world: obstacle footprints, free space, contacts.
 
-Used by :class:`~worldsim.world.World` (call them through its methods).
+Used by :class:`~alica.worldsim.world.World` (call them through its methods).
 """
 
 from __future__ import annotations
@@ -10,11 +10,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from worldsim.grid import Obstacle2D
+from alica.worldsim.grid import Obstacle2D
 
 if TYPE_CHECKING:
-    from worldsim.robots import Robot
-    from worldsim.world import World
+    from alica.worldsim.robots import Robot
+    from alica.worldsim.world import World
 
 __all__ = ["blocker", "body_names", "contacts", "obstacles"]
 

@@ -15,13 +15,13 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from worldsim.arm import Arm
-from worldsim.errors import WorldError
-from worldsim.geometry import Footprints, wrap_angle, yaw_to_quat
-from worldsim.grid import Obstacle2D
+from alica.worldsim.arm import Arm
+from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import Footprints, wrap_angle, yaw_to_quat
+from alica.worldsim.grid import Obstacle2D
 
 if TYPE_CHECKING:
-    from worldsim.world import World
+    from alica.worldsim.world import World
 
 __all__ = ["ROBOT_KINDS", "Arm", "Robot", "RobotSpec"]
 
@@ -136,13 +136,13 @@ ROBOT_KINDS: dict[str, RobotSpec] = {
 
 
 class Robot:
-    """One robot in a :class:`~worldsim.world.World` (make it with ``world.add_robot``).
+    """One robot in a :class:`~alica.worldsim.world.World` (make it with ``world.add_robot``).
 
     Attributes:
         name: unique name in the world.
         spec: the :class:`RobotSpec` of its kind.
         body_id: the pybullet body of the base.
-        arm: the :class:`~worldsim.arm.Arm` (``None`` for robots without one).
+        arm: the :class:`~alica.worldsim.arm.Arm` (``None`` for robots without one).
         bumped: true when the last drive command was stopped by a collision;
             cleared by the next :meth:`drive` (callers may also reset it).
     """
@@ -218,7 +218,7 @@ class Robot:
 
     @property
     def crashed(self) -> bool:
-        """A crashed robot ignores every command (see :func:`worldsim.faults.crash`)."""
+        """A crashed robot ignores every command (see :func:`alica.worldsim.faults.crash`)."""
         return self._crashed
 
     @property

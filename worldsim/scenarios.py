@@ -12,9 +12,9 @@ import string
 
 import numpy as np
 
-from worldsim.errors import WorldError
-from worldsim.objects import SAMPLE_KINDS
-from worldsim.world import World
+from alica.worldsim.errors import WorldError
+from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.world import World
 
 __all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "random_stacks", "sample_names"]
 

@@ -7,7 +7,7 @@
 * :func:`perceive` reports the samples and blocks in range, inside the field
   of view and in line of sight, with position noise and (for samples) a
   chance of a wrong kind: larger for a ``camera`` than for ``3d`` perception.
-* :func:`scan_to_grid` marks a scan in a :class:`~worldsim.grid.OccupancyGrid`.
+* :func:`scan_to_grid` marks a scan in a :class:`~alica.worldsim.grid.OccupancyGrid`.
 
 Noise comes from the world's seeded rng and ``world.noise``.
 """
@@ -20,13 +20,13 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from worldsim.errors import WorldError
-from worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.errors import WorldError
+from alica.worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from alica.worldsim.objects import SAMPLE_KINDS
 
 if TYPE_CHECKING:
-    from worldsim.robots import Robot
-    from worldsim.world import World
+    from alica.worldsim.robots import Robot
+    from alica.worldsim.world import World
 
 __all__ = ["Detection", "lidar_angles", "lidar_scan", "perceive", "scan_to_grid", "unknown_grid"]
 

@@ -19,15 +19,15 @@ from typing import Any, Self
 import numpy as np
 
 from alica.clock import ManualClock
-from worldsim import bodies as _bodies
-from worldsim import queries as _queries
-from worldsim._quiet import quiet_stdout
-from worldsim.errors import WorldError
-from worldsim.faults import Faults, SensorNoise
-from worldsim.geometry import Footprints
-from worldsim.grid import Obstacle2D
-from worldsim.objects import WorldObject
-from worldsim.robots import ROBOT_KINDS, Robot, RobotSpec
+from alica.worldsim import bodies as _bodies
+from alica.worldsim import queries as _queries
+from alica.worldsim._quiet import quiet_stdout
+from alica.worldsim.errors import WorldError
+from alica.worldsim.faults import Faults, SensorNoise
+from alica.worldsim.geometry import Footprints
+from alica.worldsim.grid import Obstacle2D
+from alica.worldsim.objects import WorldObject
+from alica.worldsim.robots import ROBOT_KINDS, Robot, RobotSpec
 
 with quiet_stdout():
     import pybullet
@@ -228,7 +228,7 @@ class World:
 
     # ------------------------------------------------------------- building
     def add_robot(self, kind: str | RobotSpec, name: str, pose: Sequence[float] = (0.0, 0.0, 0.0)) -> Robot:
-        """Add a robot of a kind of :data:`~worldsim.robots.ROBOT_KINDS` (or a custom spec) at ``(x, y, yaw)``.
+        """Add a robot of a kind of :data:`~alica.worldsim.robots.ROBOT_KINDS` (or a custom spec) at ``(x, y, yaw)``.
 
         Raises:
             WorldError: an unknown kind, a name taken, a pose off the field or overlapping something.
@@ -266,7 +266,7 @@ class World:
         return self._register(name, _bodies.make_block, position, size=size, colour=colour, mass=mass)
 
     def add_sample(self, name: str, kind: str, position: Sequence[float]) -> WorldObject:
-        """Add an IMPERA sample container of a kind of :data:`~worldsim.objects.SAMPLE_KINDS`."""
+        """Add an IMPERA sample container of a kind of :data:`~alica.worldsim.objects.SAMPLE_KINDS`."""
         return self._register(name, _bodies.make_sample, kind, position)
 
     def add_collection_point(self, name: str, position: Sequence[float], radius: float = 0.5) -> WorldObject:

@@ -373,7 +373,7 @@ class AgentEngine:
         def summand(plan: Plan, term: Summand, agent: str, ep: EntryPoint) -> float:
             pinned = pins.get(plan.name)
             if pinned and ep.name in pinned and agent not in pinned[ep.name]:
-                return -1.0  # a generated task only some robots can start (prophet.tasks)
+                return -1.0  # a generated task only some robots can start (alica.prophet.tasks)
             env = dict(node_env)
             env.update({"self": agent, "task": ep.task, "entry": ep.name})
             if context is not None:

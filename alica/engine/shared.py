@@ -1,7 +1,7 @@
 """What an agent keeps of the plans its team generated at run time (planning problems).
 
 The engine itself does not plan: the runtime of a planning problem
-(:mod:`prophet.runtime`) does. The engine carries its messages on
+(:mod:`alica.prophet.runtime`) does. The engine carries its messages on
 :data:`PLAN_TOPIC`, keeps the latest plan shared for each planning problem
 (so that an agent entering the state late still finds it) and the replan
 requests teammates sent, and registers generated plans with their tasks'
@@ -22,7 +22,7 @@ PLAN_TOPIC = "prophet/plan"
 
 
 class Share(Protocol):
-    """A plan shared by a leader (see :class:`prophet.runtime.PlanShare`)."""
+    """A plan shared by a leader (see :class:`alica.prophet.runtime.PlanShare`)."""
 
     key: PlanKey
     generation: int
@@ -44,7 +44,7 @@ class PlanBoard:
         self.priorities: dict[str, Mapping[str, tuple[Priority, ...]]] = {}
         self.pins: dict[str, Mapping[str, tuple[str, ...]]] = {}
         self.latest: dict[PlanKey, Any] = {}
-        """The latest generated plan (``prophet.tasks.CreatedTasks``) per planning problem, kept after it ends."""
+        """The latest generated plan (``alica.prophet.tasks.CreatedTasks``) per planning problem, kept after it ends."""
 
     def receive(self, payload: Any, now: float) -> None:
         """Take in a share (kept if it supersedes the one known) or a replan request."""

@@ -7,6 +7,7 @@ lunar and blocks-world missions both have a ``Pickup``).
 
 from __future__ import annotations
 
+import importlib.util
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -19,26 +20,26 @@ from alica.io.tree import Node
 from alica.lang import Registry, default_registry
 from alica.model import Document, PlanLibrary
 from alica.source import Diagnostic, SourceSpan
-from skills.registry import SkillRegistry
-from skills.registry import default_registry as default_skills
+from alica.skills.registry import SkillRegistry
+from alica.skills.registry import default_registry as default_skills
 
 #: File name endings the loader reads, with their format.
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
 
 
 def plans_dir() -> Path:
-    """The shipped ``plans/`` folder, found next to the installed packages.
-
-    The project installs in editable mode (``make demo``/``make test``), so the
-    folder is the checkout's own ``plans/``.
+    """The shipped plans: the package data ``alica.plans`` (the checkout's ``plans/`` in an editable install).
 
     Raises:
         FileNotFoundError: the package was installed without its plans.
     """
-    folder = Path(__file__).resolve().parents[2] / "plans"
-    if not folder.is_dir():
-        raise FileNotFoundError(f"the shipped plans are not next to the package (looked in {folder}); install the project from its checkout")
-    return folder
+    spec = importlib.util.find_spec("alica.plans")
+    locations = list(spec.submodule_search_locations or ()) if spec is not None else []
+    for location in locations:
+        folder = Path(location)
+        if (folder / "roles.yaml").is_file():
+            return folder
+    raise FileNotFoundError(f"the shipped plans are missing from the installed package (looked in {locations or 'alica.plans'}); reinstall alica-teams")
 
 
 def format_of(path: str | os.PathLike[str]) -> str | None:

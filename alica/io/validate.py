@@ -26,7 +26,7 @@ from alica.model import (
     format_cardinality,
 )
 from alica.source import SourceSpan
-from skills.registry import SkillRegistry
+from alica.skills.registry import SkillRegistry
 
 #: How far utility weights may stray from summing to 1.
 WEIGHT_TOLERANCE = 1e-6

@@ -7,8 +7,8 @@
 
 from __future__ import annotations
 
-from prophet.pddl.errors import PddlError
-from prophet.pddl.model import (
+from alica.prophet.pddl.errors import PddlError
+from alica.prophet.pddl.model import (
     OBJECT,
     Action,
     And,
@@ -31,8 +31,8 @@ from prophet.pddl.model import (
     TypedName,
     When,
 )
-from prophet.pddl.parser import SUPPORTED_REQUIREMENTS, parse_domain, parse_problem, read_domain, read_problem
-from prophet.pddl.writer import write_domain, write_formula, write_problem
+from alica.prophet.pddl.parser import SUPPORTED_REQUIREMENTS, parse_domain, parse_problem, read_domain, read_problem
+from alica.prophet.pddl.writer import write_domain, write_formula, write_problem
 
 __all__ = [
     "OBJECT", "SUPPORTED_REQUIREMENTS", "Action", "And", "Atom", "Domain", "Effect", "Equals", "Exists", "FluentTerm",

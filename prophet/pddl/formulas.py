@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field
 
-from prophet.pddl.model import (
+from alica.prophet.pddl.model import (
     OBJECT,
     And,
     Atom,
@@ -23,8 +23,8 @@ from prophet.pddl.model import (
     TypedName,
     When,
 )
-from prophet.pddl.sexpr import Node, SList, Source, Symbol
-from prophet.planner import Feature
+from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol
+from alica.prophet.planner import Feature
 
 _NUMBER = re.compile(r"-?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?")
 _NAME = re.compile(r"[a-z][a-z0-9_\-]*", re.IGNORECASE)

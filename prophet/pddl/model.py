@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from prophet.planner import Feature
+from alica.prophet.planner import Feature
 
 OBJECT = "object"
 """The root type."""

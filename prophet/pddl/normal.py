@@ -10,8 +10,8 @@ import itertools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from prophet.pddl.errors import PddlError
-from prophet.pddl.model import (
+from alica.prophet.pddl.errors import PddlError
+from alica.prophet.pddl.model import (
     And,
     Atom,
     Effect,

@@ -1,12 +1,12 @@
-"""Reading PDDL domains and problems (recursive descent over :mod:`prophet.pddl.sexpr`)."""
+"""Reading PDDL domains and problems (recursive descent over :mod:`alica.prophet.pddl.sexpr`)."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from prophet.pddl.errors import PddlError
-from prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
-from prophet.pddl.model import (
+from alica.prophet.pddl.errors import PddlError
+from alica.prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
+from alica.prophet.pddl.model import (
     OBJECT,
     Action,
     And,
@@ -28,8 +28,8 @@ from prophet.pddl.model import (
     TypedName,
     When,
 )
-from prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
-from prophet.planner import Feature
+from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
+from alica.prophet.planner import Feature
 
 _FEATURES = {f"{f.value}": frozenset({f}) for f in Feature}
 _EXTRA = {

@@ -1,4 +1,4 @@
-"""The relaxed-reachability fixpoint over lifted actions, used by :func:`prophet.ground.ground`.
+"""The relaxed-reachability fixpoint over lifted actions, used by :func:`alica.prophet.ground.ground`.
 
 Each action precondition is put in DNF (one schema per conjunction). Facts
 are processed in order; a new fact is unified with every precondition atom
@@ -6,7 +6,7 @@ of its predicate and then joined with the facts processed before it, the
 atom with the most bound arguments first, through hash indexes on the bound
 positions (built on first use and kept up to date). Negative preconditions on
 changing predicates count as true here (an over-approximation the ground
-pass of :mod:`prophet.ground` tightens).
+pass of :mod:`alica.prophet.ground` tightens).
 """
 
 from __future__ import annotations
@@ -17,9 +17,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from operator import itemgetter
 
-from prophet.pddl.errors import PddlError
-from prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
-from prophet.pddl.normal import Clause, dnf, expand, flatten_effect
+from alica.prophet.pddl.errors import PddlError
+from alica.prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
+from alica.prophet.pddl.normal import Clause, dnf, expand, flatten_effect
 
 Fact = tuple[str, ...]
 Arg = int | str

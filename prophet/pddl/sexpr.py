@@ -12,7 +12,7 @@ import re
 from dataclasses import dataclass, field
 
 from alica.source import SourceSpan
-from prophet.pddl.errors import PddlError
+from alica.prophet.pddl.errors import PddlError
 
 _TOKEN = re.compile(r"[()]|;[^\n]*|[^\s();]+")
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from prophet.pddl.model import (
+from alica.prophet.pddl.model import (
     OBJECT,
     Action,
     And,
@@ -23,7 +23,7 @@ from prophet.pddl.model import (
     TypedName,
     When,
 )
-from prophet.planner import Feature
+from alica.prophet.planner import Feature
 
 
 def _number(value: float) -> str:
@@ -112,7 +112,7 @@ def write_domain(domain: Domain) -> str:
         domain: the domain.
 
     Returns:
-        Text that :func:`prophet.pddl.parse_domain` reads back to an equal domain.
+        Text that :func:`alica.prophet.pddl.parse_domain` reads back to an equal domain.
     """
     parts = [f"(define (domain {domain.name})", f"  {_requirements(domain.requirements, domain.extra_requirements)}"]
     if domain.types:
@@ -136,7 +136,7 @@ def write_problem(problem: Problem) -> str:
         problem: the problem.
 
     Returns:
-        Text that :func:`prophet.pddl.parse_problem` reads back to an equal problem.
+        Text that :func:`alica.prophet.pddl.parse_problem` reads back to an equal problem.
     """
     parts = [f"(define (problem {problem.name})", f"  (:domain {problem.domain_name})"]
     if problem.requirements or problem.extra_requirements:

@@ -6,7 +6,7 @@ installed costs nothing. :func:`available` says which back-ends can run here
 and, for the others, why not.
 
 Example:
-    >>> from prophet.planners import get_planner
+    >>> from alica.prophet.planners import get_planner
     >>> planner = get_planner("fd", alias="lama-first")  # doctest: +SKIP
 """
 
@@ -16,13 +16,13 @@ import importlib
 from typing import Any
 
 from alica.errors import PlannerError
-from prophet.planner import Planner
+from alica.prophet.planner import Planner
 
 PLANNERS: dict[str, str] = {
-    "builtin": "prophet.search.planner:BuiltinPlanner",
-    "fd": "prophet.planners.fd:FastDownward",
+    "builtin": "alica.prophet.search.planner:BuiltinPlanner",
+    "fd": "alica.prophet.planners.fd:FastDownward",
 }
-"""Every back-end: name -> ``"module:Class"`` of a :class:`~prophet.planner.Planner` subclass."""
+"""Every back-end: name -> ``"module:Class"`` of a :class:`~alica.prophet.planner.Planner` subclass."""
 
 __all__ = ["PLANNERS", "available", "get_planner", "planner_class"]
 

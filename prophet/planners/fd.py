@@ -11,7 +11,7 @@ module needs ``unified-planning``, which this back-end does not use).
 Search configurations are Fast Downward aliases: ``lama-first`` (the default:
 greedy search, first plan), ``lama`` (anytime: the default with ``anytime=True``;
 it writes ``sas_plan.1``, ``sas_plan.2``, ... and every new file becomes an
-:class:`~prophet.planner.Improved` event while the planner runs) and
+:class:`~alica.prophet.planner.Improved` event while the planner runs) and
 ``seq-opt-lmcut`` (A* with LM-cut: optimal plans).
 """
 
@@ -32,8 +32,8 @@ from pathlib import Path
 from typing import IO
 
 from alica.errors import PlannerError
-from prophet.planner import Done, Feature, Improved, Plan, Planner, PlanResult, PlanStatus, Progress, SearchEvent
-from prophet.planners.planfile import parse_plan
+from alica.prophet.planner import Done, Feature, Improved, Plan, Planner, PlanResult, PlanStatus, Progress, SearchEvent
+from alica.prophet.planners.planfile import parse_plan
 
 INSTALL_HINT = "pip install 'alica-teams[fd]'"
 """How to install the back-end, for messages."""
@@ -110,7 +110,7 @@ class FastDownward(Planner):
         poll_interval: seconds between two looks at the running planner.
 
     Domains and problems may be given as paths of PDDL files (run as they
-    are) or as parsed objects of :mod:`prophet.pddl` (written into a
+    are) or as parsed objects of :mod:`alica.prophet.pddl` (written into a
     temporary folder with ``write_domain``/``write_problem``).
     """
 
@@ -160,7 +160,7 @@ class FastDownward(Planner):
         return found
 
     def search(self, domain: object, problem: object, *, anytime: bool = True) -> Iterator[SearchEvent]:
-        """The search as events (see :class:`~prophet.planner.Planner`).
+        """The search as events (see :class:`~alica.prophet.planner.Planner`).
 
         Raises:
             PlannerError: Fast Downward is not installed, or the task needs
@@ -236,7 +236,7 @@ def _inputs(domain: object, problem: object, folder: Path) -> tuple[Path, Path]:
                 raise PlannerError(f"{kind} file {path} does not exist")
             files.append(path.resolve())
             continue
-        from prophet import pddl
+        from alica.prophet import pddl
 
         writer = pddl.write_domain if kind == "domain" else pddl.write_problem
         target = folder / f"{kind}.pddl"

@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 from alica.errors import PlannerError
-from prophet.planner import Plan, PlanStep
+from alica.prophet.planner import Plan, PlanStep
 
 _COST = re.compile(r";\s*cost\s*=\s*([0-9.eE+-]+)")
 

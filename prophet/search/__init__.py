@@ -1,13 +1,13 @@
 """The builtin planner: bitset states, FF with preferred operators, lazy GBFS, anytime weighted A*.
 
 See ``docs/search.md``. Entry points: :class:`BuiltinPlanner` (the
-:class:`~prophet.planner.Planner` interface) and :func:`search_task` (a
+:class:`~alica.prophet.planner.Planner` interface) and :func:`search_task` (a
 grounded task directly).
 """
 
 from __future__ import annotations
 
-from prophet.search.anytime import DEFAULT_WEIGHTS, search_task
-from prophet.search.planner import BuiltinPlanner
+from alica.prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+from alica.prophet.search.planner import BuiltinPlanner
 
 __all__ = ["DEFAULT_WEIGHTS", "BuiltinPlanner", "search_task"]

@@ -2,12 +2,12 @@
 
 1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
    finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
-2. Quick window sweeps on it (:mod:`prophet.search.windows`: stretches of the
+2. Quick window sweeps on it (:mod:`alica.prophet.search.windows`: stretches of the
    plan replanned among their own objects).
 3. Restarts: unbounded lazy searches with other heuristics and weights, each
    plan then cleaned up and window-swept (it may start worse than the best
    and end better); full window sweeps on the best; the plan neighbourhood
-   graph search (:mod:`prophet.search.neighbourhood`).
+   graph search (:mod:`alica.prophet.search.neighbourhood`).
 4. Rounds over a portfolio of bounded passes, each pruning ``g >= best cost``
    and stopped after an expansion budget that doubles every round: lazy GBFS
    with FF on h_add supporters, lazy weighted A* with decreasing weights
@@ -28,14 +28,14 @@ from __future__ import annotations
 from collections.abc import Generator, Iterator, Sequence
 from typing import Any
 
-from prophet.planner import Done, Improved, Plan, PlanStatus, PlanStep, SearchEvent
-from prophet.search.astar import astar
-from prophet.search.encoding import CompiledTask, compile_task
-from prophet.search.gbfs import Stats, lazy_search
-from prophet.search.heuristics import INF, Evaluator, Relaxed
-from prophet.search.neighbourhood import neighbourhood
-from prophet.search.postprocess import improve
-from prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
+from alica.prophet.planner import Done, Improved, Plan, PlanStatus, PlanStep, SearchEvent
+from alica.prophet.search.astar import astar
+from alica.prophet.search.encoding import CompiledTask, compile_task
+from alica.prophet.search.gbfs import Stats, lazy_search
+from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
+from alica.prophet.search.neighbourhood import neighbourhood
+from alica.prophet.search.postprocess import improve
+from alica.prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
 
 DEFAULT_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1.5, 1)
 NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)

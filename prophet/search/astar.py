@@ -10,10 +10,10 @@ from __future__ import annotations
 from collections.abc import Generator
 from heapq import heappop, heappush
 
-from prophet.planner import Progress
-from prophet.search.encoding import CompiledTask
-from prophet.search.gbfs import Stats, trace
-from prophet.search.heuristics import INF, Evaluator
+from alica.prophet.planner import Progress
+from alica.prophet.search.encoding import CompiledTask
+from alica.prophet.search.gbfs import Stats, trace
+from alica.prophet.search.heuristics import INF, Evaluator
 
 
 def astar(

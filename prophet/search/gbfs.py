@@ -7,7 +7,7 @@ search finds a state with a lower estimate than before, the preferred list
 gets ``boost`` extra turns. Ties go to the earliest insertion, and states
 are plain ``int`` bitsets, so a run is deterministic.
 
-The searches are generators: they yield :class:`~prophet.planner.Progress`
+The searches are generators: they yield :class:`~alica.prophet.planner.Progress`
 every ``progress_every`` expansions and *return* the plan (compiled operator
 ids) or ``None``, and whether the open lists ran dry; use
 ``plan, exhausted = yield from ...``.
@@ -19,9 +19,9 @@ from collections.abc import Generator
 from dataclasses import dataclass
 from heapq import heappop, heappush
 
-from prophet.planner import Progress
-from prophet.search.encoding import CompiledTask
-from prophet.search.heuristics import INF, Evaluator
+from alica.prophet.planner import Progress
+from alica.prophet.search.encoding import CompiledTask
+from alica.prophet.search.heuristics import INF, Evaluator
 
 
 @dataclass(slots=True)

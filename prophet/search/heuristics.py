@@ -1,4 +1,4 @@
-"""Delete-relaxation heuristics over a :class:`~prophet.search.encoding.CompiledTask`.
+"""Delete-relaxation heuristics over a :class:`~alica.prophet.search.encoding.CompiledTask`.
 
 Every operator is one relaxed action (its fluent preconditions and adds);
 every when-effect is one more, with the effect's condition added to the
@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from heapq import heappop, heappush
 
-from prophet.search.encoding import CompiledTask, mask
+from alica.prophet.search.encoding import CompiledTask, mask
 
 INF = float("inf")
 

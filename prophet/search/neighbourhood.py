@@ -15,9 +15,9 @@ from collections import deque
 from collections.abc import Generator
 from heapq import heappop, heappush
 
-from prophet.planner import Progress
-from prophet.search.encoding import CompiledTask
-from prophet.search.gbfs import Stats
+from alica.prophet.planner import Progress
+from alica.prophet.search.encoding import CompiledTask
+from alica.prophet.search.gbfs import Stats
 
 
 def neighbourhood(

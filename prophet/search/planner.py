@@ -1,15 +1,15 @@
-"""``BuiltinPlanner``: the pure-Python planner behind the :class:`~prophet.planner.Planner` interface."""
+"""``BuiltinPlanner``: the pure-Python planner behind the :class:`~alica.prophet.planner.Planner` interface."""
 
 from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 
-from prophet.planner import Feature, Planner, SearchEvent
-from prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+from alica.prophet.planner import Feature, Planner, SearchEvent
+from alica.prophet.search.anytime import DEFAULT_WEIGHTS, search_task
 
 
 class BuiltinPlanner(Planner):
-    """Grounds the task, then runs :func:`~prophet.search.anytime.search_task`.
+    """Grounds the task, then runs :func:`~alica.prophet.search.anytime.search_task`.
 
     Args:
         weights: the weighted A* weights of the anytime phase.
@@ -33,7 +33,7 @@ class BuiltinPlanner(Planner):
         self.progress_every = progress_every
 
     def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
-        from prophet.ground import ground  # lazy: the grounding is only needed here
+        from alica.prophet.ground import ground  # lazy: the grounding is only needed here
 
         task = ground(domain, problem)
         yield from search_task(task, anytime=anytime, weights=self.weights, progress_every=self.progress_every)

@@ -8,7 +8,7 @@ the shorter plan if it still reaches the goal (repeated until nothing changes).
 
 from __future__ import annotations
 
-from prophet.search.encoding import CompiledTask
+from alica.prophet.search.encoding import CompiledTask
 
 
 def _applicable(ct: CompiledTask, state: int, op: int) -> bool:

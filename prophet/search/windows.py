@@ -20,9 +20,9 @@ from __future__ import annotations
 from collections.abc import Generator, Sequence
 from heapq import heappop, heappush
 
-from prophet.planner import Progress
-from prophet.search.encoding import CompiledTask
-from prophet.search.gbfs import Stats, trace
+from alica.prophet.planner import Progress
+from alica.prophet.search.encoding import CompiledTask
+from alica.prophet.search.gbfs import Stats, trace
 
 WINDOW_SIZES: tuple[int, ...] = (6, 10, 16, 24, 32)
 """The window lengths tried, shortest first."""

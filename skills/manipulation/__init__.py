@@ -7,13 +7,13 @@ and joint paths) for someone else to execute. See ``docs/manipulation.md``.
 
 from __future__ import annotations
 
-from skills.manipulation.arm_planner import ArmPath, interpolate_path, path_is_free, plan_arm
-from skills.manipulation.cartesian import straight_line
-from skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
-from skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps
-from skills.manipulation.ik import IKResult, solve_ik
-from skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
-from skills.manipulation.scene import ArmScene, Box, default_urdf
+from alica.skills.manipulation.arm_planner import ArmPath, interpolate_path, path_is_free, plan_arm
+from alica.skills.manipulation.cartesian import straight_line
+from alica.skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
+from alica.skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps
+from alica.skills.manipulation.ik import IKResult, solve_ik
+from alica.skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
+from alica.skills.manipulation.scene import ArmScene, Box, default_urdf
 
 __all__ = [
     "ArmPath",

@@ -30,8 +30,8 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from skills.manipulation.geometry import as_configuration
-from skills.manipulation.scene import ArmScene, Box
+from alica.skills.manipulation.geometry import as_configuration
+from alica.skills.manipulation.scene import ArmScene, Box
 
 log = logging.getLogger(__name__)
 

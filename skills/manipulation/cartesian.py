@@ -13,9 +13,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from skills.manipulation.geometry import Pose, Quat, as_configuration, as_pose, quat_angle
-from skills.manipulation.ik import solve_ik
-from skills.manipulation.scene import ArmScene
+from alica.skills.manipulation.geometry import Pose, Quat, as_configuration, as_pose, quat_angle
+from alica.skills.manipulation.ik import solve_ik
+from alica.skills.manipulation.scene import ArmScene
 
 #: Distance between waypoints along the line, metres.
 LINE_STEP = 0.05

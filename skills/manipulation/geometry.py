@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from worldsim.geometry import quat_multiply, quat_rotate  # the same quaternion algebra as the world's
+from alica.worldsim.geometry import quat_multiply, quat_rotate  # the same quaternion algebra as the world's
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from skills.manipulation.geometry import (
+from alica.skills.manipulation.geometry import (
     Pose,
     Vec3,
     as_vec3,
@@ -24,7 +24,7 @@ from skills.manipulation.geometry import (
     vertical_yaw,
     wrap_angle,
 )
-from skills.manipulation.scene import Box
+from alica.skills.manipulation.scene import Box
 
 #: Height of the approach (pre-grasp / above-place) pose over the grasp or place pose.
 APPROACH_HEIGHT = 0.10

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skills.manipulation.geometry import as_configuration, as_quat, as_vec3, quat_angle
-from skills.manipulation.scene import ArmScene, Box
+from alica.skills.manipulation.geometry import as_configuration, as_quat, as_vec3, quat_angle
+from alica.skills.manipulation.scene import ArmScene, Box
 
 log = logging.getLogger(__name__)
 

@@ -29,10 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from skills.manipulation.arm_planner import interpolate_path, path_is_free, plan_arm
-from skills.manipulation.cartesian import straight_line
-from skills.manipulation.geometry import Pose, as_configuration, as_vec3, wrap_angle
-from skills.manipulation.grasps import (
+from alica.skills.manipulation.arm_planner import interpolate_path, path_is_free, plan_arm
+from alica.skills.manipulation.cartesian import straight_line
+from alica.skills.manipulation.geometry import Pose, as_configuration, as_vec3, wrap_angle
+from alica.skills.manipulation.grasps import (
     APPROACH_HEIGHT,
     Grasp,
     held_box,
@@ -40,8 +40,8 @@ from skills.manipulation.grasps import (
     placed_box,
     top_grasps,
 )
-from skills.manipulation.ik import solve_ik
-from skills.manipulation.scene import ArmScene, Box
+from alica.skills.manipulation.ik import solve_ik
+from alica.skills.manipulation.scene import ArmScene, Box
 
 log = logging.getLogger(__name__)
 
@@ -168,7 +168,7 @@ def plan_pickup(
         object_box: the object (world box, upright) to pick.
         q_start: the arm's current configuration.
         rng: generator for IK restarts (plans are deterministic for equal generators,
-            except for OMPL paths, see :mod:`skills.manipulation.arm_planner`).
+            except for OMPL paths, see :mod:`alica.skills.manipulation.arm_planner`).
         retries: extra pre-grasp IK solutions per grasp (>= 0).
         q_transport: configuration to carry the object in (default ``scene.home_q``).
         kind: ``"box"`` or ``"cylinder"`` (see :func:`top_grasps`).

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from pybullet_utils.bullet_client import BulletClient
 
-from skills.manipulation.geometry import Pose, Vec3, pose_inverse, pose_multiply
+from alica.skills.manipulation.geometry import Pose, Vec3, pose_inverse, pose_multiply
 
 #: Panda "ready" pose: the IK seed and rest configuration.
 PANDA_REST_Q = (0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785)

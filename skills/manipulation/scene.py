@@ -26,7 +26,7 @@ import pybullet
 import pybullet_data
 from pybullet_utils.bullet_client import BulletClient
 
-from skills.manipulation.geometry import (
+from alica.skills.manipulation.geometry import (
     IDENTITY_QUAT,
     Pose,
     Vec3,
@@ -37,8 +37,8 @@ from skills.manipulation.geometry import (
     pose_multiply,
     quat_from_yaw,
 )
-from skills.manipulation.robot_model import ArmModel, read_arm_model
-from worldsim._quiet import quiet_stdout
+from alica.skills.manipulation.robot_model import ArmModel, read_arm_model
+from alica.worldsim._quiet import quiet_stdout
 
 log = logging.getLogger(__name__)
 

@@ -3,7 +3,7 @@
 Importing this package imports OMPL and FCL (``skills/__init__.py`` does not import it).
 
 Example:
-    >>> from worldsim.grid import OccupancyGrid, Obstacle2D
+    >>> from alica.worldsim.grid import OccupancyGrid, Obstacle2D
     >>> grid = OccupancyGrid.from_obstacles([Obstacle2D("circle", 0.0, 0.0, radius=1.0)], (-5, -5, 5, 5))
     >>> result = plan_path((-4.0, 0.0, 0.0), (4.0, 0.0), grid, 0.3)
     >>> result.status, result.length > 8.0
@@ -12,11 +12,11 @@ Example:
 
 from __future__ import annotations
 
-from skills.motion.exact import FclChecker
-from skills.motion.follow import PathFollower, escape_goal
-from skills.motion.planner import STATUSES, PathResult, configure_ompl, plan_path
-from skills.motion.reach import coarse_reachable
-from skills.motion.validity import GridChecker, SegmentValidator, default_margin, densify
+from alica.skills.motion.exact import FclChecker
+from alica.skills.motion.follow import PathFollower, escape_goal
+from alica.skills.motion.planner import STATUSES, PathResult, configure_ompl, plan_path
+from alica.skills.motion.reach import coarse_reachable
+from alica.skills.motion.validity import GridChecker, SegmentValidator, default_margin, densify
 
 __all__ = [
     "STATUSES",

@@ -1,6 +1,6 @@
 """Exact validity for a round robot with FCL: a cylinder against obstacles and other robots.
 
-Used to re-check final paths (:func:`skills.motion.plan_path` ``obstacles_exact``) and as
+Used to re-check final paths (:func:`alica.skills.motion.plan_path` ``obstacles_exact``) and as
 the FCL-only peer in ``bench/motion_planning.py``. FCL quaternions are (w, x, y, z).
 """
 
@@ -14,8 +14,8 @@ import numpy as np
 import trimesh
 from ompl import base as ob
 
-from skills.motion.validity import Robot, check_robots, densify
-from worldsim.grid import Obstacle2D
+from alica.skills.motion.validity import Robot, check_robots, densify
+from alica.worldsim.grid import Obstacle2D
 
 __all__ = ["FclChecker"]
 
@@ -29,7 +29,7 @@ class FclChecker:
     """Exact validity: an FCL cylinder for the robot against obstacles and other robots.
 
     Args:
-        obstacles: :class:`~worldsim.grid.Obstacle2D` (circles become cylinders, boxes boxes,
+        obstacles: :class:`~alica.worldsim.grid.Obstacle2D` (circles become cylinders, boxes boxes,
             both taller than the robot) and ``trimesh.Trimesh`` rocks in world coordinates.
         robot_radius: Robot radius in metres (>= 0; 0 is treated as 1 mm).
         robot_height: Height of the robot cylinder, standing on z = 0.

@@ -1,6 +1,6 @@
 """Following a planned path with a unicycle (pure pursuit), noticing lack of progress and blockage, escaping.
 
-Pure numpy; no OMPL objects (but :class:`~skills.motion.validity.FclChecker` may be passed).
+Pure numpy; no OMPL objects (but :class:`~alica.skills.motion.validity.FclChecker` may be passed).
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from collections.abc import Iterable, Sequence
 
 import numpy as np
 
-from skills.motion.exact import FclChecker
-from skills.motion.validity import GridChecker, check_robots, densify
-from worldsim.grid import FREE, OCCUPIED, OccupancyGrid
+from alica.skills.motion.exact import FclChecker
+from alica.skills.motion.validity import GridChecker, check_robots, densify
+from alica.worldsim.grid import FREE, OCCUPIED, OccupancyGrid
 
 __all__ = ["PathFollower", "escape_goal"]
 

@@ -22,10 +22,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from skills.motion.exact import FclChecker
-from skills.motion.search import Query, configure_ompl, search, xy_length
-from skills.motion.validity import GridChecker
-from worldsim.grid import OccupancyGrid
+from alica.skills.motion.exact import FclChecker
+from alica.skills.motion.search import Query, configure_ompl, search, xy_length
+from alica.skills.motion.validity import GridChecker
+from alica.worldsim.grid import OccupancyGrid
 
 __all__ = ["STATUSES", "PathResult", "configure_ompl", "plan_path"]
 
@@ -152,7 +152,7 @@ def plan_path(
         any_yaw: Reach the goal point with any heading (a 3-element goal's yaw is then ignored).
         simplify: Shortcut the first path (OMPL simplifyMax, a few ms).
         unknown_is_free: Plan through unknown cells.
-        margin: Extra clearance; default :func:`~skills.motion.validity.default_margin`.
+        margin: Extra clearance; default :func:`~alica.skills.motion.validity.default_margin`.
 
     Returns:
         A :class:`PathResult`; failures are statuses with a reason, not exceptions.

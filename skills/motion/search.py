@@ -1,7 +1,7 @@
-"""The OMPL side of :func:`skills.motion.plan_path`: one SE2 RRTConnect query (plus AORRTC), all objects local.
+"""The OMPL side of :func:`alica.skills.motion.plan_path`: one SE2 RRTConnect query (plus AORRTC), all objects local.
 
 Also the one module flag of the package: OMPL logging silenced and the process seed set
-(see :func:`configure_ompl` and :mod:`skills.motion.planner` on reproducibility).
+(see :func:`configure_ompl` and :mod:`alica.skills.motion.planner` on reproducibility).
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from skills.motion.reach import coarse_reachable
-from skills.motion.validity import GridChecker, SegmentValidator
-from worldsim.grid import OccupancyGrid
+from alica.skills.motion.reach import coarse_reachable
+from alica.skills.motion.validity import GridChecker, SegmentValidator
+from alica.worldsim.grid import OccupancyGrid
 
 __all__ = ["Query", "SearchResult", "configure_ompl", "search", "xy_length"]
 
@@ -40,7 +40,7 @@ def xy_length(path: np.ndarray) -> float:
 
 
 def configure_ompl(seed: int | None = None) -> bool:
-    """Silence OMPL logging (errors only) and set the process seed, once (see :mod:`skills.motion.planner`).
+    """Silence OMPL logging (errors only) and set the process seed, once (see :mod:`alica.skills.motion.planner`).
 
     Args:
         seed: Seed to use (>= 0), or None.

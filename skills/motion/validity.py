@@ -3,11 +3,11 @@
 * :class:`GridChecker` answers "may the robot centre be here?" from the occupancy grid
   inflated by the robot radius plus a safety margin, plus other robots as circles. With
   the default margin every grid-valid state is collision-free for obstacles that lie in
-  occupied cells (true for :meth:`worldsim.grid.OccupancyGrid.from_obstacles`, conservative
-  by default, and for :meth:`~worldsim.grid.OccupancyGrid.mark` of sensor points).
+  occupied cells (true for :meth:`alica.worldsim.grid.OccupancyGrid.from_obstacles`, conservative
+  by default, and for :meth:`~alica.worldsim.grid.OccupancyGrid.mark` of sensor points).
 * :class:`SegmentValidator` is an OMPL ``MotionValidator`` that checks a whole straight
   motion at once in numpy (samples every half cell; the margin covers the gaps).
-* :class:`~skills.motion.exact.FclChecker` (in :mod:`skills.motion.exact`, re-exported by
+* :class:`~alica.skills.motion.exact.FclChecker` (in :mod:`alica.skills.motion.exact`, re-exported by
   the package) is the exact check: an FCL cylinder against the obstacles (cylinders, boxes,
   convex or triangle meshes) and the other robots.
 """
@@ -20,7 +20,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from ompl import base as ob
 
-from worldsim.grid import OCCUPIED, UNKNOWN, OccupancyGrid
+from alica.worldsim.grid import OCCUPIED, UNKNOWN, OccupancyGrid
 
 __all__ = ["GridChecker", "Robot", "SegmentValidator", "check_robots", "default_margin", "densify"]
 

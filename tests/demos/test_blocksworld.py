@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from alica.demos.blocksworld import DemoConfig, goal_facts, goal_text, run_demo
+from alica.app.demos.blocksworld import DemoConfig, goal_facts, goal_text, run_demo
 from tests.conftest import ROOT
 
 START = [["a", "c"], ["b"], ["d"]]
@@ -24,7 +24,7 @@ def test_two_agents_reach_a_four_block_goal():
 
 def test_with_an_opponent_the_goal_is_still_reached_after_replanning():
     # through the CLI in a fresh process: OMPL's generator is seeded once per process, so the run is the seed's own
-    run = subprocess.run([sys.executable, "-m", "alica.cli", "demo", "blocksworld", "--agents", "2", "--opponents", "1", "--blocks", "4",
+    run = subprocess.run([sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", "2", "--opponents", "1", "--blocks", "4",
                           "--seed", "0", "--time-limit", "300", "--json", "--no-progress"], cwd=ROOT, capture_output=True, text=True, timeout=600)
     summary = json.loads(next(line for line in reversed(run.stdout.splitlines()) if line.startswith("{")))
     assert run.returncode == 0 and summary["success"], summary
@@ -54,7 +54,7 @@ def test_goal_text_and_facts():
 
 SCRIPT = """
 import json, sys
-from alica.demos.blocksworld import DemoConfig, run_demo
+from alica.app.demos.blocksworld import DemoConfig, run_demo
 events = []
 run_demo(DemoConfig(agents=2, start={start}, goal={goal}, seed=5, time_limit=120), observers=[events.append])
 open(sys.argv[1], "w").write(json.dumps(events, sort_keys=True, default=str))

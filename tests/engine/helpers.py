@@ -7,7 +7,7 @@ from pathlib import Path
 from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
 from alica.io import load_library
 from alica.model import PlanLibrary
-from skills.registry import ParamSpec, default_registry
+from alica.skills.registry import ParamSpec, default_registry
 
 ROLES = """
 alica: 1

@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from alica.cli import main
+from alica.app.cli import main
 from tests.conftest import PLANS
 
 LUNAR = str(PLANS / "lunar" / "mission.yaml")

@@ -106,7 +106,7 @@ def test_same_seed_same_trace_across_processes(tmp_path):
     for hashseed in ("1", "2"):
         out = tmp_path / f"trace{hashseed}.jsonl"
         env = dict(os.environ, PYTHONHASHSEED=hashseed)
-        cmd = [sys.executable, "-m", "alica.cli", "run", str(ROOT / "plans/lunar/mission.yaml"), "--agents", "scout,stummel,amparo",
+        cmd = [sys.executable, "-m", "alica.app.cli", "run", str(ROOT / "plans/lunar/mission.yaml"), "--agents", "scout,stummel,amparo",
                "--seed", "3", "--ticks", "120", "--loss", "0.2", "--delay", "20", "--crash", "scout@2", "--trace", str(out), "--trace-messages", "--json"]
         result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT, check=False)
         assert result.returncode == 0, result.stderr

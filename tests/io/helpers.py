@@ -10,7 +10,7 @@ from alica.io.validate import Validator
 from alica.lang import default_registry
 from alica.model import Document
 from alica.source import Diagnostic
-from skills.registry import ParamSpec, SkillRegistry
+from alica.skills.registry import ParamSpec, SkillRegistry
 
 
 def test_skills() -> SkillRegistry:

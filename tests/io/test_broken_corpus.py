@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from alica.cli import main
+from alica.app.cli import main
 
 BROKEN = Path(__file__).parent / "broken"
 EXPECT = re.compile(r"expect:\s*(?:(?P<file>[\w.]+):)?(?P<line>\d+):(?P<col>\d+)\s*(?P<fragment>.*?)\s*(?:-->)?$", re.M)

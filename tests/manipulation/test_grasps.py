@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from skills.manipulation import Box, held_box, place_poses, placed_box, top_down_quat, top_grasps
-from skills.manipulation.geometry import quat_angle, quat_rotate
+from alica.skills.manipulation import Box, held_box, place_poses, placed_box, top_down_quat, top_grasps
+from alica.skills.manipulation.geometry import quat_angle, quat_rotate
 
 
 def test_top_grasps_of_a_box() -> None:
@@ -74,8 +74,8 @@ def test_bad_arguments_raise_value_errors() -> None:
 
 
 def test_a_box_fallen_onto_a_side_is_seen_upright_with_its_faces_turned() -> None:
-    from skills.manipulation.geometry import quat_multiply, upright_box
-    from worldsim.geometry import quat_to_yaw, yaw_to_quat
+    from alica.skills.manipulation.geometry import quat_multiply, upright_box
+    from alica.worldsim.geometry import quat_to_yaw, yaw_to_quat
 
     half = (0.01, 0.02, 0.03)
     tip = (math.sin(math.pi / 4), 0.0, 0.0, math.cos(math.pi / 4))  # a quarter turn about x: the box lies on its side

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from skills.manipulation import ArmScene, Box, solve_ik, top_down_quat
-from skills.manipulation.geometry import quat_angle
+from alica.skills.manipulation import ArmScene, Box, solve_ik, top_down_quat
+from alica.skills.manipulation.geometry import quat_angle
 
 
 @pytest.mark.parametrize(

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from skills.manipulation import ArmScene, Box, default_urdf
-from skills.manipulation.geometry import quat_angle
+from alica.skills.manipulation import ArmScene, Box, default_urdf
+from alica.skills.manipulation.geometry import quat_angle
 
 
 def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from worldsim.grid import Obstacle2D, OccupancyGrid
+from alica.worldsim.grid import Obstacle2D, OccupancyGrid
 
 BOUNDS = (-20.0, -20.0, 20.0, 20.0)
 CORNER_A = (-19.0, -19.0)

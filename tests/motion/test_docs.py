@@ -19,8 +19,8 @@ def test_motion_page_example(capsys: pytest.CaptureFixture[str]) -> None:
 def test_package_docstring_example() -> None:
     import doctest
 
-    import skills.motion
-    import worldsim.grid
+    import alica.skills.motion
+    import alica.worldsim.grid
 
-    for module in (skills.motion, worldsim.grid):
+    for module in (alica.skills.motion, alica.worldsim.grid):
         assert doctest.testmod(module).failed == 0

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from skills.motion import FclChecker, GridChecker, PathFollower, escape_goal, plan_path
+from alica.skills.motion import FclChecker, GridChecker, PathFollower, escape_goal, plan_path
 from tests.motion.fields import CORNER_A, CORNER_B, field
-from worldsim.grid import Obstacle2D, OccupancyGrid
+from alica.worldsim.grid import Obstacle2D, OccupancyGrid
 
 RADIUS = 0.3
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from worldsim.grid import FREE, OCCUPIED, UNKNOWN, Obstacle2D, OccupancyGrid
+from alica.worldsim.grid import FREE, OCCUPIED, UNKNOWN, Obstacle2D, OccupancyGrid
 
 RES = 0.05
 DIAG = RES * math.sqrt(2.0)

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from skills.motion import FclChecker, GridChecker, densify, plan_path
+from alica.skills.motion import FclChecker, GridChecker, densify, plan_path
 from tests.motion.fields import BOUNDS, CORNER_A, CORNER_B, field
-from worldsim.grid import Obstacle2D, OccupancyGrid
+from alica.worldsim.grid import Obstacle2D, OccupancyGrid
 
 ROOT = Path(__file__).resolve().parents[2]
 RADIUS = 0.3
@@ -136,7 +136,7 @@ def test_rock_missing_from_the_grid_is_caught_by_the_exact_check() -> None:
 
 SCRIPT = """
 import json, sys
-from skills.motion import plan_path
+from alica.skills.motion import plan_path
 from tests.motion.fields import CORNER_A, CORNER_B, field
 _, grid = field(8, 60)
 out = []

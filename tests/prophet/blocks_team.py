@@ -12,7 +12,7 @@ from py_trees.common import Status
 from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
 from alica.io import load_library
 from alica.model import PlanLibrary
-from prophet.planner import Feature, Planner, Progress, SearchEvent
+from alica.prophet.planner import Feature, Planner, Progress, SearchEvent
 from tests.conftest import PLANS
 
 Literal = tuple[bool, str, tuple[str, ...]]

@@ -11,8 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from prophet.ground import GroundTask, ground
-from prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
+from alica.prophet.ground import GroundTask, ground
+from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl"
 

@@ -6,9 +6,9 @@ import pytest
 
 from alica.errors import PlannerError
 from alica.io import load_library
-from prophet.planner import PlanStatus
-from prophet.problem import domain_text, offline_world, problem_text, to_pddl
-from prophet.tasks import create_tasks
+from alica.prophet.planner import PlanStatus
+from alica.prophet.problem import domain_text, offline_world, problem_text, to_pddl
+from alica.prophet.tasks import create_tasks
 from tests.conftest import PLANS
 
 OBJECTS = {"a": "block", "b": "block", "c": "block", "r": "robot"}
@@ -28,7 +28,7 @@ def test_domain_has_one_action_per_element(blocks):
 
 
 def test_the_sussman_anomaly_is_planned_and_parallelised(blocks):
-    from prophet.search.planner import BuiltinPlanner
+    from alica.prophet.search.planner import BuiltinPlanner
 
     problem = blocks.problems["StackBlocks"]
     domain, pddl = to_pddl(problem, blocks, OBJECTS, SUSSMAN)

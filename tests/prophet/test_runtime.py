@@ -12,7 +12,7 @@ import pytest
 
 from alica.engine import EngineConfig
 from alica.testing import scripted
-from prophet.planners import PLANNERS
+from alica.prophet.planners import PLANNERS
 from tests.engine.helpers import library, team, where
 from tests.prophet.blocks_team import SUSSMAN, BlockSkills, blocks_team, goal_holds
 
@@ -368,8 +368,8 @@ def test_a_goal_block_taken_by_an_opponent_does_not_stop_the_rest_of_the_plan():
 
 
 def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_earlier_one():
-    from prophet.runtime import _stalled
-    from prophet.world import TaskProgress
+    from alica.prophet.runtime import _stalled
+    from alica.prophet.world import TaskProgress
 
     # T0 and T1 at work, T2 free, T3's agent waits for T2 (the plan: T0 step 0, T1 steps 1 and 2, T2 step 3, T3 step 4)
     order = [[0], [1, 2], [3], [4]]
@@ -383,8 +383,8 @@ def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_ea
 
 
 def test_a_free_task_pinned_to_an_agent_that_waits_for_it_in_an_earlier_task_is_stuck():
-    from prophet.runtime import _stalled
-    from prophet.world import TaskProgress
+    from alica.prophet.runtime import _stalled
+    from alica.prophet.world import TaskProgress
 
     # seed 10 of the 5-agent demo: T1 = Unstack(d, g) (step 1) and Stack(d, g) (step 4); T2 = Pickup(g), Stack(g, h)
     # (steps 2, 3), pinned to r5. r5 took T1 and waits before step 4, which comes after T2: nobody will ever take T2

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from prophet import pddl
-from prophet.ground import ground
-from prophet.planner import Done, Improved, PlanStatus, Progress
-from prophet.search import search_task
-from prophet.search.encoding import CompiledTask, compile_task
-from prophet.search.gbfs import Stats
-from prophet.search.windows import Windows
+from alica.prophet import pddl
+from alica.prophet.ground import ground
+from alica.prophet.planner import Done, Improved, PlanStatus, Progress
+from alica.prophet.search import search_task
+from alica.prophet.search.encoding import CompiledTask, compile_task
+from alica.prophet.search.gbfs import Stats
+from alica.prophet.search.windows import Windows
 from tests.prophet.search.helpers import BENCHMARKS, TaskBuilder, check_plan, optimal_cost
 
 ROAD = [("p0", "p1"), ("p1", "p2"), ("p2", "p3"), ("p0", "p3"), ("p3", "p4")]

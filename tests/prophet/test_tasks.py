@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from alica.errors import PlannerError
 from alica.io import load_library
-from prophet.planner import PlanStep
-from prophet.tasks import create_tasks, emit_yaml, generic_utility, parallelise, steps_of
+from alica.prophet.planner import PlanStep
+from alica.prophet.tasks import create_tasks, emit_yaml, generic_utility, parallelise, steps_of
 from tests.conftest import PLANS
 
 SUSSMAN = [("on", ("c", "a")), ("ontable", ("a",)), ("ontable", ("b",)), ("clear", ("c",)), ("clear", ("b",)), ("handempty", ("r",))]
@@ -115,7 +115,7 @@ def test_unknown_or_malformed_steps_are_refused(blocks):
 
 
 def test_the_execution_check_runs_a_free_task_with_a_robot_that_could_start_it(blocks):
-    from prophet.world import TaskProgress, remaining_fits
+    from alica.prophet.world import TaskProgress, remaining_fits
 
     # the planner gave Pickup(b) to r1, which held c at the start (it put c down in T0); r2 had an empty hand
     init = [("holding", ("r1", "c")), ("handempty", ("r2",)), ("ontable", ("b",)), ("clear", ("b",)), ("ontable", ("a",)), ("clear", ("a",))]
@@ -131,7 +131,7 @@ def test_the_execution_check_runs_a_free_task_with_a_robot_that_could_start_it(b
 
 
 def test_a_free_task_no_robot_could_start_at_the_start_is_run_by_its_planned_robot_after_its_earlier_steps(blocks):
-    from prophet.world import TaskProgress, remaining_fits
+    from alica.prophet.world import TaskProgress, remaining_fits
 
     # r1 puts c down (T0, running now), then picks b up (T1, free); r2 holds e all along (seed 18 of the demo:
     # a stand-in with r1's start facts, hand full, made the check replan eleven times)
@@ -147,7 +147,7 @@ def test_a_free_task_no_robot_could_start_at_the_start_is_run_by_its_planned_rob
 
 
 def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
-    from prophet.world import reachable_goal
+    from alica.prophet.world import reachable_goal
 
     # the tower b f d g, and e alone; an opponent holds f
     tower = [(True, ("ontable", ("b",))), (True, ("on", ("f", "b"))), (True, ("on", ("d", "f"))), (True, ("on", ("g", "d")))]
@@ -164,7 +164,7 @@ def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
     st.sets(st.sampled_from("abcdefg"), max_size=3),
 )
 def test_the_kept_part_of_the_goal_shares_no_object_with_the_left_out_part(raw, outside):
-    from prophet.world import reachable_goal
+    from alica.prophet.world import reachable_goal
 
     goal = [(True, (name, tuple(args))) for name, args in raw]
     kept = reachable_goal(goal, outside)

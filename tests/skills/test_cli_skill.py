@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from alica.cli import main
+from alica.app.cli import main
 
 
 def test_unstack_in_the_blocks_world(capfd):

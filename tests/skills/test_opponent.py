@@ -8,9 +8,9 @@ import pytest
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from skills.opponent import BlockAction, RandomBlockSkill, applicable_actions, stack_of
-from skills.testing import run_skill
-from worldsim.scenarios import blocks_facts, blocksworld
+from alica.skills.opponent import BlockAction, RandomBlockSkill, applicable_actions, stack_of
+from alica.skills.testing import run_skill
+from alica.worldsim.scenarios import blocks_facts, blocksworld
 
 STACKS = [["a", "c"], ["b"]]
 

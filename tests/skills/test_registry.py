@@ -8,13 +8,13 @@ import sys
 import pytest
 
 from alica.errors import UnknownSkillError
-from skills.registry import ParamSpec, SkillRegistry, SkillSpec, default_registry
+from alica.skills.registry import ParamSpec, SkillRegistry, SkillSpec, default_registry
 
 
 def test_validation_imports_no_simulation_backend() -> None:
     code = (
-        "import sys, alica, alica.io, alica.lang, alica.cli, skills;"
-        "from alica.io import validate_paths; from skills import default_registry; default_registry();"
+        "import sys, alica, alica.io, alica.lang, alica.app.cli, skills;"
+        "from alica.io import validate_paths; from alica.skills import default_registry; default_registry();"
         "heavy = {'pybullet', 'ompl', 'fcl', 'trimesh', 'py_trees', 'numpy'} & set(sys.modules);"
         "print(sorted(heavy)); sys.exit(1 if heavy else 0)"
     )

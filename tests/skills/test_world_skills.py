@@ -1,4 +1,4 @@
-"""Each skill alone in a small world, in simulated time (the skills.testing fixtures)."""
+"""Each skill alone in a small world, in simulated time (the alica.skills.testing fixtures)."""
 
 from __future__ import annotations
 
@@ -45,7 +45,7 @@ def test_pickup_succeeds(blocks_world, skill_run):
     assert run.ok, (run.reason, run.trace[-6:])
     arm = blocks_world.robots["r1"].arm
     assert arm.held is blocks_world.objects["c"]
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     facts = blocks_facts(blocks_world)
     assert ("holding", "r1", "c") in facts and ("ontable", "c") not in facts
@@ -53,7 +53,7 @@ def test_pickup_succeeds(blocks_world, skill_run):
 
 def test_pickup_of_a_block_hemmed_in_by_others_pushes_them_aside_on_its_last_attempt(blocks_world, skill_run):
     # blocks fell right beside c on all four sides: every grasp's fingers would touch one of them
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     cx, cy, _ = blocks_world.objects["c"].position()
     for name, (dx, dy) in zip("dfhi", [(0.056, 0), (0, 0.056), (-0.056, 0), (0, -0.056)], strict=True):
@@ -83,7 +83,7 @@ def test_pickup_fails_when_a_block_is_put_on_its_object_before_the_grip(blocks_w
 
 
 def test_pickup_retries_after_a_slip(blocks_world, skill_run):
-    from worldsim.faults import set_grasp_slip
+    from alica.worldsim.faults import set_grasp_slip
 
     set_grasp_slip(blocks_world, 1.0)
     attempts = []
@@ -101,7 +101,7 @@ def test_pickup_retries_after_a_slip(blocks_world, skill_run):
 
 
 def test_pickup_fails_after_the_retry_budget(blocks_world, skill_run):
-    from worldsim.faults import set_grasp_slip
+    from alica.worldsim.faults import set_grasp_slip
 
     set_grasp_slip(blocks_world, 1.0)
     arm = blocks_world.robots["r1"].arm
@@ -116,7 +116,7 @@ def test_pickup_fails_after_the_retry_budget(blocks_world, skill_run):
 
 
 def test_putdown_on_the_ground_and_stack_on_a_block(blocks_world, skill_run):
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
     run = skill_run("Putdown", blocks_world, "r1", {"object": "c"})
@@ -130,7 +130,7 @@ def test_putdown_on_the_ground_and_stack_on_a_block(blocks_world, skill_run):
 
 
 def test_unstack_then_stack_follow_the_ipc_domain(blocks_world, skill_run):
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     before = blocks_facts(blocks_world)
     assert ("on", "b", "a") in before and ("clear", "b") in before and ("clear", "a") not in before
@@ -172,7 +172,7 @@ def test_transport_a_sample_to_the_collection_point(lunar_world, skill_run):
 
 
 def test_putdown_on_top_of_a_block(blocks_world, skill_run):
-    from worldsim.scenarios import blocks_facts
+    from alica.worldsim.scenarios import blocks_facts
 
     assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
     run = skill_run("Putdown", blocks_world, "r1", {"object": "c", "target": "b"})

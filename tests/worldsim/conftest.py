@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from worldsim.world import World
+from alica.worldsim.world import World
 
 
 @pytest.fixture

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from worldsim.arm import Arm
-from worldsim.errors import WorldError
-from worldsim.faults import set_grasp_slip
-from worldsim.robots import Robot
-from worldsim.scenarios import blocks_facts
-from worldsim.world import World
+from alica.worldsim.arm import Arm
+from alica.worldsim.errors import WorldError
+from alica.worldsim.faults import set_grasp_slip
+from alica.worldsim.robots import Robot
+from alica.worldsim.scenarios import blocks_facts
+from alica.worldsim.world import World
 
 DOWN = (1.0, 0.0, 0.0, 0.0)  # gripper pointing at the ground
 

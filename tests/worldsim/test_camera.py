@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from matplotlib import image as mpimg
 
-from worldsim.camera import render, snapshot
-from worldsim.errors import WorldError
-from worldsim.scenarios import blocksworld
+from alica.worldsim.camera import render, snapshot
+from alica.worldsim.errors import WorldError
+from alica.worldsim.scenarios import blocksworld
 
 
 def test_snapshot_writes_a_png_of_the_given_size(tmp_path):

@@ -5,14 +5,14 @@ from __future__ import annotations
 import subprocess
 import sys
 
-import worldsim
+from alica import worldsim
 
 
 def test_alica_skills_and_the_grid_do_not_load_pybullet() -> None:
     code = (
-        "import sys, alica, skills, worldsim, worldsim.grid, worldsim.errors, worldsim.geometry\n"
+        "import sys, alica, alica.skills, alica.worldsim, alica.worldsim.grid, alica.worldsim.errors, alica.worldsim.geometry\n"
         "assert 'pybullet' not in sys.modules, 'pybullet was imported'\n"
-        "worldsim.World\n"
+        "alica.worldsim.World\n"
         "assert 'pybullet' in sys.modules\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
@@ -20,8 +20,8 @@ def test_alica_skills_and_the_grid_do_not_load_pybullet() -> None:
 
 
 def test_lazy_exports() -> None:
-    from worldsim.scenarios import lunar
-    from worldsim.world import World
+    from alica.worldsim.scenarios import lunar
+    from alica.worldsim.world import World
 
     assert worldsim.World is World
     assert worldsim.lunar is lunar
@@ -29,7 +29,7 @@ def test_lazy_exports() -> None:
 
 
 def test_importing_is_quiet() -> None:
-    code = "import worldsim.world as w\nw.World().add_robot('stummel', 's')\n"
+    code = "import alica.worldsim.world as w\nw.World().add_robot('stummel', 's')\n"
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
     assert done.returncode == 0, done.stderr
     assert done.stdout == "" and done.stderr == ""

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import pytest
 
 from alica.worldmodel.store import WorldModel
-from worldsim.perception import FactPerception
+from alica.worldsim.perception import FactPerception
 
 
 class _Team:

@@ -8,10 +8,10 @@ from pathlib import Path
 import pytest
 
 from alica.io import load_library
-from worldsim.errors import WorldError
-from worldsim.faults import crash
-from worldsim.robots import ROBOT_KINDS, RobotSpec
-from worldsim.world import World
+from alica.worldsim.errors import WorldError
+from alica.worldsim.faults import crash
+from alica.worldsim.robots import ROBOT_KINDS, RobotSpec
+from alica.worldsim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from worldsim.errors import WorldError
-from worldsim.objects import SAMPLE_KINDS
-from worldsim.scenarios import blocks_facts, blocksworld, lunar, sample_names
+from alica.worldsim.errors import WorldError
+from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.scenarios import blocks_facts, blocksworld, lunar, sample_names
 
 
 def test_blocksworld_defaults() -> None:

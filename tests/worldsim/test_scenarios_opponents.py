@@ -7,9 +7,9 @@ from itertools import pairwise
 
 import pytest
 
-from skills.testing import run_skill
-from worldsim.errors import WorldError
-from worldsim.scenarios import block_names, blocks_facts, blocksworld, random_stacks
+from alica.skills.testing import run_skill
+from alica.worldsim.errors import WorldError
+from alica.worldsim.scenarios import block_names, blocks_facts, blocksworld, random_stacks
 
 
 def test_random_stacks_hold_every_block_once_and_repeat_per_seed():

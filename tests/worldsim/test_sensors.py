@@ -8,11 +8,11 @@ import math
 import numpy as np
 import pytest
 
-from worldsim.errors import WorldError
-from worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from worldsim.objects import SAMPLE_KINDS
-from worldsim.sensors import Detection, lidar_angles, lidar_scan, perceive, scan_to_grid, unknown_grid
-from worldsim.world import World
+from alica.worldsim.errors import WorldError
+from alica.worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.sensors import Detection, lidar_angles, lidar_scan, perceive, scan_to_grid, unknown_grid
+from alica.worldsim.world import World
 
 
 def _ray(angle: float, n: int = 360) -> int:
@@ -127,7 +127,7 @@ def test_grid_from_scans_marks_the_rock(world: World) -> None:
 
 
 def test_set_sensor_noise_zero_gives_exact_positions(world: World) -> None:
-    from worldsim.faults import set_sensor_noise
+    from alica.worldsim.faults import set_sensor_noise
 
     noise = set_sensor_noise(world, lidar_sigma=0.0, position_sigma=0.0)
     assert noise.position_sigma == 0.0 and world.noise is noise

@@ -9,9 +9,9 @@ import pytest
 
 from alica.clock import ManualClock
 from alica.errors import AlicaError
-from worldsim.errors import WorldError
-from worldsim.grid import Obstacle2D
-from worldsim.world import World
+from alica.worldsim.errors import WorldError
+from alica.worldsim.grid import Obstacle2D
+from alica.worldsim.world import World
 
 
 def test_defaults(world: World) -> None:
@@ -62,7 +62,7 @@ def test_two_worlds_do_not_interfere() -> None:
 
 
 def _run(seed: int) -> tuple[list[float], np.ndarray]:
-    from worldsim.sensors import lidar_scan
+    from alica.worldsim.sensors import lidar_scan
 
     with World(seed=seed) as w:
         w.faults.set_sensor_noise(lidar_sigma=0.02)

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from prophet.ground import GroundTask, ground
-from prophet.pddl import PddlError, parse_domain, parse_problem, read_domain, read_problem
+from alica.prophet.ground import GroundTask, ground
+from alica.prophet.pddl import PddlError, parse_domain, parse_problem, read_domain, read_problem
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 

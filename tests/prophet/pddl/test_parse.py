@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from prophet.pddl import (
+from alica.prophet.pddl import (
     PddlError,
     parse_domain,
     parse_problem,
@@ -16,7 +16,7 @@ from prophet.pddl import (
     write_domain,
     write_problem,
 )
-from prophet.planner import Feature
+from alica.prophet.planner import Feature
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 from hypothesis import given
 from hypothesis import strategies as st
 
-from prophet.pddl import (
+from alica.prophet.pddl import (
     Action,
     And,
     Atom,
@@ -21,7 +21,7 @@ from prophet.pddl import (
     write_domain,
     write_problem,
 )
-from prophet.planner import Feature
+from alica.prophet.planner import Feature
 
 NAMES = st.sampled_from(["a", "b", "c", "d-1", "e_2"])
 TYPES = {"thing": "object", "box": "thing", "cup": "thing"}

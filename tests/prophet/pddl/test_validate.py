@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from prophet.ground import ground
-from prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
-from prophet.planner import Plan, PlanStep
-from prophet.validate import validate_plan
+from alica.prophet.ground import ground
+from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
+from alica.prophet.planner import Plan, PlanStep
+from alica.prophet.validate import validate_plan
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 

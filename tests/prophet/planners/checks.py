@@ -6,10 +6,10 @@ import json
 from pathlib import Path
 from typing import Any
 
-from prophet.pddl import read_domain, read_problem
-from prophet.planner import PlanStep
-from prophet.planners.planfile import parse_plan
-from prophet.validate import validate_plan
+from alica.prophet.pddl import read_domain, read_problem
+from alica.prophet.planner import PlanStep
+from alica.prophet.planners.planfile import parse_plan
+from alica.prophet.validate import validate_plan
 
 JSON_KEYS = {"solved", "cost", "plan", "time_first_s", "time_s", "expansions"}
 
@@ -37,7 +37,7 @@ def check_json(out: str, domain: Path, problem: Path) -> dict[str, Any]:
 
 def check_text(out: str, domain: Path, problem: Path) -> float:
     """The text output of a solved run, checked: a plan file whose steps are valid; its cost."""
-    assert "valid: checked with prophet.validate" in out
+    assert "valid: checked with alica.prophet.validate" in out
     assert "time to first plan:" in out and "final cost:" in out and "expansions:" in out
     plan = parse_plan(out)
     assert len(plan) > 0

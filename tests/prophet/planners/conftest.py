@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from alica.cli import main
+from alica.app.cli import main
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-import prophet.planners
-from prophet.planner import Done, Feature, Improved, Plan, Planner, PlanStatus, PlanStep, SearchEvent
+import alica.prophet.planners as planners
+from alica.prophet.planner import Done, Feature, Improved, Plan, Planner, PlanStatus, PlanStep, SearchEvent
 from tests.prophet.planners.checks import JSON_KEYS, check_json, check_text
 
 
@@ -118,14 +118,14 @@ class _Scripted(Planner):
 
 def test_an_invalid_plan_from_a_back_end_is_an_error(alica, blocks, monkeypatch: pytest.MonkeyPatch) -> None:
     wrong = Plan((PlanStep("stack", ("a", "b")),), 1.0)
-    monkeypatch.setattr(prophet.planners, "get_planner", lambda name: _Scripted(wrong, PlanStatus.SOLVED))
+    monkeypatch.setattr(planners, "get_planner", lambda name: _Scripted(wrong, PlanStatus.SOLVED))
     run = alica("plan", *blocks("4-0"))
     assert run.code == 1 and run.out == ""
     assert "planner 'scripted' returned an invalid plan: step 1" in run.err
 
 
 def test_a_failing_back_end_is_an_error(alica, blocks, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(prophet.planners, "get_planner", lambda name: _Scripted(None, PlanStatus.ERROR, "it broke"))
+    monkeypatch.setattr(planners, "get_planner", lambda name: _Scripted(None, PlanStatus.ERROR, "it broke"))
     run = alica("plan", *blocks("4-0"), "--json")
     assert run.code == 1 and run.out == ""
     assert "planner 'scripted' failed: it broke" in run.err

@@ -13,10 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from prophet.pddl import read_domain, read_problem
-from prophet.planner import Done, Improved, PlanStatus
-from prophet.planners import get_planner
-from prophet.planners.fd import FastDownward, find_driver
+from alica.prophet.pddl import read_domain, read_problem
+from alica.prophet.planner import Done, Improved, PlanStatus
+from alica.prophet.planners import get_planner
+from alica.prophet.planners.fd import FastDownward, find_driver
 from tests.prophet.planners.checks import JSON_KEYS, check_json, check_text, valid_cost
 
 if find_driver() is None:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from alica.errors import PlannerError
-from prophet.planner import Plan, PlanStep
-from prophet.planners.planfile import format_plan, parse_plan
+from alica.prophet.planner import Plan, PlanStep
+from alica.prophet.planners.planfile import format_plan, parse_plan
 
 
 def test_fast_downward_plan_with_cost_comment() -> None:

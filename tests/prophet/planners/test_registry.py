@@ -5,13 +5,13 @@ from __future__ import annotations
 import pytest
 
 from alica.errors import PlannerError
-from prophet.planner import Feature, Planner
-from prophet.planners import PLANNERS, available, fd, get_planner, planner_class
-from prophet.planners.fd import FastDownward
+from alica.prophet.planner import Feature, Planner
+from alica.prophet.planners import PLANNERS, available, fd, get_planner, planner_class
+from alica.prophet.planners.fd import FastDownward
 
 
 def test_names() -> None:
-    assert PLANNERS == {"builtin": "prophet.search.planner:BuiltinPlanner", "fd": "prophet.planners.fd:FastDownward"}
+    assert PLANNERS == {"builtin": "alica.prophet.search.planner:BuiltinPlanner", "fd": "alica.prophet.planners.fd:FastDownward"}
 
 
 def test_get_planner_by_name() -> None:
@@ -54,7 +54,7 @@ def test_available_reports_a_module_that_does_not_import(monkeypatch: pytest.Mon
 
 
 def test_not_a_planner_class(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setitem(PLANNERS, "odd", "prophet.planners.fd:find_driver")
+    monkeypatch.setitem(PLANNERS, "odd", "alica.prophet.planners.fd:find_driver")
     with pytest.raises(PlannerError, match="is not a Planner class"):
         get_planner("odd")
 

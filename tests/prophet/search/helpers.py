@@ -8,7 +8,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from prophet.planner import Plan
+from alica.prophet.planner import Plan
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from prophet import ground as grounding
-from prophet import pddl
-from prophet.planner import Done, Improved, PlanStatus
-from prophet.search import BuiltinPlanner, search_task
+from alica.prophet import ground as grounding
+from alica.prophet import pddl
+from alica.prophet.planner import Done, Improved, PlanStatus
+from alica.prophet.search import BuiltinPlanner, search_task
 from tests.prophet.search.helpers import BENCHMARKS, check_plan
 
 CASES = [

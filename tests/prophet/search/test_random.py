@@ -7,8 +7,8 @@ import itertools
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from prophet.planner import Done, Improved, PlanStatus
-from prophet.search import search_task
+from alica.prophet.planner import Done, Improved, PlanStatus
+from alica.prophet.search import search_task
 from tests.prophet.search.helpers import GroundOperator, GroundTask, check_plan, optimal_cost
 
 N_FACTS = 7

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from prophet.planner import Done, Feature, Improved, PlanStatus, Progress
-from prophet.search import BuiltinPlanner, search_task
-from prophet.search.encoding import bits, compile_task
-from prophet.search.heuristics import INF, Relaxed
+from alica.prophet.planner import Done, Feature, Improved, PlanStatus, Progress
+from alica.prophet.search import BuiltinPlanner, search_task
+from alica.prophet.search.encoding import bits, compile_task
+from alica.prophet.search.heuristics import INF, Relaxed
 from tests.prophet.search.helpers import TaskBuilder, blocks_task, check_plan, optimal_cost
 
 

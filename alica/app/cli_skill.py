@@ -50,12 +50,12 @@ def _params(items: list[str]) -> dict[str, object]:
 
 def _world(args: argparse.Namespace) -> Any:
     if args.world == "lunar":
-        from worldsim.scenarios import lunar
+        from alica.worldsim.scenarios import lunar
 
         if args.rocks < 0:
             raise AlicaError(f"--rocks must be >= 0, got {args.rocks}")
         return lunar(seed=args.seed, rocks=args.rocks)
-    from worldsim.scenarios import blocksworld
+    from alica.worldsim.scenarios import blocksworld
 
     stacks = [[b.strip() for b in stack.split(",") if b.strip()] for stack in args.stacks.split(";") if stack.strip()]
     if not stacks:
@@ -97,9 +97,9 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
 
 def cmd_skill_run(args: argparse.Namespace) -> int:
     """Run ``alica skill run``; returns the exit code."""
-    from skills.motion import configure_ompl
-    from skills.registry import default_registry
-    from skills.testing import run_skill
+    from alica.skills.motion import configure_ompl
+    from alica.skills.registry import default_registry
+    from alica.skills.testing import run_skill
 
     configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
     registry = default_registry()

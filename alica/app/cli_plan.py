@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from alica.errors import AlicaError
-from prophet.planner import Plan, PlanResult, PlanStatus
+from alica.prophet.planner import Plan, PlanResult, PlanStatus
 
 EXIT_OK, EXIT_ERROR, EXIT_UNSOLVABLE, EXIT_TIMEOUT = 0, 1, 3, 4
 PLAN_FILE_SUFFIXES = (".yaml", ".yml", ".xml")
@@ -29,12 +29,12 @@ PLAN_FILE_SUFFIXES = (".yaml", ".yml", ".xml")
 
 def add_parser(sub: Any) -> None:
     """Add the ``plan`` subcommand to the ``alica`` parser."""
-    from prophet.planners import PLANNERS
+    from alica.prophet.planners import PLANNERS
 
     p = sub.add_parser(
         "plan",
         help="solve a PDDL planning problem and print a validated plan",
-        description="Solve a PDDL problem with a planner back-end, check the plan with prophet.validate and print it "
+        description="Solve a PDDL problem with a planner back-end, check the plan with alica.prophet.validate and print it "
         "(one action a line, then ';' lines with cost, times and expansions: the output is itself a plan file). "
         "Exit 0 solved, 1 input error or planner failure, 3 proven unsolvable, 4 time limit reached without a plan.",
     )
@@ -76,8 +76,8 @@ def _positive(text: str) -> float:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     """Run ``alica plan``; returns the exit code."""
-    from prophet.pddl import PddlError, read_domain, read_problem
-    from prophet.planners import get_planner
+    from alica.prophet.pddl import PddlError, read_domain, read_problem
+    from alica.prophet.planners import get_planner
 
     if Path(args.domain).suffix.lower() in PLAN_FILE_SUFFIXES:
         return _plan_file(args)
@@ -128,10 +128,10 @@ def _plan_file(args: argparse.Namespace) -> int:
 
     from alica.io import load_library
     from alica.model import Condition, ConditionKind
-    from prophet.planners import get_planner
-    from prophet.problem import to_pddl
-    from prophet.tasks import create_tasks, emit_yaml
-    from prophet.world import read_world
+    from alica.prophet.planners import get_planner
+    from alica.prophet.problem import to_pddl
+    from alica.prophet.tasks import create_tasks, emit_yaml
+    from alica.prophet.world import read_world
 
     if args.problem is not None:
         raise AlicaError(f"{args.domain} is a plan file: name its planning problem with --problem, not a PROBLEM file")
@@ -162,7 +162,7 @@ def _plan_file(args: argparse.Namespace) -> int:
         if not result.plan.steps:
             return {"tasks": []}
         names = {o.lower(): o for o, _ in world.objects}
-        from prophet.planner import PlanStep
+        from alica.prophet.planner import PlanStep
 
         steps = [PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in result.plan.steps]
         roleset = next(iter(sorted(library.rolesets.items())))[1] if library.rolesets else None
@@ -193,12 +193,12 @@ def _check_features(planner: Any, domain: Any, problem: Any) -> None:
 
 
 def _validated_cost(name: str, task: tuple[Any, Any], plan: Plan) -> float:
-    """The plan's cost as :func:`prophet.validate.validate_plan` computes it.
+    """The plan's cost as :func:`alica.prophet.validate.validate_plan` computes it.
 
     Raises:
         AlicaError: the plan is not valid (the message gives the reason).
     """
-    from prophet.validate import validate_plan
+    from alica.prophet.validate import validate_plan
 
     check = validate_plan(task, plan)
     if not check.valid:
@@ -232,7 +232,7 @@ def _print_text(result: PlanResult, cost: float | None) -> None:
     for step in result.plan.steps:
         print(step)
     first = f"{result.time_first_s:.3f} s" if result.time_first_s is not None else "-"
-    print(f"; cost = {_number(cost)} ({len(result.plan)} steps, valid: checked with prophet.validate)")
+    print(f"; cost = {_number(cost)} ({len(result.plan)} steps, valid: checked with alica.prophet.validate)")
     print(f"; time to first plan: {first}")
     print(f"; final cost: {_number(cost)} after {result.time_s:.3f} s ({result.status.value})")
     print(f"; expansions: {result.expansions}")

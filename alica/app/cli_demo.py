@@ -1,4 +1,4 @@
-"""``alica demo blocksworld``: the blocks-world mission end to end (see :mod:`alica.demos.blocksworld`).
+"""``alica demo blocksworld``: the blocks-world mission end to end (see :mod:`alica.app.demos.blocksworld`).
 
 Exit 0 when the goal holds, 1 when the time limit passed first or the input is bad.
 """
@@ -59,7 +59,7 @@ def read_goal_file(path: str) -> tuple[list[list[str]] | None, list[list[str]]]:
     """
     import yaml
 
-    from alica.demos.blocksworld import check_stacks
+    from alica.app.demos.blocksworld import check_stacks
 
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -104,7 +104,7 @@ class Progress:
 
 def cmd_blocksworld(args: argparse.Namespace) -> int:
     """Run ``alica demo blocksworld``; returns the exit code."""
-    from alica.demos.blocksworld import DemoConfig, run_demo
+    from alica.app.demos.blocksworld import DemoConfig, run_demo
 
     start, goal = read_goal_file(args.goal) if args.goal else (None, None)
     if not args.time_limit > 0:

@@ -2,8 +2,8 @@
 
 The shipped mission ``plans/blocksworld/mission.yaml`` holds the planning
 problem StackBlocks. World comes from the simulated state: an overhead
-perception (:class:`worldsim.perception.FactPerception` with
-:func:`worldsim.scenarios.blocks_facts`) writes the IPC facts into every
+perception (:class:`alica.worldsim.perception.FactPerception` with
+:func:`alica.worldsim.scenarios.blocks_facts`) writes the IPC facts into every
 robot's world model. Goal is the goal configuration. The team robots
 ``r1..rN`` plan, allocate and execute with the real skills (mobile
 manipulators driving with OMPL paths and grasping with the Panda arm).
@@ -25,13 +25,14 @@ from pathlib import Path
 from typing import Any
 
 from alica.errors import AlicaError
+from alica.io.loader import plans_dir
 
 Stacks = list[list[str]]
 PROBLEM = "StackBlocks"
 #: Simulated seconds the run goes on once the goal holds, for the team to notice it.
 SETTLE_S = 2.0
 #: The shipped mission plan.
-MISSION = Path(__file__).resolve().parents[2] / "plans" / "blocksworld" / "mission.yaml"
+MISSION = plans_dir() / "blocksworld" / "mission.yaml"
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,7 +141,7 @@ def configurations(config: DemoConfig) -> tuple[Stacks, Stacks]:
         AlicaError: start and goal name different blocks.
     """
     if config.start is None or config.goal is None:
-        from worldsim.scenarios import random_stacks
+        from alica.worldsim.scenarios import random_stacks
     start = config.start if config.start is not None else random_stacks(config.blocks, config.seed)
     if config.goal is not None:
         goal = config.goal
@@ -209,11 +210,11 @@ def run_demo(
     """
     from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam
     from alica.io import load_library
-    from skills.registry import default_registry
-    from worldsim.perception import FactPerception
-    from worldsim.scenarios import blocks_facts, blocksworld
+    from alica.skills.registry import default_registry
+    from alica.worldsim.perception import FactPerception
+    from alica.worldsim.scenarios import blocks_facts, blocksworld
 
-    from skills.motion import configure_ompl
+    from alica.skills.motion import configure_ompl
 
     configure_ompl(config.seed)  # OMPL's generator is per process: seed it before any planner exists
     if config.agents < 1 or config.opponents < 0:
@@ -308,14 +309,14 @@ def _plan_yaml(created: Any, out: Path | None) -> str:
     """The generated plan as YAML, importing the mission from where it is written."""
     import os
 
-    from prophet.tasks import emit_yaml
+    from alica.prophet.tasks import emit_yaml
 
     where = out.resolve() if out is not None else Path.cwd()
     return emit_yaml(created, imports=(Path(os.path.relpath(MISSION, where)).as_posix(),))
 
 
 def _picture(world: Any, path: Path) -> None:
-    from worldsim.camera import snapshot
+    from alica.worldsim.camera import snapshot
 
     path.parent.mkdir(parents=True, exist_ok=True)
     snapshot(world, path)

@@ -11,6 +11,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from alica import __version__
 from alica.errors import AlicaError, PlanFormatError
 from alica.source import Diagnostic
 
@@ -57,7 +58,7 @@ def _roots(library, entry, name: str | None) -> list[str]:  # type: ignore[no-un
 
 
 def _cmd_show(args: argparse.Namespace) -> int:
-    from alica.render import dot_graph, svg, text_tree
+    from alica.app.render import dot_graph, svg, text_tree
 
     library, entry = _load(args.plan)
     try:
@@ -84,7 +85,7 @@ def _cmd_render(args: argparse.Namespace) -> int:
     import shutil
 
     from alica.io import Loader, plan_files
-    from alica.render import dot_graph, svg, text_tree
+    from alica.app.render import dot_graph, svg, text_tree
 
     files, problems = plan_files(args.paths)
     loader = Loader()
@@ -129,7 +130,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
 
 
 def _cmd_list_skills(args: argparse.Namespace) -> int:
-    from skills.registry import default_registry
+    from alica.skills.registry import default_registry
 
     for spec in default_registry():
         caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""
@@ -145,6 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``alica`` command."""
     parser = argparse.ArgumentParser(prog="alica", description="Teams of robots that carry out missions described as data.")
     parser.add_argument("--debug", action="store_true", help="show a traceback on internal errors")
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
@@ -174,10 +176,10 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("list-skills", help="list the registered skills and their parameters")
     p.set_defaults(run=_cmd_list_skills)
 
-    from alica.cli_demo import add_parser as add_demo_parser
-    from alica.cli_plan import add_parser as add_plan_parser
-    from alica.cli_run import add_parser as add_run_parser
-    from alica.cli_skill import add_parser as add_skill_parser
+    from alica.app.cli_demo import add_parser as add_demo_parser
+    from alica.app.cli_plan import add_parser as add_plan_parser
+    from alica.app.cli_run import add_parser as add_run_parser
+    from alica.app.cli_skill import add_parser as add_skill_parser
 
     add_run_parser(sub)
     add_skill_parser(sub)

@@ -99,7 +99,7 @@ def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Run the ``run`` subcommand; returns the exit code."""
-    from alica.cli import _load, _roots
+    from alica.app.cli import _load, _roots
     from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
     from alica.testing import default_fallback
