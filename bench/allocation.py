@@ -54,14 +54,20 @@ class Case:
 
 
 def _roleset(rng: random.Random, tasks: list[str]) -> RoleSet:
-    roles = tuple(
-        Role(f"R{i}", tuple(Priority(t, rng.uniform(-0.3, 1.0)) for t in tasks)) for i in range(ROLES)
-    )
+    roles = tuple(Role(f"R{i}", tuple(Priority(t, rng.uniform(-0.3, 1.0)) for t in tasks)) for i in range(ROLES))
     return RoleSet("Bench", roles)
 
 
-def _plan(rng: random.Random, name: str, agents: list[str], roles: dict[str, str], roleset: RoleSet,
-          width: int, tasks: list[str], similarity: float) -> Plan:
+def _plan(
+    rng: random.Random,
+    name: str,
+    agents: list[str],
+    roles: dict[str, str],
+    roleset: RoleSet,
+    width: int,
+    tasks: list[str],
+    similarity: float,
+) -> Plan:
     """A plan with random cardinalities that a random non-vetoed witness assignment satisfies."""
     chosen = rng.sample(tasks, width)
     counts = [0] * width
@@ -86,9 +92,7 @@ def make_case(seed: int, agents_count: int, width: int, plans: int, with_old: bo
     agents = [f"agent{i:02d}" for i in range(agents_count)]
     roles = {a: f"R{rng.randrange(ROLES)}" for a in agents}
     similarity = 0.2 if with_old else 0.0
-    candidates = tuple(
-        _plan(rng, f"P{k}", agents, roles, roleset, width, tasks, similarity) for k in range(plans)
-    )
+    candidates = tuple(_plan(rng, f"P{k}", agents, roles, roleset, width, tasks, similarity) for k in range(plans))
     old = None
     if with_old:
         first = candidates[0]
@@ -173,8 +177,10 @@ def _stats(times: list[float]) -> str:
 
 def run(seeds: int, repeat: int) -> None:
     """Solve every case and print the table."""
-    print("| agents x EPs | plans | old + sim 0.2 | allocate ms (median / p95) | expansions (median) "
-          "| exhaustive ms (median / p95) | scipy ms (median / p95) | agree |")
+    print(
+        "| agents x EPs | plans | old + sim 0.2 | allocate ms (median / p95) | expansions (median) "
+        "| exhaustive ms (median / p95) | scipy ms (median / p95) | agree |"
+    )
     print("|---|---|---|---|---|---|---|---|")
     for agents_count, width in SIZES:
         for plans in (1, 3):

@@ -30,13 +30,33 @@ OUT = ROOT / "build" / "bench"
 
 def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
     """One demo run in a fresh process; its JSON summary (``error`` set when it did not run)."""
-    argv = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", str(agents), "--opponents", str(opponents),
-            "--blocks", str(blocks), "--seed", str(seed), "--time-limit", str(time_limit), "--json", "--no-progress"]
+    argv = [
+        sys.executable,
+        "-m",
+        "alica.app.cli",
+        "demo",
+        "blocksworld",
+        "--agents",
+        str(agents),
+        "--opponents",
+        str(opponents),
+        "--blocks",
+        str(blocks),
+        "--seed",
+        str(seed),
+        "--time-limit",
+        str(time_limit),
+        "--json",
+        "--no-progress",
+    ]
     started = time.perf_counter()
     done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=time_limit * 4 + 120)
     line = next((row for row in reversed(done.stdout.splitlines()) if row.startswith("{")), None)
     if line is None:
-        return {"error": done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}", "process_s": time.perf_counter() - started}
+        return {
+            "error": done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}",
+            "process_s": time.perf_counter() - started,
+        }
     result = json.loads(line)
     result["process_s"] = time.perf_counter() - started
     return result
@@ -55,50 +75,95 @@ def main() -> int:
     parser.add_argument("--blocks", type=int, default=6, help="blocks (default 6)")
     parser.add_argument("--seeds", type=int, default=3, help="seeds per cell (default 3)")
     parser.add_argument("--time-limit", type=float, default=900.0, help="simulated seconds per run (default 900)")
-    parser.add_argument("--jobs", type=int, default=1, help="runs at once, each in its own process (default 1; wall times are then shared-machine figures)")
+    parser.add_argument(
+        "--jobs",
+        type=int,
+        default=1,
+        help="runs at once, each in its own process (default 1; wall times are then shared-machine figures)",
+    )
     args = parser.parse_args()
     cells = [(opponents, agents) for opponents in (0, args.opponents) for agents in _range(args.agents)]
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-        futures = {(o, a, seed): pool.submit(run_one, a, o, args.blocks, seed, args.time_limit) for o, a in cells for seed in range(args.seeds)}
+        futures = {
+            (o, a, seed): pool.submit(run_one, a, o, args.blocks, seed, args.time_limit)
+            for o, a in cells
+            for seed in range(args.seeds)
+        }
         results = {key: future.result() for key, future in futures.items()}
     rows = []
     for opponents, agents in cells:
         runs = [results[(opponents, agents, seed)] for seed in range(args.seeds)]
         ok = [r for r in runs if r.get("success")]
         times = [float(r["sim_time_s"]) for r in ok]  # type: ignore[arg-type]
-        rows.append({
-            "agents": agents,
-            "opponents": opponents,
-            "success": f"{len(ok)}/{len(runs)}",
-            "sim_mean": statistics.mean(times) if times else float("nan"),
-            "sim_min": min(times) if times else float("nan"),
-            "sim_max": max(times) if times else float("nan"),
-            "replans": statistics.mean(float(r.get("replans", 0)) for r in runs if "error" not in r) if any("error" not in r for r in runs) else float("nan"),  # type: ignore[arg-type]
-            "wall_mean": statistics.mean(float(r["wall_time_s"]) for r in runs if "wall_time_s" in r) if any("wall_time_s" in r for r in runs) else float("nan"),  # type: ignore[arg-type]
-            "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
-        })
+        rows.append(
+            {
+                "agents": agents,
+                "opponents": opponents,
+                "success": f"{len(ok)}/{len(runs)}",
+                "sim_mean": statistics.mean(times) if times else float("nan"),
+                "sim_min": min(times) if times else float("nan"),
+                "sim_max": max(times) if times else float("nan"),
+                "replans": statistics.mean(float(r.get("replans", 0)) for r in runs if "error" not in r)
+                if any("error" not in r for r in runs)
+                else float("nan"),  # type: ignore[arg-type]
+                "wall_mean": statistics.mean(float(r["wall_time_s"]) for r in runs if "wall_time_s" in r)
+                if any("wall_time_s" in r for r in runs)
+                else float("nan"),  # type: ignore[arg-type]
+                "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
+            }
+        )
         last = rows[-1]
-        print(f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s", file=sys.stderr, flush=True)
+        print(
+            f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s",
+            file=sys.stderr,
+            flush=True,
+        )
     header = ["agents", "opponents", "success", "sim time mean s", "min", "max", "replans mean", "wall mean s"]
-    print(f"Blocks world, {args.blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n")
+    print(
+        f"Blocks world, {args.blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n"
+    )
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
     for r in rows:
-        print(f"| {r['agents']} | {r['opponents']} | {r['success']} | {r['sim_mean']:.1f} | {r['sim_min']:.1f} | {r['sim_max']:.1f} | {r['replans']:.1f} | {r['wall_mean']:.1f} |")
+        print(
+            f"| {r['agents']} | {r['opponents']} | {r['success']} | {r['sim_mean']:.1f} | {r['sim_min']:.1f} | {r['sim_max']:.1f} | {r['replans']:.1f} | {r['wall_mean']:.1f} |"
+        )
     errors = [f"agents {r['agents']} opponents {r['opponents']}: {r['errors']}" for r in rows if r["errors"]]
     if errors:
         print("\nruns that did not finish: " + " | ".join(errors))
     OUT.mkdir(parents=True, exist_ok=True)
     with (OUT / "blocksworld_agents.tsv").open("w", encoding="utf-8") as f:
-        f.write("\t".join(["agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean"]) + "\n")
+        f.write(
+            "\t".join(["agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean"])
+            + "\n"
+        )
         for r in rows:
-            f.write("\t".join(str(r[k]) for k in ("agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean")) + "\n")
+            f.write(
+                "\t".join(
+                    str(r[k])
+                    for k in (
+                        "agents",
+                        "opponents",
+                        "success",
+                        "sim_mean",
+                        "sim_min",
+                        "sim_max",
+                        "replans",
+                        "wall_mean",
+                    )
+                )
+                + "\n"
+            )
     with (OUT / "blocksworld_runs.tsv").open("w", encoding="utf-8") as f:
         f.write("agents\topponents\tseed\tsuccess\tsim_time_s\twall_time_s\treplans\terror\n")
         for (opponents, agents, seed), r in sorted(results.items()):
-            f.write(f"{agents}\t{opponents}\t{seed}\t{r.get('success', '')}\t{r.get('sim_time_s', '')}\t{r.get('wall_time_s', '')}\t{r.get('replans', '')}\t{r.get('error', '')}\n")
+            f.write(
+                f"{agents}\t{opponents}\t{seed}\t{r.get('success', '')}\t{r.get('sim_time_s', '')}\t{r.get('wall_time_s', '')}\t{r.get('replans', '')}\t{r.get('error', '')}\n"
+            )
     _plot(rows, OUT / "blocksworld_agents.png", args)
-    print(f"\nwrote {OUT / 'blocksworld_agents.tsv'}, {OUT / 'blocksworld_runs.tsv'} (every run) and {OUT / 'blocksworld_agents.png'}")
+    print(
+        f"\nwrote {OUT / 'blocksworld_agents.tsv'}, {OUT / 'blocksworld_runs.tsv'} (every run) and {OUT / 'blocksworld_agents.png'}"
+    )
     return 0
 
 

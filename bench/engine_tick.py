@@ -32,7 +32,9 @@ def make_team(size: int, seed: int, broadcast: float = 0.2) -> SimulatedTeam:
     library = load_library(ROOT / "plans" / "lunar" / "mission.yaml")
     agents = {f"r{i:02d}": ROLES[i % 3] for i in range(size)}
     config = EngineConfig(frequency=30.0, broadcast_interval=broadcast)
-    return SimulatedTeam(library, "LunarMission", agents, seed=seed, config=config, fallback=default_fallback(seed, 5.0, 20.0))
+    return SimulatedTeam(
+        library, "LunarMission", agents, seed=seed, config=config, fallback=default_fallback(seed, 5.0, 20.0)
+    )
 
 
 def behaviours_running(team: SimulatedTeam) -> int:
@@ -60,7 +62,9 @@ def _events(team: SimulatedTeam, ticks: int) -> None:
         team.crash(name, at=start + 0.5 * ticks * period)
 
 
-def engine_cost(size: int, ticks: int, seed: int, faults: bool = False, broadcast: float = 0.2) -> tuple[float, float, int]:
+def engine_cost(
+    size: int, ticks: int, seed: int, faults: bool = False, broadcast: float = 0.2
+) -> tuple[float, float, int]:
     team = make_team(size, seed, broadcast)
     team.run(ticks=30)
     if faults:
@@ -83,7 +87,11 @@ class _Poll(py_trees.behaviour.Behaviour):
 def pytrees_cost(size: int, per_agent: int, ticks: int) -> float:
     trees = []
     for i in range(size):
-        root = py_trees.composites.Parallel(f"agent{i}", policy=py_trees.common.ParallelPolicy.SuccessOnAll(), children=[_Poll(f"b{j}") for j in range(max(1, per_agent))])
+        root = py_trees.composites.Parallel(
+            f"agent{i}",
+            policy=py_trees.common.ParallelPolicy.SuccessOnAll(),
+            children=[_Poll(f"b{j}") for j in range(max(1, per_agent))],
+        )
         trees.append(py_trees.trees.BehaviourTree(root))
     start = time.perf_counter()
     for _ in range(ticks):
@@ -97,12 +105,18 @@ def main() -> None:
     parser.add_argument("--ticks", type=int, default=300)
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    print(f"engine tick cost per agent, LunarMission at 30 Hz, {args.ticks} ticks after 30 warm-up ticks, median of {args.repeat}")
+    print(
+        f"engine tick cost per agent, LunarMission at 30 Hz, {args.ticks} ticks after 30 warm-up ticks, median of {args.repeat}"
+    )
     print()
-    print("steady: agents run their tasks, team messages every 0.2 s; with faults: the samples are found (transports start)")
+    print(
+        "steady: agents run their tasks, team messages every 0.2 s; with faults: the samples are found (transports start)"
+    )
     print("and a tenth of the team crashes; last: the same with a team message from every agent on every tick")
     print()
-    print("| agents | steady, ms per agent tick | with faults | with faults, team message every tick | goal | messages per tick (steady / every tick) | behaviours running | py_trees alone, ms per agent tick |")
+    print(
+        "| agents | steady, ms per agent tick | with faults | with faults, team message every tick | goal | messages per tick (steady / every tick) | behaviours running | py_trees alone, ms per agent tick |"
+    )
     print("|---:|---:|---:|---:|---:|---:|---:|---:|")
     for size in (5, 20, 50):
         runs = [engine_cost(size, args.ticks, seed) for seed in range(args.repeat)]
@@ -116,7 +130,9 @@ def main() -> None:
         running = runs[0][2]
         peer = statistics.median(pytrees_cost(size, round(running / size), args.ticks) for _ in range(args.repeat))
         verdict = "ok" if max(ms, ms_faults, ms_loud) <= 0.66 else "over"
-        print(f"| {size} | {ms:.3f} | {ms_faults:.3f} | {ms_loud:.3f} | 0.66 ({verdict}) | {msgs:.1f} / {msgs_loud:.1f} | {running} | {peer:.3f} |")
+        print(
+            f"| {size} | {ms:.3f} | {ms_faults:.3f} | {ms_loud:.3f} | 0.66 ({verdict}) | {msgs:.1f} / {msgs_loud:.1f} | {running} | {peer:.3f} |"
+        )
 
 
 if __name__ == "__main__":

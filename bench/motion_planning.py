@@ -82,8 +82,14 @@ def planar_length(xy: list[tuple[float, float]]) -> float:
 def run_ours(checker: GridChecker, start: tuple, goal: tuple, time_limit: float) -> Run:
     raw = plan_path(start, goal, checker, RADIUS, time_limit=time_limit, simplify=False, goal_tolerance=TOLERANCE)
     simp = plan_path(start, goal, checker, RADIUS, time_limit=time_limit, goal_tolerance=TOLERANCE)
-    return Run(raw.status == "exact", raw.first_solution_s, raw.first_solution_cpu_s, raw.length,
-               simp.plan_time_s, simp.length if simp.ok else math.nan)
+    return Run(
+        raw.status == "exact",
+        raw.first_solution_s,
+        raw.first_solution_cpu_s,
+        raw.length,
+        simp.plan_time_s,
+        simp.length if simp.ok else math.nan,
+    )
 
 
 def run_fcl_peer(exact: FclChecker, start: tuple, goal: tuple, time_limit: float, step: float) -> Run:
@@ -153,10 +159,14 @@ def main() -> None:
     args = parser.parse_args()
     configure_ompl(args.seed)
 
-    print(f"Robot radius {RADIUS} m, grid {RESOLUTION} m, {args.seeds} fields x {args.queries} queries per row, "
-          f"start-goal >= {args.min_distance} m, time limit {args.time_limit} s.\n")
-    header = ("| rocks | planner | first wall median ms | wall p95 ms | first CPU median ms | CPU p95 ms | "
-              "first length m (median) | simplified length m | plan_path total ms | solved |")
+    print(
+        f"Robot radius {RADIUS} m, grid {RESOLUTION} m, {args.seeds} fields x {args.queries} queries per row, "
+        f"start-goal >= {args.min_distance} m, time limit {args.time_limit} s.\n"
+    )
+    header = (
+        "| rocks | planner | first wall median ms | wall p95 ms | first CPU median ms | CPU p95 ms | "
+        "first length m (median) | simplified length m | plan_path total ms | solved |"
+    )
     lines = [header, "| --- " * 10 + "|"]
     verdicts = []
     for count, goal_ms in ((60, 1.0), (150, 15.0)):

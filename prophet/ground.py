@@ -91,7 +91,9 @@ class GroundTask:
         """
         if not self._ids:
             self._ids.update((f, i) for i, f in enumerate(self.facts))
-        key = " ".join(text.lower().replace("(", " ( ").replace(")", " ) ").split()).replace("( ", "(").replace(" )", ")")
+        key = (
+            " ".join(text.lower().replace("(", " ( ").replace(")", " ) ").split()).replace("( ", "(").replace(" )", ")")
+        )
         return self._ids[key]
 
     def applicable(self, state: frozenset[int], op: GroundOperator) -> bool:
@@ -221,8 +223,13 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     goal_final = {ids[text_of[i]] for i in goal_ids}
     operators = _operators([(fix.actions[k], compiled[k]) for k in fired], final)
     return GroundTask(
-        problem.name, tuple(names), frozenset(final[i] for i in init_ids if final[i] >= 0),
-        tuple(sorted(goal_final)), operators, fix.has_costs, reason,
+        problem.name,
+        tuple(names),
+        frozenset(final[i] for i in init_ids if final[i] >= 0),
+        tuple(sorted(goal_final)),
+        operators,
+        fix.has_costs,
+        reason,
     )
 
 
@@ -245,6 +252,7 @@ def _build_positive(
     names = sorted(set(text_of.values()))
     ids = {text: i for i, text in enumerate(names)}
     final = {f: ids[text_of[f]] for f in reached}
+
     def ids_of(facts: tuple[Fact, ...]) -> tuple[int, ...]:
         if len(facts) == 1:
             return (final[facts[0]],)
@@ -265,8 +273,13 @@ def _build_positive(
         if key not in operators:
             operators[key] = GroundOperator(name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost)
     return GroundTask(
-        problem.name, tuple(names), frozenset(final[f] for f in init), tuple(sorted({ids[text_of[f]] for f in goal_facts})),
-        _ordered(operators), fix.has_costs, reason,
+        problem.name,
+        tuple(names),
+        frozenset(final[f] for f in init),
+        tuple(sorted({ids[text_of[f]] for f in goal_facts})),
+        _ordered(operators),
+        fix.has_costs,
+        reason,
     )
 
 
@@ -303,7 +316,9 @@ class _Facts:
         return frozenset([new(f, len(ids)) for f in facts])
 
 
-Compiled = tuple[frozenset[int], frozenset[int], frozenset[int], tuple[tuple[frozenset[int], frozenset[int], frozenset[int]], ...]]
+Compiled = tuple[
+    frozenset[int], frozenset[int], frozenset[int], tuple[tuple[frozenset[int], frozenset[int], frozenset[int]], ...]
+]
 """Pre, add, delete (minus add) and the when-effects (condition, add, delete) of one action, over local fact ids."""
 
 
@@ -330,7 +345,9 @@ def _operators(kept: list[tuple[GroundAction, Compiled]], final: list[int]) -> t
         conds = tuple(sorted(set(cond))) if cond else ()
         key = (name, pre_ids, add_ids, del_ids, action.cost, conds)
         if key not in operators:
-            operators[key] = GroundOperator(name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost, conds)
+            operators[key] = GroundOperator(
+                name, action.action, action.args, pre_ids, add_ids, del_ids, action.cost, conds
+            )
     return _ordered(operators)
 
 

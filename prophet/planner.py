@@ -156,7 +156,9 @@ class Planner(ABC):
         lacking = self.missing(needed)
         if lacking:
             names = ", ".join(sorted(f.value for f in lacking))
-            raise PlannerError(f"planner '{self.name}' does not support :{names}; use another planner (alica plan --planner ...)")
+            raise PlannerError(
+                f"planner '{self.name}' does not support :{names}; use another planner (alica plan --planner ...)"
+            )
         return self._search(domain, problem, anytime=anytime)
 
     @abstractmethod
@@ -179,7 +181,9 @@ class Planner(ABC):
                     first = time.perf_counter() - start
                 status = PlanStatus.SOLVED
             elif isinstance(event, Done):
-                status = event.status if event.status is not PlanStatus.SOLVED or best is not None else PlanStatus.SOLVED
+                status = (
+                    event.status if event.status is not PlanStatus.SOLVED or best is not None else PlanStatus.SOLVED
+                )
                 message = event.message
                 break
             if time.perf_counter() - start > time_limit:

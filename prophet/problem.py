@@ -49,7 +49,9 @@ def _signatures(problem: PlanningProblem, library: PlanLibrary):  # type: ignore
     for name in problem.elements:
         plan = library.plans.get(name)
         if plan is None or plan.signature is None:
-            raise PlannerError(f"planning problem '{problem.name}': element '{name}' is not a skill plan with a signature")
+            raise PlannerError(
+                f"planning problem '{problem.name}': element '{name}' is not a skill plan with a signature"
+            )
         sig = plan.signature
         typed = {v.name: (v.type if v.type != "any" else "object") for v in sig.parameters}
         pre = _conjunction(sig.precondition.text if sig.precondition else None, f"the precondition of '{name}'")
@@ -87,13 +89,17 @@ def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
             f"  (:action {_symbol(name)}\n    :parameters ({params})\n"
             f"    :precondition {_and(pre) if pre else '(and)'}\n    :effect {_and(effect_parts)})"
         )
-    preds = " ".join(f"({p} {' '.join(f'?a{i} - {_symbol(t)}' for i, t in enumerate(ts))})".replace(" )", ")") for p, ts in sorted(predicates.items()))
+    preds = " ".join(
+        f"({p} {' '.join(f'?a{i} - {_symbol(t)}' for i, t in enumerate(ts))})".replace(" )", ")")
+        for p, ts in sorted(predicates.items())
+    )
     type_list = " ".join(sorted(_symbol(t) for t in types if t != "object"))
     return (
         f"(define (domain {_symbol(problem.name)})\n  (:requirements :strips :typing :negative-preconditions :action-costs)\n"
         + (f"  (:types {type_list} - object)\n" if type_list else "")
         + f"  (:predicates {preds})\n  (:functions (total-cost) - number)\n"
-        + "\n".join(actions) + "\n)\n"
+        + "\n".join(actions)
+        + "\n)\n"
     )
 
 
@@ -119,15 +125,21 @@ def offline_world(problem: PlanningProblem) -> tuple[dict[str, str], list[Fact]]
         PlannerError: no world is given, or it is not a conjunction of positive literals.
     """
     if problem.world is None:
-        raise PlannerError(f"planning problem '{problem.name}' has no 'world': it is read from the world model at run time")
+        raise PlannerError(
+            f"planning problem '{problem.name}' has no 'world': it is read from the world model at run time"
+        )
     _, found = _conjunction(problem.world.text, f"the world of '{problem.name}'")
     if any(not positive for positive, _, _ in found):
-        raise PlannerError(f"the world of '{problem.name}' lists facts that hold; leave out the ones that do not (closed world)")
+        raise PlannerError(
+            f"the world of '{problem.name}' lists facts that hold; leave out the ones that do not (closed world)"
+        )
     objects = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
     return objects, [(n, tuple(str(a) for a in args)) for _, n, args in found]
 
 
-def to_pddl(problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]) -> tuple[object, object]:
+def to_pddl(
+    problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]
+) -> tuple[object, object]:
     """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world."""
     from alica.prophet.pddl import parse_domain, parse_problem
 

@@ -315,8 +315,16 @@ class ProblemRuntime:
         if share.status == PLAN:
             name = f"{self.model.name}_g{share.generation}v{share.version}"
             try:
-                created = create_tasks(name, share.steps, engine.library, share.world, share.robots, engine.base_roleset, share.entry_task,
-                                       standby=self.model.wait_plan)
+                created = create_tasks(
+                    name,
+                    share.steps,
+                    engine.library,
+                    share.world,
+                    share.robots,
+                    engine.base_roleset,
+                    share.entry_task,
+                    standby=self.model.wait_plan,
+                )
             except (PlannerError, AlicaError) as exc:
                 engine.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
                 return
@@ -369,7 +377,11 @@ class ProblemRuntime:
 
     def _lead(self, now: float) -> None:
         share = self.share
-        requests = [r for r in self.engine.plan_board.take_requests(self.key) if share is None or r.generation >= share.generation]
+        requests = [
+            r
+            for r in self.engine.plan_board.take_requests(self.key)
+            if share is None or r.generation >= share.generation
+        ]
         if requests and share is not None and share.status == PLAN:
             self._replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
             return
@@ -385,7 +397,11 @@ class ProblemRuntime:
             if now >= self.next_update and set(self._read_world(self.problem).facts) != self.blocked:
                 self.blocked = None
                 self._start_search(now, "the world changed while planning was blocked")
-        elif share is None or share.status == SEARCHING or (share.status == PLAN and share.generation <= self.failed_generation):
+        elif (
+            share is None
+            or share.status == SEARCHING
+            or (share.status == PLAN and share.generation <= self.failed_generation)
+        ):
             self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
         if now < self.next_update:
             return
@@ -409,12 +425,18 @@ class ProblemRuntime:
         engine = self.engine
         generation = self._next_generation()
         self.pending = (now + self.model.update_time, reason)
-        self._publish(PlanShare(self.key, generation, 0, engine.name, SEARCHING, entry_task=self._entry_task(), reason=reason), now)
+        self._publish(
+            PlanShare(self.key, generation, 0, engine.name, SEARCHING, entry_task=self._entry_task(), reason=reason),
+            now,
+        )
 
     def _next_generation(self) -> int:
         """One more than any generation this agent has seen for the problem."""
         board = self.engine.plan_board
-        return max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0) + 1
+        return (
+            max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0)
+            + 1
+        )
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         from alica.prophet.planners import get_planner
@@ -430,7 +452,20 @@ class ProblemRuntime:
             world = self._read_world(problem)
             goal = goal_literals(problem)
             if holds(goal, set(world.facts)):
-                self._publish(PlanShare(self.key, generation, 0, me, DONE, world=world.facts, robots=world.robots, entry_task=task, reason="the goal holds"), now)
+                self._publish(
+                    PlanShare(
+                        self.key,
+                        generation,
+                        0,
+                        me,
+                        DONE,
+                        world=world.facts,
+                        robots=world.robots,
+                        entry_task=task,
+                        reason="the goal holds",
+                    ),
+                    now,
+                )
                 return
             partial = reachable_goal(goal, world.outside)
             if partial != goal:
@@ -447,10 +482,34 @@ class ProblemRuntime:
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
         names = {name.lower(): name for name, _ in world.objects}
-        self.search = _Search(generation, world, events, domain, pddl, now, names, goal=partial if partial != goal else ())
+        self.search = _Search(
+            generation, world, events, domain, pddl, now, names, goal=partial if partial != goal else ()
+        )
         extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
-        engine.emit("planner", key=key_text(self.key), what="started", generation=generation, reason=reason, planner=problem.planner, facts=len(world.facts), **extra)
-        self._publish(PlanShare(self.key, generation, 0, me, SEARCHING, world=world.facts, robots=world.robots, entry_task=task, reason=reason), now)
+        engine.emit(
+            "planner",
+            key=key_text(self.key),
+            what="started",
+            generation=generation,
+            reason=reason,
+            planner=problem.planner,
+            facts=len(world.facts),
+            **extra,
+        )
+        self._publish(
+            PlanShare(
+                self.key,
+                generation,
+                0,
+                me,
+                SEARCHING,
+                world=world.facts,
+                robots=world.robots,
+                entry_task=task,
+                reason=reason,
+            ),
+            now,
+        )
         self.next_update = now + self.model.update_time
 
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
@@ -458,8 +517,20 @@ class ProblemRuntime:
         self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
         self.blocked = set(world.facts)
         if self.share is None or self.share.status != SEARCHING:
-            self._publish(PlanShare(self.key, generation, 0, self.engine.name, SEARCHING, world=world.facts, robots=world.robots,
-                                    entry_task=self._entry_task(), reason=reason), now)
+            self._publish(
+                PlanShare(
+                    self.key,
+                    generation,
+                    0,
+                    self.engine.name,
+                    SEARCHING,
+                    world=world.facts,
+                    robots=world.robots,
+                    entry_task=self._entry_task(),
+                    reason=reason,
+                ),
+                now,
+            )
 
     def _read_world(self, problem: PlanningProblem, facts: Iterable[object] | None = None) -> PlanningWorld:
         """The planning world from the world model (``facts``: its facts, when the caller read them already)."""
@@ -500,30 +571,64 @@ class ProblemRuntime:
             finished = finished or Done(PlanStatus.SOLVED, search.expansions, "execution has begun")
         elif search.shared_cost is not None and now >= self.next_update:
             if set(self._read_world(self.problem).facts) != set(search.world.facts):
-                finished = finished or Done(PlanStatus.SOLVED, search.expansions, "the world changed: execution has begun")
+                finished = finished or Done(
+                    PlanStatus.SOLVED, search.expansions, "the world changed: execution has begun"
+                )
             elif best is not None and best.cost < search.shared_cost:
                 self._share_plan(now, search, best)
         if self.search is not search:
             return
         if finished is not None:
             self.search = None
-            self.engine.emit("planner", key=key_text(self.key), what="done", status=finished.status.value, expansions=search.expansions)
+            self.engine.emit(
+                "planner",
+                key=key_text(self.key),
+                what="done",
+                status=finished.status.value,
+                expansions=search.expansions,
+            )
             if search.shared_cost is None:
-                message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (f": {finished.message}" if finished.message else "")
+                message = f"planner '{self.problem.planner}' ended with '{finished.status.value}' and no plan" + (
+                    f": {finished.message}" if finished.message else ""
+                )
                 outsiders = search.world.left_out or (search.world.others and not self.model.alternative_plan)
                 if outsiders and finished.status is PlanStatus.UNSOLVABLE:
                     # robots outside the team hold objects, or may change the world and there is no AlternativePlan
-                    reason = f"{message}; robots outside the team ({', '.join(search.world.others)}) may change the world"
+                    reason = (
+                        f"{message}; robots outside the team ({', '.join(search.world.others)}) may change the world"
+                    )
                     self._wait_for_world(now, search.world, search.generation, reason)
                     return
-                self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=message), now)
+                self._publish(
+                    PlanShare(
+                        self.key,
+                        search.generation,
+                        1,
+                        self.engine.name,
+                        FAILED,
+                        entry_task=self._entry_task(),
+                        reason=message,
+                    ),
+                    now,
+                )
             return
         if search.shared_cost is None:
             if now - search.started > self.model.timeout:
                 self.search = None
                 reason = f"no plan within the timeout of {self.model.timeout:g} s"
                 self.engine.emit("planner", key=key_text(self.key), what="timeout", expansions=search.expansions)
-                self._publish(PlanShare(self.key, search.generation, 1, self.engine.name, FAILED, entry_task=self._entry_task(), reason=reason), now)
+                self._publish(
+                    PlanShare(
+                        self.key,
+                        search.generation,
+                        1,
+                        self.engine.name,
+                        FAILED,
+                        entry_task=self._entry_task(),
+                        reason=reason,
+                    ),
+                    now,
+                )
             elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
                 self._replan(now, "the world changed while planning")
 
@@ -547,15 +652,39 @@ class ProblemRuntime:
 
         result = validate_plan((search.domain, search.problem), plan)
         if not result.valid:
-            self.engine.emit("warning", key=key_text(self.key), message=f"the planner's plan is invalid and not shared: {result.reason}")
+            self.engine.emit(
+                "warning",
+                key=key_text(self.key),
+                message=f"the planner's plan is invalid and not shared: {result.reason}",
+            )
             return
         steps = tuple(PlanStep(s.action, tuple(search.names.get(a, a) for a in s.args)) for s in plan.steps)
         search.version += 1
         search.shared_cost = plan.cost
-        self.engine.emit("planner", key=key_text(self.key), what="plan", generation=search.generation, version=search.version,
-                         cost=plan.cost, steps=len(steps), expansions=search.expansions, after_s=round(now - search.started, 6))
-        share = PlanShare(self.key, search.generation, search.version, self.engine.name, PLAN, steps, plan.cost, search.world.facts, search.world.robots,
-                          self._entry_task(), goal=search.goal)
+        self.engine.emit(
+            "planner",
+            key=key_text(self.key),
+            what="plan",
+            generation=search.generation,
+            version=search.version,
+            cost=plan.cost,
+            steps=len(steps),
+            expansions=search.expansions,
+            after_s=round(now - search.started, 6),
+        )
+        share = PlanShare(
+            self.key,
+            search.generation,
+            search.version,
+            self.engine.name,
+            PLAN,
+            steps,
+            plan.cost,
+            search.world.facts,
+            search.world.robots,
+            self._entry_task(),
+            goal=search.goal,
+        )
         self._publish(share, now)
 
     # -- execution monitoring --------------------------------------------------
@@ -570,7 +699,11 @@ class ProblemRuntime:
             if node.succeeded.get(ep.name):
                 progress.append(TaskProgress(None, len(steps), done=True))
                 continue
-            holders = sorted((state_step(state, len(steps)), agent, state) for agent, (entry, state) in node.believed.items() if entry == ep.name and state)
+            holders = sorted(
+                (state_step(state, len(steps)), agent, state)
+                for agent, (entry, state) in node.believed.items()
+                if entry == ep.name and state
+            )
             if holders:
                 k, agent, state = holders[0]
                 progress.append(TaskProgress(agent, k, running="_S" in state))
@@ -587,7 +720,9 @@ class ProblemRuntime:
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         order = [[step.index for step in steps] for steps in created.tasks]
         members = self.engine.members_of(self.slot.parent)
-        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(progress, order, created.allowed, members)
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(
+            progress, order, created.allowed, members
+        )
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):  # the rest of the goal is reached
                 self._wait_for_world(now, world, self._next_generation(), _rest_holds(world))
@@ -626,6 +761,7 @@ def _stalled(
     step after it never will: with the free task pinned to it alone, that is
     a deadlock.
     """
+
     def position(i: int) -> float:  # where the task's next step is in the plan (its last steps finished: after all)
         steps, k = order[i], progress[i].next_step
         return steps[k] if k < len(steps) else math.inf
@@ -635,7 +771,11 @@ def _stalled(
         return None
     first = min(free, key=position)
     start = position(first)
-    waiting = [i for i, p in enumerate(progress) if p.agent is not None and not p.running and not p.done and position(i) > start]
+    waiting = [
+        i
+        for i, p in enumerate(progress)
+        if p.agent is not None and not p.running and not p.done and position(i) > start
+    ]
     if not waiting:
         return None
     may = set(allowed[first] if first < len(allowed) and allowed[first] is not None else members) & set(members)

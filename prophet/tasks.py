@@ -115,7 +115,11 @@ class CreatedTasks:
 
     def pins(self) -> dict[str, tuple[str, ...]]:
         """Entry point name -> the robots allowed to take it, for the pinned tasks."""
-        return {ep.name: allowed for ep, allowed in zip(self.plan.entry_points, self.allowed, strict=False) if allowed is not None}
+        return {
+            ep.name: allowed
+            for ep, allowed in zip(self.plan.entry_points, self.allowed, strict=False)
+            if allowed is not None
+        }
 
 
 def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[tuple[bool, Fact], ...]:
@@ -147,12 +151,16 @@ def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robots: str |
             raise PlannerError(f"plan step {i + 1} '{step}' names no skill plan with a planning signature")
         params = [v.name for v in skill.signature.parameters]
         if len(params) != len(step.args):
-            raise PlannerError(f"plan step {i + 1} '{step}': skill plan '{skill.name}' takes {len(params)} parameters ({', '.join(params)})")
+            raise PlannerError(
+                f"plan step {i + 1} '{step}': skill plan '{skill.name}' takes {len(params)} parameters ({', '.join(params)})"
+            )
         subst = dict(zip(params, step.args, strict=True))
         bindings = tuple((p.lstrip("?"), a) for p, a in zip(params, step.args, strict=True) if p != ROBOT)
         robot = subst.get(ROBOT, team[0])
         if robot not in team:
-            raise PlannerError(f"plan step {i + 1} '{step}' is for robot '{robot}', which is not one of the plan's robots ({', '.join(team)})")
+            raise PlannerError(
+                f"plan step {i + 1} '{step}' is for robot '{robot}', which is not one of the plan's robots ({', '.join(team)})"
+            )
         sig = skill.signature
         pre = _ground(sig.precondition.text if sig.precondition else None, subst, skill.name)
         eff = _ground(sig.effect.text if sig.effect else None, subst, skill.name)
@@ -177,7 +185,9 @@ def apply_effect(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
 
 def for_robot(literal_set: Iterable[tuple[bool, Fact]], robot: str, other: str) -> list[tuple[bool, Fact]]:
     """The literals with ``robot`` replaced by ``other``."""
-    return [(positive, (name, tuple(other if a == robot else a for a in args))) for positive, (name, args) in literal_set]
+    return [
+        (positive, (name, tuple(other if a == robot else a for a in args))) for positive, (name, args) in literal_set
+    ]
 
 
 def parallelise(steps: Sequence[Step], init: Iterable[Fact], robots: str | Sequence[str]) -> list[list[Step]]:
@@ -190,7 +200,9 @@ def parallelise(steps: Sequence[Step], init: Iterable[Fact], robots: str | Seque
     return _parallelise(steps, init, _robots(robots))[0]
 
 
-def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, ...]) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
+def _parallelise(
+    steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, ...]
+) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
     start = set(init)
     members = set(team)
     fresh = {r: {f for f in start if r in f[1]} for r in team}
@@ -200,11 +212,19 @@ def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, .
     task_of: dict[str, int] = {}
     for step in steps:
         shared = {f for f in state if not members.intersection(f[1])}
-        able = tuple(r for r in team if holds(for_robot(step.pre, step.robot, r), shared | _own_facts(r, team, task_of, step.robot, fresh, state)))
+        able = tuple(
+            r
+            for r in team
+            if holds(
+                for_robot(step.pre, step.robot, r), shared | _own_facts(r, team, task_of, step.robot, fresh, state)
+            )
+        )
         if not tasks or able:
             tasks.append([step])
             # who may take the task: the robots whose initial facts let them start it, and the planner's own robot
-            may = {r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r])} | ({step.robot} & members)
+            may = {r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r])} | (
+                {step.robot} & members
+            )
             allowed.append(tuple(sorted(may)) if may and may != members else None)
             task_of[step.robot] = len(tasks) - 1
         else:
@@ -213,7 +233,14 @@ def _parallelise(steps: Sequence[Step], init: Iterable[Fact], team: tuple[str, .
     return tasks, allowed
 
 
-def _own_facts(robot: str, team: tuple[str, ...], acted: Mapping[str, int], mover: str, fresh: Mapping[str, set[Fact]], state: set[Fact]) -> set[Fact]:
+def _own_facts(
+    robot: str,
+    team: tuple[str, ...],
+    acted: Mapping[str, int],
+    mover: str,
+    fresh: Mapping[str, set[Fact]],
+    state: set[Fact],
+) -> set[Fact]:
     """The facts a robot could start the next step with, for Algorithms 2-3.
 
     A robot that has done nothing yet has its initial facts. With one robot
@@ -253,7 +280,9 @@ def generic_utility(n: int, standby: bool = False) -> UtilityFunction:
     total = wt + wp + ws
     wt, wp, ws = wt / total, wp / total, ws / total
     coverage = f'entry != "{STANDBY}"' if standby else "1"
-    return UtilityFunction(priority_weight=wp, summands=(Summand("Coverage", wt, coverage),), similarity_weight=ws, threshold=ws)
+    return UtilityFunction(
+        priority_weight=wp, summands=(Summand("Coverage", wt, coverage),), similarity_weight=ws, threshold=ws
+    )
 
 
 #: The world-model predicate an agent asserts when it finished a step of a generated plan.
@@ -267,7 +296,10 @@ def step_token(plan: str, index: int) -> str:
 
 def conjunction(literal_set: Iterable[tuple[bool, Fact]]) -> str:
     """Ground literals as a formula: ``on(a, b) and not clear(c)``."""
-    return " and ".join(("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name) for positive, (name, args) in literal_set)
+    return " and ".join(
+        ("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name)
+        for positive, (name, args) in literal_set
+    )
 
 
 def _condition(pre: Sequence[tuple[bool, Fact]], robot: str, after: Sequence[str] = ()) -> Condition | None:
@@ -300,7 +332,9 @@ def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
     return out
 
 
-def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None, standby: str | None = None) -> tuple[Plan, tuple[Task, ...]]:
+def build_plan(
+    name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None, standby: str | None = None
+) -> tuple[Plan, tuple[Task, ...]]:
     """The multi-agent plan of the tasks (see the module docstring); ``standby`` names the WaitPlan."""
     entry_points, states, transitions, task_defs = [], [], [], []
     after = _predecessors(tasks)
@@ -309,16 +343,29 @@ def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = N
         task_defs.append(Task(task_name, description=", ".join(s.label for s in task)))
         low, high = _cardinality(task)
         first = f"T{i}_Wait0"
-        entry_points.append(EntryPoint(task_name, task_name, first, min=low if low > 1 else 0, max=high, success_required=True))
+        entry_points.append(
+            EntryPoint(task_name, task_name, first, min=low if low > 1 else 0, max=high, success_required=True)
+        )
         for k, step in enumerate(task):
             wait, run = f"T{i}_Wait{k}", f"T{i}_S{k}_{step.skill.name}"
             following = f"T{i}_Wait{k + 1}" if k + 1 < len(task) else f"T{i}_Done"
             states.append(State(wait, description=f"wait until {step.label} can run"))
             bind = tuple(Binding(var, value) for var, value in step.bindings)
             states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
-            transitions.append(Transition(f"{wait}->{run}", wait, run, _condition(step.pre, robot or step.robot, [step_token(name, h) for h in after[step.index]])))
-            transitions.append(Transition(f"{run}->{following}", run, following, Condition(ConditionKind.TRANSITION, "succeeded")))
-            transitions.append(Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed")))
+            transitions.append(
+                Transition(
+                    f"{wait}->{run}",
+                    wait,
+                    run,
+                    _condition(step.pre, robot or step.robot, [step_token(name, h) for h in after[step.index]]),
+                )
+            )
+            transitions.append(
+                Transition(f"{run}->{following}", run, following, Condition(ConditionKind.TRANSITION, "succeeded"))
+            )
+            transitions.append(
+                Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed"))
+            )
         states.append(State(f"T{i}_Done", StateKind.SUCCESS))
         states.append(State(f"T{i}_Failed", StateKind.FAILURE))
     if standby is not None:
@@ -326,8 +373,14 @@ def build_plan(name: str, tasks: Sequence[Sequence[Step]], robot: str | None = N
         task_defs.append(Task(task_name, description=f"stand by in {standby} while no task needs the agent"))
         entry_points.append(EntryPoint(STANDBY, task_name, STANDBY, min=0, success_required=False))
         states.append(State(STANDBY, children=(ChildRef(standby),), description=f"keep out of the way ({standby})"))
-    plan = Plan(name, tuple(entry_points), tuple(states), tuple(transitions), utility=generic_utility(len(tasks), standby is not None),
-                description=f"generated by pRoPhEt MAS from a plan of {sum(len(t) for t in tasks)} steps in {len(tasks)} task(s)")
+    plan = Plan(
+        name,
+        tuple(entry_points),
+        tuple(states),
+        tuple(transitions),
+        utility=generic_utility(len(tasks), standby is not None),
+        description=f"generated by pRoPhEt MAS from a plan of {sum(len(t) for t in tasks)} steps in {len(tasks)} task(s)",
+    )
     return plan, tuple(task_defs)
 
 
@@ -345,7 +398,9 @@ def state_step(state: str, length: int) -> int:
     return length if rest == "Done" else 0
 
 
-def role_priorities(roleset: RoleSet, tasks: Sequence[Sequence[Step]], task_defs: Sequence[Task], entry_task: str) -> RoleSet:
+def role_priorities(
+    roleset: RoleSet, tasks: Sequence[Sequence[Step]], task_defs: Sequence[Task], entry_task: str
+) -> RoleSet:
     """Eq. 9: ``T_i = 1 - i/n`` scaled by each role's priority ``p`` for the problem's entry task; -1 if a skill is vetoed."""
     n = len(tasks)
     roles = []
@@ -394,7 +449,13 @@ def create_tasks(
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _parallelise(steps, init, team)
     plan, task_defs = build_plan(name, tasks, standby=standby)
-    return CreatedTasks(tuple(tuple(t) for t in tasks), plan, task_defs, role_priorities(roleset, tasks, task_defs, entry_task), tuple(allowed))
+    return CreatedTasks(
+        tuple(tuple(t) for t in tasks),
+        plan,
+        task_defs,
+        role_priorities(roleset, tasks, task_defs, entry_task),
+        tuple(allowed),
+    )
 
 
 def emit_yaml(created: CreatedTasks, imports: Sequence[str] = ()) -> str:

@@ -76,7 +76,9 @@ def _validate_ground(task: GroundTask, steps: tuple[PlanStep, ...]) -> Validatio
         name = str(step).lower()
         candidates = task.operator(name)
         if not candidates:
-            return ValidationResult(False, cost, number, f"step {number} {name}: no such ground operator (unknown or unreachable)")
+            return ValidationResult(
+                False, cost, number, f"step {number} {name}: no such ground operator (unknown or unreachable)"
+            )
         op = next((o for o in candidates if task.applicable(state, o)), None)
         if op is None:
             unmet = [task.facts[p] for p in candidates[0].pre if p not in state]
@@ -103,7 +105,7 @@ class _Lifted:
         return [o for o, t in self.objects.items() if kind == OBJECT or self.domain.is_subtype(t, kind)]
 
     def validate(self, steps: tuple[PlanStep, ...]) -> ValidationResult:
-        state = {a for a in self.problem.facts}
+        state = set(self.problem.facts)
         cost = 0.0
         for number, step in enumerate(steps, 1):
             where = f"step {number} {str(step).lower()}"
@@ -132,7 +134,9 @@ class _Lifted:
                     value = effect.value
                     if isinstance(value, FluentTerm):
                         if value not in self.values:
-                            return ValidationResult(False, cost, number, f"{where}: fluent {value} has no value in :init")
+                            return ValidationResult(
+                                False, cost, number, f"{where}: fluent {value} has no value in :init"
+                            )
                         value = self.values[value]
                     step_cost += value
                 elif isinstance(effect, Not):

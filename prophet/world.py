@@ -34,6 +34,7 @@ from alica.prophet.tasks import apply_effect, for_robot, holds
 Fact = tuple[str, tuple[str, ...]]
 Literal = tuple[bool, Fact]
 
+
 @dataclass(frozen=True, slots=True)
 class PlanningWorld:
     """A world to plan from.
@@ -70,7 +71,9 @@ def goal_literals(problem: PlanningProblem) -> tuple[Literal, ...]:
     try:
         found = literals(problem.goal.text)
     except AlicaError as exc:
-        raise PlannerError(f"the goal of '{problem.name}' must be a conjunction of literals to be planned with: {exc}") from None
+        raise PlannerError(
+            f"the goal of '{problem.name}' must be a conjunction of literals to be planned with: {exc}"
+        ) from None
     return tuple((positive, (name, tuple(str(a) for a in args))) for positive, name, args in found if name != "=")
 
 
@@ -114,8 +117,12 @@ def read_world(
         arity = predicates.get(name.lower())
         if arity is None or len(args) != len(arity):
             continue
-        if not offline and any(kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)):
-            others.update(arg for arg, kind in zip(args, arity, strict=True) if kind == robot_type and arg not in members)
+        if not offline and any(
+            kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)
+        ):
+            others.update(
+                arg for arg, kind in zip(args, arity, strict=True) if kind == robot_type and arg not in members
+            )
             if len(args) > 1:  # a relation of an outside robot with an object (not just its own state)
                 left_out += 1
                 outside.update(arg for arg, kind in zip(args, arity, strict=True) if kind != robot_type)
@@ -138,8 +145,17 @@ def read_world(
     if not offline:
         # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
         mentioned = {a for _, args in kept for a in args}
-        outside.update(a for _, (_, args) in goal_literals(problem) for a in args if a not in mentioned and a not in members)
-    return PlanningWorld(tuple(sorted(types.items())), tuple(sorted(kept)), robots, left_out, tuple(sorted(outside)), tuple(sorted(others)))
+        outside.update(
+            a for _, (_, args) in goal_literals(problem) for a in args if a not in mentioned and a not in members
+        )
+    return PlanningWorld(
+        tuple(sorted(types.items())),
+        tuple(sorted(kept)),
+        robots,
+        left_out,
+        tuple(sorted(outside)),
+        tuple(sorted(others)),
+    )
 
 
 def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Literal, ...]:
@@ -228,7 +244,10 @@ def remaining_fits(
             first = task[where.next_step]
             planned = first.robot  # type: ignore[attr-defined]
             options = [planned, *(r for r in robots if r != planned)]
-            own = ({(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args} for r in options)
+            own = (
+                {(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args}
+                for r in options
+            )
             mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]  # type: ignore[attr-defined]
             fresh = next((facts for facts in own if holds(mine, facts)), None)
             if fresh is None:

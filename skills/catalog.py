@@ -52,7 +52,12 @@ def _composite(registry: SkillRegistry) -> None:
     registry.declare(
         "Putdown",
         _p("object", "object", "the held object to put down"),
-        _p("target", "position", "where to place it: a position or a term such as pos(g); by default in front of the robot", required=False),
+        _p(
+            "target",
+            "position",
+            "where to place it: a position or a term such as pos(g); by default in front of the robot",
+            required=False,
+        ),
         doc="place the held object, open the gripper, stow the arm and check the placement (Fig. 16)",
         capabilities=("arm", "gripper"),
         implementation="alica.skills.handling:Putdown",
@@ -75,7 +80,12 @@ def _composite(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "Explore",
-        _p("spacing", "float", "minimal distance in metres between the frontiers of different robots (eps of Eq. 7)", default=4.0),
+        _p(
+            "spacing",
+            "float",
+            "minimal distance in metres between the frontiers of different robots (eps of Eq. 7)",
+            default=4.0,
+        ),
         _p("timeout", "float", "seconds before the skill stops; 0 explores until no frontier is left", default=0.0),
         doc="explore unknown terrain frontier by frontier until the map is complete (Fig. 7)",
         capabilities=("base", "lidar2d"),
@@ -96,7 +106,12 @@ def _navigation(registry: SkillRegistry) -> None:
         "DriveToFreeSpace",
         _p("clearance", "float", "distance in metres to keep from obstacles, robots and work sites", default=1.0),
         _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
-        _p("keep_away", "float", "distance in metres to keep from every block or sample lying in the world (0: none)", default=0.0),
+        _p(
+            "keep_away",
+            "float",
+            "distance in metres to keep from every block or sample lying in the world (0: none)",
+            default=0.0,
+        ),
         doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
         capabilities=("base",),
         implementation="alica.skills.navigation:DriveToFreeSpace",
@@ -116,8 +131,18 @@ def _navigation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "ExploreFrontier",
-        _p("frontier", "object", "frontier cell to drive to; by default the best free one by information gain", required=False),
-        _p("spacing", "float", "minimal distance in metres to the frontiers of other robots (eps of Eq. 7)", default=4.0),
+        _p(
+            "frontier",
+            "object",
+            "frontier cell to drive to; by default the best free one by information gain",
+            required=False,
+        ),
+        _p(
+            "spacing",
+            "float",
+            "minimal distance in metres to the frontiers of other robots (eps of Eq. 7)",
+            default=4.0,
+        ),
         doc="drive to frontier cells in order of information gain and boundary relation, updating the map",
         capabilities=("base",),
     )
@@ -158,7 +183,12 @@ def _manipulation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "MoveArmToPlace",
-        _p("target", "position", "where to place: a position or a term such as pos(g); by default in front of the robot", required=False),
+        _p(
+            "target",
+            "position",
+            "where to place: a position or a term such as pos(g); by default in front of the robot",
+            required=False,
+        ),
         doc="move the held object to its place pose",
         capabilities=("arm",),
     )
@@ -176,11 +206,28 @@ def _manipulation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "RandomBlockSkill",
-        _p("blocking_radius", "float", "a stack with another robot's centre closer than this many metres is left alone "
-           "(a robot working at a stack stands about 0.7 m from it)", default=1.0),
-        _p("pause", "float", "simulated seconds to wait after each action, and between looks when nothing is applicable", default=2.0),
-        _p("action_timeout", "float", "simulated seconds after which an action still running is stopped", default=120.0),
-        _p("step_aside", "float", "after each action, drive to a free place at least this many metres from every block (0: stay)", default=1.15),
+        _p(
+            "blocking_radius",
+            "float",
+            "a stack with another robot's centre closer than this many metres is left alone "
+            "(a robot working at a stack stands about 0.7 m from it)",
+            default=1.0,
+        ),
+        _p(
+            "pause",
+            "float",
+            "simulated seconds to wait after each action, and between looks when nothing is applicable",
+            default=2.0,
+        ),
+        _p(
+            "action_timeout", "float", "simulated seconds after which an action still running is stopped", default=120.0
+        ),
+        _p(
+            "step_aside",
+            "float",
+            "after each action, drive to a free place at least this many metres from every block (0: stay)",
+            default=1.15,
+        ),
         doc="opponent: run a random applicable blocks-world skill on a stack no other robot is blocking, forever",
         capabilities=("base", "arm", "gripper"),
         implementation="alica.skills.opponent:RandomBlockSkill",
@@ -242,7 +289,12 @@ def _semantic_perception(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "FuzzyDLClassify",
-        _p("knowledge_base", "str", "fuzzy description of the objects (radius, height, orientation)", default="drill_sample"),
+        _p(
+            "knowledge_base",
+            "str",
+            "fuzzy description of the objects (radius, height, orientation)",
+            default="drill_sample",
+        ),
         _p("threshold", "float", "smallest degree of membership that counts as a match", default=0.6),
         doc="rate the fitted clusters against the fuzzy object description with FuzzyDL",
     )

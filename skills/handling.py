@@ -166,7 +166,9 @@ class ArmSkill(WorldSkill):
         self.tried_sides: list[tuple[float, float]] = []
         self.followed: list[np.ndarray] = []
         self.released = False
-        self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0)
+        self.np_rng = np.random.default_rng(
+            self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0
+        )
 
     def update(self) -> Status:
         """One step of the current phase."""
@@ -199,10 +201,14 @@ class ArmSkill(WorldSkill):
                 if self.blocked_since is None:
                     self.blocked_since = self.now()
                 elif self.now() - self.blocked_since >= STANDOFF_WAIT:
-                    return self.fail(f"every side of the work site {_xy_text(site)} was taken by other robots for {STANDOFF_WAIT:g} s")
+                    return self.fail(
+                        f"every side of the work site {_xy_text(site)} was taken by other robots for {STANDOFF_WAIT:g} s"
+                    )
                 return self.running("waiting: every side of the work site is taken by other robots")
             self.blocked_since = None
-            self.mover = MoveToPosition(f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context)
+            self.mover = MoveToPosition(
+                f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context
+            )
             self.mover.setup(context=self.context)
         if self.mover.status != Status.SUCCESS:
             self.mover.tick_once()
@@ -230,7 +236,11 @@ class ArmSkill(WorldSkill):
         x, y, _ = robot.pose
         standoff = REACH + _mount_ahead(robot)
         heading = math.atan2(site[1] - y, site[0] - x)
-        others = [(r.pose[0], r.pose[1], r.spec.radius + STANDOFF_MARGIN) for r in self.world.robots.values() if r is not robot]
+        others = [
+            (r.pose[0], r.pose[1], r.spec.radius + STANDOFF_MARGIN)
+            for r in self.world.robots.values()
+            if r is not robot
+        ]
         # the motion planner's own check of a goal (static obstacles, blocks, other robots)
         checker = planning_checker(self.world, robot.spec.radius).with_robots(others)
         for k in range(STANDOFF_TRIES):
@@ -257,7 +267,13 @@ class ArmSkill(WorldSkill):
             scene = cache[key] = ArmScene(self.robot.arm.urdf_path, self.robot.arm.base_pose(), seed=self.world.seed)
         scene.set_base_pose(self.robot.arm.base_pose())
         target = self.target_object()
-        boxes = [_box(o) for name, o in sorted(self.world.objects.items()) if name != target.name and _near(o, self._arm_xy()) and getattr(o, "kind", "") not in ("terrain", "collection_point")]
+        boxes = [
+            _box(o)
+            for name, o in sorted(self.world.objects.items())
+            if name != target.name
+            and _near(o, self._arm_xy())
+            and getattr(o, "kind", "") not in ("terrain", "collection_point")
+        ]
         scene.set_obstacles(boxes)
         q = np.asarray(self.robot.arm.q(), dtype=float)
         held = self._held_box(scene, q)
@@ -294,7 +310,9 @@ class ArmSkill(WorldSkill):
         if self.job is None and self.robot.arm.busy:
             return self.running("waiting for the arm to come back")
         if self.job is None:
-            self.job = self.jobs.submit(self.plan, self._scene(), np.asarray(self.robot.arm.q(), dtype=float), self.np_rng)
+            self.job = self.jobs.submit(
+                self.plan, self._scene(), np.asarray(self.robot.arm.q(), dtype=float), self.np_rng
+            )
             return self.running("planning the arm motion")
         if not self.job.done():
             return self.running("planning the arm motion")
@@ -337,7 +355,14 @@ class ArmSkill(WorldSkill):
         arm = self.robot.arm
         if self.grasps:
             obj = self.target_object()
-            holder = next((r.name for r in self.world.robots.values() if r.arm is not None and r.arm.held is obj and r is not self.robot), None)
+            holder = next(
+                (
+                    r.name
+                    for r in self.world.robots.values()
+                    if r.arm is not None and r.arm.held is obj and r is not self.robot
+                ),
+                None,
+            )
             if holder is not None:
                 return f"{obj.name} was taken by robot '{holder}' before the grip"
             if getattr(obj, "kind", "") == "block" and ("clear", obj.name) not in blocks_state(self.world):
@@ -373,7 +398,9 @@ class ArmSkill(WorldSkill):
         elif arm.held is not self.target_object():
             # released, but it does not rest where it should: there is nothing left to place
             x, y, z = (float(v) for v in self.target_object().position())
-            return self.fail(f"{reason}; {self.target_object().name} is no longer in the hand (it lies at ({x:.2f}, {y:.2f}, {z:.2f}))")
+            return self.fail(
+                f"{reason}; {self.target_object().name} is no longer in the hand (it lies at ({x:.2f}, {y:.2f}, {z:.2f}))"
+            )
         self.phase = "plan"
         self.job = None
         if reason.startswith("no arm plan"):
@@ -421,7 +448,9 @@ class ArmSkill(WorldSkill):
             way = [np.asarray(step, dtype=float) for step in steps[index:] if not isinstance(step, str)]
             current = steps[index - 1] if 0 < index <= len(steps) and not isinstance(steps[index - 1], str) else None
             if current is not None and arm.busy:
-                way.insert(0, np.asarray(current, dtype=float)[_reached(current, q):])  # the rest of the path it was on
+                way.insert(
+                    0, np.asarray(current, dtype=float)[_reached(current, q) :]
+                )  # the rest of the path it was on
         else:
             way = []
         self.followed = []
@@ -496,7 +525,13 @@ class Pickup(ArmSkill):
         if arm.held is not obj or arm.grip_force() <= 0:
             return f"the grip on {obj.name} failed (the object is not held)"
         me = self.robot.name
-        for positive, fact in ((False, ("ontable", obj.name)), (False, ("clear", obj.name)), (False, ("handempty", me)), (True, ("holding", me, obj.name)), (False, ("onground", obj.name))):
+        for positive, fact in (
+            (False, ("ontable", obj.name)),
+            (False, ("clear", obj.name)),
+            (False, ("handempty", me)),
+            (True, ("holding", me, obj.name)),
+            (False, ("onground", obj.name)),
+        ):
             self.write(positive, *fact)  # type: ignore[arg-type]
         return None
 
@@ -560,7 +595,9 @@ class Putdown(ArmSkill):
                 return spot
         x, y, yaw = self.robot.pose
         ahead = REACH + _mount_ahead(self.robot)
-        return x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)  # nothing free: straight ahead (the placement check fails)
+        return x + ahead * math.cos(yaw), y + ahead * math.sin(
+            yaw
+        )  # nothing free: straight ahead (the placement check fails)
 
     def _retry(self, reason: str) -> Status:
         """Try another spot on the next attempt (when no target was given)."""

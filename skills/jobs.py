@@ -53,7 +53,7 @@ class _Deferred:
             assert call is not None
             try:
                 self._value = call()
-            except Exception as exc:  # noqa: BLE001 - handed to the skill through result()
+            except Exception as exc:
                 self._error = exc
             self._done = True
         return True

@@ -93,7 +93,11 @@ class MoveToPosition(WorldSkill):
         self._plan(self.goal)
 
     def _others(self) -> list[tuple[float, float, float]]:
-        return [(r.pose[0], r.pose[1], r.spec.radius) for name, r in sorted(self.world.robots.items()) if r is not self.robot]
+        return [
+            (r.pose[0], r.pose[1], r.spec.radius)
+            for name, r in sorted(self.world.robots.items())
+            if r is not self.robot
+        ]
 
     def _plan(self, goal: tuple[float, float]) -> None:
         from alica.skills.motion import plan_path
@@ -103,8 +107,17 @@ class MoveToPosition(WorldSkill):
         # An optimizing planner after the first path, when the run allows the time (real robots): anytime
         # planning by wall time is not repeatable, so simulated runs keep RRTConnect plus simplification.
         optimize = float((getattr(self.context, "extra", None) or {}).get("optimize_time", 0.0))
-        self.job = self.jobs.submit(plan_path, self.robot.pose, goal, checker, self.robot.spec.radius, obstacles_exact=exact,
-                                    other_robots=self._others(), time_limit=1.0, optimize_time=optimize)
+        self.job = self.jobs.submit(
+            plan_path,
+            self.robot.pose,
+            goal,
+            checker,
+            self.robot.spec.radius,
+            obstacles_exact=exact,
+            other_robots=self._others(),
+            time_limit=1.0,
+            optimize_time=optimize,
+        )
         self.follower = None
 
     def update(self) -> Status:
@@ -176,7 +189,13 @@ class MoveToPosition(WorldSkill):
             return self.running(f"planning again ({self.reason})")
         spec = self.robot.spec
         self.path_length += float(result.length)
-        self.follower = PathFollower(result.path, lookahead=max(0.3, 2 * spec.radius), max_speed=spec.max_speed, max_yaw_rate=spec.max_yaw_rate, tolerance=min(self.tolerance, 0.2))
+        self.follower = PathFollower(
+            result.path,
+            lookahead=max(0.3, 2 * spec.radius),
+            max_speed=spec.max_speed,
+            max_yaw_rate=spec.max_yaw_rate,
+            tolerance=min(self.tolerance, 0.2),
+        )
         return self.running("path found")
 
     def _stuck(self, now: float) -> Status:
@@ -188,8 +207,14 @@ class MoveToPosition(WorldSkill):
         if self.replans > MAX_REPLANS:
             return self.fail(f"stuck on the way to {self.goal} after {MAX_REPLANS} escapes")
         # free space away from the other robots too: the robot it bumped into is often one of them
-        spot = escape_goal(planning_grid(self.world), robot.pose, clearance=robot.spec.radius + 0.3, max_distance=3.0, other_robots=self._others(),
-                           body_radius=robot.spec.radius)
+        spot = escape_goal(
+            planning_grid(self.world),
+            robot.pose,
+            clearance=robot.spec.radius + 0.3,
+            max_distance=3.0,
+            other_robots=self._others(),
+            body_radius=robot.spec.radius,
+        )
         if spot is None:
             return self.fail(f"stuck at {robot.pose[:2]} and no free space within 3 m to drive to")
         x, y, yaw = robot.pose
@@ -197,8 +222,14 @@ class MoveToPosition(WorldSkill):
         path = np.array([[x, y, yaw], [spot[0], spot[1], heading]])
         spec = robot.spec
         # turn on the spot first: driving an arc while touching something pushes into it, and the base refuses
-        self.follower = PathFollower(path, lookahead=0.3, max_speed=spec.max_speed * 0.5, max_yaw_rate=spec.max_yaw_rate, tolerance=0.1,
-                                     turn_in_place=math.radians(15.0))
+        self.follower = PathFollower(
+            path,
+            lookahead=0.3,
+            max_speed=spec.max_speed * 0.5,
+            max_yaw_rate=spec.max_yaw_rate,
+            tolerance=0.1,
+            turn_in_place=math.radians(15.0),
+        )
         self.escaping = True
         if hasattr(robot, "bumped"):
             robot.bumped = False
@@ -246,7 +277,14 @@ class DriveToFreeSpace(MoveToPosition):
         grid = planning_grid(self.world)
         lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
         sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
-        spot = escape_goal(grid, self.robot.pose, clearance=self.robot.spec.radius + clearance, max_distance=reach, other_robots=self._others(), keep_away=sites)
+        spot = escape_goal(
+            grid,
+            self.robot.pose,
+            clearance=self.robot.spec.radius + clearance,
+            max_distance=reach,
+            other_robots=self._others(),
+            keep_away=sites,
+        )
         self.spot = spot
         self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
         self.params.setdefault("tolerance", 0.2)

@@ -118,14 +118,21 @@ def _silent_context(context: Any) -> Any:
     """The context for the inner skills: the same agent, clock, generator and world, but no world model."""
     if dataclasses.is_dataclass(context) and not isinstance(context, type):
         return dataclasses.replace(context, world_model=None)
-    fields = {name: getattr(context, name, None) for name in ("agent", "now", "rng", "world", "belief", "behaviour", "path")}
+    fields = {
+        name: getattr(context, name, None) for name in ("agent", "now", "rng", "world", "belief", "behaviour", "path")
+    }
     return SimpleNamespace(**fields, world_model=None, extra=getattr(context, "extra", None) or {})
 
 
 def _skill_class(name: str) -> Any:
     from alica.skills import handling
 
-    return {"Pickup": handling.Pickup, "Unstack": handling.Unstack, "Putdown": handling.Putdown, "Stack": handling.Stack}[name]
+    return {
+        "Pickup": handling.Pickup,
+        "Unstack": handling.Unstack,
+        "Putdown": handling.Putdown,
+        "Stack": handling.Stack,
+    }[name]
 
 
 @functools.cache
@@ -185,7 +192,9 @@ class RandomBlockSkill(WorldSkill):
         """
         super().setup(**kwargs)
         if getattr(self.robot, "arm", None) is None:
-            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no arm; opponents must be manipulators")
+            raise SkillError(
+                f"skill '{self.name}': robot '{self.robot.name}' has no arm; opponents must be manipulators"
+            )
         self.radius = self._positive("blocking_radius", BLOCKING_RADIUS)
         self.pause = self._positive("pause", PAUSE)
         self.action_timeout = self._positive("action_timeout", ACTION_TIMEOUT)
@@ -203,7 +212,12 @@ class RandomBlockSkill(WorldSkill):
 
     def _positive(self, name: str, default: float) -> float:
         value = self.param(name, default)
-        if not isinstance(value, (int, float)) or isinstance(value, bool) or not value >= 0.0 or not math.isfinite(value):
+        if (
+            not isinstance(value, (int, float))
+            or isinstance(value, bool)
+            or not value >= 0.0
+            or not math.isfinite(value)
+        ):
             raise SkillError(f"skill '{self.name}': parameter '{name}' must be a number >= 0, got {value!r}")
         return float(value)
 
@@ -234,8 +248,14 @@ class RandomBlockSkill(WorldSkill):
                 # next to this one, say, each blocking the other for good): look for room elsewhere
                 self.blocked_looks = 0
                 self.aside = self._drive_aside(RELOCATE_CLEARANCE)
-                return self.running(f"all {len(possible)} applicable actions are blocked by other robots: looking for room")
-            why = f"all {len(possible)} applicable actions are blocked by other robots" if possible else "no action is applicable"
+                return self.running(
+                    f"all {len(possible)} applicable actions are blocked by other robots: looking for room"
+                )
+            why = (
+                f"all {len(possible)} applicable actions are blocked by other robots"
+                if possible
+                else "no action is applicable"
+            )
             self.idle_message = f"waiting: {why}; looking again at t = {self.next_look:.1f} s"
             return self.running(self.idle_message)
         self.blocked_looks = 0
@@ -244,7 +264,9 @@ class RandomBlockSkill(WorldSkill):
         self._start(self.action)
         return self._tick_inner()
 
-    def free_actions(self, facts: Facts | None = None, actions: Iterable[BlockAction] | None = None) -> list[BlockAction]:
+    def free_actions(
+        self, facts: Facts | None = None, actions: Iterable[BlockAction] | None = None
+    ) -> list[BlockAction]:
         """The applicable actions no other robot blocks, sorted: what the next choice is drawn from.
 
         Args:
@@ -308,7 +330,11 @@ class RandomBlockSkill(WorldSkill):
         from alica.skills.navigation import DriveToFreeSpace
 
         context = _silent_context(self.context)
-        aside = DriveToFreeSpace(f"{self.name}/step aside", {"clearance": clearance, "max_distance": 3.0, "keep_away": self.step_aside}, context)
+        aside = DriveToFreeSpace(
+            f"{self.name}/step aside",
+            {"clearance": clearance, "max_distance": 3.0, "keep_away": self.step_aside},
+            context,
+        )
         aside.setup(context=context)
         return aside
 
@@ -321,7 +347,11 @@ class RandomBlockSkill(WorldSkill):
     def _crowded(self, xy: tuple[float, float]) -> bool:
         """Whether another robot's centre is within the blocking radius of ``xy``."""
         x, y = xy
-        return any(math.hypot(x - r.pose[0], y - r.pose[1]) < self.radius for r in self.world.robots.values() if r is not self.robot)
+        return any(
+            math.hypot(x - r.pose[0], y - r.pose[1]) < self.radius
+            for r in self.world.robots.values()
+            if r is not self.robot
+        )
 
     def _touched(self, action: BlockAction, facts: Facts) -> Iterable[tuple[float, float]]:
         """Where ``action`` works: the blocks of the stack it takes from or puts on, or the put-down spot."""

@@ -130,7 +130,14 @@ class SkillRegistry:
         self._specs[spec.name] = spec
         return spec
 
-    def declare(self, name: str, *params: ParamSpec, doc: str = "", capabilities: tuple[str, ...] = (), implementation: str | None = None) -> SkillSpec:
+    def declare(
+        self,
+        name: str,
+        *params: ParamSpec,
+        doc: str = "",
+        capabilities: tuple[str, ...] = (),
+        implementation: str | None = None,
+    ) -> SkillSpec:
         """Register a skill from its parts; the one-line way to declare one."""
         return self.register(SkillSpec(name, tuple(params), doc, frozenset(capabilities), implementation))
 
@@ -176,7 +183,9 @@ class SkillRegistry:
         try:
             module = importlib.import_module(module_name)
         except ImportError as exc:
-            raise UnknownSkillError(f"skill '{name}' needs module '{module_name}', which cannot be imported: {exc}") from exc
+            raise UnknownSkillError(
+                f"skill '{name}' needs module '{module_name}', which cannot be imported: {exc}"
+            ) from exc
         try:
             return getattr(module, attribute)
         except AttributeError:

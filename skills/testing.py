@@ -64,7 +64,9 @@ def checked_params(spec: Any, params: Mapping[str, object]) -> dict[str, object]
     known = {p.name for p in spec.params}
     unknown = sorted(set(params) - known)
     if unknown:
-        raise SkillError(f"skill '{spec.name}' has no parameter {', '.join(map(repr, unknown))} (parameters: {', '.join(sorted(known)) or 'none'})")
+        raise SkillError(
+            f"skill '{spec.name}' has no parameter {', '.join(map(repr, unknown))} (parameters: {', '.join(sorted(known)) or 'none'})"
+        )
     for p in spec.params:
         if p.name in params:
             value = params[p.name]

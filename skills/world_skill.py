@@ -64,11 +64,15 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         self.context = context
         world = getattr(context, "world", None)
         if world is None:
-            raise SkillError(f"skill '{self.name}' acts on a world, and this run has none (run it in a simulated world, e.g. 'alica skill run {type(self).__name__} --world lunar')")
+            raise SkillError(
+                f"skill '{self.name}' acts on a world, and this run has none (run it in a simulated world, e.g. 'alica skill run {type(self).__name__} --world lunar')"
+            )
         agent = getattr(context, "agent", None)
         robots = getattr(world, "robots", {})
         if agent not in robots:
-            raise SkillError(f"skill '{self.name}': the world has no robot named '{agent}' (robots: {', '.join(sorted(robots)) or 'none'})")
+            raise SkillError(
+                f"skill '{self.name}': the world has no robot named '{agent}' (robots: {', '.join(sorted(robots)) or 'none'})"
+            )
         self.world = world
         self.robot = robots[agent]
         extra = getattr(context, "extra", None) or {}
@@ -134,7 +138,9 @@ class WorldSkill(py_trees.behaviour.Behaviour):
                     return float(position[0]), float(position[1])
                 x, y, _ = thing.pose
                 return float(x), float(y)
-        raise SkillError(f"skill '{self.name}': cannot tell where {value!r} is (give [x, y], an object's name or pos(name))")
+        raise SkillError(
+            f"skill '{self.name}': cannot tell where {value!r} is (give [x, y], an object's name or pos(name))"
+        )
 
     def object_named(self, value: object) -> Any:
         """The world object called ``value``.
@@ -144,7 +150,9 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         """
         objects = self.world.objects
         if not isinstance(value, str) or value not in objects:
-            raise SkillError(f"skill '{self.name}': the world has no object {value!r} (objects: {', '.join(sorted(objects)) or 'none'})")
+            raise SkillError(
+                f"skill '{self.name}': the world has no object {value!r} (objects: {', '.join(sorted(objects)) or 'none'})"
+            )
         return objects[value]
 
 

@@ -90,7 +90,7 @@ def test_show_broken_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
 
 
 def test_render_writes_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run(capsys, "render", str(PLANS / "lunar"), "--out", str(tmp_path))
+    code, _out, err = run(capsys, "render", str(PLANS / "lunar"), "--out", str(tmp_path))
     assert code == 0, err
     assert list(tmp_path.glob("mission.LunarMission.txt")) and list(tmp_path.glob("*.dot"))
 

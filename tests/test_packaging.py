@@ -19,7 +19,9 @@ def _installed_name(folder: Path) -> str:
 
 
 def test_every_package_folder_is_listed() -> None:
-    folders = {p.parent for top in ("alica", *CONFIG["package-dir"].values()) for p in (ROOT / top).rglob("__init__.py")}
+    folders = {
+        p.parent for top in ("alica", *CONFIG["package-dir"].values()) for p in (ROOT / top).rglob("__init__.py")
+    }
     assert sorted(_installed_name(f) for f in folders) == sorted(CONFIG["packages"])
 
 

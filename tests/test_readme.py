@@ -15,7 +15,7 @@ README = (ROOT / "README.md").read_text(encoding="utf-8")
 
 
 def _blocks(language: str) -> list[str]:
-    return re.findall(rf"```{language}\n(.*?)```", README, re.S)
+    return re.findall(rf"```{language}\n(.*?)```", README, re.DOTALL)
 
 
 def test_readme_starts_with_the_two_commands() -> None:
@@ -52,4 +52,8 @@ def test_readme_skill_example(monkeypatch: pytest.MonkeyPatch, capfd: pytest.Cap
 def test_readme_planning_example(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     monkeypatch.chdir(ROOT)
     exec(compile(_blocks("python")[3], "README.md", "exec"), {})
-    assert capsys.readouterr().out.splitlines() == ["Unstack(c, a), Putdown(c)", "Pickup(b), Stack(b, c)", "Pickup(a), Stack(a, b)"]
+    assert capsys.readouterr().out.splitlines() == [
+        "Unstack(c, a), Putdown(c)",
+        "Pickup(b), Stack(b, c)",
+        "Pickup(a), Stack(a, b)",
+    ]

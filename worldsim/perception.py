@@ -29,7 +29,9 @@ class FactPerception:
             never touched); by default every predicate it has returned so far.
     """
 
-    def __init__(self, read: Callable[[Any], Iterable[Fact]], every: float = 0.2, predicates: Iterable[str] = ()) -> None:
+    def __init__(
+        self, read: Callable[[Any], Iterable[Fact]], every: float = 0.2, predicates: Iterable[str] = ()
+    ) -> None:
         if every <= 0:
             raise ValueError(f"FactPerception: 'every' must be a positive number of seconds, got {every}")
         self.read = read

@@ -170,7 +170,9 @@ def _configuration_counts(n: int, height: int) -> list[int]:
     """``counts[m]``: the configurations of ``m`` named blocks in stacks at most ``height`` high, for m = 0..n."""
     counts = [1] + [0] * n
     for m in range(1, n + 1):
-        counts[m] = sum(math.comb(m - 1, j - 1) * math.factorial(j) * counts[m - j] for j in range(1, min(height, m) + 1))
+        counts[m] = sum(
+            math.comb(m - 1, j - 1) * math.factorial(j) * counts[m - j] for j in range(1, min(height, m) + 1)
+        )
     return counts
 
 

@@ -198,7 +198,9 @@ class World:
                 if robot._v != 0.0 or robot._w != 0.0:  # a robot without a command does not move
                     robot._advance(dt)
             for arm in arms:
-                if arm._path is not None or arm._moved or arm._base_dirty or arm._slip_at is not None:  # else nothing to do
+                if (
+                    arm._path is not None or arm._moved or arm._base_dirty or arm._slip_at is not None
+                ):  # else nothing to do
                     arm._update(dt, t)
         self._steps += n
         if n:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from bisect import bisect_left
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -29,14 +30,15 @@ class Assignment:
 
     def __post_init__(self) -> None:
         entries = tuple(sorted(self.entries, key=lambda pair: pair[0]))
-        for (first, _), (second, _) in zip(entries, entries[1:]):
+        for (first, _), (second, _) in itertools.pairwise(entries):
             if first == second:
                 raise ValueError(f"assignment of plan '{self.plan}' lists agent '{first}' twice")
         object.__setattr__(self, "entries", entries)
 
     @classmethod
-    def of(cls, plan: str, entries: Mapping[str, str | None] | Iterable[tuple[str, str | None]],
-           utility: float) -> Assignment:
+    def of(
+        cls, plan: str, entries: Mapping[str, str | None] | Iterable[tuple[str, str | None]], utility: float
+    ) -> Assignment:
         """Build an assignment from a mapping or pairs in any order.
 
         Args:

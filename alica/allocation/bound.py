@@ -94,7 +94,7 @@ def suffix_tables(table: PlanTable, prices: tuple[int, ...]) -> Suffix:
             if lows[j] and cell is not None and (len(losses[j]) < lows[j] or top - cell < losses[j][-1]):
                 losses[j] = losses[j].copy()
                 insort(losses[j], top - cell)
-                del losses[j][lows[j]:]
+                del losses[j][lows[j] :]
         if top_column < width and bounded[top_column]:
             counts[top_column] += 1
             if others:
@@ -106,8 +106,9 @@ def suffix_tables(table: PlanTable, prices: tuple[int, ...]) -> Suffix:
     return Suffix(prices, tuple(best), tuple(deficit), tuple(movers), tuple(overflow), bounded)
 
 
-def node_key(table: PlanTable, suffix: Suffix, start: int, counts: tuple[int, ...], value: int,
-             allow_idle: bool) -> int | None:
+def node_key(
+    table: PlanTable, suffix: Suffix, start: int, counts: tuple[int, ...], value: int, allow_idle: bool
+) -> int | None:
     """The key of a node whose agents ``0..start-1`` are assigned, ``None`` if it is dead.
 
     Args:
@@ -147,7 +148,7 @@ def node_key(table: PlanTable, suffix: Suffix, start: int, counts: tuple[int, ..
             if price < 0:
                 terms += price * gap
         if price > 0:
-            terms += price * (room if room < remaining else remaining)
+            terms += price * (min(remaining, room))
         free += room
         if suffix.bounded[e]:
             excess = movers[e] - room
@@ -161,5 +162,5 @@ def node_key(table: PlanTable, suffix: Suffix, start: int, counts: tuple[int, ..
     price = prices[-1]
     if price > 0:
         terms += price * remaining
-    bound = value + suffix.best[start] + terms - (short if short > crowd else crowd)
+    bound = value + suffix.best[start] + terms - (max(crowd, short))
     return fixed_point(bound, table.denominator)

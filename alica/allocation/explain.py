@@ -105,11 +105,7 @@ def plan_reason(problem: AllocationProblem, team: Team, plan: Plan, table: PlanT
     """
     if table is None:
         return _skipped(problem, team, plan)
-    messages = (
-        _stuck_agents(problem, team, table)
-        + _unfillable(team, table)
-        + _capacity(problem, team, table)
-    )
+    messages = _stuck_agents(problem, team, table) + _unfillable(team, table) + _capacity(problem, team, table)
     if not messages:
         messages = _hall(team, table)
     if not messages:
@@ -132,8 +128,7 @@ def explain(problem: AllocationProblem, team: Team, tables: list[PlanTable | Non
     if not problem.plans:
         return "no candidate plans"
     reasons = [
-        f"plan '{plan.name}' {plan_reason(problem, team, plan, table)}"
-        for plan, table in zip(problem.plans, tables)
+        f"plan '{plan.name}' {plan_reason(problem, team, plan, table)}" for plan, table in zip(problem.plans, tables)
     ]
     if len(reasons) == 1:
         return f"no valid assignment: {reasons[0]}"

@@ -71,8 +71,7 @@ class Relaxation:
     highs: tuple[int, ...]
 
 
-def move_arcs(table: PlanTable, columns: tuple[int, ...] | list[int], movable: range | list[int],
-              width: int) -> Arcs:
+def move_arcs(table: PlanTable, columns: tuple[int, ...] | list[int], movable: range | list[int], width: int) -> Arcs:
     """The best gain of moving one of the ``movable`` agents from column i to column j, per pair."""
     arcs: Arcs = [[None] * width for _ in range(width)]
     cells = table.cells
@@ -133,8 +132,9 @@ def _longest(start: list[int | None], arcs: Arcs) -> tuple[list[int | None], lis
     return dist, pred
 
 
-def _with_sink(arcs: Arcs, counts: tuple[int, ...] | list[int], lows: tuple[int, ...], highs: tuple[int, ...],
-               bonus: int) -> Arcs:
+def _with_sink(
+    arcs: Arcs, counts: tuple[int, ...] | list[int], lows: tuple[int, ...], highs: tuple[int, ...], bonus: int
+) -> Arcs:
     """The residual graph: column moves plus the sink ``t`` (last node) and its arcs."""
     width = len(counts)
     graph: Arcs = [row + [None] for row in arcs]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -70,7 +71,7 @@ def prepare(problem: AllocationProblem) -> Team:
             not in the role set; a success count is negative.
     """
     agents = tuple(sorted(problem.agents))
-    twice = sorted({a for a, b in zip(agents, agents[1:]) if a == b})
+    twice = sorted({a for a, b in itertools.pairwise(agents) if a == b})
     if twice:
         raise AllocationError(f"agents listed more than once: {', '.join(twice)}")
     missing = [a for a in agents if a not in problem.roles]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from itertools import product
 
-from alica.allocation.assignment import Assignment, AllocationResult
+from alica.allocation.assignment import AllocationResult, Assignment
 from alica.allocation.explain import explain
 from alica.allocation.problem import AllocationProblem, cardinalities, prepare, summand_function
 from alica.allocation.table import PlanTable, build_table

@@ -50,8 +50,7 @@ def _declared(agent: str, spec: AgentSpec, roleset: RoleSet) -> str:
         missing = _missing(role, spec.capabilities)
         if missing:
             raise RoleError(
-                f"agent '{agent}' declares role '{role.name}' but lacks its required "
-                f"capabilities: {', '.join(missing)}"
+                f"agent '{agent}' declares role '{role.name}' but lacks its required capabilities: {', '.join(missing)}"
             )
     return role.name
 

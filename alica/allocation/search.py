@@ -105,8 +105,11 @@ def _solve(tables: list[PlanTable | None]) -> tuple[list[_Candidate | None], int
         best key achieved (``None`` if no plan has a valid assignment).
     """
     candidates: list[_Candidate | None] = [None] * len(tables)
-    hopes = [(key, index) for index, table in enumerate(tables)
-             if table is not None and (key := _optimistic(table)) is not None]
+    hopes = [
+        (key, index)
+        for index, table in enumerate(tables)
+        if table is not None and (key := _optimistic(table)) is not None
+    ]
     floor: int | None = None
     for hope, index in sorted(hopes, key=lambda pair: (-pair[0], pair[1])):
         if floor is not None and hope < floor:
@@ -173,13 +176,13 @@ def allocate(problem: AllocationProblem) -> AllocationResult:
         kept = basis.columns[depth]
         highs = table.highs
         arcs = None
-        for j, cell in enumerate(table.cells[depth][:kept + 1]):
+        for j, cell in enumerate(table.cells[depth][: kept + 1]):
             if cell is None:
                 continue
             if j < len(counts):
                 if counts[j] >= highs[j]:
                     continue
-                child = counts[:j] + (counts[j] + 1,) + counts[j + 1:]
+                child = counts[:j] + (counts[j] + 1,) + counts[j + 1 :]
             else:
                 child = counts
             path = prefix + (j,)

@@ -57,8 +57,9 @@ def weight_sum(plan: Plan) -> Fraction:
     return total
 
 
-def utility_fraction(problem: AllocationProblem, plan: Plan, entries: Mapping[str, str | None],
-                     team: Team | None = None) -> Fraction | None:
+def utility_fraction(
+    problem: AllocationProblem, plan: Plan, entries: Mapping[str, str | None], team: Team | None = None
+) -> Fraction | None:
     """U of a complete assignment as an exact fraction, ``None`` if invalid or vetoed.
 
     Args:

@@ -51,7 +51,11 @@ def _roots(library, entry, name: str | None) -> list[str]:  # type: ignore[no-un
     if name is not None:
         library.abstract(name)
         return [name]
-    own = [p.name for p in entry.plans] + [p.name for p in entry.problems] + [b.name for b in entry.behaviours if not entry.plans]
+    own = (
+        [p.name for p in entry.plans]
+        + [p.name for p in entry.problems]
+        + [b.name for b in entry.behaviours if not entry.plans]
+    )
     used = {c for e in (*entry.plans, *entry.plantypes, *entry.problems) for c in library.children(e)}
     roots = [n for n in own if n not in used]
     return roots or own
@@ -84,8 +88,8 @@ def _cmd_show(args: argparse.Namespace) -> int:
 def _cmd_render(args: argparse.Namespace) -> int:
     import shutil
 
-    from alica.io import Loader, plan_files
     from alica.app.render import dot_graph, svg, text_tree
+    from alica.io import Loader, plan_files
 
     files, problems = plan_files(args.paths)
     loader = Loader()
@@ -134,7 +138,11 @@ def _cmd_list_skills(args: argparse.Namespace) -> int:
 
     for spec in default_registry():
         caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""
-        impl = f"  (runs {spec.implementation})" if spec.implementation else "  (no implementation yet: scripted in team runs)"
+        impl = (
+            f"  (runs {spec.implementation})"
+            if spec.implementation
+            else "  (no implementation yet: scripted in team runs)"
+        )
         print(f"{spec.name}: {spec.doc}{caps}{impl}")
         for p in spec.params:
             need = "required" if p.required else f"default {p.default!r}"
@@ -144,30 +152,53 @@ def _cmd_list_skills(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``alica`` command."""
-    parser = argparse.ArgumentParser(prog="alica", description="Teams of robots that carry out missions described as data.")
+    parser = argparse.ArgumentParser(
+        prog="alica", description="Teams of robots that carry out missions described as data."
+    )
     parser.add_argument("--debug", action="store_true", help="show a traceback on internal errors")
     parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
-    p = sub.add_parser("validate", help="check plan files and everything they import", description="Check plan files (or every plan file in folders). Exit 0 if valid, 1 if not, 2 on wrong usage. Problems are printed as FILE:LINE:COL: error: message.")
+    p = sub.add_parser(
+        "validate",
+        help="check plan files and everything they import",
+        description="Check plan files (or every plan file in folders). Exit 0 if valid, 1 if not, 2 on wrong usage. Problems are printed as FILE:LINE:COL: error: message.",
+    )
     p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing when everything is valid")
     p.set_defaults(run=_cmd_validate)
 
-    p = sub.add_parser("show", help="print a plan tree", description="Print the plan tree of a plan file: plans, entry points, states, transitions, behaviours.")
+    p = sub.add_parser(
+        "show",
+        help="print a plan tree",
+        description="Print the plan tree of a plan file: plans, entry points, states, transitions, behaviours.",
+    )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
-    p.add_argument("--format", choices=("text", "dot", "svg"), default="text", help="text (default), Graphviz dot, or SVG (needs Graphviz)")
+    p.add_argument(
+        "--format",
+        choices=("text", "dot", "svg"),
+        default="text",
+        help="text (default), Graphviz dot, or SVG (needs Graphviz)",
+    )
     p.add_argument("--name", help="show this plan (default: the file's top-level plans)")
     p.add_argument("-o", "--output", help="write to this file instead of standard output")
     p.set_defaults(run=_cmd_show)
 
-    p = sub.add_parser("render", help="render every plan tree under folders to text, dot and svg files", description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed).")
+    p = sub.add_parser(
+        "render",
+        help="render every plan tree under folders to text, dot and svg files",
+        description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed).",
+    )
     p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
     p.add_argument("--out", default="build/plans", help="output folder (default build/plans)")
     p.set_defaults(run=_cmd_render)
 
-    p = sub.add_parser("convert", help="convert a plan file between YAML and XML", description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first.")
+    p = sub.add_parser(
+        "convert",
+        help="convert a plan file between YAML and XML",
+        description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first.",
+    )
     p.add_argument("input", metavar="IN")
     p.add_argument("output", metavar="OUT")
     p.add_argument("--no-validate", action="store_true", help="convert without checking references to other files")
@@ -212,7 +243,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Exception as exc:  # a bug of ours, not bad input: say so in one line
         if args.debug:
             raise
-        print(f"alica: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details and please report it)", file=sys.stderr)
+        print(
+            f"alica: internal error: {type(exc).__name__}: {exc} (rerun with --debug for details and please report it)",
+            file=sys.stderr,
+        )
         return 70
 
 

@@ -16,7 +16,9 @@ from alica.errors import AlicaError
 
 def add_parser(sub: Any) -> None:
     """Add the ``demo`` subcommand to the ``alica`` parser."""
-    p = sub.add_parser("demo", help="run a demo mission in the simulator", description="Run a demo mission in the pybullet simulator.")
+    p = sub.add_parser(
+        "demo", help="run a demo mission in the simulator", description="Run a demo mission in the pybullet simulator."
+    )
     demos = p.add_subparsers(dest="demo", metavar="DEMO", required=True)
     b = demos.add_parser(
         "blocksworld",
@@ -27,14 +29,28 @@ def add_parser(sub: Any) -> None:
     )
     b.add_argument("--agents", type=_count(1), default=2, metavar="N", help="team robots r1..rN (default 2)")
     b.add_argument("--opponents", type=_count(0), default=0, metavar="K", help="opponent robots o1..oK (default 0)")
-    b.add_argument("--blocks", type=_count(1), default=4, metavar="B", help="blocks of the random configurations (default 4)")
-    b.add_argument("--seed", type=int, default=0, metavar="S", help="seeds the configurations, the world and the team (default 0)")
-    b.add_argument("--goal", metavar="FILE", help="a YAML file with 'goal' (and optionally 'start') stacks, bottom first: goal: [[a, b], [c]]")
-    b.add_argument("--time-limit", type=float, default=600.0, metavar="S", help="simulated seconds before giving up (default 600)")
+    b.add_argument(
+        "--blocks", type=_count(1), default=4, metavar="B", help="blocks of the random configurations (default 4)"
+    )
+    b.add_argument(
+        "--seed", type=int, default=0, metavar="S", help="seeds the configurations, the world and the team (default 0)"
+    )
+    b.add_argument(
+        "--goal",
+        metavar="FILE",
+        help="a YAML file with 'goal' (and optionally 'start') stacks, bottom first: goal: [[a, b], [c]]",
+    )
+    b.add_argument(
+        "--time-limit", type=float, default=600.0, metavar="S", help="simulated seconds before giving up (default 600)"
+    )
     b.add_argument("--out", metavar="DIR", help="write trace.jsonl, initial.png, final.png and plan.yaml here")
     b.add_argument("--json", action="store_true", help="print the summary as JSON")
     b.add_argument("--gui", action="store_true", help="show the pybullet window")
-    b.add_argument("--no-progress", action="store_true", help="no progress bar (there is none when standard error is not a terminal)")
+    b.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar (there is none when standard error is not a terminal)",
+    )
     b.set_defaults(run=cmd_blocksworld)
 
 
@@ -70,12 +86,18 @@ def read_goal_file(path: str) -> tuple[list[list[str]] | None, list[list[str]]]:
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else path
-        raise AlicaError(f"{where}: not valid YAML ({getattr(exc, 'problem', exc)}); write e.g. 'goal: [[a, b], [c]]'") from None
+        raise AlicaError(
+            f"{where}: not valid YAML ({getattr(exc, 'problem', exc)}); write e.g. 'goal: [[a, b], [c]]'"
+        ) from None
     if not isinstance(data, dict) or "goal" not in data:
-        raise AlicaError(f"{path}:1:1: the goal file needs a 'goal' key with the goal stacks, e.g. 'goal: [[a, b], [c]]'")
+        raise AlicaError(
+            f"{path}:1:1: the goal file needs a 'goal' key with the goal stacks, e.g. 'goal: [[a, b], [c]]'"
+        )
     unknown = sorted(set(data) - {"goal", "start"})
     if unknown:
-        raise AlicaError(f"{path}: unknown key(s) {', '.join(unknown)}; the goal file has 'goal' and optionally 'start'")
+        raise AlicaError(
+            f"{path}: unknown key(s) {', '.join(unknown)}; the goal file has 'goal' and optionally 'start'"
+        )
     line = next((i + 1 for i, row in enumerate(text.splitlines()) if row.lstrip().startswith("goal")), 1)
     goal = check_stacks(data["goal"], f"{path}:{line}: 'goal'")
     start = check_stacks(data["start"], f"{path}: 'start'") if data.get("start") is not None else None
@@ -93,7 +115,9 @@ class Progress:
     def __call__(self, now: float, satisfied: int, total: int, replans: int) -> None:
         done = int(self.width * satisfied / total) if total else self.width
         bar = "#" * done + "." * (self.width - done)
-        self.stream.write(f"\r[{bar}] goal {satisfied}/{total}  sim {now:7.1f} s / {self.limit:.0f} s  replans {replans}  ")
+        self.stream.write(
+            f"\r[{bar}] goal {satisfied}/{total}  sim {now:7.1f} s / {self.limit:.0f} s  replans {replans}  "
+        )
         self.stream.flush()
 
     def close(self) -> None:
@@ -109,7 +133,15 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
     start, goal = read_goal_file(args.goal) if args.goal else (None, None)
     if not args.time_limit > 0:
         raise AlicaError(f"--time-limit must be a positive number of seconds, not {args.time_limit}")
-    config = DemoConfig(agents=args.agents, opponents=args.opponents, blocks=args.blocks, seed=args.seed, start=start, goal=goal, time_limit=args.time_limit)
+    config = DemoConfig(
+        agents=args.agents,
+        opponents=args.opponents,
+        blocks=args.blocks,
+        seed=args.seed,
+        start=start,
+        goal=goal,
+        time_limit=args.time_limit,
+    )
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
     try:
         result = run_demo(config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui)
@@ -125,7 +157,9 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
 
 def _print_summary(result: Any) -> None:
     state = "success" if result.success else "time limit reached"
-    print(f"blocksworld: {state} after {result.sim_time_s:.2f} s simulated, {result.wall_time_s:.2f} s wall ({result.real_time_factor:.1f}x real time)")
+    print(
+        f"blocksworld: {state} after {result.sim_time_s:.2f} s simulated, {result.wall_time_s:.2f} s wall ({result.real_time_factor:.1f}x real time)"
+    )
     print(f"start {result.start}  goal {result.goal}  goal literals {result.satisfied}/{result.goal_literals}")
     print(f"plan length {result.plan_length}, replans {result.replans}, messages sent {result.messages}")
     print("tasks done: " + ", ".join(f"{agent} {count}" for agent, count in result.tasks.items()))

@@ -40,10 +40,21 @@ def add_parser(sub: Any) -> None:
     )
     p.add_argument("domain", metavar="DOMAIN", help="a PDDL domain file, or a plan file with a planning problem")
     p.add_argument("problem", metavar="PROBLEM", nargs="?", help="a PDDL problem file (not with a plan file)")
-    p.add_argument("--problem", dest="problem_name", metavar="NAME", help="with a plan file: the planning problem (default: its only one)")
-    p.add_argument("--world", metavar="FACTS", help="with a plan file: the world as facts, e.g. \"ontable(a) and clear(a) and handempty(r)\"")
+    p.add_argument(
+        "--problem",
+        dest="problem_name",
+        metavar="NAME",
+        help="with a plan file: the planning problem (default: its only one)",
+    )
+    p.add_argument(
+        "--world",
+        metavar="FACTS",
+        help='with a plan file: the world as facts, e.g. "ontable(a) and clear(a) and handempty(r)"',
+    )
     p.add_argument("--goal", metavar="FORMULA", help="with a plan file: the goal instead of the problem's")
-    p.add_argument("--emit-plan", metavar="FILE", help="with a plan file: write the generated ALICA plan and its tasks as YAML")
+    p.add_argument(
+        "--emit-plan", metavar="FILE", help="with a plan file: write the generated ALICA plan and its tasks as YAML"
+    )
     p.add_argument(
         "--planner",
         default="builtin",
@@ -82,7 +93,9 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if Path(args.domain).suffix.lower() in PLAN_FILE_SUFFIXES:
         return _plan_file(args)
     if args.problem is None:
-        raise AlicaError(f"{args.domain}: a PDDL domain needs a PROBLEM file (or give a plan file with a planning problem)")
+        raise AlicaError(
+            f"{args.domain}: a PDDL domain needs a PROBLEM file (or give a plan file with a planning problem)"
+        )
     if args.emit_plan or args.problem_name or args.world or args.goal:
         raise AlicaError("--problem, --world, --goal and --emit-plan go with a plan file, not with PDDL files")
     try:
@@ -100,7 +113,13 @@ def cmd_plan(args: argparse.Namespace) -> int:
     return _report(args, planner.name, (domain, problem), result)
 
 
-def _report(args: argparse.Namespace, name: str, task: tuple[Any, Any], result: PlanResult, extra: Callable[[], dict[str, Any]] | None = None) -> int:
+def _report(
+    args: argparse.Namespace,
+    name: str,
+    task: tuple[Any, Any],
+    result: PlanResult,
+    extra: Callable[[], dict[str, Any]] | None = None,
+) -> int:
     """Validate and print the result; ``extra`` adds fields (and lines) once the plan is valid."""
     if result.status is PlanStatus.ERROR and result.plan is None:
         raise AlicaError(f"planner '{name}' failed: {result.message or 'no reason given'}")
@@ -139,10 +158,14 @@ def _plan_file(args: argparse.Namespace) -> int:
     problems = library.problems
     if args.problem_name is None:
         if len(problems) != 1:
-            raise AlicaError(f"{args.domain}: choose a planning problem with --problem ({', '.join(sorted(problems)) or 'it has none'})")
+            raise AlicaError(
+                f"{args.domain}: choose a planning problem with --problem ({', '.join(sorted(problems)) or 'it has none'})"
+            )
         name = next(iter(problems))
     elif args.problem_name not in problems:
-        raise AlicaError(f"{args.domain}: no planning problem named '{args.problem_name}'; problems: {', '.join(sorted(problems)) or 'none'}")
+        raise AlicaError(
+            f"{args.domain}: no planning problem named '{args.problem_name}'; problems: {', '.join(sorted(problems)) or 'none'}"
+        )
     else:
         name = args.problem_name
     problem = problems[name]
@@ -151,7 +174,9 @@ def _plan_file(args: argparse.Namespace) -> int:
     if args.goal is not None:
         problem = replace(problem, goal=Condition(ConditionKind.POST, args.goal))
     if problem.world is None:
-        raise AlicaError(f"planning problem '{name}' has no 'world' (it is read from the world model at run time): give one with --world")
+        raise AlicaError(
+            f"planning problem '{name}' has no 'world' (it is read from the world model at run time): give one with --world"
+        )
     world = read_world(problem, library, (), ())
     domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
     planner = get_planner(args.planner)
@@ -168,13 +193,25 @@ def _plan_file(args: argparse.Namespace) -> int:
         roleset = next(iter(sorted(library.rolesets.items())))[1] if library.rolesets else None
         if roleset is None:
             raise AlicaError(f"{args.domain}: the generated plan needs a role set for its task priorities; import one")
-        created = create_tasks(f"{name}Plan", steps, library, world.facts, world.robots or ("self",), roleset, "Default", standby=problem.wait_plan)
+        created = create_tasks(
+            f"{name}Plan",
+            steps,
+            library,
+            world.facts,
+            world.robots or ("self",),
+            roleset,
+            "Default",
+            standby=problem.wait_plan,
+        )
         if args.emit_plan:
             out = Path(args.emit_plan)
             imports = sorted({_relative(Path(d.path), out) for d in library.documents if d.path})
             out.parent.mkdir(parents=True, exist_ok=True)
             out.write_text(emit_yaml(created, imports), encoding="utf-8")
-        return {"tasks": [[s.label for s in task] for task in created.tasks], **({"emitted": str(args.emit_plan)} if args.emit_plan else {})}
+        return {
+            "tasks": [[s.label for s in task] for task in created.tasks],
+            **({"emitted": str(args.emit_plan)} if args.emit_plan else {}),
+        }
 
     return _report(args, planner.name, (domain, pddl), result, tasks)
 

@@ -23,23 +23,68 @@ def add_parser(sub: Any) -> None:
         "after a while and write their post-condition). Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
-    p.add_argument("--agents", required=True, metavar="NAME:ROLE,...", help="the team, e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; NAME:+cap1+cap2 derives the role from capabilities")
+    p.add_argument(
+        "--agents",
+        required=True,
+        metavar="NAME:ROLE,...",
+        help="the team, e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; NAME:+cap1+cap2 derives the role from capabilities",
+    )
     p.add_argument("--name", help="the root plan (default: the file's top-level plan)")
     p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
     p.add_argument("--seed", type=int, default=0, help="seed of the network and the agents (default 0)")
     length = p.add_mutually_exclusive_group()
     length.add_argument("--ticks", type=int, metavar="N", help="run N engine ticks")
-    length.add_argument("--until-done", action="store_true", help="run until every agent's root plan ended (the default)")
-    p.add_argument("--max-time", type=float, default=300.0, metavar="S", help="simulated seconds at most with --until-done (default 300)")
+    length.add_argument(
+        "--until-done", action="store_true", help="run until every agent's root plan ended (the default)"
+    )
+    p.add_argument(
+        "--max-time",
+        type=float,
+        default=300.0,
+        metavar="S",
+        help="simulated seconds at most with --until-done (default 300)",
+    )
     p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
-    p.add_argument("--loss", type=float, default=0.0, metavar="P", help="probability that a best-effort message is lost (default 0)")
+    p.add_argument(
+        "--loss",
+        type=float,
+        default=0.0,
+        metavar="P",
+        help="probability that a best-effort message is lost (default 0)",
+    )
     p.add_argument("--delay", type=float, default=0.0, metavar="MS", help="message delay in milliseconds (default 0)")
-    p.add_argument("--jitter", type=float, default=0.0, metavar="MS", help="random extra delay up to this many milliseconds")
-    p.add_argument("--crash", action="append", default=[], metavar="NAME@T", help="crash agent NAME at simulated second T (repeatable)")
-    p.add_argument("--recover", action="append", default=[], metavar="NAME@T", help="restart agent NAME at second T (repeatable)")
-    p.add_argument("--partition", action="append", default=[], metavar="A,B|C@T1-T2", help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)")
-    p.add_argument("--fact", action="append", default=[], metavar="LITERALS@T", help="the operator sets facts at second T, e.g. 'found(a) and not stop@5' (repeatable)")
-    p.add_argument("--trace", metavar="FILE", help="write a JSON Lines trace of allocations, transitions, repairs, messages and faults")
+    p.add_argument(
+        "--jitter", type=float, default=0.0, metavar="MS", help="random extra delay up to this many milliseconds"
+    )
+    p.add_argument(
+        "--crash",
+        action="append",
+        default=[],
+        metavar="NAME@T",
+        help="crash agent NAME at simulated second T (repeatable)",
+    )
+    p.add_argument(
+        "--recover", action="append", default=[], metavar="NAME@T", help="restart agent NAME at second T (repeatable)"
+    )
+    p.add_argument(
+        "--partition",
+        action="append",
+        default=[],
+        metavar="A,B|C@T1-T2",
+        help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)",
+    )
+    p.add_argument(
+        "--fact",
+        action="append",
+        default=[],
+        metavar="LITERALS@T",
+        help="the operator sets facts at second T, e.g. 'found(a) and not stop@5' (repeatable)",
+    )
+    p.add_argument(
+        "--trace",
+        metavar="FILE",
+        help="write a JSON Lines trace of allocations, transitions, repairs, messages and faults",
+    )
     p.add_argument("--trace-messages", action="store_true", help="trace every message too (large)")
     p.add_argument("--show-tree", action="store_true", help="print each agent's running plan tree whenever it changes")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -90,7 +135,9 @@ def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset
             continue
         if role is None:
             if name.lower() not in names:
-                raise AlicaError(f"--agents: agent '{name}' has no role and no role is called like it; write {name}:ROLE (roles: {', '.join(sorted(set(names.values())))})")
+                raise AlicaError(
+                    f"--agents: agent '{name}' has no role and no role is called like it; write {name}:ROLE (roles: {', '.join(sorted(set(names.values())))})"
+                )
             role = names[name.lower()]
         out[name] = role
     pick_roleset(library, [r for r in out.values() if isinstance(r, str)], roleset)
@@ -125,11 +172,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         observers.append(trace)
     changed: set[str] = set()
     if args.show_tree:
-        observers.append(lambda e: changed.add(e["agent"]) if e["event"] in ("transition", "allocation", "repair") else None)
+        observers.append(
+            lambda e: changed.add(e["agent"]) if e["event"] in ("transition", "allocation", "repair") else None
+        )
     team = SimulatedTeam(
-        library, plan, roles, seed=args.seed, config=EngineConfig(frequency=args.frequency), roleset=args.roleset,
-        loss=args.loss, delay=args.delay / 1000.0, jitter=args.jitter / 1000.0,
-        fallback=default_fallback(args.seed), observers=observers, trace_messages=args.trace_messages,
+        library,
+        plan,
+        roles,
+        seed=args.seed,
+        config=EngineConfig(frequency=args.frequency),
+        roleset=args.roleset,
+        loss=args.loss,
+        delay=args.delay / 1000.0,
+        jitter=args.jitter / 1000.0,
+        fallback=default_fallback(args.seed),
+        observers=observers,
+        trace_messages=args.trace_messages,
     )
     for text in args.crash:
         who, at, _ = _timed("--crash", text)
@@ -182,11 +240,15 @@ def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running
 
 def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
     verdict = "success" if summary["success"] else ("ended" if summary["done"] else "not finished")
-    print(f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}")
+    print(
+        f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}"
+    )
     header = f"{'agent':<12} {'role':<12} {'status':<8} {'transitions':>11} {'allocations':>11} {'sent':>6} {'recv':>6} {'repairs':>7}  where"
     print(header)
     for name, a in summary["agents"].items():
-        print(f"{name:<12} {a['role']:<12} {a['status']:<8} {a['transitions']:>11} {a['allocations']:>11} {a['messages_out']:>6} {a['messages_in']:>6} {a['repairs']:>7}  {a['path']}")
+        print(
+            f"{name:<12} {a['role']:<12} {a['status']:<8} {a['transitions']:>11} {a['allocations']:>11} {a['messages_out']:>6} {a['messages_in']:>6} {a['repairs']:>7}  {a['path']}"
+        )
     m = summary["messages"]
     print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
     if summary["faults"]:

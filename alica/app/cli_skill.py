@@ -17,13 +17,27 @@ from alica.errors import AlicaError
 
 def add_parser(sub: Any) -> None:
     """Add the ``skill`` subcommand to the ``alica`` parser."""
-    p = sub.add_parser("skill", help="run one skill alone in a simulated world", description="Run one skill alone in a simulated world, in simulated time.")
+    p = sub.add_parser(
+        "skill",
+        help="run one skill alone in a simulated world",
+        description="Run one skill alone in a simulated world, in simulated time.",
+    )
     skill_sub = p.add_subparsers(dest="skill_command", metavar="ACTION")
     skill_sub.required = True
-    r = skill_sub.add_parser("run", help="run a skill until it ends", description="Run a skill on one robot of a lunar or blocks world until it succeeds, fails or times out. Exit 0 on success, 1 otherwise.")
+    r = skill_sub.add_parser(
+        "run",
+        help="run a skill until it ends",
+        description="Run a skill on one robot of a lunar or blocks world until it succeeds, fails or times out. Exit 0 on success, 1 otherwise.",
+    )
     r.add_argument("name", metavar="NAME", help="the skill, e.g. MoveToPosition (alica list-skills lists them)")
     r.add_argument("--world", choices=("lunar", "blocks"), default="lunar", help="the scenario (default lunar)")
-    r.add_argument("--param", action="append", default=[], metavar="KEY=VALUE", help="a parameter; VALUE is read as YAML, e.g. goal=[5, 5] (repeatable)")
+    r.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="a parameter; VALUE is read as YAML, e.g. goal=[5, 5] (repeatable)",
+    )
     r.add_argument("--robot", help="the robot (default: the first one that has what the skill needs)")
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
     r.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
@@ -43,7 +57,9 @@ def _params(items: list[str]) -> dict[str, object]:
         try:
             value = yaml.safe_load(text) if text.strip() else ""
         except yaml.YAMLError as exc:
-            raise AlicaError(f"--param {key}: '{text}' is not a YAML value ({exc.problem if hasattr(exc, 'problem') else exc})") from None
+            raise AlicaError(
+                f"--param {key}: '{text}' is not a YAML value ({exc.problem if hasattr(exc, 'problem') else exc})"
+            ) from None
         params[key] = tuple(value) if isinstance(value, list) else value
     return params
 
@@ -88,7 +104,9 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
         if robot is None:
             fits = [n for n, r in sorted(world.robots.items()) if spec.capabilities <= r.spec.capabilities]
             if not fits:
-                raise AlicaError(f"no robot of the {args.world} world can run {args.name} (it needs {', '.join(sorted(spec.capabilities))})")
+                raise AlicaError(
+                    f"no robot of the {args.world} world can run {args.name} (it needs {', '.join(sorted(spec.capabilities))})"
+                )
             robot = fits[0]
         return run_skill(args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry)
     finally:
@@ -108,7 +126,21 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
     with _c_prints_to_stderr():
         run = _run(args, registry, spec, params, run_skill)
     if args.json:
-        print(json.dumps({"skill": run.skill, "robot": run.robot, "status": run.status, "reason": run.reason, "sim_time_s": run.sim_time_s, "ticks": run.ticks, "trace": run.trace, "facts": [list(map(str, f)) for f in run.facts]}, indent=2))
+        print(
+            json.dumps(
+                {
+                    "skill": run.skill,
+                    "robot": run.robot,
+                    "status": run.status,
+                    "reason": run.reason,
+                    "sim_time_s": run.sim_time_s,
+                    "ticks": run.ticks,
+                    "trace": run.trace,
+                    "facts": [list(map(str, f)) for f in run.facts],
+                },
+                indent=2,
+            )
+        )
     else:
         print(f"{run.skill} on {run.robot}: {run.status} after {run.sim_time_s:.2f} s simulated ({run.ticks} ticks)")
         if run.reason:

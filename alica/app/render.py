@@ -53,10 +53,14 @@ def _text(library: PlanLibrary, element: AbstractPlan, indent: str, lines: list[
             _child(library, name, indent + "  ", lines, shown)
         return
     if isinstance(element, PlanningProblem):
-        lines.append(f"{indent}planning problem {element.name}: planner {element.planner}, update every {element.update_time:g} s")
+        lines.append(
+            f"{indent}planning problem {element.name}: planner {element.planner}, update every {element.update_time:g} s"
+        )
         lines.append(f"{indent}  goal: {element.goal.text}")
         lines.append(f"{indent}  elements: {', '.join(element.elements)}")
-        lines.append(f"{indent}  wait plan: {element.wait_plan or '-'}; alternative plan: {element.alternative_plan or '-'}")
+        lines.append(
+            f"{indent}  wait plan: {element.wait_plan or '-'}; alternative plan: {element.alternative_plan or '-'}"
+        )
         return
     plan = element
     header = f"{indent}plan {plan.name}"
@@ -107,7 +111,9 @@ def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[
         return
     done.add(element.name)
     if isinstance(element, Behaviour):
-        out.append(f"  {_q('b:' + element.name)} [shape=box style=rounded label={_q(element.name + chr(10) + 'skill ' + element.skill)}];")
+        out.append(
+            f"  {_q('b:' + element.name)} [shape=box style=rounded label={_q(element.name + chr(10) + 'skill ' + element.skill)}];"
+        )
         return
     if isinstance(element, PlanType):
         out.append(f"  {_q('t:' + element.name)} [shape=folder label={_q('plan type ' + element.name)}];")
@@ -118,7 +124,10 @@ def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[
     if isinstance(element, PlanningProblem):
         label = f"problem {element.name}\\ngoal: {element.goal.text}"
         out.append(f"  {_q('o:' + element.name)} [shape=hexagon label={_q(label)}];")
-        for name, style in [*((n, "dotted") for n in element.elements), *((n, "dashed") for n in (element.wait_plan, element.alternative_plan) if n)]:
+        for name, style in [
+            *((n, "dotted") for n in element.elements),
+            *((n, "dashed") for n in (element.wait_plan, element.alternative_plan) if n),
+        ]:
             _dot(library, library.abstract(name), out, done)
             out.append(f"  {_q('o:' + element.name)} -> {_q(_node_id(library, name))} [style={style}];")
         return
@@ -135,13 +144,17 @@ def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[
         out.append(f"    {_q(f's:{plan.name}:{state.name}')} [shape={shape} label={_q(state.name)}];")
     for t in plan.transitions:
         label = t.condition.text if t.condition else ""
-        out.append(f"    {_q(f's:{plan.name}:{t.source}')} -> {_q(f's:{plan.name}:{t.target}')} [label={_q(label)} fontsize=8];")
+        out.append(
+            f"    {_q(f's:{plan.name}:{t.source}')} -> {_q(f's:{plan.name}:{t.target}')} [label={_q(label)} fontsize=8];"
+        )
     out.append("  }")
     for state in plan.states:
         for child in state.children:
             target = library.abstract(child.name)
             _dot(library, target, out, done)
-            out.append(f"  {_q(f's:{plan.name}:{state.name}')} -> {_q(_node_id(library, child.name))} [style=dashed arrowhead=open];")
+            out.append(
+                f"  {_q(f's:{plan.name}:{state.name}')} -> {_q(_node_id(library, child.name))} [style=dashed arrowhead=open];"
+            )
 
 
 def _node_id(library: PlanLibrary, name: str) -> str:
@@ -158,7 +171,9 @@ def svg(dot_text: str) -> str:
     """
     exe = shutil.which("dot")
     if exe is None:
-        raise AlicaError("Graphviz is not installed ('dot' not found on PATH): install it (e.g. 'apt-get install graphviz') or use --format dot")
+        raise AlicaError(
+            "Graphviz is not installed ('dot' not found on PATH): install it (e.g. 'apt-get install graphviz') or use --format dot"
+        )
     done = subprocess.run([exe, "-Tsvg"], input=dot_text, capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise AlicaError(f"Graphviz failed: {done.stderr.strip()}")

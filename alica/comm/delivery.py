@@ -166,9 +166,7 @@ class Delivery:
             if earliest < self._incoming_earliest:
                 self._incoming_earliest = earliest
 
-    def _send_reliable(
-        self, sender: AgentState, envelope: Envelope, subscribers: list[AgentState], now: float
-    ) -> None:
+    def _send_reliable(self, sender: AgentState, envelope: Envelope, subscribers: list[AgentState], now: float) -> None:
         counts = self._counts
         links = self._links.get(sender.name, {})
         rng = self._rng
@@ -315,7 +313,7 @@ class Delivery:
     def _purge(self, state: AgentState, t: float, reason: str) -> int:
         """Drop everything in flight to ``state`` and its inbox; returns how many copies."""
         dropped: list[Envelope] = []
-        best_effort = self._due[self._due_position:] + self._waiting + self._incoming
+        best_effort = self._due[self._due_position :] + self._waiting + self._incoming
         for _, _, _, envelope, _, receivers in best_effort:
             if state in receivers:
                 receivers.remove(state)

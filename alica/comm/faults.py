@@ -35,7 +35,7 @@ class Partition:
         end: when it ends, or ``None`` for "until healed".
     """
 
-    __slots__ = ("handle", "groups", "start", "end")
+    __slots__ = ("end", "groups", "handle", "start")
 
     def __init__(self, handle: PartitionHandle, groups: dict[str, int], start: float, end: float | None) -> None:
         self.handle = handle

@@ -54,7 +54,7 @@ class SimNetwork(Delivery):
         clock: Clock,
         seed: int = 0,
         loss: float = 0.0,
-        delay: Delay = Delay(0.0),
+        delay: Delay = Delay(0.0),  # noqa: B008 (a frozen value)
         lease: float = 2.0,
         observer: Observer | None = None,
         *,
@@ -202,9 +202,7 @@ class SimNetwork(Delivery):
         Raises:
             ValueError: ``handle`` does not name a partition of this network.
         """
-        if handle is not None and not (
-            isinstance(handle, PartitionHandle) and 1 <= handle.id <= self._partition_count
-        ):
+        if handle is not None and not (isinstance(handle, PartitionHandle) and 1 <= handle.id <= self._partition_count):
             raise ValueError(f"{handle!r} is not a partition of this network; pass what partition() returned")
         self._advance()
         now = self._clock.now()

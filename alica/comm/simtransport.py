@@ -23,7 +23,7 @@ class Reliable:
         receiver: the receiving agent.
     """
 
-    __slots__ = ("nominal", "counter", "envelope", "delay", "sender", "receiver")
+    __slots__ = ("counter", "delay", "envelope", "nominal", "receiver", "sender")
 
     def __init__(
         self,
@@ -66,19 +66,19 @@ class AgentState:
     """
 
     __slots__ = (
-        "name",
-        "index",
-        "seq",
-        "inbox",
-        "holes",
-        "pending",
-        "last_best_effort",
-        "heard",
-        "outgoing",
+        "closed",
         "crash_at",
         "crash_token",
-        "closed",
+        "heard",
+        "holes",
+        "inbox",
+        "index",
+        "last_best_effort",
+        "name",
+        "outgoing",
+        "pending",
         "sent",
+        "seq",
     )
 
     def __init__(self, name: str, index: int) -> None:

@@ -43,14 +43,14 @@ class Counters:
     """The mutable counters behind :class:`NetStats` (internal to the network)."""
 
     __slots__ = (
-        "sent",
         "delivered",
+        "dropped_closed",
+        "dropped_crash",
         "dropped_loss",
         "dropped_partition",
-        "dropped_crash",
-        "dropped_closed",
-        "superseded",
         "retransmitted",
+        "sent",
+        "superseded",
     )
 
     def __init__(self) -> None:

@@ -31,7 +31,7 @@ class Tracer:
         messages: also report message events (send, deliver, drop).
     """
 
-    __slots__ = ("observer", "messages")
+    __slots__ = ("messages", "observer")
 
     def __init__(self, observer: Observer | None, messages: bool) -> None:
         self.observer = observer

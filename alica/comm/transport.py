@@ -21,6 +21,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from enum import Enum
 from types import TracebackType
+from typing import Self
 
 
 class QoS(Enum):
@@ -135,7 +136,7 @@ class Transport(ABC):
     def close(self) -> None:
         """Leave the team: stop sending and receiving. Closing twice is harmless."""
 
-    def __enter__(self) -> Transport:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(

@@ -117,7 +117,15 @@ class AgentEngine:
         self._transitions: dict[tuple[str, str], tuple[Transition, ...]] = {}
         self._tree_changed = True
         self._last_broadcast = float("-inf")
-        self.stats = {"ticks": 0, "transitions": 0, "allocations": 0, "messages_in": 0, "messages_out": 0, "repairs": 0, "replans": 0}
+        self.stats = {
+            "ticks": 0,
+            "transitions": 0,
+            "allocations": 0,
+            "messages_in": 0,
+            "messages_out": 0,
+            "repairs": 0,
+            "replans": 0,
+        }
         for topic in (TEAM_TOPIC, SYNC_TOPIC, WORLD_TOPIC, PLAN_TOPIC):
             transport.subscribe(topic)
         self._world_changed = False
@@ -227,7 +235,9 @@ class AgentEngine:
                 if status is not before:
                     slot.status = status
                     slot.reason = runner.reason
-                    self.emit("behaviour", key=node.key_text, behaviour=slot.name, status=status.value, reason=runner.reason)
+                    self.emit(
+                        "behaviour", key=node.key_text, behaviour=slot.name, status=status.value, reason=runner.reason
+                    )
             elif slot.node is not None:
                 self._tick_behaviours(slot.node, now)
 
@@ -238,7 +248,9 @@ class AgentEngine:
         plan = self.library.plans.get(name)
         return plan if plan is not None else self.plan_board.plans[name]
 
-    def register_generated(self, plan: Plan, roleset: RoleSet, pins: Mapping[str, tuple[str, ...]] | None = None) -> None:
+    def register_generated(
+        self, plan: Plan, roleset: RoleSet, pins: Mapping[str, tuple[str, ...]] | None = None
+    ) -> None:
         """Make a generated plan allocatable.
 
         Args:
@@ -267,7 +279,9 @@ class AgentEngine:
             AlicaError: no planning problem has that name.
         """
         if name not in self.library.problems:
-            raise AlicaError(f"no planning problem named '{name}'; problems: {', '.join(sorted(self.library.problems)) or 'none'}")
+            raise AlicaError(
+                f"no planning problem named '{name}'; problems: {', '.join(sorted(self.library.problems)) or 'none'}"
+            )
         override = dict(self.problem_overrides.get(name, {}))
         if goal is not None:
             override["goal"] = goal
@@ -326,7 +340,9 @@ class AgentEngine:
             variable = param.variable
             params[param.name] = slot.env.get(variable, param.value) if variable else param.value
         path = f"{slot.parent.key_text}/{slot.parent.state}/{behaviour.name}"
-        context = SkillContext(self.name, self.now, self.world_model, self.belief, self.rng, self.world, behaviour, path)
+        context = SkillContext(
+            self.name, self.now, self.world_model, self.belief, self.rng, self.world, behaviour, path
+        )
         try:
             factory = self.skills.factory(behaviour)
         except AlicaError as exc:
@@ -367,7 +383,9 @@ class AgentEngine:
 
     # -- allocation -----------------------------------------------------
 
-    def _summand_fn(self, node_env: Mapping[str, object], context: PlanNode | None) -> Callable[[Plan, Summand, str, EntryPoint], float]:
+    def _summand_fn(
+        self, node_env: Mapping[str, object], context: PlanNode | None
+    ) -> Callable[[Plan, Summand, str, EntryPoint], float]:
         pins = self.plan_board.pins
 
         def summand(plan: Plan, term: Summand, agent: str, ep: EntryPoint) -> float:
@@ -395,7 +413,15 @@ class AgentEngine:
         believed, state = parent.believed, parent.state
         return tuple(a for a in alive if a == self.name or (believed.get(a) or (None, None))[1] == state)
 
-    def _problem(self, agents: tuple[str, ...], plans: tuple[Plan, ...], successes: Mapping[str, Mapping[str, int]], old: Assignment | None, env: Mapping[str, object], context: PlanNode | None) -> AllocationProblem:
+    def _problem(
+        self,
+        agents: tuple[str, ...],
+        plans: tuple[Plan, ...],
+        successes: Mapping[str, Mapping[str, int]],
+        old: Assignment | None,
+        env: Mapping[str, object],
+        context: PlanNode | None,
+    ) -> AllocationProblem:
         roles = self.team.roles
         needs_summands = any(p.utility.summands for p in plans)
         return AllocationProblem(
@@ -414,7 +440,9 @@ class AgentEngine:
         key = (*slot.parent.key, slot.parent.state or "", slot.name)
         return self._allocate_new(slot, plans, key, slot.env, now)
 
-    def _allocate_new(self, slot: Slot | None, plans: tuple[Plan, ...], key: PlanKey, env: dict[str, object], now: float) -> PlanNode | None:
+    def _allocate_new(
+        self, slot: Slot | None, plans: tuple[Plan, ...], key: PlanKey, env: dict[str, object], now: float
+    ) -> PlanNode | None:
         parent = slot.parent if slot is not None else None
         members = self.members_of(parent)
         # Teammates already in this plan keep their entry points (their claims trump predictions).
@@ -450,7 +478,14 @@ class AgentEngine:
             if agent != self.name:
                 node.believed[agent] = (ep, plan.entry_point(ep).state if ep is not None else None)
                 node.predicted_at[agent] = now
-        self.emit("allocation", key=node.key_text, plan=plan.name, reason="initial", utility=round(assignment.utility, 9), entries=assignment.as_dict())
+        self.emit(
+            "allocation",
+            key=node.key_text,
+            plan=plan.name,
+            reason="initial",
+            utility=round(assignment.utility, 9),
+            entries=assignment.as_dict(),
+        )
         node.set_entry(assignment.entry_of(self.name), now)
         return node
 
@@ -491,7 +526,9 @@ class AgentEngine:
         if not needy:
             return
         reduced = replace(plan, entry_points=needy)
-        result = allocate(self._problem(tuple(free), (reduced,), {}, None, node.env, node.slot.parent if node.slot else None))
+        result = allocate(
+            self._problem(tuple(free), (reduced,), {}, None, node.env, node.slot.parent if node.slot else None)
+        )
         best = result.assignment
         if best is None or all(ep is None for _, ep in best.entries):
             return
@@ -511,7 +548,9 @@ class AgentEngine:
             agents.append(agent)
             current[agent] = entry[0] if entry is not None else None
         agents_t = tuple(agents)
-        plans: tuple[Plan, ...] = (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan)
+        plans: tuple[Plan, ...] = (
+            (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan)
+        )
         if plan not in plans:
             plans = (plan, *plans)
         successes = {plan.name: node.successes()}
@@ -531,7 +570,15 @@ class AgentEngine:
         same = best.plan == plan.name and all(best.entry_of(a) == current[a] for a in agents_t)
         if same:
             return
-        self.emit("allocation", key=node.key_text, plan=best.plan, reason="utility", utility=round(best.utility, 9), previous=round(now_utility, 9), entries=best.as_dict())
+        self.emit(
+            "allocation",
+            key=node.key_text,
+            plan=best.plan,
+            reason="utility",
+            utility=round(best.utility, 9),
+            previous=round(now_utility, 9),
+            entries=best.as_dict(),
+        )
         if best.plan != plan.name and node.slot is not None:
             slot = node.slot
             node.stop()
@@ -546,16 +593,27 @@ class AgentEngine:
         contested = node.conflicts(now, config.cycle_window) >= config.cycle_count
         if not contested:
             contested = any(
-                (c := self.team.claim(a, node.key)) is not None and c.contested for a in node.members() if a != self.name
+                (c := self.team.claim(a, node.key)) is not None and c.contested
+                for a in node.members()
+                if a != self.name
             )
         if not contested or now < node.authority_until:
             return
         if node.members()[0] == self.name:
-            window = config.authority_min if node.authority_window == 0 else min(config.authority_max, node.authority_window * config.authority_growth)
+            window = (
+                config.authority_min
+                if node.authority_window == 0
+                else min(config.authority_max, node.authority_window * config.authority_growth)
+            )
             node.authority_window = window
             node.authority_until = now + window
             node.history.clear()
-            self.emit("authority", key=node.key_text, window=window, entries=dict(sorted((a, e[0]) for a, e in node.believed.items())))
+            self.emit(
+                "authority",
+                key=node.key_text,
+                window=window,
+                entries=dict(sorted((a, e[0]) for a, e in node.believed.items())),
+            )
             self.tree_changed()
         else:
             node.contested_until = now + config.authority_min
@@ -606,11 +664,15 @@ class AgentEngine:
         self._tree_changed = False
         self._last_broadcast = now
         authority = tuple(
-            AuthorityClaim(n.key, n.plan.name, tuple(sorted((a, e[0]) for a, e in n.believed.items())), n.authority_until)
+            AuthorityClaim(
+                n.key, n.plan.name, tuple(sorted((a, e[0]) for a, e in n.believed.items())), n.authority_until
+            )
             for n in self.index.values()
             if n.authority_until > now
         )
-        self._publish(TEAM_TOPIC, TeamMessage(self.name, now, self.role, tuple(self.claims()), authority), QoS.BEST_EFFORT)
+        self._publish(
+            TEAM_TOPIC, TeamMessage(self.name, now, self.role, tuple(self.claims()), authority), QoS.BEST_EFFORT
+        )
 
     # -- trace --------------------------------------------------------------
 

@@ -129,7 +129,9 @@ class BehaviourRunner:
 
     __slots__ = ("_next_tick", "_period", "bt", "context", "factory", "model", "params", "reason", "status")
 
-    def __init__(self, model: Behaviour, params: Mapping[str, object], factory: SkillFactory, context: SkillContext) -> None:
+    def __init__(
+        self, model: Behaviour, params: Mapping[str, object], factory: SkillFactory, context: SkillContext
+    ) -> None:
         self.model = model
         self.params = dict(params)
         self.factory = factory
@@ -160,8 +162,10 @@ class BehaviourRunner:
         assert bt is not None
         try:
             bt.tick_once()
-        except Exception as exc:  # noqa: BLE001 - a skill's bug must not stop the team: the behaviour fails, with its path
-            self._finish(ChildStatus.FAILURE, f"exception in '{self.context.path}' [{model.skill}]: {type(exc).__name__}: {exc}")
+        except Exception as exc:
+            self._finish(
+                ChildStatus.FAILURE, f"exception in '{self.context.path}' [{model.skill}]: {type(exc).__name__}: {exc}"
+            )
             return self.status
         self.status = _STATUS.get(bt.status, ChildStatus.RUNNING)
         if self.status is ChildStatus.FAILURE:
@@ -175,8 +179,11 @@ class BehaviourRunner:
         except AlicaError as exc:
             self._finish(ChildStatus.FAILURE, str(exc))
             return False
-        except Exception as exc:  # noqa: BLE001 - the skill could not be built: fail this behaviour, say where
-            self._finish(ChildStatus.FAILURE, f"cannot start '{self.context.path}' [{self.model.skill}]: {type(exc).__name__}: {exc}")
+        except Exception as exc:
+            self._finish(
+                ChildStatus.FAILURE,
+                f"cannot start '{self.context.path}' [{self.model.skill}]: {type(exc).__name__}: {exc}",
+            )
             return False
         self.bt = bt
         self.status = ChildStatus.RUNNING
@@ -193,5 +200,5 @@ class BehaviourRunner:
         if bt is not None and bt.status == py_trees.common.Status.RUNNING:
             try:
                 bt.stop(py_trees.common.Status.INVALID)
-            except Exception as exc:  # noqa: BLE001 - a failing terminate must not stop the engine
+            except Exception as exc:
                 logger.warning("terminate of '%s' raised %s: %s", self.context.path, type(exc).__name__, exc)

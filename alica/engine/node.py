@@ -51,7 +51,9 @@ class PlanNode:
         now: the start time.
     """
 
-    def __init__(self, engine: AgentEngine, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float) -> None:
+    def __init__(
+        self, engine: AgentEngine, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float
+    ) -> None:
         self.engine = engine
         self.key = key
         self.key_text = key_text(key)
@@ -103,7 +105,14 @@ class PlanNode:
 
     def claim(self) -> Claim:
         """What this agent says about this plan in its team message."""
-        return Claim(self.key, self.plan.name, self.ep, self.state, self.own_successes(), self.contested_until > self.engine.now())
+        return Claim(
+            self.key,
+            self.plan.name,
+            self.ep,
+            self.state,
+            self.own_successes(),
+            self.contested_until > self.engine.now(),
+        )
 
     def integrate(self, now: float) -> bool:
         """Take teammates' claims and the team's liveness into the believed assignment.
@@ -232,7 +241,11 @@ class PlanNode:
             self.overridden_until = -1.0
             self.dirty = True
         # a prediction not confirmed by the teammate's claim within the protection time expires
-        if self.predicted_at and not self.dirty and now - min(self.predicted_at.values()) > engine.config.assignment_protection:
+        if (
+            self.predicted_at
+            and not self.dirty
+            and now - min(self.predicted_at.values()) > engine.config.assignment_protection
+        ):
             self.dirty = True
         if self.dirty:
             self.dirty = False
@@ -253,7 +266,14 @@ class PlanNode:
             if transition is None:
                 break
             fired = True
-            engine.emit("transition", key=self.key_text, plan=self.plan.name, source=transition.source, target=transition.target, name=transition.name)
+            engine.emit(
+                "transition",
+                key=self.key_text,
+                plan=self.plan.name,
+                source=transition.source,
+                target=transition.target,
+                name=transition.name,
+            )
             self.enter_state(transition.target, now)
         if self.status is ChildStatus.FAILURE:
             return
@@ -274,7 +294,9 @@ class PlanNode:
             process = engine.sync_process(self, transition.synchronisation)
             process.update_mine(transition.name, holds, now)
             if holds and process.complete():
-                engine.emit("sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="fired")
+                engine.emit(
+                    "sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="fired"
+                )
                 process.reset()
                 return transition
             if process.timed_out(now):
@@ -282,7 +304,9 @@ class PlanNode:
                 if process.sync.fail_on_timeout:
                     self.fail(f"synchronisation '{process.sync.name}' timed out after {process.sync.sync_timeout} s")
                     return None
-                engine.emit("sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="timeout")
+                engine.emit(
+                    "sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="timeout"
+                )
         return None
 
     def _abort_rule(self, fired: bool) -> None:
@@ -298,7 +322,9 @@ class PlanNode:
         if not fired:
             for slot in self.slots:
                 if slot.status is ChildStatus.FAILURE:
-                    self.fail(f"child '{slot.name}' of state '{state.name}' failed and no transition handles it ({slot.reason})")
+                    self.fail(
+                        f"child '{slot.name}' of state '{state.name}' failed and no transition handles it ({slot.reason})"
+                    )
                     return
 
     def plan_succeeded(self) -> bool:
@@ -341,7 +367,7 @@ class PlanNode:
         self._children_membership_changed()
         if me in assignment.agents:
             mine = assignment.entry_of(me)
-            if mine != self.ep or self.state is None and mine is not None:
+            if mine != self.ep or (self.state is None and mine is not None):
                 self.history.append((now, reason, me, self.ep, mine))
                 self.set_entry(mine, now)
         self.engine.tree_changed()

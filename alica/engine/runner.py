@@ -40,7 +40,9 @@ def pick_roleset(library: PlanLibrary, roles: Iterable[str], name: str | None = 
     wanted = {r for r in roles if r is not None}
     fits = [rs for _, rs in sorted(rolesets.items()) if wanted <= {r.name for r in rs.roles}]
     if not fits:
-        raise AlicaError(f"no role set has the roles {sorted(wanted)}; role sets: {', '.join(sorted(rolesets)) or 'none'} (import one in the plan file)")
+        raise AlicaError(
+            f"no role set has the roles {sorted(wanted)}; role sets: {', '.join(sorted(rolesets)) or 'none'} (import one in the plan file)"
+        )
     return fits[0]
 
 
@@ -104,7 +106,9 @@ class SimulatedTeam:
             raise AlicaError("a team needs at least one agent")
         if plan not in library.plans:
             raise AlicaError(f"no plan named '{plan}' to run; plans: {', '.join(sorted(library.plans))}")
-        specs = {name: spec if isinstance(spec, AgentSpec) else AgentSpec(role=spec) for name, spec in sorted(agents.items())}
+        specs = {
+            name: spec if isinstance(spec, AgentSpec) else AgentSpec(role=spec) for name, spec in sorted(agents.items())
+        }
         self.library = library
         self.plan = plan
         self.seed = seed
@@ -117,7 +121,15 @@ class SimulatedTeam:
         self.clock = world.clock if world is not None and hasattr(world, "clock") else ManualClock()
         self.observers = list(observers)
         self.trace_messages = trace_messages
-        self.network = SimNetwork(self.clock, seed=seed, loss=loss, delay=Delay(delay, jitter), lease=self.config.team_timeout, observer=self._network_event, trace_messages=trace_messages)
+        self.network = SimNetwork(
+            self.clock,
+            seed=seed,
+            loss=loss,
+            delay=Delay(delay, jitter),
+            lease=self.config.team_timeout,
+            observer=self._network_event,
+            trace_messages=trace_messages,
+        )
         self.binder = SkillBinder(skills, skill_registry, fallback)
         self.registry = registry
         self.engines: dict[str, AgentEngine] = {}
@@ -131,9 +143,21 @@ class SimulatedTeam:
 
     def _make_engine(self, name: str, transport: Any, listen_first: float = 0.0) -> AgentEngine:
         return AgentEngine(
-            name, self.roles, self.library, self.plan, self.roleset, transport, WorldModel(name, clock=self.clock, relay=False), self.clock,
-            config=self.config, skills=self.binder, registry=self.registry, seed=self.seed, observers=tuple(self.observers),
-            world=self.world, listen_first=listen_first,
+            name,
+            self.roles,
+            self.library,
+            self.plan,
+            self.roleset,
+            transport,
+            WorldModel(name, clock=self.clock, relay=False),
+            self.clock,
+            config=self.config,
+            skills=self.binder,
+            registry=self.registry,
+            seed=self.seed,
+            observers=tuple(self.observers),
+            world=self.world,
+            listen_first=listen_first,
         )
 
     # -- time -----------------------------------------------------------
@@ -167,7 +191,9 @@ class SimulatedTeam:
         """The engines of the agents that have not crashed, by name."""
         return [e for name, e in self.engines.items() if name not in self.crashed]
 
-    def run(self, ticks: int | None = None, *, until_done: bool = False, max_time: float | None = None) -> dict[str, Any]:
+    def run(
+        self, ticks: int | None = None, *, until_done: bool = False, max_time: float | None = None
+    ) -> dict[str, Any]:
         """Tick ``ticks`` times, or until every running agent is done (or ``max_time`` passes).
 
         Returns:
@@ -261,8 +287,12 @@ class SimulatedTeam:
                 continue
             for positive, pred, args in facts:
                 (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *args)
-        record = {"t": round(self.now(), 6), "agent": "-", "event": "operator",
-                  "facts": [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts]}
+        record = {
+            "t": round(self.now(), 6),
+            "agent": "-",
+            "event": "operator",
+            "facts": [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts],
+        }
         for observer in self.observers:
             observer(record)
 
@@ -273,7 +303,13 @@ class SimulatedTeam:
             raise AlicaError(f"no agent named '{name}' in the team; agents: {', '.join(self.engines)}") from None
 
     def _fault(self, kind: str, **fields: Any) -> None:
-        record = {"t": round(self.now(), 6), "agent": fields.pop("agent", "-"), "event": "fault", "fault": kind, **fields}
+        record = {
+            "t": round(self.now(), 6),
+            "agent": fields.pop("agent", "-"),
+            "event": "fault",
+            "fault": kind,
+            **fields,
+        }
         self.faults.append(record)
         for observer in self.observers:
             observer(record)
@@ -283,7 +319,13 @@ class SimulatedTeam:
         if kind in ("send", "deliver", "drop"):
             if not self.trace_messages:
                 return
-            record = {"t": round(float(event.get("t", self.now())), 6), "agent": event.get("sender", "-"), "event": "message", **{k: v for k, v in event.items() if k not in ("t", "event")}, "what": kind}
+            record = {
+                "t": round(float(event.get("t", self.now())), 6),
+                "agent": event.get("sender", "-"),
+                "event": "message",
+                **{k: v for k, v in event.items() if k not in ("t", "event")},
+                "what": kind,
+            }
         else:
             return  # partitions, crashes and heals are traced by the team itself
         for observer in self.observers:
@@ -312,7 +354,13 @@ class SimulatedTeam:
                     tasks.append(node.plan.entry_point(node.ep).task)
                 path.append(f"{node.plan.name}:{node.state or 'idle'}")
                 node = next((s.node for s in node.slots if s.node is not None), None)
-            agents[name] = {"role": engine.role, "status": self.status_of(name), "tasks": tasks, "path": " > ".join(path), **engine.stats}
+            agents[name] = {
+                "role": engine.role,
+                "status": self.status_of(name),
+                "tasks": tasks,
+                "path": " > ".join(path),
+                **engine.stats,
+            }
         stats = self.network.stats
         statuses = [a["status"] for a in agents.values() if a["status"] != "crashed"]
         return {
@@ -323,6 +371,12 @@ class SimulatedTeam:
             "done": self.done(),
             "success": bool(statuses) and all(s == "success" for s in statuses),
             "agents": agents,
-            "messages": {"sent": stats.sent, "delivered": stats.delivered, "dropped": stats.dropped_loss + stats.dropped_partition + stats.dropped_crash},
-            "faults": [f["fault"] + (f" {f['agent']}" if f["agent"] != "-" else "") + f" @{f['t']}" for f in self.faults],
+            "messages": {
+                "sent": stats.sent,
+                "delivered": stats.delivered,
+                "dropped": stats.dropped_loss + stats.dropped_partition + stats.dropped_crash,
+            },
+            "faults": [
+                f["fault"] + (f" {f['agent']}" if f["agent"] != "-" else "") + f" @{f['t']}" for f in self.faults
+            ],
         }

@@ -64,7 +64,9 @@ class PlanBoard:
         """The replan requests for ``key`` received since the last call."""
         return self.requests.pop(key, [])
 
-    def register(self, plan: Plan, priorities: Mapping[str, tuple[Priority, ...]], pins: Mapping[str, tuple[str, ...]]) -> None:
+    def register(
+        self, plan: Plan, priorities: Mapping[str, tuple[Priority, ...]], pins: Mapping[str, tuple[str, ...]]
+    ) -> None:
         """Make a generated plan known, with its tasks' priorities per role and its pinned entry points."""
         self.plans[plan.name] = plan
         self.priorities[plan.name] = priorities

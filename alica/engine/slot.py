@@ -35,7 +35,21 @@ class Slot:
         env: the child's variable bindings, evaluated when the state was entered.
     """
 
-    __slots__ = ("element", "env", "failed_plans", "failures", "next_try", "node", "parent", "reason", "ref", "revision", "runner", "runtime", "status")
+    __slots__ = (
+        "element",
+        "env",
+        "failed_plans",
+        "failures",
+        "next_try",
+        "node",
+        "parent",
+        "reason",
+        "ref",
+        "revision",
+        "runner",
+        "runtime",
+        "status",
+    )
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
         self.parent = parent
@@ -88,7 +102,9 @@ class Slot:
         """The plans whose pre-condition holds now (``keep`` is kept regardless: it already runs)."""
         engine = self.parent.engine
         belief = engine.belief_for(self.parent)
-        return tuple(p for p in plans if p is keep or engine.formulas.holds(p.pre.text if p.pre else None, belief, self.env))
+        return tuple(
+            p for p in plans if p is keep or engine.formulas.holds(p.pre.text if p.pre else None, belief, self.env)
+        )
 
     # -- life ----------------------------------------------------------
 

@@ -111,7 +111,11 @@ class SyncProcess:
             return None
         talk = SyncTalk(self.me, self.key, self.sync.name, mine.transition, mine.holds, tuple(sorted(mine.acks)), now)
         previous = self.last_sent
-        same = previous is not None and (previous.transition, previous.holds, previous.acks) == (talk.transition, talk.holds, talk.acks)
+        same = previous is not None and (previous.transition, previous.holds, previous.acks) == (
+            talk.transition,
+            talk.holds,
+            talk.acks,
+        )
         if same and now - self.last_talk < self.sync.talk_timeout:
             return None
         self.last_talk = now

@@ -56,7 +56,11 @@ def build_document(tree: Node, path: str, problems: Problems) -> Document:
         problems: where problems go.
     """
     if not tree.is_mapping:
-        problems.add(tree.span, f"a plan file must be a mapping of sections, not {kind_of(tree)}", "start the file with 'plans:', 'tasks:' or another section")
+        problems.add(
+            tree.span,
+            f"a plan file must be a mapping of sections, not {kind_of(tree)}",
+            "start the file with 'plans:', 'tasks:' or another section",
+        )
         return Document(path=path)
     top = Fields(tree, "the plan file", problems, TOP_KEYS)
     version = top.get("alica")
@@ -76,10 +80,14 @@ def build_document(tree: Node, path: str, problems: Problems) -> Document:
 
 def _element(node: Node, what: str, problems: Problems, keys: tuple[str, ...]) -> Fields | None:
     if not node.is_mapping:
-        problems.add(node.span, f"each entry of '{what}' must be a mapping with a 'name', not {kind_of(node)}", "write '- name: ...' and the element's keys")
+        problems.add(
+            node.span,
+            f"each entry of '{what}' must be a mapping with a 'name', not {kind_of(node)}",
+            "write '- name: ...' and the element's keys",
+        )
         return None
     label = node.value.get("name")  # type: ignore[union-attr]
-    shown = f"{what[:-1] if what.endswith('s') else what} '{label.value}'" if label is not None else what
+    shown = f"{what.removesuffix('s')} '{label.value}'" if label is not None else what
     return Fields(node, shown, problems, keys)
 
 
@@ -90,7 +98,11 @@ def _condition(f: Fields, key: str, kind: ConditionKind) -> Condition | None:
     if isinstance(node.value, bool):
         return Condition(kind, "true" if node.value else "false", span=node.span)
     if not isinstance(node.value, str):
-        f.problems.add(node.span, f"'{key}' of {f.what} must be a formula written as text, not {kind_of(node)}", "quote the formula")
+        f.problems.add(
+            node.span,
+            f"'{key}' of {f.what} must be a formula written as text, not {kind_of(node)}",
+            "quote the formula",
+        )
         return None
     return Condition(kind, node.value.strip(), span=node.text_span(1 + len(node.value) - len(node.value.lstrip())))
 
@@ -104,7 +116,9 @@ def _typed(node: Node, f: Fields, key: str) -> Variable | None:
         match = TYPED_NAME.match(node.value)
         if match:
             return Variable(match.group(1), match.group(2) or "any", span=node.span)
-    f.problems.add(node.span, f"'{node.value}' in '{key}' of {f.what} is not 'name' or 'name - type'", "write e.g. '?r - robot'")
+    f.problems.add(
+        node.span, f"'{node.value}' in '{key}' of {f.what} is not 'name' or 'name - type'", "write e.g. '?r - robot'"
+    )
     return None
 
 
@@ -150,7 +164,11 @@ def _role(node: Node, problems: Problems) -> Role:
         for task, value in table.value.items():  # type: ignore[union-attr]
             number = to_number(value.value)
             if number is None:
-                problems.add(value.span, f"priority of role '{f.values.get('name', node).value}' for task '{task}' must be a number, not {kind_of(value)}", "write a number in [-1, 1]; negative means the role cannot take the task")
+                problems.add(
+                    value.span,
+                    f"priority of role '{f.values.get('name', node).value}' for task '{task}' must be a number, not {kind_of(value)}",
+                    "write a number in [-1, 1]; negative means the role cannot take the task",
+                )
                 continue
             priorities.append(Priority(task, number, span=table.key_span(task)))
     return Role(
@@ -166,7 +184,11 @@ def _param_value(node: Node, problems: Problems, where: str) -> ParamValue:
     if isinstance(node.value, list):
         return tuple(_param_value(n, problems, where) for n in node.value)
     if isinstance(node.value, dict):
-        problems.add(node.span, f"parameter value in {where} must be a value or a list, not a mapping", "flatten it into separate parameters")
+        problems.add(
+            node.span,
+            f"parameter value in {where} must be a value or a list, not a mapping",
+            "flatten it into separate parameters",
+        )
         return None
     return node.value
 
@@ -197,8 +219,18 @@ def _behaviour(node: Node, problems: Problems) -> Behaviour:
 
 def _plan(node: Node, problems: Problems) -> Plan:
     keys = (
-        "name", "description", "entry_points", "states", "synchronisations", "variables",
-        "pre", "run", "utility", "constraints", "signature", "frequency",
+        "name",
+        "description",
+        "entry_points",
+        "states",
+        "synchronisations",
+        "variables",
+        "pre",
+        "run",
+        "utility",
+        "constraints",
+        "signature",
+        "frequency",
     )
     f = _element(node, "plans", problems, keys)
     if f is None:
@@ -212,7 +244,12 @@ def _plan(node: Node, problems: Problems) -> Plan:
         transitions.extend(outgoing)
     return Plan(
         name,
-        tuple(_entry_point(n, name, problems) for n in f.items("entry_points", required=True, hint="add 'entry_points:' with a task and its initial state")),
+        tuple(
+            _entry_point(n, name, problems)
+            for n in f.items(
+                "entry_points", required=True, hint="add 'entry_points:' with a task and its initial state"
+            )
+        ),
         tuple(states),
         tuple(transitions),
         tuple(_synchronisation(n, name, problems) for n in f.items("synchronisations")),
@@ -231,7 +268,11 @@ def _plan(node: Node, problems: Problems) -> Plan:
 def _entry_point(node: Node, plan: str, problems: Problems) -> EntryPoint:
     keys = ("name", "task", "state", "min", "max", "success_required")
     if not node.is_mapping:
-        problems.add(node.span, f"each entry point of plan '{plan}' must be a mapping with 'task' and 'state'", "write '- {task: T, state: S}'")
+        problems.add(
+            node.span,
+            f"each entry point of plan '{plan}' must be a mapping with 'task' and 'state'",
+            "write '- {task: T, state: S}'",
+        )
         return EntryPoint("", "", None, span=node.span)
     f = Fields(node, f"an entry point of plan '{plan}'", problems, keys)
     task = f.text("task", required=True, hint="name the task agents take by entering here").strip()
@@ -259,7 +300,11 @@ def _state(node: Node, plan: str, problems: Problems) -> tuple[State, list[Trans
     try:
         kind = StateKind(kind_text)
     except ValueError:
-        problems.add(f.get("kind").span if f.get("kind") else f.span, f"unknown state kind '{kind_text}'", "use normal, success or failure")  # type: ignore[union-attr]
+        problems.add(
+            f.get("kind").span if f.get("kind") else f.span,
+            f"unknown state kind '{kind_text}'",
+            "use normal, success or failure",
+        )  # type: ignore[union-attr]
         kind = StateKind.NORMAL
     children = tuple(_child(n, f, problems) for n in f.items("children"))
     transitions = [_transition(n, plan, name, problems) for n in f.items("transitions")]
@@ -273,7 +318,11 @@ def _child(node: Node, owner: Fields, problems: Problems) -> ChildRef:
     if isinstance(node.value, str):
         return ChildRef(node.value.strip(), span=node.span)
     if not node.is_mapping:
-        problems.add(node.span, f"each child of {owner.what} must be a name or a mapping with 'ref'", "write the name of a behaviour, plan, plan type or problem")
+        problems.add(
+            node.span,
+            f"each child of {owner.what} must be a name or a mapping with 'ref'",
+            "write the name of a behaviour, plan, plan type or problem",
+        )
         return ChildRef("", span=node.span)
     f = Fields(node, f"a child of {owner.what}", problems, ("ref", "bind"))
     bindings = []
@@ -281,17 +330,27 @@ def _child(node: Node, owner: Fields, problems: Problems) -> ChildRef:
     if table is not None:
         for var, value in table.value.items():  # type: ignore[union-attr]
             if isinstance(value.value, (dict, list)) or value.value is None:
-                problems.add(value.span, f"binding of '{var}' must be a term written as text", "write e.g. 'goal: pos(a)'")
+                problems.add(
+                    value.span, f"binding of '{var}' must be a term written as text", "write e.g. 'goal: pos(a)'"
+                )
                 continue
             text = str(value.value).lower() if isinstance(value.value, bool) else str(value.value)
             bindings.append(Binding(var, text, span=value.text_span(1)))
-    return ChildRef(f.text("ref", required=True, hint="name the behaviour, plan, plan type or problem").strip(), tuple(bindings), span=node.span)
+    return ChildRef(
+        f.text("ref", required=True, hint="name the behaviour, plan, plan type or problem").strip(),
+        tuple(bindings),
+        span=node.span,
+    )
 
 
 def _transition(node: Node, plan: str, source: str, problems: Problems) -> Transition:
     keys = ("name", "to", "condition", "sync")
     if not node.is_mapping:
-        problems.add(node.span, f"each transition of state '{source}' in plan '{plan}' must be a mapping with 'to'", "write '- {to: S, condition: ...}'")
+        problems.add(
+            node.span,
+            f"each transition of state '{source}' in plan '{plan}' must be a mapping with 'to'",
+            "write '- {to: S, condition: ...}'",
+        )
         return Transition("", source, "", span=node.span)
     f = Fields(node, f"a transition of state '{source}' in plan '{plan}'", problems, keys)
     target = f.text("to", required=True, hint="name the state the transition enters").strip()
@@ -312,7 +371,9 @@ def _synchronisation(node: Node, plan: str, problems: Problems) -> Synchronisati
         return Synchronisation("", (), span=node.span)
     return Synchronisation(
         f.name(),
-        tuple(n for n, _ in f.names("transitions", required=True, hint="list the names of the synchronised transitions")),
+        tuple(
+            n for n, _ in f.names("transitions", required=True, hint="list the names of the synchronised transitions")
+        ),
         f.number("talk_timeout", 0.03, low=0.0),
         f.number("sync_timeout", 10.0, low=0.0),
         f.flag("fail_on_timeout", False),
@@ -324,11 +385,17 @@ def _utility(plan: Fields, problems: Problems) -> UtilityFunction:
     node = plan.mapping("utility")
     if node is None:
         return UtilityFunction()
-    f = Fields(node, f"the utility of {plan.what}", problems, ("priority_weight", "similarity_weight", "threshold", "summands"))
+    f = Fields(
+        node, f"the utility of {plan.what}", problems, ("priority_weight", "similarity_weight", "threshold", "summands")
+    )
     summands = []
     for item in f.items("summands"):
         if not item.is_mapping:
-            problems.add(item.span, f"each summand of {f.what} must be a mapping", "write '- {name: N, weight: W, expression: ...}'")
+            problems.add(
+                item.span,
+                f"each summand of {f.what} must be a mapping",
+                "write '- {name: N, weight: W, expression: ...}'",
+            )
             continue
         g = Fields(item, f"a summand of {f.what}", problems, ("name", "weight", "expression"))
         expr = g.get("expression")
@@ -389,7 +456,19 @@ def _plantype(node: Node, problems: Problems) -> PlanType:
 
 
 def _problem(node: Node, problems: Problems) -> PlanningProblem:
-    keys = ("name", "elements", "goal", "wait_plan", "alternative_plan", "update_time", "timeout", "world", "objects", "planner", "description")
+    keys = (
+        "name",
+        "elements",
+        "goal",
+        "wait_plan",
+        "alternative_plan",
+        "update_time",
+        "timeout",
+        "world",
+        "objects",
+        "planner",
+        "description",
+    )
     f = _element(node, "problems", problems, keys)
     if f is None:
         return PlanningProblem("", (), Condition(ConditionKind.POST, "true"), span=node.span)
@@ -399,10 +478,14 @@ def _problem(node: Node, problems: Problems) -> PlanningProblem:
         goal = Condition(ConditionKind.POST, "true", span=f.span)
     update_time = f.number("update_time", 1.0)
     if not math.isfinite(update_time) or update_time <= 0:
-        problems.add(f.get("update_time").span, f"'update_time' of {f.what} must be a positive number of seconds", "use e.g. 1.0")  # type: ignore[union-attr]
+        problems.add(
+            f.get("update_time").span, f"'update_time' of {f.what} must be a positive number of seconds", "use e.g. 1.0"
+        )  # type: ignore[union-attr]
     timeout = f.number("timeout", 60.0)
     if not math.isfinite(timeout) or timeout <= 0:
-        problems.add(f.get("timeout").span, f"'timeout' of {f.what} must be a positive number of seconds", "use e.g. 60")  # type: ignore[union-attr]
+        problems.add(
+            f.get("timeout").span, f"'timeout' of {f.what} must be a positive number of seconds", "use e.g. 60"
+        )  # type: ignore[union-attr]
     return PlanningProblem(
         f.name(),
         tuple(n for n, _ in f.names("elements", required=True, hint="list the skill plans the planner may use")),

@@ -138,7 +138,9 @@ def _utility(u: UtilityFunction) -> Data:
     _put(out, "priority_weight", _number(u.priority_weight), default_priority)
     _put(out, "similarity_weight", _number(u.similarity_weight), 0)
     _put(out, "threshold", _number(u.threshold), _number(0.1))
-    _put(out, "summands", [{"name": s.name, "weight": _number(s.weight), "expression": s.expression} for s in u.summands])
+    _put(
+        out, "summands", [{"name": s.name, "weight": _number(s.weight), "expression": s.expression} for s in u.summands]
+    )
     return out
 
 

@@ -83,9 +83,7 @@ class Fields:
         self.problems.add(self.span, f"{self.what} has no '{key}'", hint or f"add '{key}:'")
 
     def _wrong(self, key: str, node: Node, expected: str, hint: str = "") -> None:
-        self.problems.add(
-            node.span, f"'{key}' of {self.what} must be {expected}, not {kind_of(node)}", hint
-        )
+        self.problems.add(node.span, f"'{key}' of {self.what} must be {expected}, not {kind_of(node)}", hint)
 
     def text(self, key: str, *, required: bool = False, default: str = "", hint: str = "") -> str:
         """A text value; numbers are accepted and turned into text."""
@@ -120,7 +118,9 @@ class Fields:
             return default
         if (low is not None and value < low) or (high is not None and value > high):
             bounds = f"[{low if low is not None else '-inf'}, {high if high is not None else 'inf'}]"
-            self.problems.add(node.span, f"'{key}' of {self.what} is {value:g}, outside {bounds}", f"use a value in {bounds}")
+            self.problems.add(
+                node.span, f"'{key}' of {self.what} is {value:g}, outside {bounds}", f"use a value in {bounds}"
+            )
         return value
 
     def integer(self, key: str, default: int, *, low: int | None = 0) -> int:
@@ -188,7 +188,9 @@ class Fields:
         out = []
         for item in self.items(key, required=required, hint=hint):
             if isinstance(item.value, bool) or not isinstance(item.value, (str, int, float)):
-                self.problems.add(item.span, f"each entry of '{key}' in {self.what} must be a name, not {kind_of(item)}", hint)
+                self.problems.add(
+                    item.span, f"each entry of '{key}' in {self.what} must be a name, not {kind_of(item)}", hint
+                )
                 continue
             out.append((str(item.value).strip(), item.span))
         return out

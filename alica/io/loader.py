@@ -19,9 +19,9 @@ from alica.io.fields import Problems
 from alica.io.tree import Node
 from alica.lang import Registry, default_registry
 from alica.model import Document, PlanLibrary
-from alica.source import Diagnostic, SourceSpan
 from alica.skills.registry import SkillRegistry
 from alica.skills.registry import default_registry as default_skills
+from alica.source import Diagnostic, SourceSpan
 
 #: File name endings the loader reads, with their format.
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
@@ -39,7 +39,9 @@ def plans_dir() -> Path:
         folder = Path(location)
         if (folder / "roles.yaml").is_file():
             return folder
-    raise FileNotFoundError(f"the shipped plans are missing from the installed package (looked in {locations or 'alica.plans'}); reinstall alica-teams")
+    raise FileNotFoundError(
+        f"the shipped plans are missing from the installed package (looked in {locations or 'alica.plans'}); reinstall alica-teams"
+    )
 
 
 def format_of(path: str | os.PathLike[str]) -> str | None:
@@ -156,10 +158,22 @@ class Loader:
             diagnostics.extend(read.diagnostics)
             for target, span in read.imports:
                 if not target.is_file():
-                    diagnostics.append(Diagnostic(span, f"imported file '{shown(target)}' does not exist", "fix the path; imports are relative to the importing file"))
+                    diagnostics.append(
+                        Diagnostic(
+                            span,
+                            f"imported file '{shown(target)}' does not exist",
+                            "fix the path; imports are relative to the importing file",
+                        )
+                    )
                     seen.add(target.resolve())
                 elif format_of(target) is None:
-                    diagnostics.append(Diagnostic(span, f"imported file '{shown(target)}' is not a plan file", "import .yaml, .yml or .xml files"))
+                    diagnostics.append(
+                        Diagnostic(
+                            span,
+                            f"imported file '{shown(target)}' is not a plan file",
+                            "import .yaml, .yml or .xml files",
+                        )
+                    )
                 else:
                     todo.append(target.resolve())
         return documents, diagnostics
@@ -234,7 +248,9 @@ def validate_paths(paths: Iterable[str | os.PathLike[str]], loader: Loader | Non
     return _unique(diagnostics)
 
 
-def load_library(*paths: str | os.PathLike[str], skills: SkillRegistry | None = None, functions: Registry | None = None) -> PlanLibrary:
+def load_library(
+    *paths: str | os.PathLike[str], skills: SkillRegistry | None = None, functions: Registry | None = None
+) -> PlanLibrary:
     """Load and validate plan files into a :class:`PlanLibrary`.
 
     Args:

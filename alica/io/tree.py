@@ -8,11 +8,10 @@ apart in meaning.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Union
 
 from alica.source import SourceSpan
 
-Scalar = Union[str, int, float, bool, None]
+Scalar = str | int | float | bool | None
 
 
 @dataclass(slots=True)

@@ -25,8 +25,8 @@ from alica.model import (
     children_of,
     format_cardinality,
 )
-from alica.source import SourceSpan
 from alica.skills.registry import SkillRegistry
+from alica.source import SourceSpan
 
 #: How far utility weights may stray from summing to 1.
 WEIGHT_TOLERANCE = 1e-6
@@ -52,7 +52,9 @@ class Validator:
         problems: where problems go.
     """
 
-    def __init__(self, documents: Sequence[Document], skills: SkillRegistry, functions: Registry, problems: Problems) -> None:
+    def __init__(
+        self, documents: Sequence[Document], skills: SkillRegistry, functions: Registry, problems: Problems
+    ) -> None:
         self.documents = documents
         self.skills = skills
         self.functions = functions
@@ -87,7 +89,11 @@ class Validator:
             if element.name in seen:
                 first = seen[element.name].span
                 where = f" (first at {first})" if first else ""
-                self.problems.add(element.span, f"duplicate name '{element.name}': another {kind} has it{where}", "rename one of them; names must be unique in the files loaded together")
+                self.problems.add(
+                    element.span,
+                    f"duplicate name '{element.name}': another {kind} has it{where}",
+                    "rename one of them; names must be unique in the files loaded together",
+                )
                 continue
             seen[element.name] = element
         return seen
@@ -96,11 +102,15 @@ class Validator:
         names: set[str] = set()
         for item in items:
             if item.name in names:
-                self.problems.add(item.span, f"{owner} has two {kind}s named '{item.name}'", f"give each {kind} its own name")
+                self.problems.add(
+                    item.span, f"{owner} has two {kind}s named '{item.name}'", f"give each {kind} its own name"
+                )
             names.add(item.name)
         return names
 
-    def _formula(self, text: str, span: SourceSpan | None, what: str, *, effect: bool = False, boolean: bool = False) -> None:
+    def _formula(
+        self, text: str, span: SourceSpan | None, what: str, *, effect: bool = False, boolean: bool = False
+    ) -> None:
         try:
             node = parse(text)
             issues = check(node, self.functions, text=text, boolean=boolean)
@@ -109,13 +119,19 @@ class Validator:
         except FormulaError as exc:
             issues = [exc]
         for issue in issues:
-            self.problems.add(formula_span(span, text, issue.column), f"{what}: {issue.message}", issue.hint or "see the formula syntax in docs/plan_format.md")
+            self.problems.add(
+                formula_span(span, text, issue.column),
+                f"{what}: {issue.message}",
+                issue.hint or "see the formula syntax in docs/plan_format.md",
+            )
 
     def _condition(self, cond: Condition | None, what: str, *, effect: bool = False) -> None:
         if cond is not None:
             self._formula(cond.text, cond.span, what, effect=effect, boolean=True)
 
-    def _ref(self, name: str, span: SourceSpan | None, what: str, kinds: tuple[type, ...] | None = None) -> object | None:
+    def _ref(
+        self, name: str, span: SourceSpan | None, what: str, kinds: tuple[type, ...] | None = None
+    ) -> object | None:
         element = self.abstract.get(name)
         if element is None:
             hint = suggest(name, self.abstract) or "define it in this file or import the file that defines it"
@@ -123,7 +139,9 @@ class Validator:
             return None
         if kinds is not None and not isinstance(element, kinds):
             wanted = " or ".join(_kind(k) for k in kinds)
-            self.problems.add(span, f"{what} names '{name}', which is a {_kind(type(element))}, not a {wanted}", f"name a {wanted}")
+            self.problems.add(
+                span, f"{what} names '{name}', which is a {_kind(type(element))}, not a {wanted}", f"name a {wanted}"
+            )
             return None
         return element
 
@@ -139,7 +157,11 @@ class Validator:
         if not rs.roles:
             self.problems.add(rs.span, f"role set '{rs.name}' has no roles", "list its roles under 'roles:'")
         if not -1.0 <= rs.default_priority <= 1.0:
-            self.problems.add(rs.span, f"default priority {rs.default_priority:g} of role set '{rs.name}' is outside [-1, 1]", "use a value in [-1, 1]")
+            self.problems.add(
+                rs.span,
+                f"default priority {rs.default_priority:g} of role set '{rs.name}' is outside [-1, 1]",
+                "use a value in [-1, 1]",
+            )
         for role in rs.roles:
             seen: set[str] = set()
             for p in role.priorities:
@@ -149,7 +171,11 @@ class Validator:
                 seen.add(p.task)
                 self._task(p.task, p.span, f"role '{role.name}'")
                 if not (-1.0 <= p.value <= 1.0) or math.isnan(p.value):
-                    self.problems.add(p.span, f"{what} is {p.value:g}, outside [-1, 1]", "use a value in [-1, 1]; a negative one means the role cannot take the task")
+                    self.problems.add(
+                        p.span,
+                        f"{what} is {p.value:g}, outside [-1, 1]",
+                        "use a value in [-1, 1]; a negative one means the role cannot take the task",
+                    )
 
     def _behaviour(self, b: Behaviour) -> None:
         what = f"behaviour '{b.name}'"
@@ -158,7 +184,11 @@ class Validator:
         variables = {v.name for v in b.variables}
         for p in b.params:
             if p.variable is not None and p.variable not in variables:
-                self.problems.add(p.span, f"parameter '{p.name}' of {what} refers to '${p.variable}', which is not a variable of the behaviour", "declare it under 'variables:' or fix the name")
+                self.problems.add(
+                    p.span,
+                    f"parameter '{p.name}' of {what} refers to '${p.variable}', which is not a variable of the behaviour",
+                    "declare it under 'variables:' or fix the name",
+                )
         if b.skill not in self.skills:
             hint = suggest(b.skill, self.skills.names()) or "run 'alica list-skills' to see the registered skills"
             self.problems.add(b.span, f"{what} binds unknown skill '{b.skill}'", hint)
@@ -174,10 +204,18 @@ class Validator:
                 continue
             reason = param.check(p.value)
             if reason is not None:
-                self.problems.add(p.span, f"parameter '{p.name}' of {what} {reason}, not {p.value!r}", f"see 'alica list-skills' for {b.skill}")
+                self.problems.add(
+                    p.span,
+                    f"parameter '{p.name}' of {what} {reason}, not {p.value!r}",
+                    f"see 'alica list-skills' for {b.skill}",
+                )
         for param in spec.params:
             if param.required and param.name not in given:
-                self.problems.add(b.span, f"{what} does not give required parameter '{param.name}' of skill '{b.skill}'", f"add '{param.name}' under 'params:' ({param.doc or param.type})")
+                self.problems.add(
+                    b.span,
+                    f"{what} does not give required parameter '{param.name}' of skill '{b.skill}'",
+                    f"add '{param.name}' under 'params:' ({param.doc or param.type})",
+                )
 
     def _plan(self, plan: Plan) -> None:
         what = f"plan '{plan.name}'"
@@ -189,46 +227,92 @@ class Validator:
         self._condition(plan.pre, f"pre condition of {what}")
         self._condition(plan.run, f"run condition of {what}")
         if not plan.entry_points:
-            self.problems.add(plan.span, f"{what} has no entry point", "add an entry point with a task and an initial state")
+            self.problems.add(
+                plan.span, f"{what} has no entry point", "add an entry point with a task and an initial state"
+            )
         for ep in plan.entry_points:
             ep_what = f"entry point '{ep.name}' of {what}"
             self._task(ep.task, ep.span, ep_what)
             if ep.state is None:
-                self.problems.add(ep.span, f"{ep_what} has no initial state", "add 'state:' naming the state agents start in")
+                self.problems.add(
+                    ep.span, f"{ep_what} has no initial state", "add 'state:' naming the state agents start in"
+                )
             elif ep.state not in states:
-                self.problems.add(ep.span, f"{ep_what} starts in unknown state '{ep.state}'", suggest(ep.state, states) or "name one of the plan's states")
+                self.problems.add(
+                    ep.span,
+                    f"{ep_what} starts in unknown state '{ep.state}'",
+                    suggest(ep.state, states) or "name one of the plan's states",
+                )
             if ep.min > ep.max:
-                self.problems.add(ep.span, f"{ep_what} has min {ep.min} > max {format_cardinality(ep.max)}", "make min at most max")
+                self.problems.add(
+                    ep.span, f"{ep_what} has min {ep.min} > max {format_cardinality(ep.max)}", "make min at most max"
+                )
         by_name = {s.name: s for s in plan.states}
         for state in plan.states:
             for child in state.children:
                 target = self._ref(child.name, child.span, f"state '{state.name}' of {what}")
                 variables = {v.name for v in getattr(target, "variables", ())}
                 for binding in child.bindings:
-                    if target is not None and isinstance(target, (Plan, Behaviour)) and binding.variable not in variables:
-                        self.problems.add(binding.span, f"'{child.name}' has no variable '{binding.variable}' to bind", suggest(binding.variable, variables) or f"declare it under 'variables:' of '{child.name}'")
-                    self._formula(binding.value, binding.span, f"binding of '{binding.variable}' in state '{state.name}' of {what}")
+                    if (
+                        target is not None
+                        and isinstance(target, (Plan, Behaviour))
+                        and binding.variable not in variables
+                    ):
+                        self.problems.add(
+                            binding.span,
+                            f"'{child.name}' has no variable '{binding.variable}' to bind",
+                            suggest(binding.variable, variables) or f"declare it under 'variables:' of '{child.name}'",
+                        )
+                    self._formula(
+                        binding.value,
+                        binding.span,
+                        f"binding of '{binding.variable}' in state '{state.name}' of {what}",
+                    )
             self._condition(state.post, f"post condition of state '{state.name}' of {what}")
         for t in plan.transitions:
             t_what = f"transition '{t.name}' of {what}"
             source = by_name.get(t.source)
             if source is not None and source.terminal:
-                self.problems.add(t.span, f"{t_what} leaves {source.kind.value} state '{t.source}'; terminal states have no outgoing transitions", "remove the transition or make the state normal")
+                self.problems.add(
+                    t.span,
+                    f"{t_what} leaves {source.kind.value} state '{t.source}'; terminal states have no outgoing transitions",
+                    "remove the transition or make the state normal",
+                )
             if t.target not in states:
-                self.problems.add(t.span, f"{t_what} enters unknown state '{t.target}'", suggest(t.target, states) or "name one of the plan's states")
+                self.problems.add(
+                    t.span,
+                    f"{t_what} enters unknown state '{t.target}'",
+                    suggest(t.target, states) or "name one of the plan's states",
+                )
             if t.synchronisation is not None and t.synchronisation not in syncs:
-                self.problems.add(t.span, f"{t_what} joins unknown synchronisation '{t.synchronisation}'", suggest(t.synchronisation, syncs) or "declare it under 'synchronisations:'")
+                self.problems.add(
+                    t.span,
+                    f"{t_what} joins unknown synchronisation '{t.synchronisation}'",
+                    suggest(t.synchronisation, syncs) or "declare it under 'synchronisations:'",
+                )
             self._condition(t.condition, f"condition of {t_what}")
         transitions = {t.name: t for t in plan.transitions}
         for sync in plan.synchronisations:
             if len(sync.transitions) < 2:
-                self.problems.add(sync.span, f"synchronisation '{sync.name}' of {what} needs at least two transitions", "list the transitions that must fire together")
+                self.problems.add(
+                    sync.span,
+                    f"synchronisation '{sync.name}' of {what} needs at least two transitions",
+                    "list the transitions that must fire together",
+                )
             for name in sync.transitions:
                 t = transitions.get(name)
                 if t is None:
-                    self.problems.add(sync.span, f"synchronisation '{sync.name}' of {what} lists unknown transition '{name}'", suggest(name, transitions) or "transition names default to 'Source->Target'")
+                    self.problems.add(
+                        sync.span,
+                        f"synchronisation '{sync.name}' of {what} lists unknown transition '{name}'",
+                        suggest(name, transitions) or "transition names default to 'Source->Target'",
+                    )
                 elif t.synchronisation != sync.name:
-                    self.problems.add(t.span, f"transition '{name}' is listed by synchronisation '{sync.name}' but does not say 'sync: {sync.name}'", f"add 'sync: {sync.name}' to the transition")
+                    self.problems.add(
+                        t.span,
+                        f"transition '{name}' is listed by synchronisation '{sync.name}' but does not say 'sync: {sync.name}'",
+                        f"add 'sync: {sync.name}' to the transition",
+                    )
         reachable: set[str] = set()
         for ep in plan.entry_points:
             if ep.state in states:
@@ -236,14 +320,22 @@ class Validator:
         if plan.entry_points and all(ep.state in states for ep in plan.entry_points):
             for state in plan.states:
                 if state.name not in reachable:
-                    self.problems.add(state.span, f"state '{state.name}' of {what} cannot be reached from any entry point", "add a transition into it or remove it")
+                    self.problems.add(
+                        state.span,
+                        f"state '{state.name}' of {what} cannot be reached from any entry point",
+                        "add a transition into it or remove it",
+                    )
         self._utility(plan)
         declared = {v.name for v in plan.variables}
         for c in plan.constraints:
             self._formula(c.text, c.span, f"constraint '{c.name}' of {what}", boolean=True)
             for var in c.variables:
                 if var not in declared:
-                    self.problems.add(c.span, f"constraint '{c.name}' of {what} constrains '{var}', which is not a variable of the plan", "declare it under 'variables:'")
+                    self.problems.add(
+                        c.span,
+                        f"constraint '{c.name}' of {what} constrains '{var}', which is not a variable of the plan",
+                        "declare it under 'variables:'",
+                    )
         if plan.signature is not None:
             sig = plan.signature
             self._unique_in(f"the signature of {what}", "parameter", sig.parameters)
@@ -255,15 +347,23 @@ class Validator:
         what = f"the utility of plan '{plan.name}'"
         total = u.weight_sum
         if abs(total - 1.0) > WEIGHT_TOLERANCE:
-            parts = [f"priority_weight {u.priority_weight:g}", f"similarity_weight {u.similarity_weight:g}"] + [f"{s.name} {s.weight:g}" for s in u.summands]
-            self.problems.add(u.span or plan.span, f"weights of {what} sum to {total:g}, not 1 ({', '.join(parts)})", "scale the weights so they add up to 1 (IMPERA Definition 6.3)")
+            parts = [f"priority_weight {u.priority_weight:g}", f"similarity_weight {u.similarity_weight:g}"] + [
+                f"{s.name} {s.weight:g}" for s in u.summands
+            ]
+            self.problems.add(
+                u.span or plan.span,
+                f"weights of {what} sum to {total:g}, not 1 ({', '.join(parts)})",
+                "scale the weights so they add up to 1 (IMPERA Definition 6.3)",
+            )
         self._unique_in(what, "summand", u.summands)
         for s in u.summands:
             self._formula(s.expression, s.span, f"summand '{s.name}' of {what}")
 
     def _plantype(self, pt: PlanType) -> None:
         if not pt.plans:
-            self.problems.add(pt.span, f"plan type '{pt.name}' has no plans", "list its alternative plans under 'plans:'")
+            self.problems.add(
+                pt.span, f"plan type '{pt.name}' has no plans", "list its alternative plans under 'plans:'"
+            )
         if len(set(pt.plans)) != len(pt.plans):
             self.problems.add(pt.span, f"plan type '{pt.name}' lists a plan twice", "list each alternative once")
         for name in pt.plans:
@@ -272,13 +372,23 @@ class Validator:
     def _problem(self, p: PlanningProblem) -> None:
         what = f"planning problem '{p.name}'"
         if not p.elements:
-            self.problems.add(p.span, f"{what} has no elements", "list the skill plans the planner may use under 'elements:'")
+            self.problems.add(
+                p.span, f"{what} has no elements", "list the skill plans the planner may use under 'elements:'"
+            )
         for name in p.elements:
             element = self._ref(name, p.span, what, (Plan,))
             if isinstance(element, Plan) and element.signature is None:
-                self.problems.add(element.span, f"plan '{name}' is an element of {what} but has no planning signature", "add 'signature:' with parameters, precondition and effect")
+                self.problems.add(
+                    element.span,
+                    f"plan '{name}' is an element of {what} but has no planning signature",
+                    "add 'signature:' with parameters, precondition and effect",
+                )
         if p.wait_plan is None:
-            self.problems.add(p.span, f"{what} has no WaitPlan", "add 'wait_plan:' naming the plan the team runs until the first plan is ready")
+            self.problems.add(
+                p.span,
+                f"{what} has no WaitPlan",
+                "add 'wait_plan:' naming the plan the team runs until the first plan is ready",
+            )
         else:
             self._ref(p.wait_plan, p.span, f"the WaitPlan of {what}", (Plan, PlanType))
         if p.alternative_plan is not None:
@@ -298,11 +408,15 @@ class Validator:
                 if child not in self.abstract:
                     continue
                 if colour.get(child) == 1:
-                    loop = path[path.index(child):] + [child]
+                    loop = path[path.index(child) :] + [child]
                     key = frozenset(loop)
                     if key not in reported:
                         reported.add(key)
-                        self.problems.add(self.abstract[child].span, f"the plan tree has a cycle: {' -> '.join(loop)}", "a plan must not run itself, directly or through other plans; break the cycle")
+                        self.problems.add(
+                            self.abstract[child].span,
+                            f"the plan tree has a cycle: {' -> '.join(loop)}",
+                            "a plan must not run itself, directly or through other plans; break the cycle",
+                        )
                 elif child not in colour:
                     visit(child, path)
             path.pop()
@@ -314,4 +428,6 @@ class Validator:
 
 
 def _kind(cls: type) -> str:
-    return {Behaviour: "behaviour", Plan: "plan", PlanType: "plan type", PlanningProblem: "planning problem"}.get(cls, cls.__name__)
+    return {Behaviour: "behaviour", Plan: "plan", PlanType: "plan type", PlanningProblem: "planning problem"}.get(
+        cls, cls.__name__
+    )

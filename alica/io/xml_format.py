@@ -121,7 +121,7 @@ from alica.io.xml_vocabulary import (
 from alica.io.xml_write import write_xml
 from alica.source import Diagnostic, SourceSpan
 
-__all__ = ["read_xml", "write_xml", "resolve_scalar"]
+__all__ = ["read_xml", "resolve_scalar", "write_xml"]
 
 
 # --------------------------------------------------------------------------- reading
@@ -206,7 +206,10 @@ def _prolog_declaration(text: str) -> int | None:
 
 _HINTS: tuple[tuple[tuple[str, ...], str], ...] = (
     (("doctype", "dtd", "entitydecl"), "remove the <!DOCTYPE ...> block; plan files take no DTD"),
-    (("entity", "entityref"), "write '&' as &amp;; only &lt; &gt; &amp; &quot; &apos; and character references like &#60; are defined"),
+    (
+        ("entity", "entityref"),
+        "write '&' as &amp;; only &lt; &gt; &amp; &quot; &apos; and character references like &#60; are defined",
+    ),
     (
         ("invalid element name", "starttag", "unescaped '<'", "'<' not allowed"),
         "write '<' in a formula as &lt; (and '&' as &amp;), or put the formula inside <![CDATA[ ... ]]>",
@@ -216,7 +219,10 @@ _HINTS: tuple[tuple[tuple[str, ...], str], ...] = (
         "close every element: each <tag> needs a matching </tag>, or write it as <tag/>",
     ),
     (("extra content",), "a plan file holds exactly one <alica> element; put every section inside it"),
-    (("document is empty", "start tag expected"), "start the file with <alica version=\"1\"> (after an optional <?xml ...?> line)"),
+    (
+        ("document is empty", "start tag expected"),
+        'start the file with <alica version="1"> (after an optional <?xml ...?> line)',
+    ),
     (("redefined",), "give each attribute once"),
     (
         ("specification mandates value", "attributes construct", "couldn't find end of start tag", "attvalue", "quote"),
@@ -237,8 +243,13 @@ def _hint_for(message: str) -> str:
 def _decode(data: bytes, path: str) -> tuple[str | None, Diagnostic | None]:
     """Bytes as text: by byte-order mark, then the XML declaration, else UTF-8."""
     encoding = "utf-8"
-    for bom, name in ((codecs.BOM_UTF8, "utf-8-sig"), (codecs.BOM_UTF32_LE, "utf-32"), (codecs.BOM_UTF32_BE, "utf-32"),
-                      (codecs.BOM_UTF16_LE, "utf-16"), (codecs.BOM_UTF16_BE, "utf-16")):
+    for bom, name in (
+        (codecs.BOM_UTF8, "utf-8-sig"),
+        (codecs.BOM_UTF32_LE, "utf-32"),
+        (codecs.BOM_UTF32_BE, "utf-32"),
+        (codecs.BOM_UTF16_LE, "utf-16"),
+        (codecs.BOM_UTF16_BE, "utf-16"),
+    ):
         if data.startswith(bom):
             encoding = name
             break
@@ -290,8 +301,7 @@ def read_xml(text: str | bytes, path: str) -> tuple[Node | None, list[Diagnostic
 
 
 def _read(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
-    if text.startswith("\ufeff"):
-        text = text[1:]
+    text = text.removeprefix("\ufeff")
     # XML reads every line end as '\n' anyway; libxml2 would not count a lone '\r' as a line.
     text = _NEWLINE.sub("\n", text)
     reader = _Reader(text, path)
@@ -310,7 +320,11 @@ def _read(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
     except (etree.LxmlError, ValueError) as exc:
         return None, [Diagnostic(SourceSpan(path, 1, 1), f"XML: {exc}", "fix the XML syntax")]
     if root is None:
-        return None, [Diagnostic(SourceSpan(path, 1, 1), "the file holds no XML element", 'start the file with <alica version="1">')]
+        return None, [
+            Diagnostic(
+                SourceSpan(path, 1, 1), "the file holds no XML element", 'start the file with <alica version="1">'
+            )
+        ]
     docinfo = root.getroottree().docinfo
     if docinfo.doctype or docinfo.internalDTD is not None or docinfo.externalDTD is not None:
         return None, [reader.dtd_problem(SourceSpan(path, 1, 1))]
@@ -381,7 +395,7 @@ class _Reader:
         self.elements = list(root.iter(etree.Element))
         try:
             tags = _scan_tags(self.text)
-        except Exception:  # noqa: BLE001 - places are best effort, never a crash
+        except Exception:
             tags = []
         if len(tags) == len(self.elements) and all(
             t.name.rsplit(":", 1)[-1] == etree.QName(e).localname for t, e in zip(tags, self.elements)
@@ -532,7 +546,9 @@ class _Reader:
                     self.entry(child, known.spec, collection)
         return Node(items, self.span(el), key_spans)
 
-    def _putter(self, tag: str, items: dict[str, Node], key_spans: dict[str, SourceSpan]) -> Callable[[str, Node, SourceSpan], None]:
+    def _putter(
+        self, tag: str, items: dict[str, Node], key_spans: dict[str, SourceSpan]
+    ) -> Callable[[str, Node, SourceSpan], None]:
         def put(key: str, node: Node, key_span: SourceSpan) -> None:
             if key in items:
                 self.problem(
@@ -603,14 +619,18 @@ class _Reader:
         """One element of an entries collection, added to ``table``."""
         entry = _ENTRIES[kind]
         tag = _raw_name(el)
-        attributes = {name: (value, name_span, value_span) for name, _, value, name_span, value_span in self.attributes(el)}
+        attributes = {
+            name: (value, name_span, value_span) for name, _, value, name_span, value_span in self.attributes(el)
+        }
         key = attributes.pop(entry.key, None)
         if entry.typed:
             node = self.typed_value(el, tag, attributes)
         else:
             node = self.entry_text(el, tag, attributes, entry.key)
         if key is None:
-            self.problem(self.span(el), f"<{tag}> has no '{entry.key}' attribute", f"write <{tag} {entry.key}=\"...\" ...>")
+            self.problem(
+                self.span(el), f"<{tag}> has no '{entry.key}' attribute", f'write <{tag} {entry.key}="..." ...>'
+            )
             return
         mapping: dict[str, Node] = table.value  # type: ignore[assignment]
         if key[0] in mapping:
@@ -623,7 +643,9 @@ class _Reader:
         mapping[key[0]] = node
         table.key_spans[key[0]] = self.span(el)
 
-    def entry_text(self, el: Any, tag: str, attributes: dict[str, tuple[str, SourceSpan, SourceSpan]], key: str) -> Node:
+    def entry_text(
+        self, el: Any, tag: str, attributes: dict[str, tuple[str, SourceSpan, SourceSpan]], key: str
+    ) -> Node:
         """The value of a priority or binding: its ``value`` attribute or its text."""
         given = attributes.pop("value", None)
         for name, (_, name_span, _) in attributes.items():
@@ -669,7 +691,9 @@ class _Reader:
                 )
         if items or kind == "list":
             if given is not None:
-                self.problem(given[1], f"<{tag}> holds a list, so it takes no 'value' attribute", "put every value in an <item>")
+                self.problem(
+                    given[1], f"<{tag}> holds a list, so it takes no 'value' attribute", "put every value in an <item>"
+                )
             self._no_text(el, tag, items)
             return Node([self.item(child) for child in items], self.span(el))
         if given is not None:
@@ -688,5 +712,7 @@ class _Reader:
 
     def item(self, el: Any) -> Node:
         """One ``<item>`` of a list value."""
-        attributes = {name: (value, name_span, value_span) for name, _, value, name_span, value_span in self.attributes(el)}
+        attributes = {
+            name: (value, name_span, value_span) for name, _, value, name_span, value_span in self.attributes(el)
+        }
         return self.typed_value(el, "item", attributes)

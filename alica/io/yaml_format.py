@@ -125,10 +125,16 @@ def read_yaml(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
         return None, [Diagnostic(SourceSpan(path, 1, 1), f"YAML syntax: {exc}", "fix the YAML syntax")]
     documents = [d for d in documents if d is not None]
     if not documents:
-        return None, [Diagnostic(SourceSpan(path, 1, 1), "the file holds no plan data", "add sections such as 'plans:' or 'tasks:'")]
+        return None, [
+            Diagnostic(
+                SourceSpan(path, 1, 1), "the file holds no plan data", "add sections such as 'plans:' or 'tasks:'"
+            )
+        ]
     if len(documents) > 1:
         span = reader.span(documents[1].start_mark)
-        return None, [Diagnostic(span, "more than one YAML document in a plan file", "put each document in its own file")]
+        return None, [
+            Diagnostic(span, "more than one YAML document in a plan file", "put each document in its own file")
+        ]
     try:
         tree = reader.convert(documents[0])
     except _TooLarge:

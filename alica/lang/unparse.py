@@ -68,7 +68,7 @@ def quote(value: str) -> str:
     return '"' + value.translate(_STRING_ESCAPES) + '"'
 
 
-def format_number(value: int | float) -> str:
+def format_number(value: float) -> str:
     """Text of a numeric literal."""
     return repr(value) if isinstance(value, float) else str(value)
 

@@ -127,7 +127,13 @@ class PlanLibrary:
 
     def roots(self) -> tuple[Plan, ...]:
         """Plans no other element runs: the top of each plan tree."""
-        used = {c for doc in self.documents for e in doc.elements() if not isinstance(e, (Task, RoleSet)) for c in self.children(e)}
+        used = {
+            c
+            for doc in self.documents
+            for e in doc.elements()
+            if not isinstance(e, (Task, RoleSet))
+            for c in self.children(e)
+        }
         return tuple(p for p in self.plans.values() if p.name not in used)
 
     def __eq__(self, other: object) -> bool:

@@ -134,10 +134,7 @@ class EntryPoint:
     span: SourceSpan | None = span_field()
 
     def __repr__(self) -> str:
-        return (
-            f"<EntryPoint {self.name} task={self.task} "
-            f"[{self.min}..{format_cardinality(self.max)}]>"
-        )
+        return f"<EntryPoint {self.name} task={self.task} [{self.min}..{format_cardinality(self.max)}]>"
 
 
 @dataclass(frozen=True, slots=True)
@@ -251,11 +248,7 @@ class Plan:
         Args:
             successes: entry point name -> number of agents in a success state.
         """
-        return all(
-            successes.get(ep.name, 0) >= max(ep.min, 1)
-            for ep in self.entry_points
-            if ep.success_required
-        )
+        return all(successes.get(ep.name, 0) >= max(ep.min, 1) for ep in self.entry_points if ep.success_required)
 
     def reachable_states(self, entry_point: str) -> frozenset[str]:
         """States an agent entering at ``entry_point`` can reach."""

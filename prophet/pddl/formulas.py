@@ -95,7 +95,9 @@ def parse_typed_list(
                 raise source.error(item.offset, f"expected a type after '-' in the {what}")
             type_node = items[index + 1]
             if isinstance(type_node, SList):
-                raise source.error(type_node.offset, "unsupported construct '(either ...)' types", "declare a common supertype")
+                raise source.error(
+                    type_node.offset, "unsupported construct '(either ...)' types", "declare a common supertype"
+                )
             type_name = expect_name(source, type_node, "a type name")
             if types is not None and type_name != OBJECT and type_name not in types:
                 raise source.error(type_node.offset, f"unknown type '{type_name}'", "declare it in (:types ...)")
@@ -146,7 +148,9 @@ class FormulaReader:
         text = node.text
         if text.startswith("?"):
             if text not in scope:
-                raise self.source.error(node.offset, f"undefined variable '{text}'", "declare it in :parameters or a quantifier")
+                raise self.source.error(
+                    node.offset, f"undefined variable '{text}'", "declare it in :parameters or a quantifier"
+                )
             return text
         if self.strict and text not in self.objects:
             raise self.source.error(node.offset, f"undefined object or constant '{text}'")
@@ -162,7 +166,9 @@ class FormulaReader:
         if declared is None:
             if not self.strict:
                 return Atom(name, args)
-            raise self.source.error(node.items[0].offset, f"undefined predicate '{name}'", "declare it in (:predicates ...)")
+            raise self.source.error(
+                node.items[0].offset, f"undefined predicate '{name}'", "declare it in (:predicates ...)"
+            )
         if len(args) != declared.arity:
             raise self.source.error(
                 node.offset, f"wrong number of arguments for '{name}': expected {declared.arity}, found {len(args)}"
@@ -179,7 +185,9 @@ class FormulaReader:
         if declared is None:
             if not self.strict:
                 return FluentTerm(name, args)
-            raise self.source.error(node.items[0].offset, f"undefined function '{name}'", "declare it in (:functions ...)")
+            raise self.source.error(
+                node.items[0].offset, f"undefined function '{name}'", "declare it in (:functions ...)"
+            )
         if len(args) != declared.arity:
             raise self.source.error(
                 node.offset, f"wrong number of arguments for '{name}': expected {declared.arity}, found {len(args)}"
@@ -258,7 +266,9 @@ class FormulaReader:
         if head == "increase":
             return self._increase(node, scope)
         if head in _NUMERIC_EFFECTS:
-            raise self.source.error(node.offset, f"unsupported construct: numeric effect '({head} ...)'", "only (increase (total-cost) x)")
+            raise self.source.error(
+                node.offset, f"unsupported construct: numeric effect '({head} ...)'", "only (increase (total-cost) x)"
+            )
         return self.atom(node, scope)
 
     def _increase(self, node: SList, scope: dict[str, str]) -> Increase:
@@ -267,7 +277,9 @@ class FormulaReader:
         target = expect_list(self.source, node.items[1], "'(total-cost)' after 'increase'")
         fluent = self.fluent(target, scope)
         if fluent != FluentTerm("total-cost"):
-            raise self.source.error(target.offset, f"unsupported construct: increase of '{fluent}'", "only (total-cost) may be increased")
+            raise self.source.error(
+                target.offset, f"unsupported construct: increase of '{fluent}'", "only (total-cost) may be increased"
+            )
         value_node = node.items[2]
         value: int | float | FluentTerm
         if isinstance(value_node, SList):
@@ -275,6 +287,8 @@ class FormulaReader:
         else:
             value = parse_number(self.source, value_node, "the cost")
             if value < 0:
-                raise self.source.error(value_node.offset, f"bad number '{value_node.text}' for the cost: costs must not be negative")
+                raise self.source.error(
+                    value_node.offset, f"bad number '{value_node.text}' for the cost: costs must not be negative"
+                )
         self.used.add(Feature.ACTION_COSTS)
         return Increase(fluent, value)

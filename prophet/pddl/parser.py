@@ -39,13 +39,23 @@ _EXTRA = {
     "quantified-preconditions": frozenset({"existential-preconditions", "universal-preconditions"}),
 }
 _ADL = (
-    frozenset({Feature.STRIPS, Feature.TYPING, Feature.NEGATIVE_PRECONDITIONS, Feature.EQUALITY, Feature.CONDITIONAL_EFFECTS}),
+    frozenset(
+        {Feature.STRIPS, Feature.TYPING, Feature.NEGATIVE_PRECONDITIONS, Feature.EQUALITY, Feature.CONDITIONAL_EFFECTS}
+    ),
     frozenset({"disjunctive-preconditions", "existential-preconditions", "universal-preconditions"}),
 )
 _UNSUPPORTED = frozenset(
     {
-        "numeric-fluents", "fluents", "object-fluents", "durative-actions", "duration-inequalities",
-        "continuous-effects", "derived-predicates", "timed-initial-literals", "preferences", "constraints",
+        "numeric-fluents",
+        "fluents",
+        "object-fluents",
+        "durative-actions",
+        "duration-inequalities",
+        "continuous-effects",
+        "derived-predicates",
+        "timed-initial-literals",
+        "preferences",
+        "constraints",
     }
 )
 SUPPORTED_REQUIREMENTS = tuple(sorted([*_FEATURES, *_EXTRA, "adl"]))
@@ -68,9 +78,17 @@ def _requirements(source: Source, section: SList) -> tuple[set[Feature], set[str
             features |= _ADL[0]
             extra |= _ADL[1]
         elif name in _UNSUPPORTED:
-            raise source.error(item.offset, f"unsupported requirement ':{name}'", "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS))
+            raise source.error(
+                item.offset,
+                f"unsupported requirement ':{name}'",
+                "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS),
+            )
         else:
-            raise source.error(item.offset, f"unknown requirement ':{name}'", "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS))
+            raise source.error(
+                item.offset,
+                f"unknown requirement ':{name}'",
+                "supported: " + " ".join(f":{n}" for n in SUPPORTED_REQUIREMENTS),
+            )
     return features, extra
 
 
@@ -142,7 +160,9 @@ def _sections(source: Source, top: SList, allowed: tuple[str, ...]) -> list[SLis
     return sections
 
 
-def _typed(source: Source, section: SList, variables: bool, types: dict[str, str] | None, what: str) -> list[tuple[TypedName, int]]:
+def _typed(
+    source: Source, section: SList, variables: bool, types: dict[str, str] | None, what: str
+) -> list[tuple[TypedName, int]]:
     return parse_typed_list(source, section.items[1:], variables=variables, types=types, what=what)
 
 
@@ -181,7 +201,9 @@ def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
         key = items[index]
         if not isinstance(key, Symbol) or key.text not in (":parameters", ":precondition", ":effect"):
             shown = key.text if isinstance(key, Symbol) else key.describe() + " ...)"
-            raise source.error(key.offset, f"expected :parameters, :precondition or :effect in '(:action {name}', found '{shown}'")
+            raise source.error(
+                key.offset, f"expected :parameters, :precondition or :effect in '(:action {name}', found '{shown}'"
+            )
         if key.text in seen:
             raise source.error(key.offset, f"duplicate {key.text} in '(:action {name}'")
         seen.add(key.text)
@@ -192,16 +214,18 @@ def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
             if index != 0:
                 raise source.error(key.offset, f"expected :parameters first in '(:action {name}'")
             plist = expect_list(source, value, "a parameter list '(?x - type ...)'")
-            typed = parse_typed_list(source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'")
+            typed = parse_typed_list(
+                source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'"
+            )
             names = [n for (n, _), _ in typed]
             for (pname, _), offset in typed:
                 if names.count(pname) > 1:
                     raise source.error(offset, f"duplicate parameter '{pname}' in '(:action {name}'")
             parameters = tuple(p for p, _ in typed)
         elif key.text == ":precondition":
-            precondition = _empty_or(value, lambda v: reader.formula(v, dict(parameters)))
+            precondition = _empty_or(value, lambda v, scope=dict(parameters): reader.formula(v, scope))
         else:
-            effect = _empty_or(value, lambda v: reader.effect(v, dict(parameters)))
+            effect = _empty_or(value, lambda v, scope=dict(parameters): reader.effect(v, scope))
     return Action(name, parameters, precondition, effect)
 
 
@@ -252,7 +276,9 @@ def parse_domain(text: str, file: str = "<string>") -> Domain:
                 types[child] = parent
             for (child, parent), offset in _typed(source, section, False, None, "type list"):
                 if parent != OBJECT and parent not in types:
-                    raise source.error(offset, f"unknown type '{parent}' (parent of '{child}')", "declare it in (:types ...)")
+                    raise source.error(
+                        offset, f"unknown type '{parent}' (parent of '{child}')", "declare it in (:types ...)"
+                    )
             features.add(Feature.TYPING)
         elif head == ":constants":
             for (const, kind), offset in _typed(source, section, False, types, "constant list"):
@@ -280,7 +306,16 @@ def parse_domain(text: str, file: str = "<string>") -> Domain:
             features.add(Feature.TYPING)
     if any(t != OBJECT for p in (*predicates, *functions) for _, t in p.parameters):
         features.add(Feature.TYPING)
-    return Domain(name, frozenset(features), types, tuple(constants), tuple(predicates), tuple(functions), tuple(actions), frozenset(extra))
+    return Domain(
+        name,
+        frozenset(features),
+        types,
+        tuple(constants),
+        tuple(predicates),
+        tuple(functions),
+        tuple(actions),
+        frozenset(extra),
+    )
 
 
 def parse_problem(text: str, file: str = "<string>", domain: Domain | None = None) -> Problem:
@@ -302,7 +337,9 @@ def parse_problem(text: str, file: str = "<string>", domain: Domain | None = Non
     name = _check_header(source, top, "problem")
     sections = _sections(source, top, (":domain", ":requirements", ":objects", ":init", ":goal", ":metric"))
     if not sections or sections[0].head() != ":domain":
-        raise source.error(sections[0].offset if sections else top.offset, "expected '(:domain NAME)' first in the problem")
+        raise source.error(
+            sections[0].offset if sections else top.offset, "expected '(:domain NAME)' first in the problem"
+        )
     dom = sections[0]
     if len(dom.items) != 2:
         raise source.error(dom.offset, "expected '(:domain NAME)' with one name")
@@ -351,7 +388,14 @@ def parse_problem(text: str, file: str = "<string>", domain: Domain | None = Non
         raise source.error(top.offset, "expected a '(:goal ...)' section in the problem")
     more, more_extra = formula_features(goal)
     return Problem(
-        name, domain_name, tuple(objects), tuple(init), goal, metric, frozenset(features | more), frozenset(extra | more_extra)
+        name,
+        domain_name,
+        tuple(objects),
+        tuple(init),
+        goal,
+        metric,
+        frozenset(features | more),
+        frozenset(extra | more_extra),
     )
 
 
@@ -370,7 +414,11 @@ def _init_item(source: Source, node: Node, reader: FormulaReader) -> Atom | Flue
 
 
 def _metric(source: Source, section: SList, reader: FormulaReader) -> Metric:
-    if len(section.items) != 3 or not isinstance(section.items[1], Symbol) or section.items[1].text not in ("minimize", "maximize"):
+    if (
+        len(section.items) != 3
+        or not isinstance(section.items[1], Symbol)
+        or section.items[1].text not in ("minimize", "maximize")
+    ):
         raise source.error(section.offset, "expected '(:metric minimize (total-cost))'")
     expression = expect_list(source, section.items[2], "a fluent '(total-cost)' in the metric")
     if expression.head() in ("+", "-", "*", "/"):

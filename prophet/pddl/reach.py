@@ -182,18 +182,34 @@ class Fixpoint:
         for item in items:
             cond = None
             if item.condition is not None:
-                cond = tuple(tuple((p, l.predicate if isinstance(l, Atom) else "=", (arg(l.left), arg(l.right)) if isinstance(l, Equals)
-                                    else tuple(arg(x) for x in l.args)) for p, l in c) for c in item.condition)
+                cond = tuple(
+                    tuple(
+                        (
+                            p,
+                            lit.predicate if isinstance(lit, Atom) else "=",
+                            (arg(lit.left), arg(lit.right))
+                            if isinstance(lit, Equals)
+                            else tuple(arg(x) for x in lit.args),
+                        )
+                        for p, lit in c
+                    )
+                    for c in item.condition
+                )
             effects.append((cond, item.positive, atom(item.atom)))
         compiled_costs = tuple(
             (c.function, tuple(arg(x) for x in c.args)) if isinstance(c, FluentTerm) else c for c in costs
         )
         kinds = [k for _, k in parameters]
         schema = _Schema(
-            name, tuple(p for p, _ in parameters),
+            name,
+            tuple(p for p, _ in parameters),
             tuple(None if k == OBJECT else frozenset(self.objects_of(k)) for k in kinds),
             tuple(tuple(self.objects_of(k)) for k in kinds),
-            tuple(pos), tuple(neg), tuple(eqs), tuple(effects), compiled_costs,
+            tuple(pos),
+            tuple(neg),
+            tuple(eqs),
+            tuple(effects),
+            compiled_costs,
         )
         return schema
 
@@ -248,7 +264,9 @@ class Fixpoint:
                     binds.append((pos, a, schema.allowed[a]))
             bound |= fresh
             table = self._table(pred, positions) if positions else self._known.setdefault(pred, [])
-            steps.append((table, _getter(key_slots) if positions else None, tuple(binds), tuple(repeats), take_checks()))
+            steps.append(
+                (table, _getter(key_slots) if positions else None, tuple(binds), tuple(repeats), take_checks())
+            )
         unbound = tuple(i for i in range(nparams) if i not in bound)
         return template, trigger, first_checks, tuple(steps), unbound
 
@@ -428,8 +446,14 @@ class Fixpoint:
                     entry[0 if positive else 1].append(fact)
         cost = self._cost(schema, value)
         action = GroundAction(
-            schema.action, args, tuple(pos), tuple(neg), tuple(add), tuple(delete),
-            tuple((c[0], c[1], tuple(e[0]), tuple(e[1])) for c, e in conditional.items()), cost,
+            schema.action,
+            args,
+            tuple(pos),
+            tuple(neg),
+            tuple(add),
+            tuple(delete),
+            tuple((c[0], c[1], tuple(e[0]), tuple(e[1])) for c, e in conditional.items()),
+            cost,
         )
         self.actions.append(action)
         for fact in add:

@@ -11,15 +11,27 @@ import bisect
 import re
 from dataclasses import dataclass, field
 
-from alica.source import SourceSpan
 from alica.prophet.pddl.errors import PddlError
+from alica.source import SourceSpan
 
 _TOKEN = re.compile(r"[()]|;[^\n]*|[^\s();]+")
 
 SECTIONS = frozenset(
     {
-        ":requirements", ":types", ":constants", ":predicates", ":functions", ":action", ":derived",
-        ":durative-action", ":domain", ":objects", ":init", ":goal", ":metric", ":constraints",
+        ":requirements",
+        ":types",
+        ":constants",
+        ":predicates",
+        ":functions",
+        ":action",
+        ":derived",
+        ":durative-action",
+        ":domain",
+        ":objects",
+        ":init",
+        ":goal",
+        ":metric",
+        ":constraints",
     }
 )
 """Keywords that open a top-level part of ``(define ...)``."""
@@ -114,7 +126,9 @@ def read_sexpr(source: Source) -> SList:
     for index, token in enumerate(tokens):
         if token == "(":
             if top is not None:
-                raise source.error(index, f"unexpected text after the end of '{top.describe()}' (opened at {source.where(top.offset)})")
+                raise source.error(
+                    index, f"unexpected text after the end of '{top.describe()}' (opened at {source.where(top.offset)})"
+                )
             items = []
             stack.append((index, items))
         elif token == ")":
@@ -136,7 +150,8 @@ def read_sexpr(source: Source) -> SList:
                 unclosed = stack[1]
                 shown = SList(tuple(unclosed[1]), unclosed[0]).describe()
                 raise source.error(
-                    stack[-1][0], f"expected ')' to close '{shown}' opened at {source.where(unclosed[0])} before '({token}'"
+                    stack[-1][0],
+                    f"expected ')' to close '{shown}' opened at {source.where(unclosed[0])} before '({token}'",
                 )
             items.append(Symbol(token, index))
     if stack:

@@ -72,7 +72,9 @@ def write_formula(formula: Formula | Effect, indent: int = 0) -> str:
         pad = "\n" + " " * (indent + 2)
         return f"({word}{pad}{pad.join(parts)})"
     if isinstance(formula, Imply):
-        return f"(imply {write_formula(formula.condition, indent + 7)} {write_formula(formula.consequence, indent + 7)})"
+        return (
+            f"(imply {write_formula(formula.condition, indent + 7)} {write_formula(formula.consequence, indent + 7)})"
+        )
     if isinstance(formula, Exists | Forall):
         word = "exists" if isinstance(formula, Exists) else "forall"
         body = write_formula(formula.body, indent + 2)
@@ -120,10 +122,14 @@ def write_domain(domain: Domain) -> str:
     if domain.constants:
         parts.append(f"  (:constants {_typed(domain.constants)})")
     if domain.predicates:
-        decls = "\n    ".join(f"({' '.join((p.name, _typed(p.parameters)))})".replace(" )", ")") for p in domain.predicates)
+        decls = "\n    ".join(
+            f"({' '.join((p.name, _typed(p.parameters)))})".replace(" )", ")") for p in domain.predicates
+        )
         parts.append(f"  (:predicates\n    {decls})")
     if domain.functions:
-        decls = "\n    ".join(f"({' '.join((f.name, _typed(f.parameters)))}) - number".replace(" )", ")") for f in domain.functions)
+        decls = "\n    ".join(
+            f"({' '.join((f.name, _typed(f.parameters)))}) - number".replace(" )", ")") for f in domain.functions
+        )
         parts.append(f"  (:functions\n    {decls})")
     parts.extend(_action(a) for a in domain.actions)
     return "\n".join(parts) + ")\n"

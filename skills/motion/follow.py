@@ -245,7 +245,9 @@ class PathFollower:
                 if (np.hypot(pts[:, 0] - rx, pts[:, 1] - ry) < robot_radius + rr).any():
                     return True
             return _disk_hits(grid, pts, robot_radius)
-        raise TypeError(f"blocked() needs an OccupancyGrid, GridChecker or FclChecker, got {type(grid_or_checker).__name__}")
+        raise TypeError(
+            f"blocked() needs an OccupancyGrid, GridChecker or FclChecker, got {type(grid_or_checker).__name__}"
+        )
 
 
 def _disk_hits(grid: OccupancyGrid, pts: np.ndarray, radius: float) -> bool:
@@ -345,7 +347,11 @@ def escape_goal(
         touch = body_radius + TOUCH_MARGIN
         near_j, near_i = np.nonzero(occupied & (dist <= touch + 0.5 * res))
         touched = [(float(xs[i]) - px, float(ys[j]) - py) for j, i in zip(near_j, near_i, strict=True)]
-        touched += [(rx - px, ry - py) for rx, ry, rr in check_robots(other_robots) if math.hypot(rx - px, ry - py) <= touch + rr]
+        touched += [
+            (rx - px, ry - py)
+            for rx, ry, rr in check_robots(other_robots)
+            if math.hypot(rx - px, ry - py) <= touch + rr
+        ]
         dx, dy = xs[cand_i] - px, ys[cand_j] - py
         towards = np.zeros(cand_i.size, dtype=bool)
         for tx, ty in touched:

@@ -193,15 +193,17 @@ def plan_path(
     checker = base.with_robots(robots) if robots else base
     robots = list(checker.robots)
     if not checker.grid.inside(sx, sy):
-        raise ValueError(f"start ({sx:.2f}, {sy:.2f}) is outside the grid {checker.grid.bounds}; use a grid that covers it")
+        raise ValueError(
+            f"start ({sx:.2f}, {sy:.2f}) is outside the grid {checker.grid.bounds}; use a grid that covers it"
+        )
     if obstacles_exact is not None:
         if abs(obstacles_exact.robot_radius - robot_radius) > 1e-9:
-            raise ValueError(
-                f"obstacles_exact was built for radius {obstacles_exact.robot_radius}, not {robot_radius}"
-            )
+            raise ValueError(f"obstacles_exact was built for radius {obstacles_exact.robot_radius}, not {robot_radius}")
         obstacles_exact.set_other_robots(robots)
 
-    def done(status: str, path: np.ndarray, reason: str, first: tuple[float, float] = (math.nan, math.nan)) -> PathResult:
+    def done(
+        status: str, path: np.ndarray, reason: str, first: tuple[float, float] = (math.nan, math.nan)
+    ) -> PathResult:
         if len(path):
             path = _with_headings(path, syaw, gyaw if status == "exact" else None)
         return PathResult(status, path, xy_length(path), time.perf_counter() - t0, reason, first[0], first[1])
@@ -228,8 +230,9 @@ def plan_path(
     current = checker
     hit = (math.nan, math.nan)
     for attempt in range(_MAX_REPAIRS + 1):
-        found = search(current, q, deadline, simplify=simplify, optimize_time=optimize_time,
-                        check_reachability=attempt == 0)
+        found = search(
+            current, q, deadline, simplify=simplify, optimize_time=optimize_time, check_reachability=attempt == 0
+        )
         first_wall += found.first_solution_s
         first_cpu += found.first_solution_cpu_s
         first_total = (first_wall, first_cpu)
@@ -244,8 +247,11 @@ def plan_path(
         if len(hits) == 0:
             return done(found.status, found.path, found.reason, first_total)
         hit = (float(hits[0, 0]), float(hits[0, 1]))
-        _log.info("path collides in the exact check at %d samples from (%.2f, %.2f); blocking them, replanning",
-                  len(hits), *hit)
+        _log.info(
+            "path collides in the exact check at %d samples from (%.2f, %.2f); blocking them, replanning",
+            len(hits),
+            *hit,
+        )
         current = current.with_blocked_disks(hits, current.robot_radius + current.margin)
         if not (current.valid_xy(sx, sy) and current.valid_xy(gx, gy)):
             break

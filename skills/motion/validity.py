@@ -79,8 +79,23 @@ class GridChecker:
         ValueError: On a negative radius or margin.
     """
 
-    __slots__ = ("_blocked", "_bytes", "_flat", "_h", "_inv", "_ox", "_oy", "_rr", "_w",
-                 "grid", "margin", "robot_radius", "robots", "step", "unknown_is_free")
+    __slots__ = (
+        "_blocked",
+        "_bytes",
+        "_flat",
+        "_h",
+        "_inv",
+        "_ox",
+        "_oy",
+        "_rr",
+        "_w",
+        "grid",
+        "margin",
+        "robot_radius",
+        "robots",
+        "step",
+        "unknown_is_free",
+    )
 
     def __init__(
         self,

@@ -53,9 +53,7 @@ def plans(draw: st.DrawFn, name: str) -> Plan:
         low = draw(st.sampled_from((0, 0, 1, 1, 1, 2, 3)))
         high = draw(st.one_of(st.just(math.inf), st.integers(max(0, low - 1), low + 3).map(float)))
         eps.append(EntryPoint(f"E{i}", draw(st.sampled_from(TASKS)), f"S{i}", low, high))
-    summands = tuple(
-        Summand(f"f{k}", draw(st.sampled_from(WEIGHTS)), "table") for k in range(draw(st.integers(0, 2)))
-    )
+    summands = tuple(Summand(f"f{k}", draw(st.sampled_from(WEIGHTS)), "table") for k in range(draw(st.integers(0, 2))))
     utility = UtilityFunction(
         priority_weight=draw(st.sampled_from(WEIGHTS)),
         summands=summands,

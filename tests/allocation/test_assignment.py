@@ -11,8 +11,11 @@ from alica.allocation import AllocationError, AllocationProblem, Assignment, all
 from alica.model import EntryPoint, Plan, Priority, Role, RoleSet, State, Summand, UtilityFunction
 
 
-def _plan(name: str = "P", eps: tuple[tuple[str, int, float], ...] = (("E0", 0, math.inf), ("E1", 0, math.inf)),
-          **utility_args: object) -> Plan:
+def _plan(
+    name: str = "P",
+    eps: tuple[tuple[str, int, float], ...] = (("E0", 0, math.inf), ("E1", 0, math.inf)),
+    **utility_args: object,
+) -> Plan:
     entry_points = tuple(EntryPoint(n, n, "S", lo, hi) for n, lo, hi in eps)
     return Plan(name, entry_points, (State("S"),), utility=UtilityFunction(**utility_args))  # type: ignore[arg-type]
 
@@ -22,7 +25,7 @@ def _roles(**tasks: float) -> RoleSet:
 
 
 def _problem(agents: tuple[str, ...], plans: tuple[Plan, ...], roleset: RoleSet, **extra: object) -> AllocationProblem:
-    return AllocationProblem(agents, {a: "R" for a in agents}, roleset, plans, **extra)  # type: ignore[arg-type]
+    return AllocationProblem(agents, dict.fromkeys(agents, "R"), roleset, plans, **extra)  # type: ignore[arg-type]
 
 
 def _best(problem: AllocationProblem) -> Assignment:

@@ -30,8 +30,9 @@ print(allocate(problem).assignment)
 
 def _run(seed: str) -> str:
     env = {**os.environ, "PYTHONHASHSEED": seed}
-    done = subprocess.run([sys.executable, "-c", _SCRIPT], cwd=ROOT, env=env, capture_output=True, text=True,
-                          check=True)
+    done = subprocess.run(
+        [sys.executable, "-c", _SCRIPT], cwd=ROOT, env=env, capture_output=True, text=True, check=True
+    )
     return done.stdout
 
 
@@ -43,7 +44,7 @@ def test_hash_seed_does_not_change_the_assignment() -> None:
 
 def test_docs_example_prints_what_it_says() -> None:
     text = (ROOT / "docs" / "allocation.md").read_text(encoding="utf-8")
-    block = re.search(r"```python\n(.*?)```", text, re.S)
+    block = re.search(r"```python\n(.*?)```", text, re.DOTALL)
     assert block is not None
     code = block.group(1)
     claimed = re.search(r"print\(result\.assignment\)\s+# (.*)", code)

@@ -146,7 +146,10 @@ def test_a_second_scout_explores_too(lunar: Lunar) -> None:
     assignment = _solve(lunar.problem(("scout", "scout2", "stummel", "amparo")))
     assert assignment is not None
     assert assignment.as_dict() == {
-        "amparo": "Transport1", "scout": "Explore", "scout2": "Explore", "stummel": "Transport2",
+        "amparo": "Transport1",
+        "scout": "Explore",
+        "scout2": "Explore",
+        "stummel": "Transport2",
     }
 
 

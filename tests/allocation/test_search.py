@@ -127,8 +127,6 @@ def test_relaxation_is_the_plan_optimum_and_its_prices_are_tight(problem: Alloca
         # The Lagrangian bound with the prices is exact at the root.
         prices = relaxation.prices
         lows, highs = relaxation.lows, relaxation.highs
-        bound = sum(
-            max(cell - price for cell, price in zip(row, prices) if cell is not None) for row in table.cells
-        )
+        bound = sum(max(cell - price for cell, price in zip(row, prices) if cell is not None) for row in table.cells)
         bound += sum(p * (hi if p > 0 else lo) for p, lo, hi in zip(prices, lows, highs) if p)
         assert bound == best

@@ -102,7 +102,11 @@ def test_sequence_numbers_count_per_sender_and_topic(harness: Harness) -> None:
     b.publish("x", None, QoS.RELIABLE)
     [got] = settle(harness, c)
     assert sorted((e.sender, e.topic, e.seq) for e in got) == [
-        ("a", "x", 1), ("a", "x", 2), ("a", "x", 3), ("a", "y", 1), ("b", "x", 1)
+        ("a", "x", 1),
+        ("a", "x", 2),
+        ("a", "x", 3),
+        ("a", "y", 1),
+        ("b", "x", 1),
     ]
 
 

@@ -162,7 +162,7 @@ def test_reliable_is_exactly_once_and_in_order_after_the_final_heal(
             assert len(set(received)) == len(received), link  # no duplicates
             assert is_subsequence(received, expected), link  # in order, nothing invented
             tail = run.after_last_recovery.get(link, [])
-            assert received[len(received) - len(tail):] == tail, link  # all since the last recovery
+            assert received[len(received) - len(tail) :] == tail, link  # all since the last recovery
         else:
             assert received == expected, link
     for (sender, receiver, topic), seqs in run.best_effort.items():

@@ -85,7 +85,7 @@ def test_loss_per_link() -> None:
 
 @pytest.mark.parametrize("base, jitter", [(0.0, 0.0), (0.02, 0.0), (0.01, 0.05)])
 def test_uniform_delay_stays_in_bounds(base: float, jitter: float) -> None:
-    clock, network, (a, b, c), events = traced(3, delay=Delay(base, jitter), seed=1)
+    clock, _network, (a, b, _c), events = traced(3, delay=Delay(base, jitter), seed=1)
     for i in range(300):
         a.publish("t", i, QoS.RELIABLE if i % 2 else QoS.BEST_EFFORT)
         clock.advance(0.007)
@@ -100,7 +100,7 @@ def test_uniform_delay_stays_in_bounds(base: float, jitter: float) -> None:
 
 
 def test_exponential_delay_has_the_configured_mean() -> None:
-    clock, network, (a, b), events = traced(delay=Delay(0.01, 0.03, "exponential"), seed=2)
+    clock, _network, (a, b), events = traced(delay=Delay(0.01, 0.03, "exponential"), seed=2)
     for i in range(2000):
         a.publish("t", i, QoS.RELIABLE)
         clock.advance(0.5)
@@ -128,7 +128,7 @@ def test_link_delay_override_is_directed_unless_symmetric() -> None:
 
 
 def test_reliable_order_survives_jitter_and_retransmission() -> None:
-    clock, network, (a, b) = make(delay=Delay(0.0, 0.5), loss=0.4, seed=9)
+    clock, _network, (a, b) = make(delay=Delay(0.0, 0.5), loss=0.4, seed=9)
     for i in range(100):
         a.publish("t", i, QoS.RELIABLE)
     got: list[int] = []
@@ -139,7 +139,7 @@ def test_reliable_order_survives_jitter_and_retransmission() -> None:
 
 
 def test_poll_orders_by_delivery_time_then_send_order() -> None:
-    clock, network, (a, b, c), events = traced(3, delay=Delay(0.0, 0.1), seed=4)
+    clock, _network, (a, b, c), events = traced(3, delay=Delay(0.0, 0.1), seed=4)
     for i in range(50):
         a.publish("t", ("a", i), QoS.RELIABLE)
         c.publish("t", ("c", i))
@@ -334,7 +334,7 @@ def test_stats_add_up() -> None:
 
 def test_without_trace_messages_the_observer_sees_only_faults() -> None:
     events: list[dict] = []
-    clock, network, (a, b) = make(observer=events.append)
+    clock, network, (a, _b) = make(observer=events.append)
     a.publish("t", 1)
     network.crash("b")
     network.recover("b")
@@ -343,7 +343,7 @@ def test_without_trace_messages_the_observer_sees_only_faults() -> None:
 
 
 def test_message_events_are_json() -> None:
-    clock, network, (a, b, c), events = traced(3, loss=0.5, seed=1)
+    clock, network, (a, b, _c), events = traced(3, loss=0.5, seed=1)
     network.partition([["c"]], start=0.5)
     for i in range(10):
         a.publish("t", (i, "x"))

@@ -24,8 +24,31 @@ def test_two_agents_reach_a_four_block_goal():
 
 def test_with_an_opponent_the_goal_is_still_reached_after_replanning():
     # through the CLI in a fresh process: OMPL's generator is seeded once per process, so the run is the seed's own
-    run = subprocess.run([sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", "2", "--opponents", "1", "--blocks", "4",
-                          "--seed", "0", "--time-limit", "300", "--json", "--no-progress"], cwd=ROOT, capture_output=True, text=True, timeout=600)
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "alica.app.cli",
+            "demo",
+            "blocksworld",
+            "--agents",
+            "2",
+            "--opponents",
+            "1",
+            "--blocks",
+            "4",
+            "--seed",
+            "0",
+            "--time-limit",
+            "300",
+            "--json",
+            "--no-progress",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     summary = json.loads(next(line for line in reversed(run.stdout.splitlines()) if line.startswith("{")))
     assert run.returncode == 0 and summary["success"], summary
     assert summary["replans"] >= 1 and summary["satisfied"] == summary["goal_literals"] == 4
@@ -42,7 +65,9 @@ def test_a_robot_crash_in_the_middle_the_team_still_reaches_the_goal():
         crashed.append(name)
         team.crash(name)
 
-    result = run_demo(DemoConfig(agents=3, start=START, goal=GOAL, seed=3, time_limit=400), actions=[(12.0, crash_one_not_holding)])
+    result = run_demo(
+        DemoConfig(agents=3, start=START, goal=GOAL, seed=3, time_limit=400), actions=[(12.0, crash_one_not_holding)]
+    )
     assert result.crashed == crashed and len(crashed) == 1
     assert result.success, result.as_json()
 
@@ -68,8 +93,14 @@ def test_the_same_seed_gives_the_same_trace(hash_seed, tmp_path):
     outputs = []
     for seed in hash_seed:
         out = tmp_path / f"trace-{seed}.json"
-        run = subprocess.run([sys.executable, "-c", script, str(out)], cwd=ROOT, capture_output=True, text=True, timeout=600,
-                             env={"PYTHONHASHSEED": seed, "PATH": "", "PYTHONPATH": str(ROOT)})
+        run = subprocess.run(
+            [sys.executable, "-c", script, str(out)],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=600,
+            env={"PYTHONHASHSEED": seed, "PATH": "", "PYTHONPATH": str(ROOT)},
+        )
         assert run.returncode == 0, run.stderr[-2000:]
         outputs.append(json.loads(out.read_text()))
     assert outputs[0] == outputs[1]

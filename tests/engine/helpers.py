@@ -34,10 +34,14 @@ def library(tmp_path: Path, plans: str) -> PlanLibrary:
     return load_library(tmp_path / "plans.yaml", skills=skills)
 
 
-def team(lib: PlanLibrary, plan: str, agents: dict[str, str], skills: dict, **kwargs) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[type-arg]
+def team(
+    lib: PlanLibrary, plan: str, agents: dict[str, str], skills: dict, **kwargs
+) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[type-arg]
     """A simulated team with a trace recorder."""
     recorder = TraceRecorder()
-    kwargs.setdefault("config", EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3))
+    kwargs.setdefault(
+        "config", EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    )
     sim = SimulatedTeam(lib, plan, agents, skills=skills, observers=[recorder], **kwargs)
     return sim, recorder
 

@@ -13,7 +13,9 @@ LUNAR = str(PLANS / "lunar" / "mission.yaml")
 
 
 def test_run_until_done_prints_a_summary(capsys):
-    code = main(["run", LUNAR, "--agents", "scout,stummel,amparo", "--fact", "found(a) and found(b)@3", "--max-time", "120"])
+    code = main(
+        ["run", LUNAR, "--agents", "scout,stummel,amparo", "--fact", "found(a) and found(b)@3", "--max-time", "120"]
+    )
     out = capsys.readouterr().out
     assert code == 0, out
     assert out.startswith("LunarMission: success after")
@@ -22,8 +24,25 @@ def test_run_until_done_prints_a_summary(capsys):
 
 def test_json_summary_and_trace(tmp_path, capsys):
     trace = tmp_path / "run.jsonl"
-    code = main(["run", LUNAR, "--agents", "scout:Scout,stummel:Stummel,amparo:Amparo", "--ticks", "150", "--crash", "scout@1",
-                 "--loss", "0.1", "--delay", "30", "--trace", str(trace), "--json"])
+    code = main(
+        [
+            "run",
+            LUNAR,
+            "--agents",
+            "scout:Scout,stummel:Stummel,amparo:Amparo",
+            "--ticks",
+            "150",
+            "--crash",
+            "scout@1",
+            "--loss",
+            "0.1",
+            "--delay",
+            "30",
+            "--trace",
+            str(trace),
+            "--json",
+        ]
+    )
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["ticks"] == 150 and summary["agents"]["scout"]["status"] == "crashed"
@@ -42,7 +61,22 @@ def test_show_tree_prints_running_trees(capsys):
 
 
 def test_partition_option(capsys):
-    assert main(["run", LUNAR, "--agents", "scout,stummel,amparo", "--ticks", "60", "--partition", "scout|stummel,amparo@0.5-1.5", "--json"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                LUNAR,
+                "--agents",
+                "scout,stummel,amparo",
+                "--ticks",
+                "60",
+                "--partition",
+                "scout|stummel,amparo@0.5-1.5",
+                "--json",
+            ]
+        )
+        == 0
+    )
     summary = json.loads(capsys.readouterr().out)
     assert any(f.startswith("partition") for f in summary["faults"])
 

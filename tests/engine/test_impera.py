@@ -19,8 +19,15 @@ def lunar():
 
 def _team(lunar, seed=0):
     recorder = TraceRecorder()
-    sim = SimulatedTeam(lunar, "LunarMission", TEAM, seed=seed, fallback=default_fallback(seed, 0.5, 1.5), observers=[recorder],
-                        config=EngineConfig(frequency=10.0, team_timeout=0.5))
+    sim = SimulatedTeam(
+        lunar,
+        "LunarMission",
+        TEAM,
+        seed=seed,
+        fallback=default_fallback(seed, 0.5, 1.5),
+        observers=[recorder],
+        config=EngineConfig(frequency=10.0, team_timeout=0.5),
+    )
     return sim, recorder
 
 

@@ -68,9 +68,9 @@ def test_three_repair_stages(tmp_path):
     sim.run(ticks=20)
     stages = [(e["stage"], e["plan"]) for e in trace.of("repair")]
     assert stages == [
-        ("retry", "ByWorking"),      # 1. the failed plan is restarted
-        ("replace", "ByWorking"),    # 2. it failed again: the next-best alternative replaces it
-        ("retry", "ByHelping"),      #    which gets its own retry
+        ("retry", "ByWorking"),  # 1. the failed plan is restarted
+        ("replace", "ByWorking"),  # 2. it failed again: the next-best alternative replaces it
+        ("retry", "ByHelping"),  #    which gets its own retry
         ("propagate", "ByHelping"),  # 3. no alternative left: the plan type fails
     ]
     assert len(work.instances) == 2 and len(check.instances) == 2
@@ -79,7 +79,9 @@ def test_three_repair_stages(tmp_path):
 
 def test_replacement_succeeds(tmp_path):
     lib = library(tmp_path, PLANS)
-    sim, trace = team(lib, "Top", {"w": "Worker"}, {"Work": scripted(["failure"]), "Check": scripted(["running", "success"])})
+    sim, trace = team(
+        lib, "Top", {"w": "Worker"}, {"Work": scripted(["failure"]), "Check": scripted(["running", "success"])}
+    )
     sim.run(until_done=True, max_time=10)
     assert where(sim, "w") == ("Default", "Done")
     assert [e["stage"] for e in trace.of("repair")] == ["retry", "replace"]

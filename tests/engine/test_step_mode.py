@@ -32,15 +32,29 @@ plans:
 
 def subtree(name, params, context):
     """A skill made of two steps: a py_trees sequence."""
-    return py_trees.composites.Sequence(name, memory=True, children=[ScriptedSkill("approach", ["running", "success"]), ScriptedSkill("grasp", ["success"])])
+    return py_trees.composites.Sequence(
+        name,
+        memory=True,
+        children=[ScriptedSkill("approach", ["running", "success"]), ScriptedSkill("grasp", ["success"])],
+    )
 
 
 def test_an_agent_engine_in_step_mode_with_a_subtree_skill(tmp_path):
     lib = library(tmp_path, JOB)
     clock = ManualClock()
     network = SimNetwork(clock, seed=0)
-    engine = AgentEngine("w", {"w": "Worker"}, lib, "Job", lib.rolesets["Crew"], network.attach("w"), WorldModel("w"), clock,
-                         config=EngineConfig(frequency=10), skills=SkillBinder({"Work": subtree}))
+    engine = AgentEngine(
+        "w",
+        {"w": "Worker"},
+        lib,
+        "Job",
+        lib.rolesets["Crew"],
+        network.attach("w"),
+        WorldModel("w"),
+        clock,
+        config=EngineConfig(frequency=10),
+        skills=SkillBinder({"Work": subtree}),
+    )
     states = []
     for _ in range(5):
         engine.tick()
@@ -52,11 +66,25 @@ def test_an_agent_engine_in_step_mode_with_a_subtree_skill(tmp_path):
 
 
 @settings(max_examples=12)
-@given(seed=st.integers(0, 10_000), crash=st.sampled_from(["scout", "stummel", "amparo", None]), at=st.floats(0.2, 3.0), loss=st.sampled_from([0.0, 0.2]))
+@given(
+    seed=st.integers(0, 10_000),
+    crash=st.sampled_from(["scout", "stummel", "amparo", None]),
+    at=st.floats(0.2, 3.0),
+    loss=st.sampled_from([0.0, 0.2]),
+)
 def test_survivors_agree_on_the_assignment(seed, crash, at, loss):
     lunar = load_library(PLANS / "lunar" / "mission.yaml")
-    team = SimulatedTeam(lunar, "LunarMission", {"scout": "Scout", "stummel": "Stummel", "amparo": "Amparo"}, seed=seed, loss=loss, delay=0.02,
-                         jitter=0.02, fallback=default_fallback(seed, 5.0, 10.0), config=EngineConfig(frequency=10, team_timeout=0.6))
+    team = SimulatedTeam(
+        lunar,
+        "LunarMission",
+        {"scout": "Scout", "stummel": "Stummel", "amparo": "Amparo"},
+        seed=seed,
+        loss=loss,
+        delay=0.02,
+        jitter=0.02,
+        fallback=default_fallback(seed, 5.0, 10.0),
+        config=EngineConfig(frequency=10, team_timeout=0.6),
+    )
     if crash:
         team.crash(crash, at=at)
     team.run(ticks=50)

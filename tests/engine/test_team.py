@@ -89,7 +89,17 @@ def test_same_seed_same_trace_with_loss_and_delay(tmp_path):
     lib = library(tmp_path, PLANS)
 
     def run(seed):
-        sim, trace = team(lib, "Shop", {"w": "Worker", "h": "Helper", "x": "Helper"}, {"Work": scripted(["running"]), "Check": scripted(["running"])}, seed=seed, loss=0.3, delay=0.05, jitter=0.05, trace_messages=True)
+        sim, trace = team(
+            lib,
+            "Shop",
+            {"w": "Worker", "h": "Helper", "x": "Helper"},
+            {"Work": scripted(["running"]), "Check": scripted(["running"])},
+            seed=seed,
+            loss=0.3,
+            delay=0.05,
+            jitter=0.05,
+            trace_messages=True,
+        )
         sim.crash("w", at=1.0)
         sim.run(ticks=40)
         return trace.lines()
@@ -106,8 +116,29 @@ def test_same_seed_same_trace_across_processes(tmp_path):
     for hashseed in ("1", "2"):
         out = tmp_path / f"trace{hashseed}.jsonl"
         env = dict(os.environ, PYTHONHASHSEED=hashseed)
-        cmd = [sys.executable, "-m", "alica.app.cli", "run", str(ROOT / "plans/lunar/mission.yaml"), "--agents", "scout,stummel,amparo",
-               "--seed", "3", "--ticks", "120", "--loss", "0.2", "--delay", "20", "--crash", "scout@2", "--trace", str(out), "--trace-messages", "--json"]
+        cmd = [
+            sys.executable,
+            "-m",
+            "alica.app.cli",
+            "run",
+            str(ROOT / "plans/lunar/mission.yaml"),
+            "--agents",
+            "scout,stummel,amparo",
+            "--seed",
+            "3",
+            "--ticks",
+            "120",
+            "--loss",
+            "0.2",
+            "--delay",
+            "20",
+            "--crash",
+            "scout@2",
+            "--trace",
+            str(out),
+            "--trace-messages",
+            "--json",
+        ]
         result = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT, check=False)
         assert result.returncode == 0, result.stderr
         json.loads(result.stdout)
@@ -118,14 +149,23 @@ def test_same_seed_same_trace_across_processes(tmp_path):
 
 def test_lossy_network_still_converges_on_one_assignment(tmp_path):
     lib = library(tmp_path, PLANS)
-    sim, _ = team(lib, "Shop", {"w": "Worker", "h": "Helper"}, SKILLS, loss=0.5, config=EngineConfig(frequency=10, team_timeout=2.0))
+    sim, _ = team(
+        lib,
+        "Shop",
+        {"w": "Worker", "h": "Helper"},
+        SKILLS,
+        loss=0.5,
+        config=EngineConfig(frequency=10, team_timeout=2.0),
+    )
     sim.run(ticks=40)
     assert where(sim, "w") == ("Work", "Working") and where(sim, "h") == ("Help", "Helping")
     views = {name: dict(e.root.believed) for name, e in sim.engines.items()}
     assert views["w"] == views["h"]
 
 
-STICKY = PLANS.replace("  - name: Shop\n", "  - name: Shop\n    utility: {priority_weight: 0.5, similarity_weight: 0.5, threshold: 0.3}\n")
+STICKY = PLANS.replace(
+    "  - name: Shop\n", "  - name: Shop\n    utility: {priority_weight: 0.5, similarity_weight: 0.5, threshold: 0.3}\n"
+)
 
 
 def test_threshold_keeps_the_current_assignment(tmp_path):

@@ -9,8 +9,8 @@ from alica.io.loader import read_text
 from alica.io.validate import Validator
 from alica.lang import default_registry
 from alica.model import Document
-from alica.source import Diagnostic
 from alica.skills.registry import ParamSpec, SkillRegistry
+from alica.source import Diagnostic
 
 
 def test_skills() -> SkillRegistry:

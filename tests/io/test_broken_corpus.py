@@ -18,7 +18,9 @@ import pytest
 from alica.app.cli import main
 
 BROKEN = Path(__file__).parent / "broken"
-EXPECT = re.compile(r"expect:\s*(?:(?P<file>[\w.]+):)?(?P<line>\d+):(?P<col>\d+)\s*(?P<fragment>.*?)\s*(?:-->)?$", re.M)
+EXPECT = re.compile(
+    r"expect:\s*(?:(?P<file>[\w.]+):)?(?P<line>\d+):(?P<col>\d+)\s*(?P<fragment>.*?)\s*(?:-->)?$", re.MULTILINE
+)
 CASES = sorted(p for p in BROKEN.iterdir() if "expect-valid" not in p.read_text(encoding="utf-8")[:200])
 
 

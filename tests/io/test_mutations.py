@@ -66,10 +66,14 @@ def test_text_mutations(workdir: Path, path: Path, data: st.DataObject) -> None:
     if kind == "delete" and text:
         i = data.draw(st.integers(0, len(text) - 1))
         n = data.draw(st.integers(1, 8))
-        text = text[:i] + text[i + n:]
+        text = text[:i] + text[i + n :]
     elif kind == "insert":
         i = data.draw(st.integers(0, len(text)))
-        text = text[:i] + data.draw(st.sampled_from([":", "-", "[", "{", "'", '"', "<", ">", "&", "\t", "  ", "\n", "*", "#", "x"])) + text[i:]
+        text = (
+            text[:i]
+            + data.draw(st.sampled_from([":", "-", "[", "{", "'", '"', "<", ">", "&", "\t", "  ", "\n", "*", "#", "x"]))
+            + text[i:]
+        )
     elif kind == "swap" and len(lines) > 1:
         i = data.draw(st.integers(0, len(lines) - 2))
         lines[i], lines[i + 1] = lines[i + 1], lines[i]

@@ -111,7 +111,12 @@ def test_the_json_schema_is_a_valid_2020_12_schema() -> None:
 
 def test_element_mappings_take_no_additional_keys() -> None:
     objects = [d for d in JSON_SCHEMA["$defs"].values() if d.get("type") == "object"]
-    objects += [b for d in JSON_SCHEMA["$defs"].values() for b in d.get("anyOf", []) if b.get("type") == "object" and "properties" in b]
+    objects += [
+        b
+        for d in JSON_SCHEMA["$defs"].values()
+        for b in d.get("anyOf", [])
+        if b.get("type") == "object" and "properties" in b
+    ]
     assert len(objects) >= 16
     assert all(o["additionalProperties"] is False for o in objects)
     assert JSON_SCHEMA["additionalProperties"] is False
@@ -179,9 +184,15 @@ def test_the_json_schema_accepts_every_builder_alternative() -> None:
         ("param value a mapping", {"behaviours": [{"name": "B", "skill": "S", "params": {"p": {"x": 1}}}]}),
         ("priority not a number", {"rolesets": [{"name": "R", "roles": [{"name": "A", "priorities": {"T": "high"}}]}]}),
         ("task without name", {"tasks": [{"description": "x"}]}),
-        ("flag", {"plans": [{"name": "P", "entry_points": [{"task": "T", "success_required": "maybe"}], "states": []}]}),
+        (
+            "flag",
+            {"plans": [{"name": "P", "entry_points": [{"task": "T", "success_required": "maybe"}], "states": []}]},
+        ),
         ("version", {"alica": 2}),
-        ("child without ref", {"plans": [{"name": "P", "entry_points": [], "states": [{"name": "S", "children": [{"bind": {}}]}]}]}),
+        (
+            "child without ref",
+            {"plans": [{"name": "P", "entry_points": [], "states": [{"name": "S", "children": [{"bind": {}}]}]}]},
+        ),
         ("negative min", {"plans": [{"name": "P", "entry_points": [{"task": "T", "min": -1}], "states": []}]}),
     ],
 )

@@ -459,7 +459,9 @@ def test_the_reader_gives_the_yaml_tree_shape() -> None:
     assert plain["behaviours"][0]["params"] == {"goal": "$goal", "tolerance": 0.3, "label": "0.3", "corners": [1, 2]}
     assert plain["behaviours"][0]["variables"] == [{"name": "goal", "type": "position"}]
     assert plain["plans"][0]["states"][2]["children"] == [{"ref": "DriveToGoal", "bind": {"goal": "pos(a)"}}]
-    assert plain["plans"][0]["utility"]["summands"] == [{"name": "Near", "weight": "0.2", "expression": "1 - dist(pos(self), pos(a))/40"}]
+    assert plain["plans"][0]["utility"]["summands"] == [
+        {"name": "Near", "weight": "0.2", "expression": "1 - dist(pos(self), pos(a))/40"}
+    ]
     assert plain["alica"] == "1"
 
 
@@ -589,8 +591,29 @@ def test_the_writer_marks_text_that_would_resolve(value: Any, written: str) -> N
 
 @pytest.mark.parametrize(
     "scalar",
-    ["0.3", "1e3", "1.0e+3", "true", "True", "yes", "off", "~", "null", "010", "0x1F", "1_000", "1:30", ".inf", "-.inf",
-     "2001-12-14", "hello", "$goal", "0o17", "+1", "-0"],
+    [
+        "0.3",
+        "1e3",
+        "1.0e+3",
+        "true",
+        "True",
+        "yes",
+        "off",
+        "~",
+        "null",
+        "010",
+        "0x1F",
+        "1_000",
+        "1:30",
+        ".inf",
+        "-.inf",
+        "2001-12-14",
+        "hello",
+        "$goal",
+        "0o17",
+        "+1",
+        "-0",
+    ],
 )
 def test_resolve_scalar_agrees_with_the_yaml_reader(scalar: str) -> None:
     tree, problems = read_yaml(f"v: {scalar}\n", "s.yaml")
@@ -643,11 +666,21 @@ def test_elements_and_attributes_are_located_exactly() -> None:
 
 @pytest.mark.parametrize("line_end", ["\n", "\r\n", "\r"], ids=["lf", "crlf", "cr"])
 def test_every_kind_of_line_end_gives_the_same_places(line_end: str) -> None:
-    lines = ['<alica>', '  <task name="A"', '     colour="x"/>', '  <plan name="P">', "    <pre>a</pre>", "    <pre>b</pre>",
-             "  </plan>", "</alica>", ""]
+    lines = [
+        "<alica>",
+        '  <task name="A"',
+        '     colour="x"/>',
+        '  <plan name="P">',
+        "    <pre>a</pre>",
+        "    <pre>b</pre>",
+        "  </plan>",
+        "</alica>",
+        "",
+    ]
     problems = xml_problems(line_end.join(lines))
-    assert sorted((p.span.line, p.span.column) for p in problems if "colour" in p.message or "duplicate" in p.message) == [
-        (3, 6), (6, 5)]
+    assert sorted(
+        (p.span.line, p.span.column) for p in problems if "colour" in p.message or "duplicate" in p.message
+    ) == [(3, 6), (6, 5)]
     tree, syntax = read_xml(line_end.join(lines[:5] + ["  <pre>x < 3</pre>"] + lines[6:]), "s.xml")
     assert tree is None and syntax[0].span.line == 6
 
@@ -670,7 +703,7 @@ def test_places_fall_back_to_the_source_line(monkeypatch: pytest.MonkeyPatch) ->
 def test_places_survive_comments_cdata_and_non_ascii() -> None:
     text = (
         "<!-- <task name='fake'/> -->\n<alica><!-- x --><task name=\"Größe\" description='日本 &lt;&amp;>'/>"
-        "<![CDATA[<task>]]>\n  <task name=\"B\"/></alica>"
+        '<![CDATA[<task>]]>\n  <task name="B"/></alica>'
     )
     tree, diagnostics = read_xml(text, "c.xml")
     assert tree is not None
@@ -708,7 +741,10 @@ def test_unknown_element_is_reported_by_the_builder_with_its_line() -> None:
 
 
 def test_misspelt_attribute_gets_a_suggestion() -> None:
-    problem = one_problem('<alica><plan name="P" frequncy="1"><entrypoint task="T" state="S"/><state name="S"/></plan></alica>', "frequncy")
+    problem = one_problem(
+        '<alica><plan name="P" frequncy="1"><entrypoint task="T" state="S"/><state name="S"/></plan></alica>',
+        "frequncy",
+    )
     assert "frequency" in problem.hint
 
 
@@ -767,18 +803,24 @@ def test_duplicate_entries_are_reported() -> None:
 
 
 def test_entry_without_its_key_attribute_is_reported() -> None:
-    assert one_problem('<alica><roleset name="R"><role name="A"><priority value="1"/></role></roleset></alica>', "no 'task' attribute")
+    assert one_problem(
+        '<alica><roleset name="R"><role name="A"><priority value="1"/></role></roleset></alica>', "no 'task' attribute"
+    )
 
 
 def test_keys_may_be_attributes_or_elements() -> None:
-    xml = '<alica><plan name="P"><entrypoint task="T" state="S"/><state><name>S</name>' \
-          '<transition to="S" condition="go"/></state></plan></alica>'
+    xml = (
+        '<alica><plan name="P"><entrypoint task="T" state="S"/><state><name>S</name>'
+        '<transition to="S" condition="go"/></state></plan></alica>'
+    )
     yaml_text = "plans: [{name: P, entry_points: [{task: T, state: S}], states: [{name: S, transitions: [{to: S, condition: go}]}]}]\n"
     assert from_xml(xml) == from_yaml(yaml_text)
 
 
 def test_text_elements_hold_only_text() -> None:
-    problem = one_problem('<alica><behaviour name="B" skill="S"><pre>x <b/> y</pre></behaviour></alica>', "holds only text")
+    problem = one_problem(
+        '<alica><behaviour name="B" skill="S"><pre>x <b/> y</pre></behaviour></alica>', "holds only text"
+    )
     assert "&lt;" in problem.hint
 
 
@@ -820,7 +862,15 @@ def test_formula_spans_point_at_the_formula_text() -> None:
         "bind": doc.plans[0].states[0].children[0].bindings[0].span,
         "condition": doc.plans[0].transitions[0].condition.span,  # type: ignore[union-attr]
     }
-    starts = {"pre": "not   stuck", "run": "battery", "post": "dist(a", "summand": " 1 - f", "constraint": "a = b", "bind": "pos(a)", "condition": "reached"}
+    starts = {
+        "pre": "not   stuck",
+        "run": "battery",
+        "post": "dist(a",
+        "summand": " 1 - f",
+        "constraint": "a = b",
+        "bind": "pos(a)",
+        "condition": "reached",
+    }
     expected = {k: where(FORMULAS, v) for k, v in starts.items()}
     assert expected["run"] == (5, 9) and expected["post"] == (8, 20)
     assert {k: (s.line, s.column) for k, s in places.items()} == expected  # type: ignore[union-attr]
@@ -864,7 +914,7 @@ def test_syntax_error_has_the_place_lxml_reports_and_a_hint() -> None:
         ("<alica/>\n<alica/>\n", 2, "exactly one <alica>"),
         ("", 1, "start the file"),
         ("   \n", 2, "start the file"),
-        ('<alica>\n  <task name=A/>\n</alica>', 2, 'name="value"'),
+        ("<alica>\n  <task name=A/>\n</alica>", 2, 'name="value"'),
     ],
 )
 def test_syntax_errors(text: str, line: int, hint: str) -> None:
@@ -942,7 +992,9 @@ def test_entity_attacks_give_a_diagnostic_fast(text: str) -> None:
     [
         "<!DOCTYPE alica>\n<alica/>",
         '\ufeff<?xml version="1.0"?><!-- c --><!DOCTYPE alica SYSTEM "http://example.com/plan.dtd"><alica/>',
-        b'<?xml version="1.0" encoding="UTF-16"?><!DOCTYPE a [<!ENTITY x "y">]><alica>&x;</alica>'.decode().encode("utf-16"),
+        b'<?xml version="1.0" encoding="UTF-16"?><!DOCTYPE a [<!ENTITY x "y">]><alica>&x;</alica>'.decode().encode(
+            "utf-16"
+        ),
     ],
 )
 def test_any_doctype_is_refused(text: str | bytes) -> None:
@@ -983,8 +1035,12 @@ def test_writer_accepts_every_builder_alternative() -> None:
 
 XML_CHARS = st.characters(codec="utf-8", exclude_categories=("Cs", "Cc", "Cn")) | st.sampled_from("\t\n\r")
 TAGS = sorted({"alica", "item", "name"} | set(_SPECS) | {c.tag for s in _SPECS.values() for c in s.children})
-ATTRIBUTES = sorted({a for s in _SPECS.values() for a in s.attributes} | {"value", "type", "href", "variable", "task", "bogus"})
-VALUES = st.sampled_from(["", "0.3", "true", "*", "-1", "x", "a - b", "str", "list", " 1 ", "normal", "nan"]) | st.text(XML_CHARS, max_size=6)
+ATTRIBUTES = sorted(
+    {a for s in _SPECS.values() for a in s.attributes} | {"value", "type", "href", "variable", "task", "bogus"}
+)
+VALUES = st.sampled_from(["", "0.3", "true", "*", "-1", "x", "a - b", "str", "list", " 1 ", "normal", "nan"]) | st.text(
+    XML_CHARS, max_size=6
+)
 
 
 def _element(draw_children: st.SearchStrategy[list[Any]]) -> st.SearchStrategy[Any]:
@@ -1035,7 +1091,9 @@ def test_any_bytes_never_raise(data: bytes) -> None:
     check_result(read_xml(data, "b.xml"), "b.xml")
 
 
-ENCODINGS = st.sampled_from(["utf-8", "UTF-16", "latin-1", "ascii", "idna", "punycode", "utf-7", "rot13", "hex", "cp1252", "nope"])
+ENCODINGS = st.sampled_from(
+    ["utf-8", "UTF-16", "latin-1", "ascii", "idna", "punycode", "utf-7", "rot13", "hex", "cp1252", "nope"]
+)
 
 
 @given(ENCODINGS, st.binary(max_size=40) | st.text(max_size=40).map(lambda t: f"<alica>{t}</alica>".encode()))
@@ -1051,9 +1109,38 @@ def test_any_element_tree_never_raises(root: Any, pretty: bool) -> None:
 
 
 PIECES = st.sampled_from(
-    ["<alica>", "</alica>", "<plan name='P'>", "</plan>", "<pre>", "</pre>", "<![CDATA[", "]]>", "<!--", "-->", "&lt;",
-     "&", "<", ">", '"', "=", "<?pi x?>", "<!DOCTYPE a>", "\n", " ", "x", "é", "<task name='a' ", "/>", "<param name='p'>",
-     "<item>", "</item>", "&#0;", "&#x10FFFF;", "\r\n"]
+    [
+        "<alica>",
+        "</alica>",
+        "<plan name='P'>",
+        "</plan>",
+        "<pre>",
+        "</pre>",
+        "<![CDATA[",
+        "]]>",
+        "<!--",
+        "-->",
+        "&lt;",
+        "&",
+        "<",
+        ">",
+        '"',
+        "=",
+        "<?pi x?>",
+        "<!DOCTYPE a>",
+        "\n",
+        " ",
+        "x",
+        "é",
+        "<task name='a' ",
+        "/>",
+        "<param name='p'>",
+        "<item>",
+        "</item>",
+        "&#0;",
+        "&#x10FFFF;",
+        "\r\n",
+    ]
 )
 
 
@@ -1070,7 +1157,11 @@ def test_deep_nesting_is_a_diagnostic() -> None:
 
 # --------------------------------------------------------------------------- any document round-trips
 
-NAME = st.text(st.characters(codec="utf-8", categories=("L", "N")) | st.sampled_from("_-<>&'\". "), min_size=1, max_size=8).map(str.strip).filter(bool)
+NAME = (
+    st.text(st.characters(codec="utf-8", categories=("L", "N")) | st.sampled_from("_-<>&'\". "), min_size=1, max_size=8)
+    .map(str.strip)
+    .filter(bool)
+)
 IDENT = st.from_regex(r"\??[A-Za-z_][A-Za-z0-9_-]{0,5}", fullmatch=True)
 TYPE = st.from_regex(r"[A-Za-z_][A-Za-z0-9_-]{0,5}", fullmatch=True)
 TEXT = st.text(XML_CHARS, max_size=20)
@@ -1078,8 +1169,14 @@ UNIT = st.floats(0, 1)
 NON_NEGATIVE = st.floats(min_value=0, allow_nan=False)
 TYPED = IDENT | st.tuples(IDENT, TYPE).map(" - ".join) | st.fixed_dictionaries({"name": IDENT}, optional={"type": TYPE})
 SCALARS = (
-    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | TEXT
-    | st.sampled_from(["0.3", "true", "", "~", "null", "1_000", "0x1F", "2001-12-14", "<<", "=", " 1", "$goal", "yes", ".inf", "1e3"])
+    st.none()
+    | st.booleans()
+    | st.integers()
+    | st.floats(allow_nan=False)
+    | TEXT
+    | st.sampled_from(
+        ["0.3", "true", "", "~", "null", "1_000", "0x1F", "2001-12-14", "<<", "=", " 1", "$goal", "yes", ".inf", "1e3"]
+    )
 )
 PARAM = st.recursive(SCALARS, lambda inner: st.lists(inner, max_size=3), max_leaves=6)
 
@@ -1088,38 +1185,102 @@ def _optional(required: dict[str, Any], **optional: Any) -> st.SearchStrategy[di
     return st.fixed_dictionaries(required, optional=optional)
 
 
-ROLE = _optional({"name": NAME}, description=TEXT, requires=st.lists(NAME, max_size=3),
-                 priorities=st.dictionaries(NAME, st.floats(-1, 1), max_size=3))
+ROLE = _optional(
+    {"name": NAME},
+    description=TEXT,
+    requires=st.lists(NAME, max_size=3),
+    priorities=st.dictionaries(NAME, st.floats(-1, 1), max_size=3),
+)
 CHILD = NAME | _optional({"ref": NAME}, bind=st.dictionaries(NAME, TEXT, max_size=2))
 TRANSITION = _optional({"to": NAME}, name=NAME, condition=TEXT, sync=NAME)
-STATE = _optional({"name": NAME}, kind=st.sampled_from(["normal", "success", "failure"]), description=TEXT,
-                  children=st.lists(CHILD, max_size=3), post=TEXT, transitions=st.lists(TRANSITION, max_size=2))
-ENTRY = _optional({"task": NAME}, name=NAME, state=NAME, min=st.integers(0, 5), max=st.integers(0, 9) | st.just("*"),
-                  success_required=st.booleans())
+STATE = _optional(
+    {"name": NAME},
+    kind=st.sampled_from(["normal", "success", "failure"]),
+    description=TEXT,
+    children=st.lists(CHILD, max_size=3),
+    post=TEXT,
+    transitions=st.lists(TRANSITION, max_size=2),
+)
+ENTRY = _optional(
+    {"task": NAME},
+    name=NAME,
+    state=NAME,
+    min=st.integers(0, 5),
+    max=st.integers(0, 9) | st.just("*"),
+    success_required=st.booleans(),
+)
 PLAN = _optional(
-    {"name": NAME, "entry_points": st.lists(ENTRY, min_size=1, max_size=2), "states": st.lists(STATE, min_size=1, max_size=3, unique_by=lambda s: s["name"])},
-    description=TEXT, variables=st.lists(TYPED, max_size=2), pre=TEXT, run=TEXT, frequency=NON_NEGATIVE,
-    utility=_optional({}, priority_weight=UNIT, similarity_weight=UNIT, threshold=st.floats(0, 10),
-                      summands=st.lists(_optional({"name": NAME, "weight": UNIT, "expression": TEXT}), max_size=2)),
+    {
+        "name": NAME,
+        "entry_points": st.lists(ENTRY, min_size=1, max_size=2),
+        "states": st.lists(STATE, min_size=1, max_size=3, unique_by=lambda s: s["name"]),
+    },
+    description=TEXT,
+    variables=st.lists(TYPED, max_size=2),
+    pre=TEXT,
+    run=TEXT,
+    frequency=NON_NEGATIVE,
+    utility=_optional(
+        {},
+        priority_weight=UNIT,
+        similarity_weight=UNIT,
+        threshold=st.floats(0, 10),
+        summands=st.lists(_optional({"name": NAME, "weight": UNIT, "expression": TEXT}), max_size=2),
+    ),
     constraints=st.lists(_optional({"name": NAME, "formula": TEXT}, variables=st.lists(IDENT, max_size=2)), max_size=2),
     signature=_optional({}, parameters=st.lists(TYPED, max_size=2), precondition=TEXT, effect=TEXT, cost=NON_NEGATIVE),
-    synchronisations=st.lists(_optional({"name": NAME, "transitions": st.lists(NAME, min_size=1, max_size=2)},
-                                        talk_timeout=NON_NEGATIVE, sync_timeout=NON_NEGATIVE, fail_on_timeout=st.booleans()), max_size=2),
+    synchronisations=st.lists(
+        _optional(
+            {"name": NAME, "transitions": st.lists(NAME, min_size=1, max_size=2)},
+            talk_timeout=NON_NEGATIVE,
+            sync_timeout=NON_NEGATIVE,
+            fail_on_timeout=st.booleans(),
+        ),
+        max_size=2,
+    ),
 )
 DOCUMENT_DATA = _optional(
     {},
     imports=st.lists(NAME, max_size=2),
     tasks=st.lists(NAME | _optional({"name": NAME}, description=TEXT), max_size=3),
-    rolesets=st.lists(_optional({"name": NAME, "roles": st.lists(ROLE, min_size=1, max_size=2)}, description=TEXT,
-                                default_priority=st.floats(-1, 1)), max_size=2),
-    behaviours=st.lists(_optional({"name": NAME, "skill": NAME}, description=TEXT, variables=st.lists(TYPED, max_size=3),
-                                  params=st.dictionaries(NAME, PARAM, max_size=4), pre=TEXT, run=TEXT, post=TEXT,
-                                  frequency=NON_NEGATIVE), max_size=2),
+    rolesets=st.lists(
+        _optional(
+            {"name": NAME, "roles": st.lists(ROLE, min_size=1, max_size=2)},
+            description=TEXT,
+            default_priority=st.floats(-1, 1),
+        ),
+        max_size=2,
+    ),
+    behaviours=st.lists(
+        _optional(
+            {"name": NAME, "skill": NAME},
+            description=TEXT,
+            variables=st.lists(TYPED, max_size=3),
+            params=st.dictionaries(NAME, PARAM, max_size=4),
+            pre=TEXT,
+            run=TEXT,
+            post=TEXT,
+            frequency=NON_NEGATIVE,
+        ),
+        max_size=2,
+    ),
     plans=st.lists(PLAN, max_size=2),
-    plantypes=st.lists(_optional({"name": NAME, "plans": st.lists(NAME, min_size=1, max_size=3)}, description=TEXT), max_size=2),
-    problems=st.lists(_optional({"name": NAME, "elements": st.lists(NAME, min_size=1, max_size=2), "goal": TEXT, "wait_plan": NAME},
-                                description=TEXT, alternative_plan=NAME, update_time=st.floats(1e-3, 1e3), timeout=st.floats(1e-3, 1e3), planner=NAME,
-                                objects=st.lists(TYPED, max_size=2), world=TEXT), max_size=2),
+    plantypes=st.lists(
+        _optional({"name": NAME, "plans": st.lists(NAME, min_size=1, max_size=3)}, description=TEXT), max_size=2
+    ),
+    problems=st.lists(
+        _optional(
+            {"name": NAME, "elements": st.lists(NAME, min_size=1, max_size=2), "goal": TEXT, "wait_plan": NAME},
+            description=TEXT,
+            alternative_plan=NAME,
+            update_time=st.floats(1e-3, 1e3),
+            timeout=st.floats(1e-3, 1e3),
+            planner=NAME,
+            objects=st.lists(TYPED, max_size=2),
+            world=TEXT,
+        ),
+        max_size=2,
+    ),
 )
 
 

@@ -75,7 +75,10 @@ def test_full_plan_builds() -> None:
 def test_unknown_key_is_reported_with_suggestion() -> None:
     _, problems = read_text("plans:\n  - name: P\n    entry_point: []\n    states: []\n", "f.yaml")
     texts = [p.format() for p in problems]
-    assert any(t.startswith("f.yaml:3:5: error: unknown key 'entry_point' in plan 'P' (fix: did you mean 'entry_points'?)") for t in texts), texts
+    assert any(
+        t.startswith("f.yaml:3:5: error: unknown key 'entry_point' in plan 'P' (fix: did you mean 'entry_points'?)")
+        for t in texts
+    ), texts
 
 
 def test_wrong_type_is_reported() -> None:
@@ -84,5 +87,7 @@ def test_wrong_type_is_reported() -> None:
 
 
 def test_bad_number_is_reported() -> None:
-    _, problems = read_text("plans:\n  - name: P\n    entry_points: [{task: T, state: A, min: many}]\n    states: [{name: A}]\n", "f.yaml")
+    _, problems = read_text(
+        "plans:\n  - name: P\n    entry_points: [{task: T, state: A, min: many}]\n    states: [{name: A}]\n", "f.yaml"
+    )
     assert any("'min' of an entry point of plan 'P' must be a whole number, not text" in p.message for p in problems)

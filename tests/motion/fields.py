@@ -13,8 +13,9 @@ CORNER_A = (-19.0, -19.0)
 CORNER_B = (19.0, 19.0)
 
 
-def rocks(seed: int, count: int, keep_free: tuple[tuple[float, float], ...] = (CORNER_A, CORNER_B),
-          free_radius: float = 2.0) -> list[Obstacle2D]:
+def rocks(
+    seed: int, count: int, keep_free: tuple[tuple[float, float], ...] = (CORNER_A, CORNER_B), free_radius: float = 2.0
+) -> list[Obstacle2D]:
     """``count`` circular rocks (radius 0.2-1.0 m), none within ``free_radius`` of the ``keep_free`` points."""
     rng = np.random.default_rng(seed)
     out: list[Obstacle2D] = []

@@ -8,14 +8,15 @@ import numpy as np
 import pytest
 
 from alica.skills.motion import FclChecker, GridChecker, PathFollower, escape_goal, plan_path
-from tests.motion.fields import CORNER_A, CORNER_B, field
 from alica.worldsim.grid import Obstacle2D, OccupancyGrid
+from tests.motion.fields import CORNER_A, CORNER_B, field
 
 RADIUS = 0.3
 
 
-def drive(follower: PathFollower, pose: tuple[float, float, float], dt: float = 0.05,
-          steps: int = 20000) -> tuple[tuple[float, float, float], list[tuple[float, float]]]:
+def drive(
+    follower: PathFollower, pose: tuple[float, float, float], dt: float = 0.05, steps: int = 20000
+) -> tuple[tuple[float, float, float], list[tuple[float, float]]]:
     """Integrate the unicycle x' = v cos(yaw), y' = v sin(yaw), yaw' = w until done."""
     x, y, yaw = pose
     trace = [(x, y)]
@@ -68,8 +69,9 @@ def test_blocked_detects_a_new_obstacle_on_the_path() -> None:
     assert not follower.blocked(GridChecker(grid, RADIUS), pose)
     assert not follower.blocked(grid, pose, robot_radius=RADIUS)
     newer = grid.copy()
-    newer.add_obstacles([Obstacle2D("circle", 1.0, float(np.interp(1.0, result.path[:, 0], result.path[:, 1])),
-                                    radius=0.2)])
+    newer.add_obstacles(
+        [Obstacle2D("circle", 1.0, float(np.interp(1.0, result.path[:, 0], result.path[:, 1])), radius=0.2)]
+    )
     assert follower.blocked(GridChecker(newer, RADIUS), pose)
     assert follower.blocked(newer, pose, robot_radius=RADIUS)
     assert not follower.blocked(newer, pose, robot_radius=RADIUS, horizon=3.0), "the obstacle is 6 m ahead"

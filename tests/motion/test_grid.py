@@ -67,6 +67,7 @@ def test_inflation_is_a_disk_of_the_radius() -> None:
 
 def test_inflation_matches_euclidean_distance_transform() -> None:
     from scipy import ndimage  # in the test extra
+
     rng = np.random.default_rng(4)
     cells = (rng.random((120, 90)) < 0.01).astype(np.uint8)
     cells[rng.random(cells.shape) < 0.05] = UNKNOWN

@@ -13,15 +13,16 @@ import pytest
 import trimesh
 
 from alica.skills.motion import FclChecker, GridChecker, densify, plan_path
-from tests.motion.fields import BOUNDS, CORNER_A, CORNER_B, field
 from alica.worldsim.grid import Obstacle2D, OccupancyGrid
+from tests.motion.fields import BOUNDS, CORNER_A, CORNER_B, field
 
 ROOT = Path(__file__).resolve().parents[2]
 RADIUS = 0.3
 
 
-def assert_path_valid(path: np.ndarray, grid: OccupancyGrid, obstacles: list, radius: float = RADIUS,
-                      robots: tuple = ()) -> None:
+def assert_path_valid(
+    path: np.ndarray, grid: OccupancyGrid, obstacles: list, radius: float = RADIUS, robots: tuple = ()
+) -> None:
     """Every state sampled along the path (every 2.5 cm) is valid in the grid (inflated by the radius) and in FCL."""
     pts = densify(path, 0.025)
     plain = GridChecker(grid, radius, margin=0.0, other_robots=robots)
@@ -88,8 +89,10 @@ def test_start_in_a_rock_is_invalid_start() -> None:
 
 
 def test_enclosed_goal_is_unreachable_quickly() -> None:
-    ring = [Obstacle2D("circle", 5.0 + 3.0 * math.cos(a), 5.0 + 3.0 * math.sin(a), radius=0.5)
-            for a in np.linspace(0.0, 2.0 * math.pi, 24, endpoint=False)]
+    ring = [
+        Obstacle2D("circle", 5.0 + 3.0 * math.cos(a), 5.0 + 3.0 * math.sin(a), radius=0.5)
+        for a in np.linspace(0.0, 2.0 * math.pi, 24, endpoint=False)
+    ]
     obstacles, _ = field(2, 40)
     obstacles = [o for o in obstacles if math.hypot(o.x - 5.0, o.y - 5.0) > 5.0] + ring
     grid = OccupancyGrid.from_obstacles(obstacles, BOUNDS, 0.05)
@@ -148,8 +151,9 @@ print(json.dumps(out))
 
 
 def run_seeded(seed: int) -> list:
-    done = subprocess.run([sys.executable, "-c", SCRIPT, str(seed)], cwd=ROOT, capture_output=True, text=True,
-                          timeout=120, check=True)
+    done = subprocess.run(
+        [sys.executable, "-c", SCRIPT, str(seed)], cwd=ROOT, capture_output=True, text=True, timeout=120, check=True
+    )
     return json.loads(done.stdout)
 
 

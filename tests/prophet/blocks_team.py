@@ -22,22 +22,41 @@ def effects(skill: str, params: Mapping[str, object], me: str) -> list[Literal]:
     """What the blocks-world skill ``skill`` changes when it succeeds (the signatures' effects)."""
     x = str(params.get("object"))
     if skill == "Pickup":
-        return [(False, "ontable", (x,)), (False, "clear", (x,)), (False, "handempty", (me,)), (True, "holding", (me, x))]
+        return [
+            (False, "ontable", (x,)),
+            (False, "clear", (x,)),
+            (False, "handempty", (me,)),
+            (True, "holding", (me, x)),
+        ]
     if skill == "Putdown":
         return [(False, "holding", (me, x)), (True, "clear", (x,)), (True, "handempty", (me,)), (True, "ontable", (x,))]
     if skill == "Stack":
         y = str(params.get("target"))
-        return [(False, "holding", (me, x)), (False, "clear", (y,)), (True, "clear", (x,)), (True, "handempty", (me,)), (True, "on", (x, y))]
+        return [
+            (False, "holding", (me, x)),
+            (False, "clear", (y,)),
+            (True, "clear", (x,)),
+            (True, "handempty", (me,)),
+            (True, "on", (x, y)),
+        ]
     if skill == "Unstack":
         y = str(params.get("from"))
-        return [(False, "on", (x, y)), (False, "clear", (x,)), (False, "handempty", (me,)), (True, "holding", (me, x)), (True, "clear", (y,))]
+        return [
+            (False, "on", (x, y)),
+            (False, "clear", (x,)),
+            (False, "handempty", (me,)),
+            (True, "holding", (me, x)),
+            (True, "clear", (y,)),
+        ]
     return []
 
 
 class BlockSkill(py_trees.behaviour.Behaviour):
     """Runs for ``ticks`` ticks, then succeeds and writes its effects (or fails, when told to)."""
 
-    def __init__(self, name: str, skill: str, params: Mapping[str, object], context: Any, ticks: int | None, fail: bool) -> None:
+    def __init__(
+        self, name: str, skill: str, params: Mapping[str, object], context: Any, ticks: int | None, fail: bool
+    ) -> None:
         super().__init__(name)
         self.skill, self.params, self.context, self.ticks, self.fail = skill, dict(params), context, ticks, fail
         self.count = 0
@@ -103,13 +122,28 @@ SUSSMAN = [["a", "c"], ["b"]]
 """c on a, b alone: the goal a on b on c takes 6 steps."""
 
 
-def blocks_team(agents: Iterable[str], skills: BlockSkills, stacks=SUSSMAN, seed: int = 0, **config: Any) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[no-untyped-def]
+def blocks_team(
+    agents: Iterable[str], skills: BlockSkills, stacks=SUSSMAN, seed: int = 0, **config: Any
+) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[no-untyped-def]
     """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model."""
     names = list(agents)
     recorder = TraceRecorder()
-    settings = {"frequency": 10.0, "broadcast_interval": 0.1, "team_timeout": 0.5, "assignment_protection": 0.3, **config}
-    sim = SimulatedTeam(blocks_library(), "BlocksWorldMission", dict.fromkeys(names, "Manipulator"), seed=seed,
-                        config=EngineConfig(**settings), skills=skills.mapping(), observers=[recorder])
+    settings = {
+        "frequency": 10.0,
+        "broadcast_interval": 0.1,
+        "team_timeout": 0.5,
+        "assignment_protection": 0.3,
+        **config,
+    }
+    sim = SimulatedTeam(
+        blocks_library(),
+        "BlocksWorldMission",
+        dict.fromkeys(names, "Manipulator"),
+        seed=seed,
+        config=EngineConfig(**settings),
+        skills=skills.mapping(),
+        observers=[recorder],
+    )
     sim.set_facts(world_facts(stacks, names))
     return sim, recorder
 

@@ -12,7 +12,14 @@ from alica.prophet.tasks import create_tasks
 from tests.conftest import PLANS
 
 OBJECTS = {"a": "block", "b": "block", "c": "block", "r": "robot"}
-SUSSMAN = [("on", ("c", "a")), ("ontable", ("a",)), ("ontable", ("b",)), ("clear", ("c",)), ("clear", ("b",)), ("handempty", ("r",))]
+SUSSMAN = [
+    ("on", ("c", "a")),
+    ("ontable", ("a",)),
+    ("ontable", ("b",)),
+    ("clear", ("c",)),
+    ("clear", ("b",)),
+    ("handempty", ("r",)),
+]
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +42,9 @@ def test_the_sussman_anomaly_is_planned_and_parallelised(blocks):
     result = BuiltinPlanner().solve(domain, pddl, time_limit=10, anytime=True)
     assert result.status in (PlanStatus.SOLVED, PlanStatus.OPTIMAL)
     assert result.cost == 6
-    created = create_tasks("StackBlocksPlan", result.plan.steps, blocks, SUSSMAN, "r", next(iter(blocks.rolesets.values())), "Default")
+    created = create_tasks(
+        "StackBlocksPlan", result.plan.steps, blocks, SUSSMAN, "r", next(iter(blocks.rolesets.values())), "Default"
+    )
     assert len(created.tasks) >= 2
     assert sum(len(t) for t in created.tasks) == 6
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 import pytest
 
 from alica.engine import EngineConfig
-from alica.testing import scripted
 from alica.prophet.planners import PLANNERS
+from alica.testing import scripted
 from tests.engine.helpers import library, team, where
 from tests.prophet.blocks_team import SUSSMAN, BlockSkills, blocks_team, goal_holds
 
@@ -67,7 +67,11 @@ def test_agents_no_task_needs_stand_by_in_the_wait_plan():
     working = sorted(a for a, entry in allocation["entries"].items() if entry not in ("Standby", None))
     assert len(standing_by) == 2 and len(working) == 3
     # they run the WaitPlan inside the generated plan's Standby state
-    waiting = {e["agent"] for e in events(rec, "allocation", plan="DriveToFreePosition") if e["key"].endswith("/Standby/DriveToFreePosition")}
+    waiting = {
+        e["agent"]
+        for e in events(rec, "allocation", plan="DriveToFreePosition")
+        if e["key"].endswith("/Standby/DriveToFreePosition")
+    }
     assert waiting == set(standing_by)
     summary = sim.run(until_done=True, max_time=60)
     assert summary["success"] and goal_holds(sim, "r1")
@@ -80,7 +84,14 @@ def test_one_robot_runs_every_task_in_turn():
     sim, _ = blocks_team(["r1"], skills)
     summary = sim.run(until_done=True, max_time=60)
     assert summary["success"] and goal_holds(sim, "r1")
-    assert [s for _, s, _ in skills.runs if s in ("Pickup", "Unstack", "Stack", "Putdown")] == ["Unstack", "Putdown", "Pickup", "Stack", "Pickup", "Stack"]
+    assert [s for _, s, _ in skills.runs if s in ("Pickup", "Unstack", "Stack", "Putdown")] == [
+        "Unstack",
+        "Putdown",
+        "Pickup",
+        "Stack",
+        "Pickup",
+        "Stack",
+    ]
 
 
 def test_a_failed_step_sends_the_team_back_to_the_wait_plan_and_the_leader_replans():
@@ -153,7 +164,7 @@ def test_the_same_seed_gives_the_same_trace():
     def trace():
         sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(fail=["Stack"]), seed=7)
         sim.run(until_done=True, max_time=60)
-        return [e for e in rec.events]
+        return list(rec.events)
 
     assert trace() == trace()
 
@@ -217,7 +228,13 @@ def problem_team(tmp_path, planner="builtin", alternative=True):
     text = PROBLEM.replace("PLANNER", planner).replace("ALTERNATIVE", "alternative_plan: Home" if alternative else "")
     lib = library(tmp_path, text)
     config = EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
-    return team(lib, "Top", {"w": "Worker", "h": "Helper"}, {"Wait": scripted(["running"]), "Work": scripted(["running", "success"])}, config=config)
+    return team(
+        lib,
+        "Top",
+        {"w": "Worker", "h": "Helper"},
+        {"Wait": scripted(["running"]), "Work": scripted(["running", "success"])},
+        config=config,
+    )
 
 
 def test_an_unsolvable_problem_runs_the_alternative_plan(tmp_path):
@@ -310,9 +327,13 @@ def test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_wa
     assert started["goal"] == "ontable(e)" and started["outside"] == ["b"]
     assert sim.engines["r1"].world_model.holds("ontable", "e")
     assert sim.engines["r1"].world_model.holds("on", "c", "a")
-    assert any("robots outside the team hold, or nobody sees, b" in e["reason"] for e in events(rec, "planner", what="waiting"))
+    assert any(
+        "robots outside the team hold, or nobody sees, b" in e["reason"] for e in events(rec, "planner", what="waiting")
+    )
     assert events(rec, "problem", phase="failed") == []
-    sim.set_facts([(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))])  # it puts b down
+    sim.set_facts(
+        [(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))]
+    )  # it puts b down
     summary = sim.run(until_done=True, max_time=90)
     assert summary["success"] and goal_holds(sim, "r1")
     assert events(rec, "planner", what="started", reason="the world changed while planning was blocked")
@@ -373,7 +394,12 @@ def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_ea
 
     # T0 and T1 at work, T2 free, T3's agent waits for T2 (the plan: T0 step 0, T1 steps 1 and 2, T2 step 3, T3 step 4)
     order = [[0], [1, 2], [3], [4]]
-    progress = [TaskProgress("r1", 0, running=True), TaskProgress("r2", 1, running=True), TaskProgress(None, 0), TaskProgress("r4", 0)]
+    progress = [
+        TaskProgress("r1", 0, running=True),
+        TaskProgress("r2", 1, running=True),
+        TaskProgress(None, 0),
+        TaskProgress("r4", 0),
+    ]
     members = ("r1", "r2", "r4")
     assert _stalled(progress, order, (None, None, ("r1", "r2"), ("r4",)), members) is None  # r1 or r2 takes T2 next
     # only r4 may take T2, and it waits in T3: stuck
@@ -391,7 +417,9 @@ def test_a_free_task_pinned_to_an_agent_that_waits_for_it_in_an_earlier_task_is_
     order = [[0], [1, 4], [2, 3], [5]]
     progress = [TaskProgress(None, 1, done=True), TaskProgress("r5", 1), TaskProgress(None, 0), TaskProgress("r3", 0)]
     members = ("r1", "r3", "r5")
-    assert "task T2 has nobody, and the agent of task T3 waits for it" in _stalled(progress, order, (None, ("r1", "r5"), ("r5",), ("r3",)), members)
+    assert "task T2 has nobody, and the agent of task T3 waits for it" in _stalled(
+        progress, order, (None, ("r1", "r5"), ("r5",), ("r3",)), members
+    )
     # r3 may take it as well, and runs its step now: it takes T2 when that step is done
     at_work = [*progress[:3], TaskProgress("r3", 0, running=True)]
     assert _stalled(at_work, order, (None, ("r1", "r5"), ("r3", "r5"), ("r3",)), members) is None

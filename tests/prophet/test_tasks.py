@@ -14,9 +14,22 @@ from alica.prophet.planner import PlanStep
 from alica.prophet.tasks import create_tasks, emit_yaml, generic_utility, parallelise, steps_of
 from tests.conftest import PLANS
 
-SUSSMAN = [("on", ("c", "a")), ("ontable", ("a",)), ("ontable", ("b",)), ("clear", ("c",)), ("clear", ("b",)), ("handempty", ("r",))]
-PLAN = [PlanStep("Unstack", ("r", "c", "a")), PlanStep("Putdown", ("r", "c")), PlanStep("Pickup", ("r", "b")),
-        PlanStep("Stack", ("r", "b", "c")), PlanStep("Pickup", ("r", "a")), PlanStep("Stack", ("r", "a", "b"))]
+SUSSMAN = [
+    ("on", ("c", "a")),
+    ("ontable", ("a",)),
+    ("ontable", ("b",)),
+    ("clear", ("c",)),
+    ("clear", ("b",)),
+    ("handempty", ("r",)),
+]
+PLAN = [
+    PlanStep("Unstack", ("r", "c", "a")),
+    PlanStep("Putdown", ("r", "c")),
+    PlanStep("Pickup", ("r", "b")),
+    PlanStep("Stack", ("r", "b", "c")),
+    PlanStep("Pickup", ("r", "a")),
+    PlanStep("Stack", ("r", "a", "b")),
+]
 
 
 @pytest.fixture(scope="module")
@@ -25,7 +38,9 @@ def blocks():
 
 
 def _created(blocks):
-    roleset = blocks.rolesets["BlocksWorld"] if "BlocksWorld" in blocks.rolesets else next(iter(blocks.rolesets.values()))
+    roleset = (
+        blocks.rolesets["BlocksWorld"] if "BlocksWorld" in blocks.rolesets else next(iter(blocks.rolesets.values()))
+    )
     return create_tasks("StackBlocksPlan", PLAN, blocks, SUSSMAN, "r", roleset, "Default"), roleset
 
 
@@ -33,9 +48,9 @@ def test_algorithm_2_3_opens_a_task_when_a_new_robot_could_act(blocks):
     steps = steps_of(PLAN, blocks, "r")
     tasks = parallelise(steps, SUSSMAN, "r")
     assert [[s.label for s in t] for t in tasks] == [
-        ["Unstack(c, a)", "Putdown(c)"],   # Putdown needs the block the first robot holds
-        ["Pickup(b)", "Stack(b, c)"],      # a fresh robot can pick b up
-        ["Pickup(a)", "Stack(a, b)"],      # a is clear once c is off it
+        ["Unstack(c, a)", "Putdown(c)"],  # Putdown needs the block the first robot holds
+        ["Pickup(b)", "Stack(b, c)"],  # a fresh robot can pick b up
+        ["Pickup(a)", "Stack(a, b)"],  # a is clear once c is off it
     ]
 
 
@@ -49,7 +64,11 @@ def test_a_robot_that_has_acted_is_no_longer_new(blocks):
     # r5 holds f at the start and stacks it on g; r1 takes f off again and puts it back. r5's initial
     # holding(r5, f) is used up: the second Stack(f, g) is not a new task for r5, it continues r1's task
     init = [("holding", ("r5", "f")), ("ontable", ("g",)), ("clear", ("g",)), ("handempty", ("r1",))]
-    plan = [PlanStep("Stack", ("r5", "f", "g")), PlanStep("Unstack", ("r1", "f", "g")), PlanStep("Stack", ("r1", "f", "g"))]
+    plan = [
+        PlanStep("Stack", ("r5", "f", "g")),
+        PlanStep("Unstack", ("r1", "f", "g")),
+        PlanStep("Stack", ("r1", "f", "g")),
+    ]
     created = create_tasks("P", plan, blocks, init, ("r1", "r5"), next(iter(blocks.rolesets.values())), "Default")
     assert [[s.label for s in t] for t in created.tasks] == [["Stack(f, g)"], ["Unstack(f, g)", "Stack(f, g)"]]
     # the first is pinned to the robot that holds f; the second to r1, whose initial empty hand can start it
@@ -63,7 +82,9 @@ def test_role_task_priorities_follow_eq_9(blocks):
         p = roleset.priority(role.name, "Default")
         prio = role.priority_map
         for i, task in enumerate(created.task_defs):
-            vetoed = p < 0 or any(roleset.priority(role.name, s.skill.entry_points[0].task) < 0 for s in created.tasks[i])
+            vetoed = p < 0 or any(
+                roleset.priority(role.name, s.skill.entry_points[0].task) < 0 for s in created.tasks[i]
+            )
             assert prio[task.name] == pytest.approx(-1.0 if vetoed else (1 - i / n) * p)
 
 
@@ -118,11 +139,26 @@ def test_the_execution_check_runs_a_free_task_with_a_robot_that_could_start_it(b
     from alica.prophet.world import TaskProgress, remaining_fits
 
     # the planner gave Pickup(b) to r1, which held c at the start (it put c down in T0); r2 had an empty hand
-    init = [("holding", ("r1", "c")), ("handempty", ("r2",)), ("ontable", ("b",)), ("clear", ("b",)), ("ontable", ("a",)), ("clear", ("a",))]
+    init = [
+        ("holding", ("r1", "c")),
+        ("handempty", ("r2",)),
+        ("ontable", ("b",)),
+        ("clear", ("b",)),
+        ("ontable", ("a",)),
+        ("clear", ("a",)),
+    ]
     plan = [PlanStep("Putdown", ("r1", "c")), PlanStep("Pickup", ("r1", "b"))]
     tasks = [[s] for s in steps_of(plan, blocks, ("r1", "r2"))]
-    now = [("ontable", ("c",)), ("clear", ("c",)), ("handempty", ("r1",)), ("handempty", ("r2",)), ("ontable", ("b",)), ("clear", ("b",)),
-           ("ontable", ("a",)), ("clear", ("a",))]
+    now = [
+        ("ontable", ("c",)),
+        ("clear", ("c",)),
+        ("handempty", ("r1",)),
+        ("handempty", ("r2",)),
+        ("ontable", ("b",)),
+        ("clear", ("b",)),
+        ("ontable", ("a",)),
+        ("clear", ("a",)),
+    ]
     progress = [TaskProgress(None, 1, done=True), TaskProgress(None, 0)]
     goal = [(True, ("holding", ("~T1", "b")))]
     assert remaining_fits(tasks, progress, now, init, goal, ("r1", "r2")) is None
@@ -150,7 +186,12 @@ def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
     from alica.prophet.world import reachable_goal
 
     # the tower b f d g, and e alone; an opponent holds f
-    tower = [(True, ("ontable", ("b",))), (True, ("on", ("f", "b"))), (True, ("on", ("d", "f"))), (True, ("on", ("g", "d")))]
+    tower = [
+        (True, ("ontable", ("b",))),
+        (True, ("on", ("f", "b"))),
+        (True, ("on", ("d", "f"))),
+        (True, ("on", ("g", "d"))),
+    ]
     alone = [(True, ("ontable", ("e",)))]
     assert reachable_goal(tower + alone, ["f"]) == tuple(alone)
     assert reachable_goal(tower + alone, ["e"]) == tuple(tower)
@@ -160,7 +201,10 @@ def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
 
 
 @given(
-    st.lists(st.tuples(st.sampled_from(["on", "ontable"]), st.lists(st.sampled_from("abcdefg"), min_size=1, max_size=2)), max_size=8),
+    st.lists(
+        st.tuples(st.sampled_from(["on", "ontable"]), st.lists(st.sampled_from("abcdefg"), min_size=1, max_size=2)),
+        max_size=8,
+    ),
     st.sets(st.sampled_from("abcdefg"), max_size=3),
 )
 def test_the_kept_part_of_the_goal_shares_no_object_with_the_left_out_part(raw, outside):

@@ -18,7 +18,21 @@ def test_unstack_in_the_blocks_world(capfd):
 
 
 def test_move_to_a_goal_inside_a_rock_fails_with_the_reason(capfd):
-    code = main(["skill", "run", "MoveToPosition", "--world", "lunar", "--robot", "scout", "--rocks", "0", "--param", "goal=[100, 0]"])
+    code = main(
+        [
+            "skill",
+            "run",
+            "MoveToPosition",
+            "--world",
+            "lunar",
+            "--robot",
+            "scout",
+            "--rocks",
+            "0",
+            "--param",
+            "goal=[100, 0]",
+        ]
+    )
     out = capfd.readouterr().out
     assert code == 1
     assert "MoveToPosition on scout: failure" in out

@@ -84,7 +84,9 @@ def test_the_same_seed_gives_the_same_choices():
 def _park_at_every_stack(world):
     """Team robots at the work position of each stack (base centre 0.68 m in front of it)."""
     bottoms = [o for o in world.objects.values() if o.kind == "block" and ("ontable", o.name) in blocks_facts(world)]
-    for robot, block in zip(sorted(n for n in world.robots if n.startswith("r")), sorted(bottoms, key=lambda o: o.name), strict=True):
+    for robot, block in zip(
+        sorted(n for n in world.robots if n.startswith("r")), sorted(bottoms, key=lambda o: o.name), strict=True
+    ):
         x, y = (float(v) for v in block.position()[:2])
         side = -1.0 if robot == "r1" else 1.0
         world.robots[robot].set_pose(x, y + side * 0.68, -side * 0.5 * math.pi)

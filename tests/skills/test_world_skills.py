@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 import pytest
 
 from alica.errors import SkillError
@@ -162,7 +161,11 @@ def test_a_robot_without_an_arm_cannot_pick_up(lunar_world, skill_run):
 
 
 def test_transport_a_sample_to_the_collection_point(lunar_world, skill_run):
-    steps = [("Pickup", {"object": "a"}), ("MoveToPosition", {"goal": "pos(g)", "tolerance": 1.0}), ("Putdown", {"object": "a", "target": "pos(g)"})]
+    steps = [
+        ("Pickup", {"object": "a"}),
+        ("MoveToPosition", {"goal": "pos(g)", "tolerance": 1.0}),
+        ("Putdown", {"object": "a", "target": "pos(g)"}),
+    ]
     for name, params in steps:
         run = skill_run(name, lunar_world, "stummel", params, timeout=200)
         assert run.ok, (name, run.reason, run.trace[-6:])
@@ -233,7 +236,9 @@ def test_an_escape_turns_on_the_spot_before_it_drives(blocks_world, skill_run):
         behaviour._stuck(world.now())  # as if the base had just bumped
         x, y, _ = robot.pose
         spot = behaviour.follower.path[-1]
-        robot.set_pose(x, y, math.atan2(spot[1] - y, spot[0] - x) + math.radians(40.0))  # free space 40 degrees to the right
+        robot.set_pose(
+            x, y, math.atan2(spot[1] - y, spot[0] - x) + math.radians(40.0)
+        )  # free space 40 degrees to the right
         escapes.append(behaviour.follower.command(robot.pose, 0.1))
 
     run = skill_run("MoveToPosition", blocks_world, "r1", {"goal": [cx - 1.2, cy - 0.6]}, on_tick=stuck_once_then_watch)

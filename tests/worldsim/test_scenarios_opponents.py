@@ -47,7 +47,9 @@ def test_opponents_stand_clear_and_the_team_keeps_its_places():
     with blocksworld(stacks, agents=5) as plain, blocksworld(stacks, agents=5, opponents=2) as world:
         assert sorted(world.robots) == ["o1", "o2", "r1", "r2", "r3", "r4", "r5"]
         assert all(r.spec.kind == "manipulator" for r in world.robots.values())
-        assert {n: r.pose for n, r in world.robots.items() if n.startswith("r")} == {n: r.pose for n, r in plain.robots.items()}
+        assert {n: r.pose for n, r in world.robots.items() if n.startswith("r")} == {
+            n: r.pose for n, r in plain.robots.items()
+        }
         robots = list(world.robots.values())
         for one, other in ((a, b) for i, a in enumerate(robots) for b in robots[i + 1 :]):
             assert math.dist(one.pose[:2], other.pose[:2]) >= one.spec.radius + other.spec.radius + 0.5
@@ -94,5 +96,7 @@ def test_every_robot_can_drive_around_the_stacks(robot):
 def test_stacks_of_a_random_configuration_stand_in_the_row():
     stacks = random_stacks(8, 11, max_height=3)
     with blocksworld(stacks, agents=5, opponents=2, seed=11) as world:
-        wanted = {("ontable", s[0]) for s in stacks} | {("on", upper, lower) for s in stacks for lower, upper in pairwise(s)}
+        wanted = {("ontable", s[0]) for s in stacks} | {
+            ("on", upper, lower) for s in stacks for lower, upper in pairwise(s)
+        }
         assert wanted <= blocks_facts(world)

@@ -125,7 +125,9 @@ def check_stacks(stacks: object, what: str) -> Stacks:
         AlicaError: not a list of non-empty lists of distinct names.
     """
     if not isinstance(stacks, list) or not stacks or not all(isinstance(s, list) and s for s in stacks):
-        raise AlicaError(f"{what} must be a list of stacks, each a non-empty list of block names (bottom first), e.g. [[a, b], [c]]")
+        raise AlicaError(
+            f"{what} must be a list of stacks, each a non-empty list of block names (bottom first), e.g. [[a, b], [c]]"
+        )
     names = [str(b) for s in stacks for b in s]
     if len(set(names)) != len(names):
         raise AlicaError(f"{what} names a block twice: {names}")
@@ -150,7 +152,9 @@ def configurations(config: DemoConfig) -> tuple[Stacks, Stacks]:
         k = 1
         while True:
             candidate = _renamed(random_stacks(len(blocks), config.seed * 7919 + k), blocks)
-            if sorted(map(sorted, candidate)) != sorted(map(sorted, start)) or sorted(goal_facts(candidate)) != sorted(goal_facts(start)):
+            if sorted(map(sorted, candidate)) != sorted(map(sorted, start)) or sorted(goal_facts(candidate)) != sorted(
+                goal_facts(start)
+            ):
                 goal = candidate
                 break
             k += 1
@@ -176,7 +180,11 @@ class _Counter:
 
     def __call__(self, event: dict[str, Any]) -> None:
         kind = event["event"]
-        if kind == "transition" and str(event.get("plan", "")).startswith(f"{PROBLEM}_g") and str(event.get("target", "")).endswith("_Done"):
+        if (
+            kind == "transition"
+            and str(event.get("plan", "")).startswith(f"{PROBLEM}_g")
+            and str(event.get("target", "")).endswith("_Done")
+        ):
             agent = str(event["agent"])
             self.tasks[agent] = self.tasks.get(agent, 0) + 1
         elif kind == "replan":
@@ -210,15 +218,16 @@ def run_demo(
     """
     from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam
     from alica.io import load_library
+    from alica.skills.motion import configure_ompl
     from alica.skills.registry import default_registry
     from alica.worldsim.perception import FactPerception
     from alica.worldsim.scenarios import blocks_facts, blocksworld
 
-    from alica.skills.motion import configure_ompl
-
     configure_ompl(config.seed)  # OMPL's generator is per process: seed it before any planner exists
     if config.agents < 1 or config.opponents < 0:
-        raise AlicaError(f"the demo needs at least 1 agent and 0 or more opponents, got {config.agents} and {config.opponents}")
+        raise AlicaError(
+            f"the demo needs at least 1 agent and 0 or more opponents, got {config.agents} and {config.opponents}"
+        )
     start, goal = configurations(config)
     library = load_library(MISSION)
     extra: dict[str, Any] = {"opponents": config.opponents} if config.opponents else {}
@@ -231,15 +240,34 @@ def run_demo(
     settings = EngineConfig(frequency=config.frequency)
     perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
     registry = default_registry()
-    team = SimulatedTeam(library, "BlocksWorldMission", {f"r{i + 1}": "Manipulator" for i in range(config.agents)}, seed=config.seed,
-                         config=settings, skill_registry=registry, observers=watchers, world=world, perception=perception, step_world=False)
+    team = SimulatedTeam(
+        library,
+        "BlocksWorldMission",
+        {f"r{i + 1}": "Manipulator" for i in range(config.agents)},
+        seed=config.seed,
+        config=settings,
+        skill_registry=registry,
+        observers=watchers,
+        world=world,
+        perception=perception,
+        step_world=False,
+    )
     text = goal_text(goal)
     for engine in team.engines.values():
         engine.set_problem(PROBLEM, goal=text)
     rivals = None
     if config.opponents:
-        rivals = SimulatedTeam(library, "BlocksWorldOpponent", {f"o{i + 1}": "Opponent" for i in range(config.opponents)}, seed=config.seed + 1,
-                               config=settings, skill_registry=registry, observers=watchers, world=world, step_world=False)
+        rivals = SimulatedTeam(
+            library,
+            "BlocksWorldOpponent",
+            {f"o{i + 1}": "Opponent" for i in range(config.opponents)},
+            seed=config.seed + 1,
+            config=settings,
+            skill_registry=registry,
+            observers=watchers,
+            world=world,
+            step_world=False,
+        )
     for when, action in actions:
         team.at(when, "demo action", lambda action=action: action(team))
     wanted = set(goal_facts(goal))

@@ -43,7 +43,9 @@ def test_rovers_static_facts_leave_preconditions() -> None:
     assert sorted(task.facts[p] for p in nav.pre) == ["(at rover0 waypoint3)", "(available rover0)"]
     # channel_free is deleted and added: the add wins
     comm = next(op for op in task.operators if op.action == "communicate_soil_data")
-    assert task.fact_id("(channel_free general)") in comm.add and task.fact_id("(channel_free general)") not in comm.delete
+    assert (
+        task.fact_id("(channel_free general)") in comm.add and task.fact_id("(channel_free general)") not in comm.delete
+    )
 
 
 @pytest.mark.parametrize(("names", "limit"), [([f"p{i:02d}" for i in range(1, 21)], 0.5), (["p30", "p40"], 15.0)])
@@ -65,7 +67,12 @@ NEG = """(define (domain neg) (:requirements :negative-preconditions :equality)
 
 
 def test_negative_preconditions_compiled() -> None:
-    task = _task(NEG, "(define (problem q) (:domain neg) (:objects a b) (:init (lit b)) (:goal (and (p a b) (not (lit c)))))".replace(" (not (lit c))", ""))
+    task = _task(
+        NEG,
+        "(define (problem q) (:domain neg) (:objects a b) (:init (lit b)) (:goal (and (p a b) (not (lit c)))))".replace(
+            " (not (lit c))", ""
+        ),
+    )
     light_a = task.operator("(light a)")[0]
     assert [task.facts[i] for i in light_a.pre] == ["(not-lit a)"]
     assert [task.facts[i] for i in light_a.add] == ["(lit a)"]
@@ -96,7 +103,10 @@ COND = """(define (domain cond) (:requirements :conditional-effects :typing)
 
 
 def test_conditional_effects_applied() -> None:
-    task = _task(COND, "(define (problem c) (:domain cond) (:objects r1 r2 - room b1 b2 - ball) (:init (robot r1) (at b1 r1) (at b2 r2)) (:goal (and (at b1 r2) (at b2 r2))))")
+    task = _task(
+        COND,
+        "(define (problem c) (:domain cond) (:objects r1 r2 - room b1 b2 - ball) (:init (robot r1) (at b1 r1) (at b2 r2)) (:goal (and (at b1 r2) (at b2 r2))))",
+    )
     op = task.operator("(move r1 r2)")[0]
     assert len(op.conditional) >= 1
     after = task.apply(task.init, op)
@@ -115,7 +125,10 @@ COSTS = """(define (domain roads) (:requirements :typing :action-costs)
 
 
 def test_costs_read_from_fluents() -> None:
-    task = _task(COSTS, "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road x y) (= (length x y) 7) (= (total-cost) 0)) (:goal (at y)) (:metric minimize (total-cost)))")
+    task = _task(
+        COSTS,
+        "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road x y) (= (length x y) 7) (= (total-cost) 0)) (:goal (at y)) (:metric minimize (total-cost)))",
+    )
     assert task.has_costs
     assert task.operator("(drive x y)")[0].cost == 7
     assert task.operator("(wait)")[0].cost == 3
@@ -123,11 +136,17 @@ def test_costs_read_from_fluents() -> None:
 
 def test_missing_cost_value_is_an_error() -> None:
     with pytest.raises(PddlError, match=r"\(length x y\) has no value"):
-        _task(COSTS, "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road x y)) (:goal (at y)))")
+        _task(
+            COSTS,
+            "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road x y)) (:goal (at y)))",
+        )
 
 
 def test_unreachable_goal_marked() -> None:
-    task = _task(COSTS, "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road y x) (= (length y x) 1)) (:goal (at y)))")
+    task = _task(
+        COSTS,
+        "(define (problem r) (:domain roads) (:objects x y - place) (:init (at x) (road y x) (= (length y x) 1)) (:goal (at y)))",
+    )
     assert task.unsolvable_reason is not None and "(at y)" in task.unsolvable_reason
 
 

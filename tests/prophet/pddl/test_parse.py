@@ -62,7 +62,11 @@ def test_model_of_blocks_and_rovers() -> None:
 
 
 BROKEN = [
-    ("missing paren at the end", "(define (domain d)\n  (:predicates (p ?x))", r"d\.pddl:2:23: error: expected '\)' to close '\(define' opened at 1:1"),
+    (
+        "missing paren at the end",
+        "(define (domain d)\n  (:predicates (p ?x))",
+        r"d\.pddl:2:23: error: expected '\)' to close '\(define' opened at 1:1",
+    ),
     (
         "missing paren in an action",
         "(define (domain d)\n  (:predicates (p ?x))\n  (:action pick-up :parameters (?x)\n    :precondition (p ?x) :effect (not (p ?x))\n  (:action b :parameters ()))",
@@ -79,15 +83,31 @@ BROKEN = [
         "(define (domain d) (:predicates (p ?x))\n (:action a :parameters (?x) :effect (p ?x ?x)))",
         r"d\.pddl:2:38: error: wrong number of arguments for 'p': expected 1, found 2",
     ),
-    ("unknown type", "(define (domain d) (:types a)\n (:predicates (p ?x - b)))", r"d\.pddl:2:23: error: unknown type 'b'"),
-    ("unsupported requirement", "(define (domain d)\n (:requirements :strips :fluents))", r"d\.pddl:2:25: error: unsupported requirement ':fluents'"),
-    ("unknown requirement", "(define (domain d) (:requirements :teleport))", r"d\.pddl:1:35: error: unknown requirement ':teleport'"),
+    (
+        "unknown type",
+        "(define (domain d) (:types a)\n (:predicates (p ?x - b)))",
+        r"d\.pddl:2:23: error: unknown type 'b'",
+    ),
+    (
+        "unsupported requirement",
+        "(define (domain d)\n (:requirements :strips :fluents))",
+        r"d\.pddl:2:25: error: unsupported requirement ':fluents'",
+    ),
+    (
+        "unknown requirement",
+        "(define (domain d) (:requirements :teleport))",
+        r"d\.pddl:1:35: error: unknown requirement ':teleport'",
+    ),
     (
         "undefined variable",
         "(define (domain d) (:predicates (p ?x))\n (:action a :parameters (?x) :precondition (p ?y)))",
         r"d\.pddl:2:47: error: undefined variable '\?y'",
     ),
-    ("derived predicates", "(define (domain d) (:derived (p) (q)))", r"d\.pddl:1:20: error: unsupported construct '\(:derived"),
+    (
+        "derived predicates",
+        "(define (domain d) (:derived (p) (q)))",
+        r"d\.pddl:1:20: error: unsupported construct '\(:derived",
+    ),
     (
         "numeric effect",
         "(define (domain d) (:functions (f)) (:action a :parameters () :effect (assign (f) 1)))",
@@ -112,12 +132,32 @@ def test_broken_domains_name_the_place(case: str, text: str, message: str) -> No
 DOMAIN = "(define (domain d) (:requirements :typing :action-costs) (:types block) (:predicates (p ?x - block))\n (:functions (total-cost) - number))"
 
 BROKEN_PROBLEMS = [
-    ("unknown object", "(define (problem x) (:domain d) (:objects a - block)\n (:init (p b)) (:goal (p a)))", r"p\.pddl:2:12: error: undefined object or constant 'b'"),
-    ("bad number in init", "(define (problem x) (:domain d) (:init (= (total-cost) zero)) (:goal (and)))", r"p\.pddl:1:56: error: bad number 'zero'"),
-    ("wrong domain", "(define (problem x) (:domain e) (:goal (and)))", r"p\.pddl:1:30: error: problem is for domain 'e', not 'd'"),
-    ("unknown object type", "(define (problem x) (:domain d) (:objects a - ball) (:goal (and)))", r"p\.pddl:1:47: error: unknown type 'ball'"),
+    (
+        "unknown object",
+        "(define (problem x) (:domain d) (:objects a - block)\n (:init (p b)) (:goal (p a)))",
+        r"p\.pddl:2:12: error: undefined object or constant 'b'",
+    ),
+    (
+        "bad number in init",
+        "(define (problem x) (:domain d) (:init (= (total-cost) zero)) (:goal (and)))",
+        r"p\.pddl:1:56: error: bad number 'zero'",
+    ),
+    (
+        "wrong domain",
+        "(define (problem x) (:domain e) (:goal (and)))",
+        r"p\.pddl:1:30: error: problem is for domain 'e', not 'd'",
+    ),
+    (
+        "unknown object type",
+        "(define (problem x) (:domain d) (:objects a - ball) (:goal (and)))",
+        r"p\.pddl:1:47: error: unknown type 'ball'",
+    ),
     ("no goal", "(define (problem x) (:domain d))", r"p\.pddl:1:1: error: expected a '\(:goal \.\.\.\)' section"),
-    ("negative init", "(define (problem x) (:domain d) (:objects a - block) (:init (not (p a))) (:goal (p a)))", r"p\.pddl:1:61: error: unsupported construct '\(not"),
+    (
+        "negative init",
+        "(define (problem x) (:domain d) (:objects a - block) (:init (not (p a))) (:goal (p a)))",
+        r"p\.pddl:1:61: error: unsupported construct '\(not",
+    ),
 ]
 
 

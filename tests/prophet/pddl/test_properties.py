@@ -53,7 +53,13 @@ def domains(draw: st.DrawFn) -> Domain:
         precondition = pre_parts[0] if len(pre_parts) == 1 and draw(st.booleans()) else And(tuple(pre_parts))
         actions.append(Action(f"act{k}", params, precondition, And(tuple(effects))))
     return Domain(
-        draw(NAMES), frozenset(Feature), dict(TYPES), (("k", "box"),), predicates, (), tuple(actions),
+        draw(NAMES),
+        frozenset(Feature),
+        dict(TYPES),
+        (("k", "box"),),
+        predicates,
+        (),
+        tuple(actions),
         frozenset({"disjunctive-preconditions"}),
     )
 
@@ -65,7 +71,9 @@ def test_generated_domains_round_trip(domain: Domain) -> None:
 
 @given(domains(), st.data())
 def test_generated_problems_round_trip(domain: Domain, data: st.DataObject) -> None:
-    objects = tuple((f"o{i}", data.draw(st.sampled_from(["object", *TYPES]))) for i in range(data.draw(st.integers(0, 3))))
+    objects = tuple(
+        (f"o{i}", data.draw(st.sampled_from(["object", *TYPES]))) for i in range(data.draw(st.integers(0, 3)))
+    )
     names = [o for o, _ in objects] + ["k"]
     facts = tuple(
         Atom(p.name, tuple(data.draw(st.sampled_from(names)) for _ in range(p.arity)))
@@ -77,9 +85,44 @@ def test_generated_problems_round_trip(domain: Domain, data: st.DataObject) -> N
 
 
 TOKENS = st.sampled_from(
-    ["(", ")", "(", ")", "define", "domain", "problem", ":action", ":predicates", ":parameters", ":precondition",
-     ":effect", ":types", ":requirements", ":strips", ":typing", "and", "not", "or", "forall", "when", "=", "-",
-     "?x", "?y", "p", "q", "1", "1.5x", ";c\n", "\n", "increase", "(total-cost)", ":init", ":goal", ":objects"]
+    [
+        "(",
+        ")",
+        "(",
+        ")",
+        "define",
+        "domain",
+        "problem",
+        ":action",
+        ":predicates",
+        ":parameters",
+        ":precondition",
+        ":effect",
+        ":types",
+        ":requirements",
+        ":strips",
+        ":typing",
+        "and",
+        "not",
+        "or",
+        "forall",
+        "when",
+        "=",
+        "-",
+        "?x",
+        "?y",
+        "p",
+        "q",
+        "1",
+        "1.5x",
+        ";c\n",
+        "\n",
+        "increase",
+        "(total-cost)",
+        ":init",
+        ":goal",
+        ":objects",
+    ]
 )
 
 

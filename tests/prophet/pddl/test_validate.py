@@ -13,7 +13,14 @@ from alica.prophet.validate import validate_plan
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
 
-GOOD = [("pick-up", "b"), ("stack", "b", "a"), ("pick-up", "c"), ("stack", "c", "b"), ("pick-up", "d"), ("stack", "d", "c")]
+GOOD = [
+    ("pick-up", "b"),
+    ("stack", "b", "a"),
+    ("pick-up", "c"),
+    ("stack", "c", "b"),
+    ("pick-up", "d"),
+    ("stack", "d", "c"),
+]
 
 
 @pytest.fixture
@@ -47,12 +54,21 @@ def test_wrong_plan_rejected_with_step_and_literal(blocks: tuple, lifted: bool) 
 def test_goal_not_reached(blocks: tuple, lifted: bool) -> None:
     task = blocks if lifted else ground(*blocks)
     result = validate_plan(task, _steps(GOOD[:2]))
-    assert not result.valid and result.failed_step is None and result.reason.startswith("goal (on ") and "does not hold" in result.reason
+    assert (
+        not result.valid
+        and result.failed_step is None
+        and result.reason.startswith("goal (on ")
+        and "does not hold" in result.reason
+    )
 
 
 def test_lifted_checks_names_and_types() -> None:
-    domain = parse_domain("(define (domain t) (:types a b) (:predicates (p ?x - a)) (:action go :parameters (?x - a) :effect (p ?x)))")
-    problem = parse_problem("(define (problem q) (:domain t) (:objects x - a y - b) (:init) (:goal (p x)))", domain=domain)
+    domain = parse_domain(
+        "(define (domain t) (:types a b) (:predicates (p ?x - a)) (:action go :parameters (?x - a) :effect (p ?x)))"
+    )
+    problem = parse_problem(
+        "(define (problem q) (:domain t) (:objects x - a y - b) (:init) (:goal (p x)))", domain=domain
+    )
     assert "unknown action" in validate_plan((domain, problem), [PlanStep("fly", ("x",))]).reason
     assert "'y' is no a" in validate_plan((domain, problem), [PlanStep("go", ("y",))]).reason
     assert "unknown object 'z'" in validate_plan((domain, problem), [PlanStep("go", ("z",))]).reason
@@ -64,7 +80,10 @@ def test_costs_summed() -> None:
       (:predicates (at ?p) (road ?a ?b)) (:functions (total-cost) (length ?a ?b))
       (:action drive :parameters (?a ?b) :precondition (and (at ?a) (road ?a ?b))
         :effect (and (not (at ?a)) (at ?b) (increase (total-cost) (length ?a ?b)))))""")
-    problem = parse_problem("(define (problem r) (:domain roads) (:objects x y z) (:init (at x) (road x y) (road y z) (= (length x y) 2) (= (length y z) 5)) (:goal (at z)))", domain=domain)
+    problem = parse_problem(
+        "(define (problem r) (:domain roads) (:objects x y z) (:init (at x) (road x y) (road y z) (= (length x y) 2) (= (length y z) 5)) (:goal (at z)))",
+        domain=domain,
+    )
     plan = [PlanStep("drive", ("x", "y")), PlanStep("drive", ("y", "z"))]
     assert validate_plan((domain, problem), plan).cost == 7
     assert validate_plan(ground(domain, problem), plan).cost == 7

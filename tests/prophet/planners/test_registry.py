@@ -11,7 +11,10 @@ from alica.prophet.planners.fd import FastDownward
 
 
 def test_names() -> None:
-    assert PLANNERS == {"builtin": "alica.prophet.search.planner:BuiltinPlanner", "fd": "alica.prophet.planners.fd:FastDownward"}
+    assert PLANNERS == {
+        "builtin": "alica.prophet.search.planner:BuiltinPlanner",
+        "fd": "alica.prophet.planners.fd:FastDownward",
+    }
 
 
 def test_get_planner_by_name() -> None:
