@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: demo test setup clean
+.PHONY: demo test check setup clean
 
 setup: $(STAMP)
 
@@ -27,6 +27,10 @@ demo: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest
+
+# The quality gates: ruff (lint, format), mypy, the import-linter layer contracts.
+check: $(STAMP)
+	$(BIN)/python tools/quality.py
 
 clean:
 	rm -rf $(VENV) build
