@@ -3,8 +3,9 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
+DOCS_STAMP := $(VENV)/.installed-docs
 
-.PHONY: demo test check setup clean
+.PHONY: demo test check docs setup clean
 
 setup: $(STAMP)
 
@@ -31,6 +32,16 @@ test: $(STAMP)
 # The quality gates: ruff (lint, format), mypy, the import-linter layer contracts.
 check: $(STAMP)
 	$(BIN)/python tools/quality.py
+
+# The documentation site (mkdocs, Material, API reference by mkdocstrings) into
+# build/site/. Its tools are the `docs` extra, installed here only, so that
+# `make test` does not need them.
+$(DOCS_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test,docs]'
+	touch $(DOCS_STAMP)
+
+docs: $(DOCS_STAMP)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict -d build/site
 
 clean:
 	rm -rf $(VENV) build
