@@ -10,6 +10,7 @@ renders (``::: name``) can be imported.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import re
 from collections.abc import Iterator
 from pathlib import Path
@@ -108,3 +109,15 @@ def test_reference_objects_import() -> None:
     assert identifiers, "the API reference renders no object"
     for identifier in identifiers:
         _import(identifier)
+
+
+def test_nested_lists_are_indented_for_python_markdown() -> None:
+    pytest.importorskip("mkdocs")  # the hook module needs the docs extra
+    pytest.importorskip("griffe")
+    spec = importlib.util.spec_from_file_location("docs_hooks", ROOT / "tools" / "docs_hooks.py")
+    assert spec is not None and spec.loader is not None
+    hooks = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hooks)
+    page = "1. top\n   of it\n   - inner\n     more\n2. next\n\n```\n  - code\n```\n- a\n  - b\n"
+    expected = "1. top\n   of it\n    - inner\n      more\n2. next\n\n```\n  - code\n```\n- a\n    - b\n"
+    assert hooks.nest_lists(page) == expected

@@ -75,3 +75,50 @@ def _code(match: re.Match[str]) -> str:
     target = match.group(1)
     shown = target.rsplit(".", 1)[-1] if match.group(0).split("`", 1)[1].startswith("~") else target
     return f"`{shown}`"
+
+
+ITEM = re.compile(r"^( *)([-*+]|\d+[.)]) +")
+
+
+def nest_lists(markdown: str) -> str:
+    """Indent nested list items by 4 spaces per level, as Python-Markdown needs.
+
+    The pages are written for GitHub, where an item indented to its parent's
+    text (2 or 3 spaces) is nested; Python-Markdown would flatten it into the
+    parent list. Item lines, and the indented lines that follow them, are
+    shifted to 4 spaces per level; fenced code is left alone.
+    """
+    out: list[str] = []
+    stack: list[tuple[int, int]] = []  # per open item: (its text's column in the source, its indent on output)
+    shift = 0
+    fence = ""
+    for line in markdown.split("\n"):
+        stripped = line.lstrip(" ")
+        indent = len(line) - len(stripped)
+        if fence or stripped.startswith(("```", "~~~")):
+            marker = stripped[:3]
+            fence = "" if fence and stripped.startswith(fence) else (fence or marker)
+            stack, shift = ([], 0) if indent == 0 else (stack, shift)
+            out.append(line)
+            continue
+        item = ITEM.match(line)
+        if item:
+            while stack and indent < stack[-1][0]:
+                stack.pop()
+            level = stack[-1][1] + 4 if stack else 0
+            shift = level - indent
+            stack.append((len(item.group(0)), level))
+            out.append(" " * level + stripped)
+        elif not stripped:
+            out.append(line)
+        elif indent == 0:
+            stack, shift = [], 0
+            out.append(line)
+        else:
+            out.append(" " * max(indent + shift, 0) + stripped)
+    return "\n".join(out)
+
+
+def on_page_markdown(markdown: str, **kwargs: Any) -> str:
+    """mkdocs event: nest the page's lists the way GitHub shows them."""
+    return nest_lists(markdown)
