@@ -13,46 +13,24 @@ out ``build/typecheck/`` the same way.
 
 from __future__ import annotations
 
-import os
 import re
-import shutil
-import tomllib
+import sys
 from pathlib import Path
 from typing import Any
 
 import griffe
 from mkdocs.plugins import event_priority
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from layout import ROOT, stage  # a sibling module, found through the line above
+
 STAGE = ROOT / "build" / "docs-api"
-SUFFIXES = {".py", ".pyi", ".typed"}
-
-
-def package_dirs(root: Path = ROOT) -> dict[str, str]:
-    """Installed package name -> checkout folder, for every package with Python code."""
-    config = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
-    dirs: dict[str, str] = config.get("package-dir", {})
-    return {"alica": "alica", **{name: src for name, src in dirs.items() if name != "alica.plans"}}
-
-
-def stage(root: Path = ROOT, target: Path = STAGE) -> Path:
-    """Link every source file under ``target`` by its installed name; return ``target``."""
-    shutil.rmtree(target, ignore_errors=True)
-    for name, source in package_dirs(root).items():
-        base = target.joinpath(*name.split("."))
-        for path in (root / source).rglob("*"):
-            if "__pycache__" in path.parts or path.is_dir() or path.suffix not in SUFFIXES:
-                continue
-            link = base / path.relative_to(root / source)
-            link.parent.mkdir(parents=True, exist_ok=True)
-            os.symlink(path, link)
-    return target
 
 
 @event_priority(100)  # before mkdocstrings sets up its handler
 def on_config(config: Any) -> Any:
     """mkdocs event: stage the sources before any plugin reads them."""
-    stage()
+    stage(STAGE)
     return config
 
 
