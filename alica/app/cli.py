@@ -134,7 +134,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
 
 
 def _cmd_list_skills(args: argparse.Namespace) -> int:
-    from alica.skills.registry import default_registry
+    from alica.lang.skill_plugins import default_registry
 
     for spec in default_registry():
         caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""

@@ -115,8 +115,8 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
 
 def cmd_skill_run(args: argparse.Namespace) -> int:
     """Run ``alica skill run``; returns the exit code."""
+    from alica.lang.skill_plugins import default_registry
     from alica.skills.motion import configure_ompl
-    from alica.skills.registry import default_registry
     from alica.skills.testing import run_skill
 
     configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists

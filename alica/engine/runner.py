@@ -67,7 +67,7 @@ class SimulatedTeam:
         loss: probability that a best-effort message is lost on a link.
         delay: base message delay in seconds; ``jitter`` adds a uniform random part.
         skills: skill factories by behaviour or skill name (test doubles, real skills).
-        skill_registry: a :class:`alica.skills.registry.SkillRegistry` for implementations.
+        skill_registry: a :class:`alica.lang.skills.SkillRegistry` for implementations.
         fallback: factory maker for skills nothing implements; ``None`` makes them fail.
         registry: predicates and functions of formulas.
         observers: trace observers.
