@@ -14,7 +14,17 @@ LUNAR = str(PLANS / "lunar" / "mission.yaml")
 
 def test_run_until_done_prints_a_summary(capsys):
     code = main(
-        ["run", LUNAR, "--stand-ins", "--agents", "scout,stummel,amparo", "--fact", "found(a) and found(b)@3", "--max-time", "120"]
+        [
+            "run",
+            LUNAR,
+            "--stand-ins",
+            "--agents",
+            "scout,stummel,amparo",
+            "--fact",
+            "found(a) and found(b)@3",
+            "--max-time",
+            "120",
+        ]
     )
     out = capsys.readouterr().out
     assert code == 0, out
