@@ -46,7 +46,7 @@ def _register_function(target: object, where: str) -> Callable[[SkillRegistry], 
                 f"skill module '{where}' has no register(registry) function; define one that declares its skills"
             )
     else:
-        function = target  # type: ignore[assignment]
+        function = target
     if not callable(function):
         raise SkillPluginError(f"skill module '{where}': register is not a function")
     return function

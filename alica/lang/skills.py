@@ -208,7 +208,7 @@ class SkillRegistry:
         """An independent registry with the same declarations."""
         return SkillRegistry(dict(self._specs), self.origin)
 
-    def load(self, name: str) -> object:
+    def load(self, name: str) -> Callable[..., Any]:
         """Import and return the implementation of ``name``.
 
         Raises:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+import textwrap
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -246,3 +247,37 @@ def test_public_names() -> None:
     registry = SkillRegistry()
     spec = registry.declare("Wave", ParamSpec("times", "int", required=False, default=2), implementation="m:Wave")
     assert spec.implementation_name == "m:Wave" and registry.get("Wave").param("times") is not None
+
+
+def test_a_project_with_its_own_skills_package_runs_pytest_with_the_fixtures(tmp_path: Path) -> None:
+    import importlib.metadata
+    import subprocess
+
+    plugins = {e.value for e in importlib.metadata.entry_points(group="pytest11")}
+    assert "alica.skills.pytest_plugin" in plugins  # the installed name, which a user's skills/ cannot shadow
+
+    (tmp_path / "skills").mkdir()
+    (tmp_path / "skills" / "__init__.py").write_text('"""The user\'s own skills package."""\nMINE = True\n')
+    (tmp_path / "test_mine.py").write_text(
+        textwrap.dedent(
+            """
+            import alica.io
+            import skills
+
+
+            def test_fixtures_and_imports(blocks_world, skill_run):
+                assert skills.MINE and alica.io.load_library is not None
+                run = skill_run("Idle", blocks_world, "r1", {"duration": 0.5})
+                assert run.status == "success", run.reason
+            """
+        )
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "test_mine.py"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "1 passed" in done.stdout
