@@ -16,14 +16,15 @@ $(STAMP): pyproject.toml
 
 # The main demo. Until the lunar mission demo with robots exists: validate every
 # plan, render the plan trees, run the lunar mission's team in simulation
-# (scripted skills; Scout crashes and Stummel takes over the exploration), then
+# (--stand-ins: its skills have no implementation yet, so scripted stand-ins run
+# them; Scout crashes and Stummel takes over the exploration), then
 # the blocks-world mission in pybullet (planned at run time, real skills).
 demo: $(STAMP)
 	$(BIN)/alica validate plans/
 	$(BIN)/alica render plans/ --out build/plans
 	$(BIN)/alica run plans/lunar/mission.yaml --agents scout,stummel,amparo \
 		--fact "found(a) and found(b)@5" --crash scout@2 --loss 0.1 --delay 20 \
-		--seed 1 --trace build/lunar.jsonl
+		--seed 1 --stand-ins --trace build/lunar.jsonl
 	$(BIN)/alica demo blocksworld --agents 3 --blocks 5 --seed 1 --out build/blocks
 
 test: $(STAMP)

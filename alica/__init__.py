@@ -4,7 +4,8 @@
 """
 
 from alica.lang.fact import Fact
+from alica.lang.skills import ParamSpec, SkillRegistry, SkillSpec
 
 __version__ = "0.1.0"
 
-__all__ = ["Fact", "__version__"]
+__all__ = ["Fact", "ParamSpec", "SkillRegistry", "SkillSpec", "__version__"]

@@ -19,6 +19,7 @@ from py_trees.common import Status
 from alica.clock import ManualClock
 from alica.errors import AlicaError
 from alica.lang import literals
+from alica.lang.skills import SkillRegistry
 from alica.model import Behaviour
 
 __all__ = ["ManualClock", "ScriptedSkill", "TimedSkill", "default_fallback", "scripted"]
@@ -161,28 +162,51 @@ def post_facts(behaviour: Behaviour) -> tuple[Fact, ...]:
     return tuple((positive, name, tuple(args)) for positive, name, args in found if name != "=")
 
 
-#: Skills that wait in place until their state is left.
+#: Skills that wait in place until their state is left (when their duration is 0 or not given).
 IDLE_SKILLS = frozenset({"Idle"})
+#: Parameter names a stand-in reads as how long it runs, in simulated seconds.
+DURATION_PARAMS = ("duration", "seconds", "wait")
 
 
-def default_fallback(seed: int = 0, low: float = 0.5, high: float = 2.0) -> Any:
+def _duration(params: Mapping[str, object]) -> float | None:
+    """The first positive duration-like parameter (``duration``, ``seconds``, ``wait``, ``*_duration``)."""
+    names = [n for n in DURATION_PARAMS if n in params] + sorted(n for n in params if n.endswith("_duration"))
+    for name in names:
+        value = params[name]
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0:
+            return float(value)
+    return None
+
+
+def default_fallback(seed: int = 0, low: float = 0.5, high: float = 2.0, registry: SkillRegistry | None = None) -> Any:
     """Scripted stand-ins for skills that have no implementation, for dry runs of plans.
 
-    ``Idle`` runs until its state is left. Every other skill runs for its
-    ``duration`` parameter if it has one, else for a time drawn from
-    ``[low, high]`` seconds (fixed per behaviour and seed), then succeeds and
-    writes its post-condition's literals to the world model.
+    A stand-in honours the skill's parameters, with the defaults ``registry``
+    declares: it runs for its duration-like parameter (see :data:`DURATION_PARAMS`)
+    when that is positive; else ``Idle`` runs until its state is left and
+    every other skill for a time drawn from ``[low, high]`` seconds (fixed per
+    behaviour and seed). Then it succeeds and writes its post-condition's
+    literals to the world model (``Idle`` writes none).
+
+    Args:
+        seed: seeds the drawn times.
+        low: shortest drawn time in seconds.
+        high: longest drawn time in seconds.
+        registry: skill declarations whose parameter defaults the stand-ins use.
     """
     import random
 
     def fallback(behaviour: Behaviour) -> Any:
+        spec = registry.get(behaviour.skill) if registry is not None and behaviour.skill in registry else None
+        defaults = {p.name: p.default for p in spec.params if not p.required} if spec is not None else {}
+
         def factory(name: str, params: Mapping[str, object], context: Any) -> TimedSkill:
+            duration = _duration({**defaults, **params})
             if behaviour.skill in IDLE_SKILLS:
-                return TimedSkill(name, None)
-            duration = params.get("duration")
-            if not isinstance(duration, (int, float)) or isinstance(duration, bool) or duration <= 0:
+                return TimedSkill(name, duration)
+            if duration is None:
                 duration = round(random.Random(f"{seed}:{behaviour.name}").uniform(low, high), 3)
-            return TimedSkill(name, float(duration), "success", post_facts(behaviour))
+            return TimedSkill(name, duration, "success", post_facts(behaviour))
 
         return factory
 

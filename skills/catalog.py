@@ -14,6 +14,11 @@ Two layers:
   ``plans/skills/`` (Figs. 7, 8, 10, 13, 15 and 16 of the paper); each state
   of those plans runs one of them.
 
+The catalogue is a skill plug-in like any other: this package lists
+:func:`register` under the entry-point group ``alica.skills``, so
+:func:`alica.lang.skill_plugins.default_registry` loads it without the
+language layer importing this one.
+
 Capabilities name what a robot needs to run a skill; role sets list the same
 words under ``requires`` (``base``, ``arm``, ``gripper``, ``lidar2d``,
 ``camera``, ``lidar3d``, ``stereo_camera``).
@@ -21,7 +26,7 @@ words under ``requires`` (``base``, ``arm``, ``gripper``, ``lidar2d``,
 
 from __future__ import annotations
 
-from alica.skills.registry import ParamSpec, SkillRegistry
+from alica.lang.skills import ParamSpec, SkillRegistry
 
 
 def _p(name: str, type: str, doc: str, *, default: object = None, required: bool | None = None) -> ParamSpec:
@@ -314,3 +319,8 @@ def declare_all(registry: SkillRegistry) -> None:
     _manipulation(registry)
     _directed_vision(registry)
     _semantic_perception(registry)
+
+
+def register(registry: SkillRegistry) -> None:
+    """The plug-in entry point of the shipped catalogue: :func:`declare_all`."""
+    declare_all(registry)

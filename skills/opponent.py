@@ -138,7 +138,7 @@ def _skill_class(name: str) -> Any:
 @functools.cache
 def _catalog_defaults(skill: str) -> tuple[tuple[str, object], ...]:
     """The optional parameters of ``skill`` in the catalog, with their defaults."""
-    from alica.skills.registry import default_registry
+    from alica.lang.skill_plugins import default_registry
 
     return tuple((p.name, p.default) for p in default_registry().get(skill).params if not p.required)
 

@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from alica.errors import SkillError
-from alica.skills.registry import SkillRegistry, default_registry
+from alica.lang.skill_plugins import default_registry
+from alica.lang.skills import SkillRegistry
 
 
 @dataclass(slots=True)

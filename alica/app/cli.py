@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from alica import __version__
+from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError, PlanFormatError
 from alica.source import Diagnostic
 
@@ -24,10 +25,11 @@ def _print_diagnostics(diagnostics: Sequence[Diagnostic]) -> None:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from alica.io import plan_files, validate_paths
+    from alica.app.skill_options import skill_registry
+    from alica.io import Loader, plan_files, validate_paths
 
     files, _ = plan_files(args.paths)
-    diagnostics = validate_paths(args.paths)
+    diagnostics = validate_paths(args.paths, Loader(skills=skill_registry(args)))
     _print_diagnostics(diagnostics)
     errors = sum(1 for d in diagnostics if d.severity == "error")
     if errors:
@@ -134,16 +136,17 @@ def _cmd_convert(args: argparse.Namespace) -> int:
 
 
 def _cmd_list_skills(args: argparse.Namespace) -> int:
-    from alica.skills.registry import default_registry
+    from alica.app.skill_options import SHIPPED, skill_registry
 
-    for spec in default_registry():
+    for spec in skill_registry(args):
         caps = f"  [needs {', '.join(sorted(spec.capabilities))}]" if spec.capabilities else ""
         impl = (
-            f"  (runs {spec.implementation})"
-            if spec.implementation
-            else "  (no implementation yet: scripted in team runs)"
+            f"  (runs {spec.implementation_name})"
+            if spec.implementation is not None
+            else "  (no implementation yet: 'alica run --stand-ins' scripts it)"
         )
-        print(f"{spec.name}: {spec.doc}{caps}{impl}")
+        origin = f"  (from {spec.origin})" if spec.origin and spec.origin != SHIPPED else ""
+        print(f"{spec.name}: {spec.doc}{caps}{impl}{origin}")
         for p in spec.params:
             need = "required" if p.required else f"default {p.default!r}"
             print(f"    {p.name} ({p.type}, {need}){': ' + p.doc if p.doc else ''}")
@@ -167,6 +170,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
     p.add_argument("-q", "--quiet", action="store_true", help="print nothing when everything is valid")
+    add_skills_option(p)
     p.set_defaults(run=_cmd_validate)
 
     p = sub.add_parser(
@@ -204,7 +208,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-validate", action="store_true", help="convert without checking references to other files")
     p.set_defaults(run=_cmd_convert)
 
-    p = sub.add_parser("list-skills", help="list the registered skills and their parameters")
+    p = sub.add_parser(
+        "list-skills",
+        help="list the registered skills and their parameters",
+        description="List every declared skill: the shipped catalogue, installed plug-ins and --skills modules, "
+        "with its parameters, where it came from and what implements it.",
+    )
+    add_skills_option(p)
     p.set_defaults(run=_cmd_list_skills)
 
     from alica.app.cli_demo import add_parser as add_demo_parser

@@ -1,4 +1,11 @@
-"""``alica run``: a team runs a plan in simulation, with faults, a trace and a summary."""
+"""``alica run``: a team runs a plan in simulation, with faults, a trace and a summary.
+
+Every skill with an implementation runs for real; ``--world blocks|lunar``
+gives the team a pybullet world with one robot named after each agent.
+Scripted stand-ins (:func:`alica.testing.default_fallback`) run only with
+``--stand-ins``, for the skills that have no implementation or that act on a
+robot when the run has no world.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +15,7 @@ import re
 import sys
 from typing import Any
 
+from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError
 
 _AT = re.compile(r"^(?P<what>.+)@(?P<start>[0-9.]+)(?:-(?P<end>[0-9.]+))?$")
@@ -19,8 +27,11 @@ def add_parser(sub: Any) -> None:
         "run",
         help="run a team on a plan in simulated time",
         description="Run a team of agents on a plan in simulated time over a simulated network. "
-        "Team runs have no simulated world yet, so every skill is a scripted stand-in (Idle waits; others succeed "
-        "after a while and write their post-condition). Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
+        "Every skill with an implementation runs for real; --world gives the team a pybullet world. "
+        "With --stand-ins, skills without an implementation (or, without --world, those that act on a robot) "
+        "are scripted stand-ins: they run for their duration parameter (Idle until its state is left when it is 0), "
+        "others succeed after a while and write their post-condition. "
+        "Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
     p.add_argument(
@@ -88,6 +99,21 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--trace-messages", action="store_true", help="trace every message too (large)")
     p.add_argument("--show-tree", action="store_true", help="print each agent's running plan tree whenever it changes")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument(
+        "--world",
+        choices=("blocks", "lunar"),
+        help="run the skills in a pybullet world: blocks (one manipulator per agent, named after it) "
+        "or lunar (the robots scout, stummel and amparo; name the agents after them)",
+    )
+    p.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first (default 'a,b;c')")
+    p.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
+    p.add_argument(
+        "--stand-ins",
+        action="store_true",
+        help="run scripted stand-ins for skills that have no implementation (and, without --world, for skills "
+        "that act on a robot) instead of stopping with an error",
+    )
+    add_skills_option(p)
     p.set_defaults(run=cmd_run)
 
 
@@ -147,9 +173,9 @@ def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset
 def cmd_run(args: argparse.Namespace) -> int:
     """Run the ``run`` subcommand; returns the exit code."""
     from alica.app.cli import _load, _roots
-    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
-    from alica.lang import literals
-    from alica.testing import default_fallback
+    from alica.app.run_skills import plan_skills, run_world, skill_wiring
+    from alica.app.skill_options import skill_registry
+    from alica.io import Loader
 
     if not 0 <= args.loss < 1:
         raise AlicaError(f"--loss must lie in [0, 1), got {args.loss}")
@@ -157,7 +183,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise AlicaError("--delay and --jitter must be >= 0 and --frequency > 0")
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
-    library, entry = _load(args.plan)
+    registry = skill_registry(args)
+    library, entry = _load(args.plan, Loader(skills=registry))
     if args.name is None:
         roots = [r for r in _roots(library, entry, None) if r in library.plans]
         if not roots:
@@ -165,7 +192,22 @@ def cmd_run(args: argparse.Namespace) -> int:
         plan = roots[0]
     else:
         plan = args.name
-    roles = _roles(library, _agents(args.agents), args.roleset)
+    agents = _agents(args.agents)
+    roles = _roles(library, agents, args.roleset)
+    wiring = skill_wiring(
+        registry, plan_skills(library, plan), world=args.world is not None, stand_ins=args.stand_ins, plan=plan
+    )
+    with run_world(args, sorted(agents)) as (world, perception):
+        return _run_team(args, library, plan, roles, wiring, world, perception)
+
+
+def _run_team(
+    args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], wiring: Any, world: Any, perception: Any
+) -> int:
+    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
+    from alica.lang import literals
+    from alica.testing import default_fallback
+
     observers: list[Any] = []
     trace = JsonlTrace(args.trace) if args.trace else None
     if trace is not None:
@@ -185,9 +227,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         loss=args.loss,
         delay=args.delay / 1000.0,
         jitter=args.jitter / 1000.0,
-        fallback=default_fallback(args.seed),
+        skill_registry=wiring.registry,
+        fallback=default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None,
         observers=observers,
         trace_messages=args.trace_messages,
+        world=world,
+        perception=perception,
     )
     for text in args.crash:
         who, at, _ = _timed("--crash", text)
@@ -212,6 +257,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         if trace is not None:
             trace.close()
     summary = team.summary()
+    summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": args.world}
     if args.json:
         print(json.dumps(summary, indent=2, sort_keys=True))
     else:
@@ -249,6 +295,12 @@ def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
         print(
             f"{name:<12} {a['role']:<12} {a['status']:<8} {a['transitions']:>11} {a['allocations']:>11} {a['messages_out']:>6} {a['messages_in']:>6} {a['repairs']:>7}  {a['path']}"
         )
+    skills = summary.get("skills") or {}
+    if skills.get("real"):
+        where = f" in the {skills['world']} world" if skills.get("world") else ""
+        print(f"real skills{where}: {', '.join(skills['real'])}")
+    if skills.get("stand_ins"):
+        print(f"scripted stand-ins (--stand-ins): {', '.join(skills['stand_ins'])}")
     m = summary["messages"]
     print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
     if summary["faults"]:

@@ -12,6 +12,7 @@ from typing import Any
 
 import yaml
 
+from alica.app.skill_options import add_skills_option, skill_registry
 from alica.errors import AlicaError
 
 
@@ -44,6 +45,7 @@ def add_parser(sub: Any) -> None:
     r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
     r.add_argument("--timeout", type=float, default=120.0, help="simulated seconds before giving up (default 120)")
     r.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_skills_option(r)
     r.set_defaults(run=cmd_skill_run)
 
 
@@ -116,11 +118,10 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
 def cmd_skill_run(args: argparse.Namespace) -> int:
     """Run ``alica skill run``; returns the exit code."""
     from alica.skills.motion import configure_ompl
-    from alica.skills.registry import default_registry
     from alica.skills.testing import run_skill
 
+    registry = skill_registry(args)
     configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
-    registry = default_registry()
     spec = registry.get(args.name)
     params = _params(args.param)
     with _c_prints_to_stderr():

@@ -74,7 +74,7 @@ class SkillBinder:
 
     Args:
         overrides: factories by behaviour or skill name.
-        registry: a :class:`alica.skills.registry.SkillRegistry`; ``None`` skips it.
+        registry: a :class:`alica.lang.skills.SkillRegistry`; ``None`` skips it.
         fallback: a function ``behaviour -> factory`` for skills with no implementation.
     """
 

@@ -22,6 +22,7 @@ from alica.engine.config import EngineConfig
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError
 from alica.lang import Registry
+from alica.lang.skills import SkillRegistry
 from alica.model import PlanLibrary, RoleSet
 from alica.worldmodel import WorldModel
 
@@ -67,8 +68,10 @@ class SimulatedTeam:
         loss: probability that a best-effort message is lost on a link.
         delay: base message delay in seconds; ``jitter`` adds a uniform random part.
         skills: skill factories by behaviour or skill name (test doubles, real skills).
-        skill_registry: a :class:`alica.skills.registry.SkillRegistry` for implementations.
-        fallback: factory maker for skills nothing implements; ``None`` makes them fail.
+        skill_registry: the skill declarations whose implementations run (the shipped
+            catalogue and plug-ins: :func:`alica.lang.skill_plugins.default_registry`).
+        fallback: factory maker for skills nothing implements, e.g. the scripted stand-ins of
+            :func:`alica.testing.default_fallback`; ``None`` makes them fail.
         registry: predicates and functions of formulas.
         observers: trace observers.
         trace_messages: also trace every message sent and delivered.
@@ -93,7 +96,7 @@ class SimulatedTeam:
         delay: float = 0.0,
         jitter: float = 0.0,
         skills: Mapping[str, SkillFactory] | None = None,
-        skill_registry: Any = None,
+        skill_registry: SkillRegistry | None = None,
         fallback: Callable[[Any], SkillFactory] | None = None,
         registry: Registry | None = None,
         observers: Iterable[Observer] = (),

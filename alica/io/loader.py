@@ -18,9 +18,9 @@ from alica.io.build import build_document
 from alica.io.fields import Problems
 from alica.io.tree import Node
 from alica.lang import Registry, default_registry
+from alica.lang.skill_plugins import default_registry as default_skills
+from alica.lang.skills import SkillRegistry
 from alica.model import Document, PlanLibrary
-from alica.skills.registry import SkillRegistry
-from alica.skills.registry import default_registry as default_skills
 from alica.source import Diagnostic, SourceSpan
 
 #: File name endings the loader reads, with their format.
@@ -255,7 +255,7 @@ def load_library(
 
     Args:
         paths: entry files (their imports are followed).
-        skills: skill declarations; the library's own by default.
+        skills: skill declarations; by default the installed plug-ins (the shipped catalogue among them).
         functions: formula predicates and functions; the built-ins by default.
 
     Raises:

@@ -14,6 +14,7 @@ from collections.abc import Iterable, Sequence
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
 from alica.lang import Registry, check, literals, parse
+from alica.lang.skills import SkillRegistry
 from alica.model import (
     Behaviour,
     Condition,
@@ -25,7 +26,6 @@ from alica.model import (
     children_of,
     format_cardinality,
 )
-from alica.skills.registry import SkillRegistry
 from alica.source import SourceSpan
 
 #: How far utility weights may stray from summing to 1.

@@ -6,8 +6,9 @@ from pathlib import Path
 
 from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
 from alica.io import load_library
+from alica.lang.skill_plugins import default_registry
+from alica.lang.skills import ParamSpec
 from alica.model import PlanLibrary
-from alica.skills.registry import ParamSpec, default_registry
 
 ROLES = """
 alica: 1

@@ -14,7 +14,17 @@ LUNAR = str(PLANS / "lunar" / "mission.yaml")
 
 def test_run_until_done_prints_a_summary(capsys):
     code = main(
-        ["run", LUNAR, "--agents", "scout,stummel,amparo", "--fact", "found(a) and found(b)@3", "--max-time", "120"]
+        [
+            "run",
+            LUNAR,
+            "--stand-ins",
+            "--agents",
+            "scout,stummel,amparo",
+            "--fact",
+            "found(a) and found(b)@3",
+            "--max-time",
+            "120",
+        ]
     )
     out = capsys.readouterr().out
     assert code == 0, out
@@ -28,6 +38,7 @@ def test_json_summary_and_trace(tmp_path, capsys):
         [
             "run",
             LUNAR,
+            "--stand-ins",
             "--agents",
             "scout:Scout,stummel:Stummel,amparo:Amparo",
             "--ticks",
@@ -55,7 +66,7 @@ def test_json_summary_and_trace(tmp_path, capsys):
 
 
 def test_show_tree_prints_running_trees(capsys):
-    assert main(["run", LUNAR, "--agents", "scout,stummel,amparo", "--ticks", "3", "--show-tree"]) == 0
+    assert main(["run", LUNAR, "--stand-ins", "--agents", "scout,stummel,amparo", "--ticks", "3", "--show-tree"]) == 0
     out = capsys.readouterr().out
     assert "scout [Scout]" in out and "└─ LunarMission  task Explore  state Exploring" in out
 
@@ -66,6 +77,7 @@ def test_partition_option(capsys):
             [
                 "run",
                 LUNAR,
+                "--stand-ins",
                 "--agents",
                 "scout,stummel,amparo",
                 "--ticks",
@@ -95,7 +107,7 @@ def test_partition_option(capsys):
     ],
 )
 def test_bad_input_gets_a_clear_error(argv, message, capsys):
-    code = main(["run", LUNAR, "--ticks", "1", *argv])
+    code = main(["run", LUNAR, "--stand-ins", "--ticks", "1", *argv])
     err = capsys.readouterr().err
     assert code == 1
     assert message in err
@@ -109,12 +121,12 @@ def test_missing_plan_file(capsys):
 
 def test_roles_from_capabilities(capsys):
     agents = "r1:+base+lidar2d+camera,r2:+base+arm+gripper+lidar2d+camera,r3:+base+arm+gripper+lidar3d+stereo_camera"
-    assert main(["run", LUNAR, "--agents", agents, "--ticks", "3", "--json"]) == 0
+    assert main(["run", LUNAR, "--stand-ins", "--agents", agents, "--ticks", "3", "--json"]) == 0
     roles = {name: a["role"] for name, a in json.loads(capsys.readouterr().out)["agents"].items()}
     assert roles == {"r1": "Scout", "r2": "Stummel", "r3": "Amparo"}
 
 
 def test_capabilities_that_fit_no_role(capsys):
-    assert main(["run", LUNAR, "--agents", "r1:+wings", "--ticks", "1"]) == 1
+    assert main(["run", LUNAR, "--stand-ins", "--agents", "r1:+wings", "--ticks", "1"]) == 1
     err = capsys.readouterr().err
     assert "fits no role" in err and "Scout:" in err and "missing" in err

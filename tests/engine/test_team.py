@@ -122,6 +122,7 @@ def test_same_seed_same_trace_across_processes(tmp_path):
             "alica.app.cli",
             "run",
             str(ROOT / "plans/lunar/mission.yaml"),
+            "--stand-ins",
             "--agents",
             "scout,stummel,amparo",
             "--seed",

@@ -8,8 +8,8 @@ from alica.io.fields import Problems
 from alica.io.loader import read_text
 from alica.io.validate import Validator
 from alica.lang import default_registry
+from alica.lang.skills import ParamSpec, SkillRegistry
 from alica.model import Document
-from alica.skills.registry import ParamSpec, SkillRegistry
 from alica.source import Diagnostic
 
 

@@ -8,7 +8,8 @@ import sys
 import pytest
 
 from alica.errors import UnknownSkillError
-from alica.skills.registry import ParamSpec, SkillRegistry, SkillSpec, default_registry
+from alica.lang.skill_plugins import default_registry
+from alica.lang.skills import ParamSpec, SkillRegistry, SkillSpec
 
 
 def test_validation_imports_no_simulation_backend() -> None:

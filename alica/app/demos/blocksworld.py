@@ -218,8 +218,8 @@ def run_demo(
     """
     from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam
     from alica.io import load_library
+    from alica.lang.skill_plugins import default_registry
     from alica.skills.motion import configure_ompl
-    from alica.skills.registry import default_registry
     from alica.worldsim.perception import FactPerception
     from alica.worldsim.scenarios import blocks_facts, blocksworld
 

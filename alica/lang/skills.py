@@ -1,15 +1,20 @@
-"""The skill registry: what each skill is called and which parameters it takes.
+"""The skill vocabulary: what each skill is called, which parameters it takes, what runs it.
 
 Declarations are plain data so ``alica validate`` can check plan files
 without importing pybullet, OMPL or FCL. Each declaration names its
-implementation as ``"module:attribute"``, imported only when asked for.
+implementation as ``"module:attribute"`` (imported only when asked for) or
+gives the py_trees behaviour class itself. The shipped catalogue
+(:mod:`alica.skills.catalog`) and users' plug-ins register into a
+:class:`SkillRegistry`; :mod:`alica.lang.skill_plugins` finds and loads them.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 from alica.errors import UnknownSkillError
 
@@ -91,15 +96,20 @@ class SkillSpec:
         params: the parameters it takes.
         doc: one line saying what it does.
         capabilities: what a robot needs to run it (e.g. ``arm``).
-        implementation: ``"module:attribute"`` of the py_trees behaviour class
-            or factory, or ``None`` if not implemented yet.
+        implementation: the py_trees behaviour class (or factory) constructed as
+            ``Cls(name, params, context)``, or its ``"module:attribute"``, or
+            ``None`` if not implemented yet.
+        origin: where the declaration came from: ``alica`` for the shipped
+            catalogue, else the plug-in module (set by the registry while a
+            plug-in registers).
     """
 
     name: str
     params: tuple[ParamSpec, ...] = ()
     doc: str = ""
     capabilities: frozenset[str] = frozenset()
-    implementation: str | None = None
+    implementation: str | Callable[..., Any] | None = None
+    origin: str = ""
 
     def param(self, name: str) -> ParamSpec | None:
         """The parameter called ``name``, if declared."""
@@ -108,12 +118,26 @@ class SkillSpec:
                 return p
         return None
 
+    @property
+    def implementation_name(self) -> str | None:
+        """The implementation as ``"module:attribute"``, or ``None`` when there is none."""
+        impl = self.implementation
+        if impl is None or isinstance(impl, str):
+            return impl
+        return f"{getattr(impl, '__module__', '?')}:{getattr(impl, '__qualname__', repr(impl))}"
+
 
 @dataclass
 class SkillRegistry:
-    """Skill declarations by name."""
+    """Skill declarations by name.
+
+    Attributes:
+        origin: stamped on declarations that name no origin of their own (the
+            plug-in loader sets it to the module while the module registers).
+    """
 
     _specs: dict[str, SkillSpec] = field(default_factory=dict)
+    origin: str = ""
 
     def register(self, spec: SkillSpec, *, replace: bool = False) -> SkillSpec:
         """Add a declaration.
@@ -123,10 +147,13 @@ class SkillRegistry:
                 parameters share a name.
         """
         if spec.name in self._specs and not replace:
-            raise ValueError(f"skill '{spec.name}' is already registered")
+            taken = self._specs[spec.name].origin
+            raise ValueError(f"skill '{spec.name}' is already registered" + (f" by {taken}" if taken else ""))
         names = [p.name for p in spec.params]
         if len(names) != len(set(names)):
             raise ValueError(f"skill '{spec.name}' declares a parameter twice")
+        if not spec.origin and self.origin:
+            spec = dataclasses.replace(spec, origin=self.origin)
         self._specs[spec.name] = spec
         return spec
 
@@ -135,10 +162,22 @@ class SkillRegistry:
         name: str,
         *params: ParamSpec,
         doc: str = "",
-        capabilities: tuple[str, ...] = (),
-        implementation: str | None = None,
+        capabilities: tuple[str, ...] | frozenset[str] = (),
+        implementation: str | Callable[..., Any] | None = None,
     ) -> SkillSpec:
-        """Register a skill from its parts; the one-line way to declare one."""
+        """Register a skill from its parts; the one-line way to declare one.
+
+        Args:
+            name: the name plan files use in ``skill:``.
+            params: the parameters it takes.
+            doc: one line saying what it does.
+            capabilities: what a robot needs to run it (e.g. ``("base",)``).
+            implementation: the py_trees behaviour class, constructed as
+                ``Cls(name, params, context)``, or its ``"module:attribute"``.
+
+        Raises:
+            ValueError: the name is taken, or two parameters share a name.
+        """
         return self.register(SkillSpec(name, tuple(params), doc, frozenset(capabilities), implementation))
 
     def __contains__(self, name: object) -> bool:
@@ -167,9 +206,9 @@ class SkillRegistry:
 
     def copy(self) -> SkillRegistry:
         """An independent registry with the same declarations."""
-        return SkillRegistry(dict(self._specs))
+        return SkillRegistry(dict(self._specs), self.origin)
 
-    def load(self, name: str) -> object:
+    def load(self, name: str) -> Callable[..., Any]:
         """Import and return the implementation of ``name``.
 
         Raises:
@@ -179,6 +218,8 @@ class SkillRegistry:
         spec = self.get(name)
         if spec.implementation is None:
             raise UnknownSkillError(f"skill '{name}' is declared but has no implementation yet")
+        if not isinstance(spec.implementation, str):
+            return spec.implementation
         module_name, _, attribute = spec.implementation.partition(":")
         try:
             module = importlib.import_module(module_name)
@@ -190,12 +231,3 @@ class SkillRegistry:
             return getattr(module, attribute)
         except AttributeError:
             raise UnknownSkillError(f"skill '{name}': module '{module_name}' has no '{attribute}'") from None
-
-
-def default_registry() -> SkillRegistry:
-    """A fresh registry holding every skill the library declares."""
-    from alica.skills.catalog import declare_all
-
-    registry = SkillRegistry()
-    declare_all(registry)
-    return registry
