@@ -159,4 +159,4 @@ def test_validate_reports_a_misspelt_condition_with_a_suggestion(
     assert "unknown predicate 'succeded' (did you mean 'succeeded'?)" in err
     plan.write_text(plan.read_text(encoding="utf-8").replace("succeded", "succeeded"), encoding="utf-8")
     code, out, err = run(capsys, "validate", str(plan))
-    assert code == 0, err
+    assert code == 0 and out.startswith("ok: "), err

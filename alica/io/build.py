@@ -44,7 +44,18 @@ from alica.model import (
 )
 
 #: Keys of the top level of a plan file.
-TOP_KEYS = ("alica", "imports", "predicates", "functions", "tasks", "rolesets", "behaviours", "plans", "plantypes", "problems")
+TOP_KEYS = (
+    "alica",
+    "imports",
+    "predicates",
+    "functions",
+    "tasks",
+    "rolesets",
+    "behaviours",
+    "plans",
+    "plantypes",
+    "problems",
+)
 #: ``name`` or ``name - type``, the way typed names are written in both formats.
 TYPED_NAME = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\s*$")
 #: ``name/arity``, the short form of a predicate or function declaration.
@@ -167,7 +178,7 @@ def _declaration(node: Node, key: str, problems: Problems) -> Declaration | None
     name = f.name()
     if not name:
         return None
-    if (not _IDENTIFIER.match(name) or name in KEYWORDS):
+    if not _IDENTIFIER.match(name) or name in KEYWORDS:
         problems.add(
             f.get("name").span,  # type: ignore[union-attr]
             f"'{name}' in '{key}' is not a name formulas can use",

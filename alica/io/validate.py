@@ -147,9 +147,7 @@ class Validator:
                 issue.hint or "see the formula syntax in docs/plan_format.md",
             )
 
-    def _condition(
-        self, cond: Condition | None, what: str, *, effect: bool = False, bound: Iterable[str] = ()
-    ) -> None:
+    def _condition(self, cond: Condition | None, what: str, *, effect: bool = False, bound: Iterable[str] = ()) -> None:
         if cond is not None:
             self._formula(cond.text, cond.span, what, effect=effect, boolean=True, bound=bound)
 

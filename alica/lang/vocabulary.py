@@ -154,4 +154,3 @@ ENGINE_FACTS: tuple[Symbol, ...] = (
 def default_vocabulary() -> Vocabulary:
     """A fresh vocabulary holding the engine's own facts (:data:`ENGINE_FACTS`)."""
     return Vocabulary(ENGINE_FACTS)
-
