@@ -136,3 +136,27 @@ def test_version(capsys: pytest.CaptureFixture[str]) -> None:
 
     code, out, _ = run(capsys, "--version")
     assert code == 0 and out.strip() == f"alica {__version__}"
+
+
+def test_validate_reports_a_misspelt_condition_with_a_suggestion(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plan = tmp_path / "typo.yaml"
+    plan.write_text(
+        "tasks: [T]\n"
+        "plans:\n"
+        "  - name: P\n"
+        "    entry_points: [{task: T, state: A}]\n"
+        "    states:\n"
+        "      - name: A\n"
+        "        transitions: [{to: B, condition: succeded}]\n"
+        "      - {name: B, kind: success}\n",
+        encoding="utf-8",
+    )
+    code, _, err = run(capsys, "validate", str(plan))
+    assert code == 1
+    assert "typo.yaml:7:42: error: condition of transition 'A->B' of plan 'P': " in err
+    assert "unknown predicate 'succeded' (did you mean 'succeeded'?)" in err
+    plan.write_text(plan.read_text(encoding="utf-8").replace("succeded", "succeeded"), encoding="utf-8")
+    code, out, err = run(capsys, "validate", str(plan))
+    assert code == 0 and out.startswith("ok: "), err

@@ -12,6 +12,7 @@ import re
 
 from alica.io.fields import Fields, Problems, kind_of, to_number
 from alica.io.tree import Node
+from alica.lang.ast import KEYWORDS
 from alica.model import (
     UNBOUNDED,
     Behaviour,
@@ -20,6 +21,7 @@ from alica.model import (
     Condition,
     ConditionKind,
     Constraint,
+    Declaration,
     Document,
     EntryPoint,
     Param,
@@ -42,9 +44,23 @@ from alica.model import (
 )
 
 #: Keys of the top level of a plan file.
-TOP_KEYS = ("alica", "imports", "tasks", "rolesets", "behaviours", "plans", "plantypes", "problems")
+TOP_KEYS = (
+    "alica",
+    "imports",
+    "predicates",
+    "functions",
+    "tasks",
+    "rolesets",
+    "behaviours",
+    "plans",
+    "plantypes",
+    "problems",
+)
 #: ``name`` or ``name - type``, the way typed names are written in both formats.
 TYPED_NAME = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\s*$")
+#: ``name/arity``, the short form of a predicate or function declaration.
+DECLARED_NAME = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*/\s*([0-9]+)\s*$")
+_IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
 def build_document(tree: Node, path: str, problems: Problems) -> Document:
@@ -68,6 +84,8 @@ def build_document(tree: Node, path: str, problems: Problems) -> Document:
         problems.add(version.span, f"unknown format version '{version.value}'", "write 'alica: 1' or leave it out")
     return Document(
         imports=tuple(n for n, _ in top.names("imports")),
+        predicates=_declarations(top, "predicates", problems),
+        functions=_declarations(top, "functions", problems),
         tasks=tuple(_task(n, problems) for n in top.items("tasks")),
         rolesets=tuple(_roleset(n, problems) for n in top.items("rolesets")),
         behaviours=tuple(_behaviour(n, problems) for n in top.items("behaviours")),
@@ -130,6 +148,47 @@ def _typed_list(f: Fields, key: str) -> tuple[Variable, ...]:
             out.append(Variable(name, str(value.value) if value.value is not None else "any", span=node.key_span(name)))
         return tuple(out)
     return tuple(v for v in (_typed(n, f, key) for n in f.items(key)) if v is not None)
+
+
+def _declarations(top: Fields, key: str, problems: Problems) -> tuple[Declaration, ...]:
+    """``name/arity`` or ``{name, arity, doc}`` entries of ``predicates`` or ``functions``."""
+    out = []
+    for node in top.items(key):
+        declaration = _declaration(node, key, problems)
+        if declaration is not None:
+            out.append(declaration)
+    return tuple(out)
+
+
+def _declaration(node: Node, key: str, problems: Problems) -> Declaration | None:
+    example = "found/1" if key == "predicates" else "pos/1"
+    if isinstance(node.value, str):
+        match = DECLARED_NAME.match(node.value)
+        if match is None:
+            problems.add(
+                node.span,
+                f"'{node.value}' in '{key}' is not 'name/arity'",
+                f"write the name and its number of arguments, e.g. '{example}'",
+            )
+            return None
+        return Declaration(match.group(1), int(match.group(2)), span=node.span)
+    f = _element(node, key, problems, ("name", "arity", "doc"))
+    if f is None:
+        return None
+    name = f.name()
+    if not name:
+        return None
+    if not _IDENTIFIER.match(name) or name in KEYWORDS:
+        problems.add(
+            f.get("name").span,  # type: ignore[union-attr]
+            f"'{name}' in '{key}' is not a name formulas can use",
+            "use letters, digits and '_', starting with a letter, and no keyword",
+        )
+        return None
+    if f.get("arity") is None:
+        problems.add(node.span, f"{f.what} has no 'arity'", f"give its number of arguments, e.g. '{example}'")
+        return None
+    return Declaration(name, f.integer("arity", 0), f.text("doc"), span=node.span)
 
 
 def _task(node: Node, problems: Problems) -> Task:

@@ -13,6 +13,7 @@ from alica.model import (
     Behaviour,
     ChildRef,
     Condition,
+    Declaration,
     Document,
     EntryPoint,
     Plan,
@@ -36,6 +37,10 @@ def document_data(doc: Document) -> Data:
     out: Data = {}
     if doc.imports:
         out["imports"] = list(doc.imports)
+    if doc.predicates:
+        out["predicates"] = [_declaration(d) for d in doc.predicates]
+    if doc.functions:
+        out["functions"] = [_declaration(d) for d in doc.functions]
     if doc.tasks:
         out["tasks"] = [_task(t) for t in doc.tasks]
     if doc.rolesets:
@@ -66,6 +71,13 @@ def _cond(cond: Condition | None) -> str | None:
 
 def _typed(variables: tuple[Variable, ...]) -> list[str]:
     return [v.name if v.type == "any" else f"{v.name} - {v.type}" for v in variables]
+
+
+def _declaration(d: Declaration) -> Any:
+    """``name/arity``, or a mapping when there is a doc line."""
+    if not d.doc:
+        return str(d)
+    return {"name": d.name, "arity": d.arity, "doc": d.doc}
 
 
 def _task(task: Task) -> Any:

@@ -10,14 +10,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
+from pathlib import Path
 
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
-from alica.lang import Registry, check, literals, parse
+from alica.lang import ENGINE_VARIABLES, Registry, Vocabulary, check, default_vocabulary, literals, parse
 from alica.lang.skills import SkillRegistry
 from alica.model import (
     Behaviour,
     Condition,
+    Declaration,
     Document,
     Plan,
     PlanningProblem,
@@ -50,15 +52,26 @@ class Validator:
         skills: the skill declarations behaviours are checked against.
         functions: the registered predicates and functions formulas may call.
         problems: where problems go.
+        vocabulary: the predicates and functions every formula may read without a
+            declaration (the engine's own facts by default); each file adds its own
+            declarations and those of the files it imports.
     """
 
     def __init__(
-        self, documents: Sequence[Document], skills: SkillRegistry, functions: Registry, problems: Problems
+        self,
+        documents: Sequence[Document],
+        skills: SkillRegistry,
+        functions: Registry,
+        problems: Problems,
+        vocabulary: Vocabulary | None = None,
     ) -> None:
         self.documents = documents
         self.skills = skills
         self.functions = functions
         self.problems = problems
+        self.vocabularies = _Vocabularies(documents, vocabulary or default_vocabulary(), problems)
+        self.vocabulary: Vocabulary | None = None
+        self.bound: frozenset[str] = ENGINE_VARIABLES
         self.tasks = self._unique("task", (t for d in documents for t in d.tasks))
         self.rolesets = self._unique("role set", (r for d in documents for r in d.rolesets))
         abstract = [e for d in documents for e in (*d.behaviours, *d.plans, *d.plantypes, *d.problems)]
@@ -69,6 +82,7 @@ class Validator:
         for rs in self.rolesets.values():
             self._roleset(rs)
         for element in self.abstract.values():
+            self.vocabulary = self.vocabularies.of(element)
             if isinstance(element, Behaviour):
                 self._behaviour(element)
             elif isinstance(element, Plan):
@@ -109,11 +123,19 @@ class Validator:
         return names
 
     def _formula(
-        self, text: str, span: SourceSpan | None, what: str, *, effect: bool = False, boolean: bool = False
+        self,
+        text: str,
+        span: SourceSpan | None,
+        what: str,
+        *,
+        effect: bool = False,
+        boolean: bool = False,
+        bound: Iterable[str] = (),
     ) -> None:
         try:
             node = parse(text)
-            issues = check(node, self.functions, text=text, boolean=boolean)
+            names = self.bound | set(bound)
+            issues = check(node, self.functions, text=text, boolean=boolean, vocabulary=self.vocabulary, bound=names)
             if effect:
                 literals(node)
         except FormulaError as exc:
@@ -125,9 +147,9 @@ class Validator:
                 issue.hint or "see the formula syntax in docs/plan_format.md",
             )
 
-    def _condition(self, cond: Condition | None, what: str, *, effect: bool = False) -> None:
+    def _condition(self, cond: Condition | None, what: str, *, effect: bool = False, bound: Iterable[str] = ()) -> None:
         if cond is not None:
-            self._formula(cond.text, cond.span, what, effect=effect, boolean=True)
+            self._formula(cond.text, cond.span, what, effect=effect, boolean=True, bound=bound)
 
     def _ref(
         self, name: str, span: SourceSpan | None, what: str, kinds: tuple[type, ...] | None = None
@@ -179,6 +201,7 @@ class Validator:
 
     def _behaviour(self, b: Behaviour) -> None:
         what = f"behaviour '{b.name}'"
+        self.bound = ENGINE_VARIABLES | {v.name for v in b.variables}
         for kind, cond in (("pre", b.pre), ("run", b.run), ("post", b.post)):
             self._condition(cond, f"{kind} condition of {what}")
         variables = {v.name for v in b.variables}
@@ -219,6 +242,7 @@ class Validator:
 
     def _plan(self, plan: Plan) -> None:
         what = f"plan '{plan.name}'"
+        self.bound = ENGINE_VARIABLES | {v.name for v in plan.variables}
         states = self._unique_in(what, "state", plan.states)
         self._unique_in(what, "entry point", plan.entry_points)
         self._unique_in(what, "transition", plan.transitions)
@@ -339,8 +363,9 @@ class Validator:
         if plan.signature is not None:
             sig = plan.signature
             self._unique_in(f"the signature of {what}", "parameter", sig.parameters)
-            self._condition(sig.precondition, f"precondition of {what}")
-            self._condition(sig.effect, f"effect of {what}", effect=True)
+            parameters = [v.name for v in sig.parameters]
+            self._condition(sig.precondition, f"precondition of {what}", bound=parameters)
+            self._condition(sig.effect, f"effect of {what}", effect=True, bound=parameters)
 
     def _utility(self, plan: Plan) -> None:
         u = plan.utility
@@ -357,7 +382,7 @@ class Validator:
             )
         self._unique_in(what, "summand", u.summands)
         for s in u.summands:
-            self._formula(s.expression, s.span, f"summand '{s.name}' of {what}")
+            self._formula(s.expression, s.span, f"summand '{s.name}' of {what}", bound=("task", "entry"))
 
     def _plantype(self, pt: PlanType) -> None:
         if not pt.plans:
@@ -371,6 +396,7 @@ class Validator:
 
     def _problem(self, p: PlanningProblem) -> None:
         what = f"planning problem '{p.name}'"
+        self.bound = ENGINE_VARIABLES | {v.name for v in p.objects}
         if not p.elements:
             self.problems.add(
                 p.span, f"{what} has no elements", "list the skill plans the planner may use under 'elements:'"
@@ -425,6 +451,73 @@ class Validator:
         for name in self.abstract:
             if name not in colour:
                 visit(name, [])
+
+
+class _Vocabularies:
+    """What each file's formulas may read: the base vocabulary, its own declarations and its imports'."""
+
+    def __init__(self, documents: Sequence[Document], base: Vocabulary, problems: Problems) -> None:
+        self.base = base
+        self.problems = problems
+        self.by_path = {_resolved(d.path): d for d in documents if d.path}
+        self.owner = {id(e): d for d in documents for e in d.elements()}
+        self.cache: dict[int, Vocabulary] = {}
+        self.reported: set[tuple[str, int, str]] = set()
+        for document in documents:
+            self.of_document(document)
+
+    def of(self, element: object) -> Vocabulary | None:
+        """The vocabulary of the file that holds ``element`` (None for an element built without a file)."""
+        document = self.owner.get(id(element))
+        return self.of_document(document) if document is not None else self.base
+
+    def of_document(self, document: Document) -> Vocabulary:
+        """The declarations visible in ``document``."""
+        hit = self.cache.get(id(document))
+        if hit is not None:
+            return hit
+        vocabulary = self.base.copy()
+        for visible in self._visible(document):
+            for kind, declarations in (("predicate", visible.predicates), ("function", visible.functions)):
+                for declaration in declarations:
+                    self._declare(vocabulary, kind, declaration)
+        self.cache[id(document)] = vocabulary
+        return vocabulary
+
+    def _visible(self, document: Document) -> list[Document]:
+        """``document`` and every file it imports, directly or not, each once."""
+        out, seen, todo = [], set(), [document]
+        while todo:
+            current = todo.pop(0)
+            if id(current) in seen:
+                continue
+            seen.add(id(current))
+            out.append(current)
+            folder = Path(current.path).parent if current.path else Path()
+            for name in current.imports:
+                target = self.by_path.get(_resolved(str(folder / name)))
+                if target is not None:
+                    todo.append(target)
+        return out
+
+    def _declare(self, vocabulary: Vocabulary, kind: str, d: Declaration) -> None:
+        try:
+            if kind == "predicate":
+                vocabulary.declare_predicate(d.name, d.arity, d.doc, origin=str(d.span or ""))
+            else:
+                vocabulary.declare_function(d.name, d.arity, d.doc, origin=str(d.span or ""))
+        except ValueError as exc:
+            key = (str(d.span), d.arity, kind)
+            if key not in self.reported:
+                self.reported.add(key)
+                self.problems.add(d.span, f"{kind} {d}: {exc}", "declare each name as one kind only")
+
+
+def _resolved(path: str) -> str:
+    try:
+        return str(Path(path).resolve())
+    except OSError:
+        return path
 
 
 def _kind(cls: type) -> str:

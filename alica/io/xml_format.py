@@ -18,6 +18,8 @@ the shape the table below gives it. Tags and attributes are the YAML keys
     element          attributes (text)                  children -> key (shape)
     ---------------  ---------------------------------  ---------------------------------------------
     <alica>          version (-> 'alica')               import -> imports (names, or href="...")
+                                                        predicate, function -> predicates,
+                                                        functions (lists)
                                                         task, roleset, behaviour, plan, plantype,
                                                         problem -> tasks ... problems (lists)
     <task>           name description
@@ -49,6 +51,7 @@ the shape the table below gives it. Tags and attributes are the YAML keys
     <problem>        name wait_plan alternative_plan    element -> elements (names), object -> objects
                      update_time timeout planner description    (list), world goal (text)
     <variable>, <parameter>, <object>: name type  (a typed name, ``{name, type}`` in YAML)
+    <predicate>, <function>: name arity doc  (``name/arity`` or ``{name, arity, doc}`` in YAML)
 
 Shapes:
 

@@ -53,6 +53,7 @@ class _Spec:
         renamed: attribute -> key where the two differ.
         item_text: a list entry given as plain text in the data means ``{item_text: text}``.
         typed: a list entry given as text is ``name`` or ``name - type``.
+        declared: a list entry given as text is ``name/arity``.
     """
 
     attributes: tuple[str, ...] = ()
@@ -61,6 +62,7 @@ class _Spec:
     renamed: tuple[tuple[str, str], ...] = ()
     item_text: str = ""
     typed: bool = False
+    declared: bool = False
 
     def key_of(self, attribute: str) -> str:
         """The key an attribute gives."""
@@ -100,6 +102,8 @@ _SPECS: dict[str, _Spec] = {
         ("version",),
         (
             _Child("import", "imports", NAMES, attribute="href"),
+            _Child("predicate", "predicates", LIST, "declaration"),
+            _Child("function", "functions", LIST, "declaration"),
             _Child("task", "tasks", LIST, "task"),
             _Child("roleset", "rolesets", LIST, "roleset"),
             _Child("behaviour", "behaviours", LIST, "behaviour"),
@@ -109,6 +113,7 @@ _SPECS: dict[str, _Spec] = {
         ),
         renamed=(("version", "alica"),),
     ),
+    "declaration": _Spec(("name", "arity", "doc"), declared=True),
     "task": _Spec(("name", "description"), (_DESCRIPTION,), item_text="name"),
     "roleset": _Spec(
         ("name", "default_priority", "description"),

@@ -8,7 +8,7 @@ from typing import Any
 
 from lxml import etree
 
-from alica.io.build import TYPED_NAME
+from alica.io.build import DECLARED_NAME, TYPED_NAME
 from alica.io.xml_vocabulary import (
     _ENTRIES,
     _SPECS,
@@ -106,6 +106,15 @@ def _typed_entry(item: Any) -> dict[str, Any]:
     return {"name": text}
 
 
+def _declared_entry(item: Any) -> dict[str, Any]:
+    """``name/arity`` as ``{name, arity}``."""
+    text = _scalar_text(item, "a declaration")
+    match = DECLARED_NAME.match(text)
+    if match is None:
+        raise ValueError(f"'{text}' is not 'name/arity': cannot write it as XML")
+    return {"name": match.group(1), "arity": int(match.group(2))}
+
+
 def _fill(el: Any, spec_name: str, data: dict[str, Any], where: str) -> None:
     spec = _SPECS[spec_name]
     label = data.get("name") if isinstance(data.get("name"), str) else None
@@ -138,6 +147,8 @@ def _fill(el: Any, spec_name: str, data: dict[str, Any], where: str) -> None:
             for item in _listed(value):
                 if item_spec.typed:
                     item = _typed_entry(item)
+                elif item_spec.declared and not isinstance(item, dict):
+                    item = _declared_entry(item)
                 elif not isinstance(item, dict) and item_spec.item_text:
                     item = {item_spec.item_text: item}
                 if not isinstance(item, dict):

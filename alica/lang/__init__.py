@@ -31,6 +31,10 @@ Evaluation rules:
   the items 0, 1, 2.
 * Failures raise :class:`~alica.errors.EvaluationError` naming the
   sub-expression and its column.
+
+The predicates and functions a formula may read are declared in a
+:class:`Vocabulary`; :func:`check` given one reports unknown names and wrong
+arities (see :mod:`alica.lang.vocabulary`).
 """
 
 from __future__ import annotations
@@ -61,9 +65,12 @@ from alica.lang.parser import parse
 from alica.lang.prelude import default_registry
 from alica.lang.registry import Entry, Registry
 from alica.lang.unparse import unparse
+from alica.lang.vocabulary import ENGINE_FACTS, ENGINE_VARIABLES, Symbol, Vocabulary, default_vocabulary
 from alica.lang.walk import atoms, calls, free_names, literals, walk
 
 __all__ = [
+    "ENGINE_FACTS",
+    "ENGINE_VARIABLES",
     "And",
     "Attr",
     "BeliefBase",
@@ -83,12 +90,15 @@ __all__ = [
     "Quantified",
     "Registry",
     "String",
+    "Symbol",
     "Unary",
+    "Vocabulary",
     "atoms",
     "calls",
     "check",
     "compile_formula",
     "default_registry",
+    "default_vocabulary",
     "evaluate",
     "free_names",
     "holds",

@@ -11,11 +11,23 @@ Checked:
   and ``true``/``false`` or a logical formula as an operand of ``<``, ``<=``,
   ``>``, ``>=``.
 
-Unknown predicate and function names are allowed: they are facts of the
-belief base.
+With a :class:`~alica.lang.vocabulary.Vocabulary` also checked:
+
+* a predicate or function that is neither registered nor declared, with the
+  closest known name as a suggestion;
+* a declared one called with an arity it is not declared with;
+* a declared function where a truth value is needed.
+
+A bare name where a truth value is needed must be a bound variable (of a
+quantifier, or one of ``bound``) or a registered or declared 0-ary predicate;
+elsewhere a bare name is a symbol (an object constant such as ``a`` in
+``On(a, g)``) and is never reported. Without a vocabulary unknown names are
+allowed: they are facts of the belief base.
 """
 
 from __future__ import annotations
+
+import difflib
 
 from alica.errors import FormulaError
 from alica.lang.ast import (
@@ -27,6 +39,7 @@ from alica.lang.ast import (
     Compare,
     Iff,
     Implies,
+    Name,
     Node,
     Not,
     Number,
@@ -39,6 +52,7 @@ from alica.lang.ast import (
 from alica.lang.parser import parse
 from alica.lang.registry import Registry
 from alica.lang.unparse import unparse
+from alica.lang.vocabulary import FUNCTION, PREDICATE, Vocabulary, arity_text
 
 
 def _describe(node: Node) -> str:
@@ -54,9 +68,13 @@ def _describe(node: Node) -> str:
 
 
 class _Checker:
-    def __init__(self, registry: Registry | None, text: str) -> None:
+    def __init__(
+        self, registry: Registry | None, text: str, vocabulary: Vocabulary | None, bound: frozenset[str]
+    ) -> None:
         self.registry = registry
         self.text = text
+        self.vocabulary = vocabulary
+        self.bound = bound
         self.errors: list[FormulaError] = []
 
     def report(self, node: Node, message: str, hint: str = "") -> None:
@@ -71,6 +89,11 @@ class _Checker:
             )
         if isinstance(node, Call):
             self.check_call(node)
+            if self.vocabulary is not None:
+                self.check_declared(node, len(node.args), boolean)
+        elif isinstance(node, Name):
+            if self.vocabulary is not None and boolean and node.name not in self.bound:
+                self.check_declared(node, 0, boolean)
         elif isinstance(node, Quantified):
             self.check_binders(node)
         elif isinstance(node, (Binary, Unary)):
@@ -90,8 +113,55 @@ class _Checker:
                         "use = or != to compare truth values",
                     )
         logical = isinstance(node, (Not, And, Or, Implies, Iff, Quantified))
+        if isinstance(node, Quantified):
+            outer = self.bound
+            self.bound = outer | {var for var, _ in node.binders}
+            self.visit(node.body, True)
+            self.bound = outer
+            return
         for child in children(node):
             self.visit(child, logical)
+
+    def check_declared(self, node: Name | Call, count: int, boolean: bool) -> None:
+        """A name read as a predicate (``boolean``) or a function must be registered or declared."""
+        assert self.vocabulary is not None
+        name = node.name
+        if self.registry is not None and name in self.registry:
+            return  # registered: its arity is checked by check_call
+        symbols = self.vocabulary.lookup(name)
+        wanted = PREDICATE if boolean else FUNCTION
+        if not symbols:
+            close = difflib.get_close_matches(name, self._known(boolean), n=1, cutoff=0.6)
+            mean = f" (did you mean '{close[0]}'?)" if close else ""
+            self.report(
+                node,
+                f"unknown {wanted} '{name}'{mean}",
+                f"declare it, e.g. under '{wanted}s:' as {name}/{count}, or import the file that declares it",
+            )
+            return
+        symbol = self.vocabulary.get(name, count)
+        if symbol is None:
+            arities = [s.arity for s in symbols]
+            self.report(
+                node,
+                f"{symbols[0].kind} '{name}' takes {arity_text(arities)}, got {count}",
+                symbols[0].doc or f"declared as {', '.join(str(s) for s in symbols)}",
+            )
+        elif boolean and symbol.kind == FUNCTION:
+            self.report(
+                node,
+                f"'{unparse(node)}' is a function, not a predicate, so it is no truth value",
+                f"compare its value, e.g. {unparse(node)} = x, or declare {symbol} as a predicate",
+            )
+
+    def _known(self, boolean: bool) -> list[str]:
+        """Names to suggest: where a truth value is needed, the predicates and bound variables only."""
+        names = set(self.bound) if boolean else set()
+        if self.vocabulary is not None:
+            names.update(s.name for s in self.vocabulary if not boolean or s.kind == PREDICATE)
+        if self.registry is not None:
+            names.update(e.name for e in self.registry if not boolean or e.kind == PREDICATE)
+        return sorted(names)
 
     def check_call(self, node: Call) -> None:
         entry = self.registry.get(node.name) if self.registry is not None else None
@@ -118,6 +188,8 @@ def check(
     *,
     text: str = "",
     boolean: bool = False,
+    vocabulary: Vocabulary | None = None,
+    bound: frozenset[str] | set[str] = frozenset(),
 ) -> list[FormulaError]:
     """Find static problems in a formula.
 
@@ -131,6 +203,11 @@ def check(
             a utility summand or a binding value. Operands of ``and``,
             ``or``, ``not``, ``->``, ``<->`` and quantifier bodies are always
             checked.
+        vocabulary: the declared predicates and functions; when given, a
+            name read as a predicate or function must be registered or
+            declared with the arity it is used with. None checks no names.
+        bound: variables bound around the formula (``self``, the plan's
+            variables); a bare one is allowed where a truth value is needed.
 
     Returns:
         The problems found, in pre-order; empty when none.
@@ -141,6 +218,6 @@ def check(
     if isinstance(node, str):
         text = text or node
         node = parse(node)
-    checker = _Checker(registry, text)
+    checker = _Checker(registry, text, vocabulary, frozenset(bound))
     checker.visit(node, boolean)
     return checker.errors

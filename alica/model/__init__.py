@@ -15,6 +15,7 @@ from alica.model.common import (
     Variable,
     format_cardinality,
 )
+from alica.model.declaration import Declaration
 from alica.model.library import SECTIONS, AbstractPlan, Document, PlanLibrary, children_of
 from alica.model.plan import (
     Binding,
@@ -42,6 +43,7 @@ __all__ = [
     "Condition",
     "ConditionKind",
     "Constraint",
+    "Declaration",
     "Document",
     "EntryPoint",
     "Param",

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 from alica.model.behaviour import Behaviour
+from alica.model.declaration import Declaration
 from alica.model.plan import Plan, PlanType
 from alica.model.planning import PlanningProblem
 from alica.model.roles import RoleSet, Task
@@ -48,9 +49,13 @@ class Document:
     Args:
         path: the file, as given to the loader (ignored by ``==``).
         imports: other files this one refers to, relative to it.
+        predicates: the predicates declared here for formulas to read.
+        functions: the functions declared here for formulas to read.
     """
 
     imports: tuple[str, ...] = ()
+    predicates: tuple[Declaration, ...] = ()
+    functions: tuple[Declaration, ...] = ()
     tasks: tuple[Task, ...] = ()
     rolesets: tuple[RoleSet, ...] = ()
     behaviours: tuple[Behaviour, ...] = ()

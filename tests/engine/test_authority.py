@@ -6,6 +6,7 @@ from alica.testing import scripted
 from tests.engine.helpers import library, team, where
 
 PLANS = """
+functions: [bias/2]
 behaviours:
   - {name: DoWork, skill: Work}
 plans:

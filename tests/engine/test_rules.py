@@ -7,6 +7,7 @@ from alica.testing import scripted
 from tests.engine.helpers import library, team, where
 
 PLANS = """
+predicates: [ready/0, abort/0, stop/0]
 behaviours:
   - {name: DoWork, skill: Work}
   - {name: Guarded, skill: Work, pre: "ready"}

@@ -6,6 +6,7 @@ from alica.testing import scripted
 from tests.engine.helpers import library, team, where
 
 PLANS = """
+predicates: [grasped/1]
 behaviours:
   - {name: Hold, skill: Wait}
 plans:

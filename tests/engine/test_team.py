@@ -186,6 +186,7 @@ def test_threshold_keeps_the_current_assignment(tmp_path):
 
 
 PROBLEM = """
+predicates: [done/0, ready/0]
 behaviours:
   - {name: Hold, skill: Wait}
 plans:

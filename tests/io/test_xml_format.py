@@ -28,6 +28,10 @@ from alica.source import Diagnostic, SourceSpan
 FULL = """\
 alica: 1
 imports: [roles.yaml, skills/move_to_position.xml]
+predicates:
+  - stuck/0
+  - {name: found, arity: 1, doc: "a sample was found & <seen>"}
+functions: [pos/1, {name: battery, arity: 1}]
 tasks:
   - Default
   - {name: Explore, description: "map the area & look for <samples>"}
@@ -204,6 +208,8 @@ HANDWRITTEN_XML = """\
 <alica version="1" xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"
        xsi:noNamespaceSchemaLocation="plan.xsd">
   <import href="roles.yaml"/>
+  <predicate name="stuck" arity="0" doc="the robot cannot move"/>
+  <function name="pos" arity="1"/>
   <task name="Explore" description="map the area"/>
   <task name="Transport"/>
   <roleset name="Impera" default_priority="0">
@@ -256,6 +262,8 @@ HANDWRITTEN_XML = """\
 
 HANDWRITTEN_YAML = """\
 imports: [roles.yaml]
+predicates: [{name: stuck, arity: 0, doc: the robot cannot move}]
+functions: [pos/1]
 tasks: [{name: Explore, description: map the area}, Transport]
 rolesets:
   - name: Impera

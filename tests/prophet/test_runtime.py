@@ -184,6 +184,7 @@ def test_the_operator_sets_a_new_goal_and_the_leader_replans():
 # -- planner failure and timeout: the AlternativePlan -------------------------------
 
 PROBLEM = """
+predicates: [done/0, ready/0]
 behaviours:
   - {name: Hold, skill: Wait}
   - {name: GoHome, skill: Work}
