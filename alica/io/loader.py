@@ -194,7 +194,7 @@ class Loader:
             for doc in docs:
                 documents.setdefault(doc.path, doc)
         problems = Problems()
-        Validator(list(documents.values()), self.skills, self.functions, problems).run()
+        Validator(list(documents.values()), self.skills, self.functions, problems, vocabulary=self.skills.facts).run()
         return list(documents.values()), _unique(diagnostics + problems.items)
 
     def load(self, *entries: str | os.PathLike[str]) -> PlanLibrary:

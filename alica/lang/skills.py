@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from alica.errors import UnknownSkillError
+from alica.lang.vocabulary import Symbol, Vocabulary, default_vocabulary
 
 #: Parameter types a skill may declare, with what a literal value of each must be.
 PARAM_TYPES: dict[str, str] = {
@@ -138,6 +139,20 @@ class SkillRegistry:
 
     _specs: dict[str, SkillSpec] = field(default_factory=dict)
     origin: str = ""
+    facts: Vocabulary = field(default_factory=default_vocabulary)
+    """The predicates and functions conditions may read: the engine's own, and what the skills write."""
+
+    def declare_predicate(self, name: str, arity: int, doc: str = "") -> Symbol:
+        """Declare a predicate a skill writes to the world model (``found/1``), so plans may read it undeclared.
+
+        Raises:
+            ValueError: the name is declared as a function, or is not a name.
+        """
+        return self.facts.declare_predicate(name, arity, doc, origin=self.origin)
+
+    def declare_function(self, name: str, arity: int, doc: str = "") -> Symbol:
+        """Declare a function (a value, such as ``pos/1``) a skill writes; see :meth:`declare_predicate`."""
+        return self.facts.declare_function(name, arity, doc, origin=self.origin)
 
     def register(self, spec: SkillSpec, *, replace: bool = False) -> SkillSpec:
         """Add a declaration.

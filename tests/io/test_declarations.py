@@ -175,3 +175,15 @@ def test_a_declared_predicate_validates_with_its_arity_only(
     wrong = ", ".join(f"o{i}" for i in range(arity + extra))
     (found,) = problems(folder, {"plan.yaml": plan_yaml(f"{name}({wrong})", head)})
     assert f"takes {arity} argument" in found.message
+
+
+def test_a_skill_registry_declares_the_facts_its_skills_write(tmp_path: Path) -> None:
+    from alica.lang.skills import SkillRegistry
+
+    text = plan_yaml("counted(self) and not counted")
+    assert any("unknown predicate 'counted'" in p.message for p in problems(tmp_path, {"plan.yaml": text}))
+    registry = SkillRegistry()
+    registry.declare_predicate("counted", 1, "the agent counted")
+    found = Loader(skills=registry).check(tmp_path / "plan.yaml")[1]
+    # declared with one argument: the 0-ary use is still wrong
+    assert [p.message for p in found] and all("counted" in p.message and "argument" in p.message for p in found)

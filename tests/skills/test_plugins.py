@@ -42,6 +42,7 @@ class CountTicks(py_trees.behaviour.Behaviour):
 
 
 def register(registry):
+    registry.declare_predicate("counted", 1, "the agent counted its ticks")
     registry.declare(
         "CountTicks",
         ParamSpec("times", "int", required=False, default=3, doc="ticks to count"),
