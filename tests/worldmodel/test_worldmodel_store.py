@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from alica.lang import BeliefBase
+from alica.lang.fact import Fact
 from alica.worldmodel import Key, LamportClock, Stamp, WorldModel, order_key
 
 
@@ -237,7 +238,7 @@ def test_facts_and_values_listings() -> None:
     wm.retract_fact("found", "c")
     wm.set("pos", "scout", value=(1.0, 2.0))
     wm.add_to_set("invalid", "c9")
-    assert wm.facts() == [("found", "a"), ("found", "b"), ("invalid", "c9")]
+    assert wm.facts() == [Fact("found", ("a",)), Fact("found", ("b",)), Fact("invalid", ("c9",))]
     assert wm.values() == [("pos", ("scout",), (1.0, 2.0))]
 
 
