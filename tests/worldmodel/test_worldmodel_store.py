@@ -289,3 +289,12 @@ def test_keys_sort_deterministically() -> None:
     keys = {Key("set", "s", ("x",)), Key("register", "pos", (2,)), Key("register", "pos", ("a",))}
     assert sorted(keys) == [Key("register", "pos", (2,)), Key("register", "pos", ("a",)), Key("set", "s", ("x",))]
     assert str(Key("register", "pos", ("a",))) == "register:pos('a')"
+
+
+def test_the_world_model_offers_its_protocol() -> None:
+    from alica.worldmodel import WorldModelLike
+
+    wm: WorldModelLike = WorldModel("scout")
+    wm.assert_fact("found", "a")
+    assert isinstance(wm, WorldModelLike) and wm.facts() == [Fact("found", ("a",))]
+    assert not isinstance(object(), WorldModelLike)
