@@ -76,7 +76,7 @@ def _box(obj: WorldThing) -> Box:
     if half and half[0] > 0.0:
         center, quat = obj.pose()
         yaw, upright = upright_box(quat, half)  # a block that fell onto a side has its faces turned another way
-        return Box(obj.name, tuple(float(v) for v in center), upright, yaw)
+        return Box(obj.name, (float(center[0]), float(center[1]), float(center[2])), upright, yaw)
     return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
 
 
@@ -136,7 +136,8 @@ class ArmSkill(WorldSkill):
 
     def site(self) -> tuple[float, float]:
         """Where the work happens, for the approach."""
-        return tuple(self.target_object().position()[:2])  # type: ignore[return-value]
+        position = self.target_object().position()
+        return float(position[0]), float(position[1])
 
     def check_before(self) -> str | None:
         """Why the skill cannot start now, or None."""
@@ -173,7 +174,7 @@ class ArmSkill(WorldSkill):
 
     def initialise(self) -> None:
         """Start with the approach."""
-        self.retries = int(self.param("retries", 3))  # type: ignore[arg-type]
+        self.retries = int(self.param("retries", 3))  # type: ignore[call-overload]
         self.attempts = 0
         self.phase = "check"
         self.mover: MoveToPosition | None = None
@@ -336,7 +337,7 @@ class ArmSkill(WorldSkill):
         paths = [np.asarray(p) for p in result.paths]
         # pick: to the pre-grasp, down, grip, up to the transport pose;
         # place: above the place, down, release, up to the transport pose
-        self.steps: list[object] = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
+        self.steps = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
         self.step_index = 0
         self.phase = "execute"
         if self.grasps:
@@ -381,7 +382,7 @@ class ArmSkill(WorldSkill):
             if obj.kind == "block" and ("clear", obj.name) not in blocks_state(self.world):
                 return f"something was put on {obj.name} before the grip"  # lifting it would throw that off
             arm.close()
-            arm.attach(obj)
+            arm.attach(obj.name)
         else:
             arm.detach()
             arm.open()
@@ -544,7 +545,7 @@ class Pickup(ArmSkill):
             (True, ("holding", me, obj.name)),
             (False, ("onground", obj.name)),
         ):
-            self.write(positive, *fact)  # type: ignore[arg-type]
+            self.write(positive, *fact)
         return None
 
 

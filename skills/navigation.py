@@ -175,9 +175,11 @@ class MoveToPosition(WorldSkill):
             if now < self.wait_until:
                 return self.running(f"waiting for another robot to clear the goal ({self.reason})")
             self._plan(self.goal)
-        if not self.job.done():
+        job = self.job
+        assert job is not None  # _plan submitted one
+        if not job.done():
             return self.running("planning")
-        result = self.job.result()
+        result = job.result()
         target = self.goal
         if result.status != "exact":
             self.reason = result.reason or result.status

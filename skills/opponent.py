@@ -258,6 +258,7 @@ class RandomBlockSkill(WorldSkill):
             self.idle_message = f"waiting: {why}; looking again at t = {self.next_look:.1f} s"
             return self.running(self.idle_message)
         self.blocked_looks = 0
+        assert self.context is not None  # set up with one
         self.action = self.context.rng.choice(free)
         self.chosen.append(self.action)
         self._start(self.action)
@@ -296,21 +297,22 @@ class RandomBlockSkill(WorldSkill):
         return inner
 
     def _tick_inner(self) -> Status:
-        assert self.action is not None
+        assert self.action is not None and self.inner is not None
+        inner = self.inner
         label = self.action.label
         if self.now() - self.action_started > self.action_timeout:
-            self.inner.stop(Status.INVALID)
+            inner.stop(Status.INVALID)
             return self._finished(label, "timeout", f"still running after {self.action_timeout:.0f} s")
         try:
-            self.inner.tick_once()
+            inner.tick_once()
         except (SkillError, WorldError) as exc:  # the world changed under the action (a block taken, say)
-            self.inner.stop(Status.INVALID)
+            inner.stop(Status.INVALID)
             return self._finished(label, "failure", str(exc))
-        status = self.inner.status
+        status = inner.status
         if status == Status.RUNNING:
-            return self.running(f"{label}: {self.inner.feedback_message}")
+            return self.running(f"{label}: {inner.feedback_message}")
         outcome = "success" if status == Status.SUCCESS else "failure"
-        return self._finished(label, outcome, self.inner.feedback_message)
+        return self._finished(label, outcome, inner.feedback_message)
 
     def _finished(self, label: str, outcome: str, reason: str) -> Status:
         self.outcomes.append((label, outcome, reason))

@@ -130,7 +130,8 @@ def run_skill(
         raise SkillError(f"the world has no robot named '{robot}' (robots: {', '.join(sorted(world.robots))})")
     factory = registry.load(name)
     wm = world_model if world_model is not None else WorldModel(robot, clock=world.clock)
-    context = SkillContext(robot, world.now, wm, wm, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
+    belief: Any = wm  # alone, the world model is the skill's whole belief base
+    context = SkillContext(robot, world.now, wm, belief, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
     behaviour = factory(name, values, context)
     behaviour.setup(context=context)
     start = world.now()
