@@ -25,7 +25,8 @@ from alica.model import Behaviour
 __all__ = ["ManualClock", "ScriptedSkill", "TimedSkill", "default_fallback", "scripted"]
 
 _STATUS = {"running": Status.RUNNING, "success": Status.SUCCESS, "failure": Status.FAILURE}
-Fact = tuple[bool, str, tuple[object, ...]]
+#: A change a scripted skill writes on success: ``(positive, predicate, args)`` (assert when positive, else retract).
+FactChange = tuple[bool, str, tuple[object, ...]]
 
 
 def _status(value: str | Status) -> Status:
@@ -37,7 +38,7 @@ def _status(value: str | Status) -> Status:
         raise ValueError(f"unknown status '{value}' in a script (use running, success or failure)") from None
 
 
-def _write(context: Any, facts: Sequence[Fact]) -> None:
+def _write(context: Any, facts: Sequence[FactChange]) -> None:
     world = getattr(context, "world_model", None)
     if world is None:
         return
@@ -64,7 +65,9 @@ class ScriptedSkill(py_trees.behaviour.Behaviour):
         ticks: updates since the last start.
     """
 
-    def __init__(self, name: str, script: Sequence[str | Status] = ("success",), facts: Sequence[Fact] = ()) -> None:
+    def __init__(
+        self, name: str, script: Sequence[str | Status] = ("success",), facts: Sequence[FactChange] = ()
+    ) -> None:
         super().__init__(name)
         if not script:
             raise ValueError("a script needs at least one status")
@@ -107,7 +110,9 @@ class TimedSkill(py_trees.behaviour.Behaviour):
         facts: written to the world model on success, as for :class:`ScriptedSkill`.
     """
 
-    def __init__(self, name: str, duration: float | None, outcome: str = "success", facts: Sequence[Fact] = ()) -> None:
+    def __init__(
+        self, name: str, duration: float | None, outcome: str = "success", facts: Sequence[FactChange] = ()
+    ) -> None:
         super().__init__(name)
         self.duration = duration
         self.outcome = _status(outcome)
@@ -140,7 +145,7 @@ class scripted:
         facts: as for :class:`ScriptedSkill`.
     """
 
-    def __init__(self, script: Sequence[str | Status] = ("success",), facts: Sequence[Fact] = ()) -> None:
+    def __init__(self, script: Sequence[str | Status] = ("success",), facts: Sequence[FactChange] = ()) -> None:
         self.script = list(script)
         self.facts = tuple(facts)
         self.instances: list[ScriptedSkill] = []
@@ -151,7 +156,7 @@ class scripted:
         return skill
 
 
-def post_facts(behaviour: Behaviour) -> tuple[Fact, ...]:
+def post_facts(behaviour: Behaviour) -> tuple[FactChange, ...]:
     """The post-condition of a behaviour as facts to write, when it is a conjunction of ground literals."""
     if behaviour.post is None:
         return ()

@@ -712,7 +712,7 @@ class ProblemRuntime:
         predicates = self._predicates()
         world_model = self.engine.world_model
         believed = list(world_model.facts())
-        facts = [(str(f[0]), tuple(str(a) for a in f[1:])) for f in believed if str(f[0]).lower() in predicates]
+        facts = [(f.predicate, tuple(str(a) for a in f.args)) for f in believed if f.predicate.lower() in predicates]
         goal = goal_literals(self.problem)
         world = self._read_world(self.problem, believed)
         reachable = reachable_goal(goal, world.outside)

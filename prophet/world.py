@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 from alica.errors import AlicaError, PlannerError
 from alica.lang import literals
+from alica.lang.fact import Fact as WorldFact
 from alica.model import PlanLibrary, PlanningProblem
 from alica.prophet.problem import offline_world, predicate_types
 from alica.prophet.tasks import apply_effect, for_robot, holds
@@ -80,7 +81,7 @@ def goal_literals(problem: PlanningProblem) -> tuple[Literal, ...]:
 def read_world(
     problem: PlanningProblem,
     library: PlanLibrary,
-    facts: Iterable[tuple[object, ...]],
+    facts: Iterable[WorldFact | tuple[object, ...]],
     team: Iterable[str],
     typed_objects: Mapping[str, Iterable[object]] | None = None,
 ) -> PlanningWorld:
@@ -89,8 +90,8 @@ def read_world(
     Args:
         problem: the planning problem.
         library: holds its elements' signatures.
-        facts: true facts as ``(predicate, *args)`` tuples (the world model's
-            :meth:`facts`); ignored when the problem has its own ``world``.
+        facts: true facts (the world model's :meth:`facts`, or flat ``(predicate, *args)``
+            tuples); ignored when the problem has its own ``world``.
         team: the alive team members: the robots of the plan.
         typed_objects: type -> objects, e.g. from the world model.
 
@@ -103,7 +104,7 @@ def read_world(
     declared: dict[str, str] = {}
     if offline:
         declared, given = offline_world(problem)
-        source: Iterable[tuple[object, ...]] = ((name, *args) for name, args in given)
+        source: Iterable[WorldFact | tuple[object, ...]] = (WorldFact(name, tuple(args)) for name, args in given)
     else:
         source = facts
     members = tuple(sorted(set(team)))
@@ -111,9 +112,10 @@ def read_world(
     left_out = 0
     outside: set[str] = set()
     others: set[str] = set()
-    for fact in source:
-        name = str(fact[0])
-        args = tuple(str(a) for a in fact[1:])
+    for item in source:
+        fact = WorldFact.of(item)
+        name = fact.predicate
+        args = tuple(str(a) for a in fact.args)
         arity = predicates.get(name.lower())
         if arity is None or len(args) != len(arity):
             continue

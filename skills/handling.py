@@ -24,14 +24,23 @@ simulated state before and after; the effects are written to the world model.
 from __future__ import annotations
 
 import math
-from typing import Any
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from py_trees.common import Status
 
+from alica.errors import SkillError
+from alica.skills.context import SkillContextLike
+from alica.skills.jobs import Job
 from alica.skills.navigation import MoveToPosition
 from alica.skills.world_skill import WorldSkill, distance, world_cache
 from alica.worldsim.geometry import wrap_angle
+from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
+
+if TYPE_CHECKING:
+    from alica.skills.manipulation import ArmScene, Box
+    from alica.worldsim.arm import Arm
 
 #: Horizontal distance from the arm's base at which the arm works best.
 REACH = 0.55
@@ -53,25 +62,25 @@ STANDOFF_WAIT = 30.0
 SIDE_TRIED = 0.2
 
 
-def _box(obj: Any) -> Any:
+def _box(obj: WorldThing) -> Box:
     """An object as a box for arm planning: its own extents and yaw for boxes, else its bounding box."""
     from alica.skills.manipulation import Box
     from alica.skills.manipulation.geometry import upright_box
 
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
-    half = tuple(getattr(obj, "half_extents", (0.0, 0.0, 0.0)))
-    if getattr(obj, "kind", "") == "sample" and getattr(obj, "radius", 0.0):
+    half = tuple(obj.half_extents)
+    if obj.kind == "sample" and obj.radius:
         # a standing cylinder: its true size, not a bounding box that grows as it turns in the hand
         r = float(obj.radius)
         half = (r, r, 0.5 * float(obj.size))
     if half and half[0] > 0.0:
         center, quat = obj.pose()
         yaw, upright = upright_box(quat, half)  # a block that fell onto a side has its faces turned another way
-        return Box(obj.name, tuple(float(v) for v in center), upright, yaw)
+        return Box(obj.name, (float(center[0]), float(center[1]), float(center[2])), upright, yaw)
     return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
 
 
-def _crowds(box: Any, target: Any) -> bool:
+def _crowds(box: Box, target: Box) -> bool:
     """Whether ``box`` stands beside ``target`` closer than the fingers need to close around it.
 
     Beside: its top is above the target's bottom (not the block the target stands on), and its centre
@@ -88,7 +97,7 @@ def _duration(path: np.ndarray) -> float:
     return max(0.2, float(steps.sum()) / JOINT_SPEED)
 
 
-def blocks_state(world: Any) -> set[tuple[object, ...]]:
+def blocks_state(world: RobotWorld) -> set[tuple[str, ...]]:
     """The IPC blocks facts of the simulated state."""
     from alica.worldsim.scenarios import blocks_facts
 
@@ -104,32 +113,43 @@ class ArmSkill(WorldSkill):
     def setup(self, **kwargs: Any) -> None:
         """Find the robot; it needs an arm."""
         super().setup(**kwargs)
-        if getattr(self.robot, "arm", None) is None:
-            from alica.errors import SkillError
-
+        if self.robot.arm is None:
             raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no arm")
+
+    @property
+    def arm(self) -> Arm:
+        """The robot's arm (:meth:`setup` checked that it has one).
+
+        Raises:
+            SkillError: the robot has no arm.
+        """
+        arm = self.robot.arm
+        if arm is None:
+            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no arm")
+        return arm
 
     # -- what subclasses define -----------------------------------------------
 
-    def target_object(self) -> Any:
+    def target_object(self) -> WorldThing:
         """The object grasped (or held, for placing)."""
         return self.object_named(self.param("object"))
 
     def site(self) -> tuple[float, float]:
         """Where the work happens, for the approach."""
-        return tuple(self.target_object().position()[:2])  # type: ignore[return-value]
+        position = self.target_object().position()
+        return float(position[0]), float(position[1])
 
     def check_before(self) -> str | None:
         """Why the skill cannot start now, or None."""
         return None
 
-    def plan(self, scene: Any, q: np.ndarray, rng: np.random.Generator) -> Any:
+    def plan(self, scene: ArmScene, q: np.ndarray, rng: np.random.Generator) -> Any:
         """The arm plan, run as a job: grasp and lift, or place at :meth:`place_top` and retreat."""
         from alica.skills.manipulation import plan_pickup, plan_place
 
         if self.grasps:
             obj = self.target_object()
-            shape = "cylinder" if getattr(obj, "kind", "") == "sample" else "box"
+            shape = "cylinder" if obj.kind == "sample" else "box"
             return plan_pickup(scene, _box(obj), q, rng=rng, kind=shape)
         from alica.skills.manipulation import held_box
 
@@ -154,21 +174,19 @@ class ArmSkill(WorldSkill):
 
     def initialise(self) -> None:
         """Start with the approach."""
-        self.retries = int(self.param("retries", 3))  # type: ignore[arg-type]
+        self.retries = int(self.param("retries", 3))  # type: ignore[call-overload]
         self.attempts = 0
         self.phase = "check"
         self.mover: MoveToPosition | None = None
-        self.steps = []
+        self.steps: list[Any] = []
         self.step_index = 0
-        self.job: Any = None
+        self.job: Job | None = None
         self.settle_until = 0.0
         self.blocked_since: float | None = None
         self.tried_sides: list[tuple[float, float]] = []
         self.followed: list[np.ndarray] = []
         self.released = False
-        self.np_rng = np.random.default_rng(
-            self.context.rng.randrange(2**31) if hasattr(self.context.rng, "randrange") else 0
-        )
+        self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if self.context is not None else 0)
 
     def update(self) -> Status:
         """One step of the current phase."""
@@ -183,7 +201,7 @@ class ArmSkill(WorldSkill):
         return self._phase_approach()
 
     def _arm_xy(self) -> tuple[float, float]:
-        position = self.robot.arm.base_pose()[0]
+        position = self.arm.base_pose()[0]
         return float(position[0]), float(position[1])
 
     def _phase_approach(self) -> Status:
@@ -257,25 +275,23 @@ class ArmSkill(WorldSkill):
         """Whether the arm found no plan from a stand-off point this close to ``xy`` already."""
         return any(distance(xy, side) < SIDE_TRIED for side in self.tried_sides)
 
-    def _scene(self) -> Any:
+    def _scene(self) -> ArmScene:
         from alica.skills.manipulation import ArmScene
 
         cache = world_cache(self.world)
         key = f"arm-scene:{self.robot.name}"
         scene = cache.get(key)
         if scene is None:
-            scene = cache[key] = ArmScene(self.robot.arm.urdf_path, self.robot.arm.base_pose(), seed=self.world.seed)
-        scene.set_base_pose(self.robot.arm.base_pose())
+            scene = cache[key] = ArmScene(self.arm.urdf_path, self.arm.base_pose(), seed=self.world.seed)
+        scene.set_base_pose(self.arm.base_pose())
         target = self.target_object()
         boxes = [
             _box(o)
             for name, o in sorted(self.world.objects.items())
-            if name != target.name
-            and _near(o, self._arm_xy())
-            and getattr(o, "kind", "") not in ("terrain", "collection_point")
+            if name != target.name and _near(o, self._arm_xy()) and o.kind not in ("terrain", "collection_point")
         ]
         scene.set_obstacles(boxes)
-        q = np.asarray(self.robot.arm.q(), dtype=float)
+        q = np.asarray(self.arm.q(), dtype=float)
         held = self._held_box(scene, q)
         if boxes and scene.collides(q, held):
             # the arm, or what it holds, touches an object already (pushed against it): no plan could
@@ -295,7 +311,7 @@ class ArmSkill(WorldSkill):
                 scene.set_obstacles([b for b in boxes if b not in crowding])
         return scene
 
-    def _held_box(self, scene: Any, q: np.ndarray) -> Any:
+    def _held_box(self, scene: ArmScene, q: np.ndarray) -> Box | None:
         """What the arm holds, as a box in the tool's frame (None when grasping)."""
         if self.grasps:
             return None
@@ -307,12 +323,10 @@ class ArmSkill(WorldSkill):
             return None  # tilted in the hand: the planner says so itself
 
     def _phase_plan(self) -> Status:
-        if self.job is None and self.robot.arm.busy:
+        if self.job is None and self.arm.busy:
             return self.running("waiting for the arm to come back")
         if self.job is None:
-            self.job = self.jobs.submit(
-                self.plan, self._scene(), np.asarray(self.robot.arm.q(), dtype=float), self.np_rng
-            )
+            self.job = self.jobs.submit(self.plan, self._scene(), np.asarray(self.arm.q(), dtype=float), self.np_rng)
             return self.running("planning the arm motion")
         if not self.job.done():
             return self.running("planning the arm motion")
@@ -323,15 +337,15 @@ class ArmSkill(WorldSkill):
         paths = [np.asarray(p) for p in result.paths]
         # pick: to the pre-grasp, down, grip, up to the transport pose;
         # place: above the place, down, release, up to the transport pose
-        self.steps: list[object] = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
+        self.steps = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
         self.step_index = 0
         self.phase = "execute"
         if self.grasps:
-            self.robot.arm.open()
+            self.arm.open()
         return self.running("arm plan ready")
 
     def _phase_execute(self) -> Status:
-        arm = self.robot.arm
+        arm = self.arm
         if arm.busy:
             return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
         while self.step_index < len(self.steps):
@@ -352,7 +366,7 @@ class ArmSkill(WorldSkill):
 
     def _grip_or_release(self) -> str | None:
         """Close on the object or let it go; why not, when another robot has taken the object or put one on it meanwhile."""
-        arm = self.robot.arm
+        arm = self.arm
         if self.grasps:
             obj = self.target_object()
             holder = next(
@@ -365,10 +379,10 @@ class ArmSkill(WorldSkill):
             )
             if holder is not None:
                 return f"{obj.name} was taken by robot '{holder}' before the grip"
-            if getattr(obj, "kind", "") == "block" and ("clear", obj.name) not in blocks_state(self.world):
+            if obj.kind == "block" and ("clear", obj.name) not in blocks_state(self.world):
                 return f"something was put on {obj.name} before the grip"  # lifting it would throw that off
             arm.close()
-            arm.attach(obj)
+            arm.attach(obj.name)
         else:
             arm.detach()
             arm.open()
@@ -390,7 +404,7 @@ class ArmSkill(WorldSkill):
             self.world_model.set("attempts", self.robot.name, value=self.attempts)
         if self.attempts >= self.retries:
             return self.fail(f"gave up after {self.attempts} attempt(s): {reason}")
-        arm = self.robot.arm
+        arm = self.arm
         if self.grasps and arm.held is not None:
             arm.detach()
         if self.grasps:
@@ -419,7 +433,7 @@ class ArmSkill(WorldSkill):
         """
         if self.mover is not None and self.mover.status == Status.RUNNING:
             self.mover.stop(Status.INVALID)
-        if self.robot is not None:
+        if self.has_robot:
             self.robot.stop()
             if new_status != Status.SUCCESS:
                 self._back_out()
@@ -438,12 +452,12 @@ class ArmSkill(WorldSkill):
         if arm is None or self.robot.crashed or arm.held is not None:
             return
         q = np.asarray(arm.q(), dtype=float)
-        followed = getattr(self, "followed", [])
+        followed = self.followed
         if followed:
             last = followed[-1]
             k = _reached(last, q)
             way = [last[: k + 1][::-1], *(path[::-1] for path in reversed(followed[:-1]))]
-        elif getattr(self, "released", False):
+        elif self.released:
             steps, index = self.steps, self.step_index
             way = [np.asarray(step, dtype=float) for step in steps[index:] if not isinstance(step, str)]
             current = steps[index - 1] if 0 < index <= len(steps) and not isinstance(steps[index - 1], str) else None
@@ -468,13 +482,12 @@ def _xy_text(xy: tuple[float, float]) -> str:
     return f"({float(xy[0]):.2f}, {float(xy[1]):.2f})"
 
 
-def _mount_ahead(robot: Any) -> float:
-    """How far ahead of the base centre the arm is mounted (metres)."""
-    offset = getattr(robot.arm, "mount_offset", (0.0, 0.0, 0.0))
-    return float(offset[0])
+def _mount_ahead(robot: MobileRobot) -> float:
+    """How far ahead of the base centre the arm is mounted (metres; 0 without an arm)."""
+    return float(robot.arm.mount_offset[0]) if robot.arm is not None else 0.0
 
 
-def putdown_spots(world: Any, robot: Any) -> list[tuple[float, float]]:
+def putdown_spots(world: RobotWorld, robot: MobileRobot) -> list[tuple[float, float]]:
     """The spots at the arm's reach where ``robot`` could put a block down, straight ahead first, then turned.
 
     Only spots with :data:`PUTDOWN_ROOM` free of objects and other robots are listed.
@@ -492,7 +505,7 @@ def putdown_spots(world: Any, robot: Any) -> list[tuple[float, float]]:
     return spots
 
 
-def _near(obj: Any, xy: tuple[float, float], radius: float = 1.2) -> bool:
+def _near(obj: WorldThing, xy: tuple[float, float], radius: float = 1.2) -> bool:
     position = obj.position()
     return distance((float(position[0]), float(position[1])), xy) <= radius
 
@@ -505,10 +518,10 @@ class Pickup(ArmSkill):
 
     def check_before(self) -> str | None:
         """The hand must be empty; a block must be clear and on the table (IPC pickup)."""
-        if self.robot.arm.held is not None:
-            return f"the hand is not empty: it holds {self.robot.arm.held.name}"
+        if self.arm.held is not None:
+            return f"the hand is not empty: it holds {self.arm.held.name}"
         obj = self.target_object()
-        if getattr(obj, "kind", "") == "block":
+        if obj.kind == "block":
             facts = blocks_state(self.world)
             if ("clear", obj.name) not in facts:
                 return f"precondition clear({obj.name}) does not hold: something lies on it"
@@ -520,7 +533,7 @@ class Pickup(ArmSkill):
 
     def check_after(self) -> str | None:
         """The object is held with force."""
-        arm = self.robot.arm
+        arm = self.arm
         obj = self.target_object()
         if arm.held is not obj or arm.grip_force() <= 0:
             return f"the grip on {obj.name} failed (the object is not held)"
@@ -532,7 +545,7 @@ class Pickup(ArmSkill):
             (True, ("holding", me, obj.name)),
             (False, ("onground", obj.name)),
         ):
-            self.write(positive, *fact)  # type: ignore[arg-type]
+            self.write(positive, *fact)
         return None
 
 
@@ -567,9 +580,16 @@ class Putdown(ArmSkill):
 
     grasps = False
 
+    def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
+        super().__init__(name, params, context)
+        #: The free spot chosen (kept from when an opponent asked for :meth:`site` before the start).
+        self._spot: tuple[float, float] | None = None
+        #: Spots where a placement failed.
+        self._tried: list[tuple[float, float]] = []
+
     def check_before(self) -> str | None:
         """The robot must hold the object."""
-        held = self.robot.arm.held
+        held = self.arm.held
         obj = self.target_object()
         if held is not obj:
             return f"precondition holding({self.robot.name}, {obj.name}) does not hold (holding {held.name if held else 'nothing'})"
@@ -584,12 +604,12 @@ class Putdown(ArmSkill):
         target = self.param("target")
         if target is not None:
             return self.resolve_position(target)
-        if getattr(self, "_spot", None) is None:
+        if self._spot is None:
             self._spot = self._free_spot()
         return self._spot
 
     def _free_spot(self) -> tuple[float, float]:
-        tried = getattr(self, "_tried", [])
+        tried = self._tried
         for spot in putdown_spots(self.world, self.robot):
             if not any(distance(spot, old) < PUTDOWN_ROOM for old in tried):
                 return spot
@@ -603,7 +623,7 @@ class Putdown(ArmSkill):
         """Try another spot on the next attempt (when no target was given)."""
         status = super()._retry(reason)
         if status == Status.RUNNING and self.param("target") is None:
-            self._tried = [*getattr(self, "_tried", []), self.site()]
+            self._tried = [*self._tried, self.site()]
             self._spot = None
             self.phase = "approach"
             self.mover = None
@@ -612,7 +632,7 @@ class Putdown(ArmSkill):
     def check_after(self) -> str | None:
         """Released, resting near the place."""
         obj = self.target_object()
-        if self.robot.arm.held is not None:
+        if self.arm.held is not None:
             return f"{obj.name} is still in the hand"
         x, y, _ = self.place_top()
         here = obj.position()
@@ -625,13 +645,14 @@ class Putdown(ArmSkill):
         self.outcome_facts(obj)
         return None
 
-    def outcome_facts(self, obj: Any) -> None:
+    def outcome_facts(self, obj: WorldThing) -> None:
         """Putdown: the object is on the target block, on the table (blocks) or on the ground."""
         target = self.param("target")
-        if isinstance(target, str) and getattr(self.world.objects.get(target), "kind", "") == "block":
+        below = self.world.objects.get(target) if isinstance(target, str) else None
+        if isinstance(target, str) and below is not None and below.kind == "block":
             self.write(True, "on", obj.name, target)
             self.write(False, "clear", target)
-        elif getattr(obj, "kind", "") == "block":
+        elif obj.kind == "block":
             self.write(True, "ontable", obj.name)
         else:
             self.write(True, "onground", obj.name)
@@ -670,7 +691,7 @@ class Stack(Putdown):
         """``on(object, target)`` holds in the simulated state."""
         obj = self.target_object()
         below = str(self.param("target"))
-        if self.robot.arm.held is not None:
+        if self.arm.held is not None:
             return f"{obj.name} is still in the hand"
         if ("on", obj.name, below) not in blocks_state(self.world):
             return f"{obj.name} did not come to rest on {below}"

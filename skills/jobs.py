@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 
 class Job(Protocol):
@@ -26,6 +26,7 @@ class Job(Protocol):
         ...
 
 
+@runtime_checkable
 class Jobs(Protocol):
     """Runs jobs for skills."""
 

@@ -11,18 +11,24 @@ a job; ``update`` only polls.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from py_trees.common import Status
 
+from alica.skills.jobs import Job
 from alica.skills.world_skill import WorldSkill, distance, world_cache
+from alica.worldsim.interface import RobotWorld
+
+if TYPE_CHECKING:
+    from alica.skills.motion import FclChecker, GridChecker, PathFollower
+    from alica.worldsim.grid import OccupancyGrid
 
 #: Replans (after being stuck or blocked) before MoveToPosition gives up.
 MAX_REPLANS = 5
 
 
-def planning_grid(world: Any) -> Any:
+def planning_grid(world: RobotWorld) -> OccupancyGrid:
     """The world's static obstacles as an occupancy grid (5 cm cells), built once per world layout."""
     from alica.worldsim.grid import OccupancyGrid
 
@@ -33,10 +39,11 @@ def planning_grid(world: Any) -> Any:
         hit = cache["grid"] = (obstacles, OccupancyGrid.from_obstacles(list(obstacles), world.bounds, 0.05))
         cache.pop("checkers", None)
         cache.pop("exact", None)
-    return hit[1]
+    grid: OccupancyGrid = hit[1]
+    return grid
 
 
-def exact_checker(world: Any, radius: float) -> Any:
+def exact_checker(world: RobotWorld, radius: float) -> FclChecker:
     """FCL against the world's static obstacles (rocks as their convex meshes, tables) for a robot of ``radius``.
 
     The final exact check of a path; movable objects (blocks, samples, held or not) are left to the grid.
@@ -45,26 +52,27 @@ def exact_checker(world: Any, radius: float) -> Any:
 
     planning_grid(world)  # drops stale checkers when the layout changed
     checkers = world_cache(world).setdefault("exact", {})
-    checker = checkers.get(radius)
+    checker: FclChecker | None = checkers.get(radius)
     if checker is None:
         shapes: list[Any] = []
         for _, obj in sorted(world.objects.items()):
-            mesh = obj.world_mesh() if hasattr(obj, "world_mesh") else None
+            mesh = obj.world_mesh()
+            footprint = obj.footprint() if obj.kind == "table" else None
             if mesh is not None:
                 shapes.append(mesh)
-            elif getattr(obj, "kind", "") == "table" and obj.footprint() is not None:
-                shapes.append(obj.footprint())
+            elif footprint is not None:
+                shapes.append(footprint)
         checker = checkers[radius] = FclChecker(shapes, radius)
     return checker
 
 
-def planning_checker(world: Any, radius: float) -> Any:
+def planning_checker(world: RobotWorld, radius: float) -> GridChecker:
     """The grid inflated for a robot of ``radius`` (a :class:`alica.skills.motion.GridChecker`), built once per radius."""
     from alica.skills.motion import GridChecker
 
     grid = planning_grid(world)
     checkers = world_cache(world).setdefault("checkers", {})
-    checker = checkers.get(radius)
+    checker: GridChecker | None = checkers.get(radius)
     if checker is None:
         checker = checkers[radius] = GridChecker(grid, radius)
     return checker
@@ -85,7 +93,9 @@ class MoveToPosition(WorldSkill):
         self.started = self.now()
         self.last = self.started
         self.replans = 0
-        self.follower: Any = None
+        self.follower: PathFollower | None = None
+        self.job: Job | None = None
+        self.next_block_check = 0.0
         self.escaping = False
         self.reason = ""
         self.path_length = 0.0
@@ -106,7 +116,8 @@ class MoveToPosition(WorldSkill):
         exact = exact_checker(self.world, self.robot.spec.radius)
         # An optimizing planner after the first path, when the run allows the time (real robots): anytime
         # planning by wall time is not repeatable, so simulated runs keep RRTConnect plus simplification.
-        optimize = float((getattr(self.context, "extra", None) or {}).get("optimize_time", 0.0))
+        extra = self.context.extra if self.context is not None else {}
+        optimize = float(extra.get("optimize_time", 0.0))  # type: ignore[arg-type]
         self.job = self.jobs.submit(
             plan_path,
             self.robot.pose,
@@ -164,9 +175,11 @@ class MoveToPosition(WorldSkill):
             if now < self.wait_until:
                 return self.running(f"waiting for another robot to clear the goal ({self.reason})")
             self._plan(self.goal)
-        if not self.job.done():
+        job = self.job
+        assert job is not None  # _plan submitted one
+        if not job.done():
             return self.running("planning")
-        result = self.job.result()
+        result = job.result()
         target = self.goal
         if result.status != "exact":
             self.reason = result.reason or result.status
@@ -231,15 +244,14 @@ class MoveToPosition(WorldSkill):
             turn_in_place=math.radians(15.0),
         )
         self.escaping = True
-        if hasattr(robot, "bumped"):
-            robot.bumped = False
+        robot.bumped = False
         return self.running(f"stuck: driving into free space at ({spot[0]:.2f}, {spot[1]:.2f})")
 
     def _blocked(self) -> bool:
         """Whether another robot or a new obstacle stands on the next metres of the path (checked every 0.3 s)."""
         follower = self.follower
         now = self.now()
-        if follower is None or self.escaping or now < getattr(self, "next_block_check", 0.0):
+        if follower is None or self.escaping or now < self.next_block_check:
             return False
         self.next_block_check = now + 0.3
         checker = planning_checker(self.world, self.robot.spec.radius)  # rebuilt when the layout changed
@@ -255,7 +267,7 @@ class MoveToPosition(WorldSkill):
 
     def terminate(self, new_status: Status) -> None:
         """Stop the base whenever the skill ends or is stopped."""
-        if self.robot is not None:
+        if self.has_robot:
             self.robot.stop()
 
 
@@ -303,14 +315,14 @@ class Idle(WorldSkill):
     def setup(self, **kwargs: Any) -> None:
         """Idle needs no world."""
         self.context = kwargs.get("context", self.context)
-        world = getattr(self.context, "world", None)
-        if world is not None and getattr(self.context, "agent", None) in getattr(world, "robots", {}):
+        world = self.context.world if self.context is not None else None
+        if isinstance(world, RobotWorld) and self.context is not None and self.context.agent in world.robots:
             super().setup(**kwargs)
 
     def initialise(self) -> None:
         """Stop the robot, remember when."""
         self.started = self.now() if self.context is not None else 0.0
-        if self.robot is not None:
+        if self.has_robot:
             self.robot.stop()
 
     def update(self) -> Status:

@@ -11,19 +11,22 @@ simulated state only.
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from types import SimpleNamespace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from py_trees.common import Status
 
 from alica.errors import SkillError
+from alica.skills.context import SkillContextLike, SkillEnv
 from alica.skills.world_skill import WorldSkill
 from alica.worldsim.errors import WorldError
+
+if TYPE_CHECKING:
+    from alica.skills.handling import ArmSkill
+    from alica.skills.navigation import DriveToFreeSpace
 
 __all__ = ["BlockAction", "RandomBlockSkill", "applicable_actions", "stack_of"]
 
@@ -114,17 +117,12 @@ def stack_of(block: str, facts: Facts) -> set[str]:
     return members
 
 
-def _silent_context(context: Any) -> Any:
+def _silent_context(context: SkillContextLike | None) -> SkillContextLike | None:
     """The context for the inner skills: the same agent, clock, generator and world, but no world model."""
-    if dataclasses.is_dataclass(context) and not isinstance(context, type):
-        return dataclasses.replace(context, world_model=None)
-    fields = {
-        name: getattr(context, name, None) for name in ("agent", "now", "rng", "world", "belief", "behaviour", "path")
-    }
-    return SimpleNamespace(**fields, world_model=None, extra=getattr(context, "extra", None) or {})
+    return SkillEnv.without_world_model(context) if context is not None else None
 
 
-def _skill_class(name: str) -> Any:
+def _skill_class(name: str) -> type[ArmSkill]:
     from alica.skills import handling
 
     return {
@@ -175,13 +173,14 @@ class RandomBlockSkill(WorldSkill):
         outcomes: ``(label, status, reason)`` of every action that ended.
     """
 
-    def __init__(self, name: str, params: Mapping[str, object], context: Any = None) -> None:
+    def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
         super().__init__(name, params, context)
         self.chosen: list[BlockAction] = []
         self.outcomes: list[tuple[str, str, str]] = []
-        self.inner: Any = None
+        self.inner: ArmSkill | None = None
+        self.aside: DriveToFreeSpace | None = None
         self.action: BlockAction | None = None
-        self._prepared: dict[BlockAction, Any] = {}
+        self._prepared: dict[BlockAction, ArmSkill] = {}
 
     def setup(self, **kwargs: Any) -> None:
         """Find the robot; it needs an arm.
@@ -191,7 +190,7 @@ class RandomBlockSkill(WorldSkill):
                 or a parameter that is not a number >= 0.
         """
         super().setup(**kwargs)
-        if getattr(self.robot, "arm", None) is None:
+        if self.robot.arm is None:
             raise SkillError(
                 f"skill '{self.name}': robot '{self.robot.name}' has no arm; opponents must be manipulators"
             )
@@ -204,7 +203,7 @@ class RandomBlockSkill(WorldSkill):
         """Start idle: look at the world on this first tick."""
         self.inner = None
         self.action = None
-        self.aside: Any = None
+        self.aside = None
         self.blocked_looks = 0
         self._prepared = {}
         self.next_look = self.now()
@@ -259,6 +258,7 @@ class RandomBlockSkill(WorldSkill):
             self.idle_message = f"waiting: {why}; looking again at t = {self.next_look:.1f} s"
             return self.running(self.idle_message)
         self.blocked_looks = 0
+        assert self.context is not None  # set up with one
         self.action = self.context.rng.choice(free)
         self.chosen.append(self.action)
         self._start(self.action)
@@ -289,7 +289,7 @@ class RandomBlockSkill(WorldSkill):
         self.inner = prepared.get(action) or self._build(action)
         self.action_started = self.now()
 
-    def _build(self, action: BlockAction, **extra: object) -> Any:
+    def _build(self, action: BlockAction, **extra: object) -> ArmSkill:
         context = _silent_context(self.context)
         params = _catalog_params(action.skill, {**action.params(), **extra})
         inner = _skill_class(action.skill)(f"{self.name}/{action.label}", params, context)
@@ -297,21 +297,22 @@ class RandomBlockSkill(WorldSkill):
         return inner
 
     def _tick_inner(self) -> Status:
-        assert self.action is not None
+        assert self.action is not None and self.inner is not None
+        inner = self.inner
         label = self.action.label
         if self.now() - self.action_started > self.action_timeout:
-            self.inner.stop(Status.INVALID)
+            inner.stop(Status.INVALID)
             return self._finished(label, "timeout", f"still running after {self.action_timeout:.0f} s")
         try:
-            self.inner.tick_once()
+            inner.tick_once()
         except (SkillError, WorldError) as exc:  # the world changed under the action (a block taken, say)
-            self.inner.stop(Status.INVALID)
+            inner.stop(Status.INVALID)
             return self._finished(label, "failure", str(exc))
-        status = self.inner.status
+        status = inner.status
         if status == Status.RUNNING:
-            return self.running(f"{label}: {self.inner.feedback_message}")
+            return self.running(f"{label}: {inner.feedback_message}")
         outcome = "success" if status == Status.SUCCESS else "failure"
-        return self._finished(label, outcome, self.inner.feedback_message)
+        return self._finished(label, outcome, inner.feedback_message)
 
     def _finished(self, label: str, outcome: str, reason: str) -> Status:
         self.outcomes.append((label, outcome, reason))
@@ -325,7 +326,7 @@ class RandomBlockSkill(WorldSkill):
         self.idle_message = f"pausing after {label}: {outcome}{why}; next look at t = {self.next_look:.1f} s"
         return self.running(self.idle_message)
 
-    def _drive_aside(self, clearance: float) -> Any:
+    def _drive_aside(self, clearance: float) -> DriveToFreeSpace:
         """A drive to a free place ``clearance`` metres from obstacles and robots, ``step_aside`` from every block."""
         from alica.skills.navigation import DriveToFreeSpace
 
@@ -389,10 +390,10 @@ class RandomBlockSkill(WorldSkill):
         """Stop the running action (the inner skill stops its base and approach) and the base."""
         if self.inner is not None and self.inner.status == Status.RUNNING:
             self.inner.stop(Status.INVALID)
-        if getattr(self, "aside", None) is not None and self.aside.status == Status.RUNNING:
+        if self.aside is not None and self.aside.status == Status.RUNNING:
             self.aside.stop(Status.INVALID)
         self.inner = None
         self.aside = None
         self.action = None
-        if self.robot is not None:
+        if self.has_robot:
             self.robot.stop()

@@ -18,11 +18,18 @@ from __future__ import annotations
 import random
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.errors import SkillError
+from alica.lang.fact import Fact
 from alica.lang.skill_plugins import default_registry
 from alica.lang.skills import SkillRegistry
+from alica.worldmodel.protocol import WorldModelLike
+
+if TYPE_CHECKING:
+    from py_trees.behaviour import Behaviour
+
+    from alica.worldsim.world import World
 
 
 @dataclass(slots=True)
@@ -37,7 +44,7 @@ class SkillRun:
         sim_time_s: simulated seconds until it ended.
         ticks: skill ticks.
         trace: ``{"t", "status", "feedback"}`` whenever the feedback or status changed.
-        facts: the world-model facts and values after the run (outcome facts the skill wrote).
+        facts: the world-model facts after the run (the outcome facts the skill wrote), sorted.
     """
 
     skill: str
@@ -47,12 +54,16 @@ class SkillRun:
     sim_time_s: float
     ticks: int
     trace: list[dict[str, object]] = field(default_factory=list)
-    facts: list[tuple[object, ...]] = field(default_factory=list)
+    facts: list[Fact] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
         """Whether the skill succeeded."""
         return self.status == "success"
+
+    def holds(self, predicate: str, *args: object) -> bool:
+        """Whether ``predicate(*args)`` is among the facts after the run."""
+        return Fact(predicate, args) in self.facts
 
 
 def checked_params(spec: Any, params: Mapping[str, object]) -> dict[str, object]:
@@ -86,7 +97,7 @@ def checked_params(spec: Any, params: Mapping[str, object]) -> dict[str, object]
 
 def run_skill(
     name: str,
-    world: Any,
+    world: World,
     robot: str,
     params: Mapping[str, object] | None = None,
     *,
@@ -94,8 +105,8 @@ def run_skill(
     rate: float = 10.0,
     seed: int = 0,
     registry: SkillRegistry | None = None,
-    world_model: Any = None,
-    on_tick: Callable[[Any, Any], None] | None = None,
+    world_model: WorldModelLike | None = None,
+    on_tick: Callable[[World, Behaviour], None] | None = None,
 ) -> SkillRun:
     """Run skill ``name`` on ``robot`` of ``world`` until it ends or ``timeout`` simulated seconds pass.
 
@@ -120,7 +131,8 @@ def run_skill(
         raise SkillError(f"the world has no robot named '{robot}' (robots: {', '.join(sorted(world.robots))})")
     factory = registry.load(name)
     wm = world_model if world_model is not None else WorldModel(robot, clock=world.clock)
-    context = SkillContext(robot, world.now, wm, wm, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
+    belief: Any = wm  # alone, the world model is the skill's whole belief base
+    context = SkillContext(robot, world.now, wm, belief, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
     behaviour = factory(name, values, context)
     behaviour.setup(context=context)
     start = world.now()
@@ -150,5 +162,5 @@ def run_skill(
             break
         world.step(period)
     reason = behaviour.feedback_message or ("" if status != "timeout" else f"still running after {timeout:.0f} s")
-    facts = sorted((tuple(f) for f in wm.facts()), key=repr) if hasattr(wm, "facts") else []
+    facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
     return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts)

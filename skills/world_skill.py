@@ -1,9 +1,11 @@
 """The base of skills that act on a world: the robot of the agent, positions, outcome facts.
 
 A skill class is its own factory: the engine calls ``Skill(name, params,
-context)``, then ``setup(context=...)``; ``context.world`` is a
-:class:`worldsim.World` (or a real robot interface with the same methods) and
-the robot is the one named like the agent. ``update`` only polls: planning runs
+context)``, then ``setup(context=...)``; ``context.world`` is a :class:`alica.worldsim.World`
+(or a real robot interface with the same members) and
+the robot is the one named like the agent. Skills see the world through the
+robot interface (:mod:`alica.worldsim.interface`) and the context through
+:class:`~alica.skills.context.SkillContextLike`. ``update`` only polls: planning runs
 as a job (:mod:`alica.skills.jobs`).
 """
 
@@ -19,14 +21,17 @@ import py_trees
 from py_trees.common import Status
 
 from alica.errors import SkillError
+from alica.skills.context import SkillContextLike
 from alica.skills.jobs import DeferredJobs, Jobs
+from alica.worldmodel.protocol import WorldModelLike
+from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 
 _TERM = re.compile(r"^\s*(?:pos|pose)\s*\(\s*([A-Za-z_][A-Za-z0-9_\-]*)\s*\)\s*$")
 #: Per-world caches (planning grids, arm scenes); entries go with their world.
-_CACHES: weakref.WeakKeyDictionary[Any, dict[str, Any]] = weakref.WeakKeyDictionary()
+_CACHES: weakref.WeakKeyDictionary[RobotWorld, dict[str, Any]] = weakref.WeakKeyDictionary()
 
 
-def world_cache(world: Any) -> dict[str, Any]:
+def world_cache(world: RobotWorld) -> dict[str, Any]:
     """A dict that lives as long as ``world``, for things skills build once per world."""
     cache = _CACHES.get(world)
     if cache is None:
@@ -40,17 +45,48 @@ class WorldSkill(py_trees.behaviour.Behaviour):
     Args:
         name: the behaviour's name.
         params: the skill's parameters (declared in :mod:`alica.skills.catalog`).
-        context: the engine's :class:`~alica.engine.SkillContext` (or any object with
-            ``agent``, ``world``, ``world_model``, ``now`` and ``rng``).
+        context: the engine's :class:`~alica.engine.SkillContext` (any
+            :class:`~alica.skills.context.SkillContextLike`).
+
+    Attributes:
+        world: the robot world (after :meth:`setup`).
+        robot: the agent's robot in it (after :meth:`setup`; :attr:`has_robot` tells).
     """
 
-    def __init__(self, name: str, params: Mapping[str, object], context: Any = None) -> None:
+    def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
         super().__init__(name)
         self.params = dict(params)
         self.context = context
-        self.world: Any = None
-        self.robot: Any = None
+        self._world: RobotWorld | None = None
+        self._robot: MobileRobot | None = None
         self.jobs: Jobs = DeferredJobs()
+
+    @property
+    def world(self) -> RobotWorld:
+        """The robot world.
+
+        Raises:
+            SkillError: the skill was not set up in a world.
+        """
+        if self._world is None:
+            raise SkillError(f"skill '{self.name}' has no world: call setup(context=...) with a world first")
+        return self._world
+
+    @property
+    def robot(self) -> MobileRobot:
+        """The agent's robot.
+
+        Raises:
+            SkillError: the skill was not set up in a world.
+        """
+        if self._robot is None:
+            raise SkillError(f"skill '{self.name}' has no robot: call setup(context=...) with a world first")
+        return self._robot
+
+    @property
+    def has_robot(self) -> bool:
+        """Whether :meth:`setup` found the agent's robot."""
+        return self._robot is not None
 
     # -- life cycle -----------------------------------------------------------
 
@@ -60,27 +96,30 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         Raises:
             SkillError: there is no world, or no robot named like the agent.
         """
-        context = kwargs.get("context", self.context)
+        context: SkillContextLike | None = kwargs.get("context", self.context)
         self.context = context
-        world = getattr(context, "world", None)
-        if world is None:
+        world = context.world if context is not None else None
+        if context is None or world is None:
             raise SkillError(
                 f"skill '{self.name}' acts on a world, and this run has none (run it in a simulated world, e.g. 'alica skill run {type(self).__name__} --world lunar')"
             )
-        agent = getattr(context, "agent", None)
-        robots = getattr(world, "robots", {})
-        if agent not in robots:
+        if not isinstance(world, RobotWorld):
             raise SkillError(
-                f"skill '{self.name}': the world has no robot named '{agent}' (robots: {', '.join(sorted(robots)) or 'none'})"
+                f"skill '{self.name}': {type(world).__name__} does not offer the robot interface (alica.worldsim.interface.RobotWorld)"
             )
-        self.world = world
-        self.robot = robots[agent]
-        extra = getattr(context, "extra", None) or {}
-        self.jobs = extra.get("jobs") or DeferredJobs()
+        robots = world.robots
+        if context.agent not in robots:
+            raise SkillError(
+                f"skill '{self.name}': the world has no robot named '{context.agent}' (robots: {', '.join(sorted(robots)) or 'none'})"
+            )
+        self._world = world
+        self._robot = robots[context.agent]
+        jobs = context.extra.get("jobs")
+        self.jobs = jobs if isinstance(jobs, Jobs) else DeferredJobs()
 
     def now(self) -> float:
         """Simulated (or wall) time of the run."""
-        return float(self.context.now()) if self.context is not None else float(self.world.now())
+        return float(self.context.now()) if self.context is not None else self.world.now()
 
     def fail(self, reason: str) -> Status:
         """End with FAILURE and say why (the engine reports ``feedback_message``)."""
@@ -100,9 +139,9 @@ class WorldSkill(py_trees.behaviour.Behaviour):
     # -- helpers ---------------------------------------------------------------
 
     @property
-    def world_model(self) -> Any:
+    def world_model(self) -> WorldModelLike | None:
         """The agent's world-model replica, or None."""
-        return getattr(self.context, "world_model", None)
+        return self.context.world_model if self.context is not None else None
 
     def write(self, positive: bool, pred: str, *args: object) -> None:
         """Write an outcome fact to the world model, when there is one."""
@@ -131,18 +170,19 @@ class WorldSkill(py_trees.behaviour.Behaviour):
             known = wm.lookup("pos", (name,)) if wm is not None else None
             if isinstance(known, (tuple, list)) and len(known) >= 2:
                 return float(known[0]), float(known[1])
-            thing = self.world.objects.get(name) or self.world.robots.get(name)
-            if thing is not None:
-                if hasattr(thing, "position"):
-                    position = thing.position()
-                    return float(position[0]), float(position[1])
-                x, y, _ = thing.pose
+            obj = self.world.objects.get(name)
+            if obj is not None:
+                position = obj.position()
+                return float(position[0]), float(position[1])
+            robot = self.world.robots.get(name)
+            if robot is not None:
+                x, y, _ = robot.pose
                 return float(x), float(y)
         raise SkillError(
             f"skill '{self.name}': cannot tell where {value!r} is (give [x, y], an object's name or pos(name))"
         )
 
-    def object_named(self, value: object) -> Any:
+    def object_named(self, value: object) -> WorldThing:
         """The world object called ``value``.
 
         Raises:

@@ -14,23 +14,50 @@ reading, not only when the world changes again.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Protocol
 
-Fact = tuple[object, ...]
+from alica.lang.fact import Fact
+from alica.worldmodel.protocol import WorldModelLike
+
+if TYPE_CHECKING:
+    from alica.worldsim.world import World
+
+#: A fact as a reader gives it: a :class:`~alica.lang.fact.Fact` or a flat ``(predicate, *args)`` tuple.
+Reading = Fact | tuple[object, ...]
+
+
+class _Agent(Protocol):
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def world_model(self) -> WorldModelLike: ...
+
+
+class _Team(Protocol):
+    @property
+    def world(self) -> World: ...
+
+    def now(self) -> float: ...
+
+    def running(self) -> Iterable[_Agent]: ...
 
 
 class FactPerception:
     """A ``perception`` hook for :class:`alica.engine.SimulatedTeam`.
 
     Args:
-        read: the facts of a world, as ``(predicate, *args)`` tuples.
+        read: the facts of a world, as :class:`~alica.lang.fact.Fact` or ``(predicate, *args)`` tuples.
         every: seconds of simulated time between two readings.
         predicates: the predicates ``read`` senses (facts of other predicates are
             never touched); by default every predicate it has returned so far.
+
+    Attributes:
+        facts: the last reading, as ``read`` gave it (flat tuples stay flat tuples).
     """
 
     def __init__(
-        self, read: Callable[[Any], Iterable[Fact]], every: float = 0.2, predicates: Iterable[str] = ()
+        self, read: Callable[[World], Iterable[Reading]], every: float = 0.2, predicates: Iterable[str] = ()
     ) -> None:
         if every <= 0:
             raise ValueError(f"FactPerception: 'every' must be a positive number of seconds, got {every}")
@@ -38,28 +65,34 @@ class FactPerception:
         self.every = every
         self.next_at = float("-inf")
         self.predicates: set[str] = set(predicates)
-        self.facts: set[Fact] = set()
+        self.facts: set[Reading] = set()
+        self._seen: set[Fact] = set()
 
-    def __call__(self, team: Any) -> None:
+    def __call__(self, team: _Team) -> None:
         """Read the world (when a reading is due) and update every running agent's world model."""
         now = team.now()
         if now + 1e-9 < self.next_at:
             return
         self.next_at = now + self.every
-        self.facts = {tuple(f) for f in self.read(team.world)}
-        self.predicates.update(str(f[0]) for f in self.facts)
+        self.facts = set(self.read(team.world))
+        self._seen = {Fact.of(f) for f in self.facts}
+        self.predicates.update(f.predicate for f in self._seen)
         for engine in team.running():
             self.write(engine.name, engine.world_model)
 
-    def write(self, agent: str, world_model: Any) -> int:
+    def write(self, agent: str, world_model: WorldModelLike) -> int:
         """Bring ``world_model`` in line with the last reading (the sensed predicates only); returns the number of writes."""
         sensed = self.predicates
-        believed = {tuple(f) for f in world_model.facts() if str(f[0]) in sensed}
+        believed = {f for f in world_model.facts() if f.predicate in sensed}
         writes = 0
-        for fact in sorted(self.facts - believed, key=repr):
-            world_model.assert_fact(str(fact[0]), *fact[1:])
+        for fact in sorted(self._seen - believed, key=_order):
+            world_model.assert_fact(fact.predicate, *fact.args)
             writes += 1
-        for fact in sorted(believed - self.facts, key=repr):
-            world_model.retract_fact(str(fact[0]), *fact[1:])
+        for fact in sorted(believed - self._seen, key=_order):
+            world_model.retract_fact(fact.predicate, *fact.args)
             writes += 1
         return writes
+
+
+def _order(fact: Fact) -> str:
+    return repr(fact.flat)  # the order of the flat tuples the readers give: the writes come in the same order

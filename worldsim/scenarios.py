@@ -13,6 +13,7 @@ import string
 import numpy as np
 
 from alica.worldsim.errors import WorldError
+from alica.worldsim.interface import RobotWorld
 from alica.worldsim.objects import SAMPLE_KINDS
 from alica.worldsim.world import World
 
@@ -176,7 +177,7 @@ def _configuration_counts(n: int, height: int) -> list[int]:
     return counts
 
 
-def blocks_facts(world: World, tolerance: float | None = None) -> set[tuple[str, ...]]:
+def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple[str, ...]]:
     """The IPC blocks-world facts of the simulated state.
 
     ``("on", x, y)``, ``("ontable", x)``, ``("clear", x)``, ``("holding", robot, x)``

@@ -137,7 +137,7 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
                     "sim_time_s": run.sim_time_s,
                     "ticks": run.ticks,
                     "trace": run.trace,
-                    "facts": [list(map(str, f)) for f in run.facts],
+                    "facts": [list(map(str, f.flat)) for f in run.facts],
                 },
                 indent=2,
             )

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from alica.worldmodel.delta import Add, Delta, Digest, Key, Write
 from alica.worldmodel.encoding import order_key
+from alica.worldmodel.protocol import WorldModelLike
 from alica.worldmodel.replica import Replica
 from alica.worldmodel.stamp import LamportClock, Stamp
 from alica.worldmodel.state import ReplicaState
@@ -32,6 +33,7 @@ __all__ = [
     "ReplicaState",
     "Stamp",
     "WorldModel",
+    "WorldModelLike",
     "Write",
     "order_key",
 ]

@@ -2,25 +2,27 @@
 
 from __future__ import annotations
 
+from alica.lang.fact import Fact
 from alica.worldmodel.delta import Add
 from alica.worldmodel.encoding import order_key
 from alica.worldmodel.encoding import to_json as json_data
 from alica.worldmodel.state import ReplicaState
 
 
-def facts(state: ReplicaState) -> list[tuple[object, ...]]:
-    """True facts and set memberships as ``(name, *args)`` tuples, sorted.
+def facts(state: ReplicaState) -> list[Fact]:
+    """True facts and set memberships (``Fact(set_name, (item,))``), sorted.
 
     Args:
         state: the replica's state.
 
     Returns:
-        The facts, sorted by :func:`~alica.worldmodel.encoding.order_key`.
+        The facts, sorted by :func:`~alica.worldmodel.encoding.order_key` of their flat
+        ``(name, *args)`` form.
     """
-    found: list[tuple[object, ...]] = [(name, *args) for (name, args), value in state.live.items() if value is True]
+    found = [Fact(name, args) for (name, args), value in state.live.items() if value is True]
     for name, table in state.sets.items():
-        found.extend((name, item) for item in table)
-    return sorted(found, key=order_key)
+        found.extend(Fact(name, (item,)) for item in table)
+    return sorted(found, key=lambda fact: order_key(fact.flat))
 
 
 def values(state: ReplicaState) -> list[tuple[str, tuple[object, ...], object]]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 
 from alica.clock import Clock
+from alica.lang.fact import Fact
 from alica.worldmodel import listing
 from alica.worldmodel.delta import Add, Write
 from alica.worldmodel.encoding import order_key
@@ -221,8 +222,8 @@ class WorldModel(Replica):
 
     # -- listings ----------------------------------------------------------
 
-    def facts(self) -> list[tuple[object, ...]]:
-        """True facts and set memberships as ``(name, *args)`` tuples, sorted (for traces)."""
+    def facts(self) -> list[Fact]:
+        """True facts and set memberships (``Fact(set_name, (item,))``) as :class:`~alica.lang.fact.Fact`, sorted."""
         return listing.facts(self._state)
 
     def values(self) -> list[tuple[str, tuple[object, ...], object]]:

@@ -7,7 +7,7 @@ and joint paths) for someone else to execute. See ``docs/manipulation.md``.
 
 from __future__ import annotations
 
-from alica.skills.manipulation.arm_planner import ArmPath, interpolate_path, path_is_free, plan_arm
+from alica.skills.manipulation.arm_paths import ArmPath, interpolate_path, path_is_free, plan_arm
 from alica.skills.manipulation.cartesian import straight_line
 from alica.skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
 from alica.skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps

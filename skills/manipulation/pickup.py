@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from alica.skills.manipulation.arm_planner import interpolate_path, path_is_free, plan_arm
+from alica.skills.manipulation.arm_paths import interpolate_path, path_is_free, plan_arm
 from alica.skills.manipulation.cartesian import straight_line
 from alica.skills.manipulation.geometry import Pose, as_configuration, as_vec3, wrap_angle
 from alica.skills.manipulation.grasps import (
@@ -168,7 +168,7 @@ def plan_pickup(
         object_box: the object (world box, upright) to pick.
         q_start: the arm's current configuration.
         rng: generator for IK restarts (plans are deterministic for equal generators,
-            except for OMPL paths, see :mod:`alica.skills.manipulation.arm_planner`).
+            except for OMPL paths, see :mod:`alica.skills.manipulation.arm_paths`).
         retries: extra pre-grasp IK solutions per grasp (>= 0).
         q_transport: configuration to carry the object in (default ``scene.home_q``).
         kind: ``"box"`` or ``"cylinder"`` (see :func:`top_grasps`).

@@ -12,9 +12,9 @@ Example:
 
 from __future__ import annotations
 
+from alica.skills.motion.base_paths import STATUSES, PathResult, configure_ompl, plan_path
 from alica.skills.motion.exact import FclChecker
 from alica.skills.motion.follow import PathFollower, escape_goal
-from alica.skills.motion.planner import STATUSES, PathResult, configure_ompl, plan_path
 from alica.skills.motion.reach import coarse_reachable
 from alica.skills.motion.validity import GridChecker, SegmentValidator, default_margin, densify
 

@@ -1,7 +1,7 @@
 """The OMPL side of :func:`alica.skills.motion.plan_path`: one SE2 RRTConnect query (plus AORRTC), all objects local.
 
 Also the one module flag of the package: OMPL logging silenced and the process seed set
-(see :func:`configure_ompl` and :mod:`alica.skills.motion.planner` on reproducibility).
+(see :func:`configure_ompl` and :mod:`alica.skills.motion.base_paths` on reproducibility).
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ def xy_length(path: np.ndarray) -> float:
 
 
 def configure_ompl(seed: int | None = None) -> bool:
-    """Silence OMPL logging (errors only) and set the process seed, once (see :mod:`alica.skills.motion.planner`).
+    """Silence OMPL logging (errors only) and set the process seed, once (see :mod:`alica.skills.motion.base_paths`).
 
     Args:
         seed: Seed to use (>= 0), or None.

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from alica.errors import SkillError
+from alica.lang.fact import Fact
 
 
 def _far_free_goal(world, robot, distance=8.0):
@@ -27,7 +28,7 @@ def test_move_to_position_reaches_a_goal_around_rocks(lunar_world, skill_run):
     x, y, _ = lunar_world.robots["scout"].pose
     assert math.hypot(x - goal[0], y - goal[1]) <= 0.3
     assert not lunar_world.robots["scout"].bumped
-    assert any(f[0] == "pos" for f in run.facts) or run.facts == []
+    assert any(f.predicate == "pos" for f in run.facts) or run.facts == []
 
 
 def test_move_to_position_fails_clearly_on_an_unreachable_goal(lunar_world, skill_run):
@@ -171,7 +172,7 @@ def test_transport_a_sample_to_the_collection_point(lunar_world, skill_run):
         assert run.ok, (name, run.reason, run.trace[-6:])
     a, g = lunar_world.objects["a"].position(), lunar_world.objects["g"].position()
     assert math.hypot(a[0] - g[0], a[1] - g[1]) < 0.1
-    assert ("at", "a", "g") in run.facts and ("onground", "a") in run.facts
+    assert Fact("at", ("a", "g")) in run.facts and Fact("onground", ("a",)) in run.facts
 
 
 def test_putdown_on_top_of_a_block(blocks_world, skill_run):
@@ -181,7 +182,7 @@ def test_putdown_on_top_of_a_block(blocks_world, skill_run):
     run = skill_run("Putdown", blocks_world, "r1", {"object": "c", "target": "b"})
     assert run.ok, (run.reason, run.trace[-6:])
     assert ("on", "c", "b") in blocks_facts(blocks_world)
-    assert ("on", "c", "b") in run.facts
+    assert Fact("on", ("c", "b")) in run.facts
 
 
 def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run):

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from alica.lang import BeliefBase
+from alica.lang.fact import Fact
 from alica.worldmodel import Key, LamportClock, Stamp, WorldModel, order_key
 
 
@@ -237,7 +238,7 @@ def test_facts_and_values_listings() -> None:
     wm.retract_fact("found", "c")
     wm.set("pos", "scout", value=(1.0, 2.0))
     wm.add_to_set("invalid", "c9")
-    assert wm.facts() == [("found", "a"), ("found", "b"), ("invalid", "c9")]
+    assert wm.facts() == [Fact("found", ("a",)), Fact("found", ("b",)), Fact("invalid", ("c9",))]
     assert wm.values() == [("pos", ("scout",), (1.0, 2.0))]
 
 
@@ -288,3 +289,12 @@ def test_keys_sort_deterministically() -> None:
     keys = {Key("set", "s", ("x",)), Key("register", "pos", (2,)), Key("register", "pos", ("a",))}
     assert sorted(keys) == [Key("register", "pos", (2,)), Key("register", "pos", ("a",)), Key("set", "s", ("x",))]
     assert str(Key("register", "pos", ("a",))) == "register:pos('a')"
+
+
+def test_the_world_model_offers_its_protocol() -> None:
+    from alica.worldmodel import WorldModelLike
+
+    wm: WorldModelLike = WorldModel("scout")
+    wm.assert_fact("found", "a")
+    assert isinstance(wm, WorldModelLike) and wm.facts() == [Fact("found", ("a",))]
+    assert not isinstance(object(), WorldModelLike)

@@ -1,0 +1,78 @@
+"""What a skill is given when it is built: the agent, its time, its world model and the robot world.
+
+The engine passes its :class:`~alica.engine.SkillContext` (a dataclass) and
+:func:`alica.skills.testing.run_skill` passes the same. Skills type against
+:class:`SkillContextLike`, so any object with these members serves;
+:class:`SkillEnv` is a plain one (the opponents' inner skills run with it).
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from alica.worldmodel.protocol import WorldModelLike
+
+__all__ = ["SkillContextLike", "SkillEnv"]
+
+
+class SkillContextLike(Protocol):
+    """The members of a skill's context that skills read."""
+
+    @property
+    def agent(self) -> str:
+        """The agent's name (its robot in the world is named alike)."""
+        ...
+
+    @property
+    def now(self) -> Callable[[], float]:
+        """A function giving the current (simulated) time."""
+        ...
+
+    @property
+    def world_model(self) -> WorldModelLike | None:
+        """The agent's world-model replica (outcome facts go here), or None."""
+        ...
+
+    @property
+    def rng(self) -> random.Random:
+        """A random generator seeded from the run's seed and the agent."""
+        ...
+
+    @property
+    def world(self) -> object | None:
+        """The robot world (a :class:`~alica.worldsim.interface.RobotWorld`), when there is one."""
+        ...
+
+    @property
+    def extra(self) -> Mapping[str, object]:
+        """Run options (``jobs``, ``optimize_time``)."""
+        ...
+
+
+@dataclass(frozen=True, slots=True)
+class SkillEnv:
+    """A plain :class:`SkillContextLike`.
+
+    Attributes:
+        agent: the agent's name.
+        now: the clock.
+        rng: the random generator.
+        world: the robot world, or None.
+        world_model: the world model, or None (what the skill writes goes nowhere).
+        extra: run options.
+    """
+
+    agent: str
+    now: Callable[[], float]
+    rng: random.Random
+    world: object | None = None
+    world_model: WorldModelLike | None = None
+    extra: Mapping[str, object] = field(default_factory=dict)
+
+    @classmethod
+    def without_world_model(cls, context: SkillContextLike) -> SkillEnv:
+        """``context`` with the same agent, clock, generator, world and options, but no world model."""
+        return cls(context.agent, context.now, context.rng, context.world, None, dict(context.extra))

@@ -1,0 +1,162 @@
+"""The robot interface: what a skill may use of a world, its robots and its objects.
+
+Skills (:mod:`alica.skills`) act on a world through these Protocols, never on
+pybullet directly. :class:`~alica.worldsim.world.World` satisfies
+:class:`RobotWorld` (its robots :class:`MobileRobot`, its objects
+:class:`WorldThing`; checked by mypy below and by a test); a real robot's
+driver satisfies them too by offering the same members.
+
+Every object has a ``kind`` (one of :data:`~alica.worldsim.objects.OBJECT_KINDS`),
+a ``radius`` and ``half_extents`` (zeros when they do not apply), so a skill
+reads ``obj.kind`` instead of probing for it. Arms are typed by
+:class:`~alica.worldsim.arm.Arm` itself for now.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+if TYPE_CHECKING:
+    import numpy as np
+    import trimesh
+
+    from alica.worldsim.arm import Arm
+    from alica.worldsim.grid import Obstacle2D
+    from alica.worldsim.robots import RobotSpec
+
+__all__ = ["MobileRobot", "RobotWorld", "WorldThing"]
+
+Position = tuple[float, float, float]
+Quaternion = tuple[float, float, float, float]
+
+
+class WorldThing(Protocol):
+    """An object of the world that is not a robot: a block, a sample, a rock, a table, a marker, the terrain."""
+
+    @property
+    def name(self) -> str:
+        """Unique name in the world."""
+        ...
+
+    @property
+    def kind(self) -> str:
+        """``block``, ``sample``, ``rock``, ``table``, ``collection_point`` or ``terrain``."""
+        ...
+
+    @property
+    def size(self) -> float:
+        """Edge of a block, height of a sample or table, radius of a rock or marker."""
+        ...
+
+    @property
+    def radius(self) -> float:
+        """Footprint radius (samples, rocks, markers); 0 for boxes."""
+        ...
+
+    @property
+    def half_extents(self) -> tuple[float, ...]:
+        """Box half extents (blocks, tables); zeros otherwise."""
+        ...
+
+    def pose(self) -> tuple[Position, Quaternion]:
+        """Position and quaternion ``(x, y, z, w)``."""
+        ...
+
+    def position(self) -> np.ndarray:
+        """The position as an array of 3."""
+        ...
+
+    def aabb(self) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned bounding box ``(lower, upper)``."""
+        ...
+
+    def footprint(self) -> Obstacle2D | None:
+        """The 2-D footprint now (``None`` for markers and terrain)."""
+        ...
+
+    def world_mesh(self) -> trimesh.Trimesh | None:
+        """The rock's mesh at its pose (``None`` for other objects)."""
+        ...
+
+
+class MobileRobot(Protocol):
+    """A robot base a skill drives, with its arm when it has one.
+
+    ``bumped`` is true when the last drive command was stopped by a collision; a skill may reset it.
+    """
+
+    bumped: bool
+
+    @property
+    def name(self) -> str:
+        """Unique name in the world (the agent's name)."""
+        ...
+
+    @property
+    def spec(self) -> RobotSpec:
+        """Radius, speeds and capabilities of its kind."""
+        ...
+
+    @property
+    def arm(self) -> Arm | None:
+        """The arm, or ``None``."""
+        ...
+
+    @property
+    def pose(self) -> Position:
+        """``(x, y, yaw)``."""
+        ...
+
+    @property
+    def crashed(self) -> bool:
+        """Whether the robot is out (it no longer moves)."""
+        ...
+
+    def drive(self, v: float, w: float) -> None:
+        """Drive at ``v`` m/s and turn at ``w`` rad/s until told otherwise."""
+        ...
+
+    def stop(self) -> None:
+        """Stand still."""
+        ...
+
+
+@runtime_checkable
+class RobotWorld(Protocol):
+    """The world a skill acts on: its robots and objects by name, its bounds, its time, its obstacles."""
+
+    @property
+    def robots(self) -> Mapping[str, MobileRobot]:
+        """Robots by name."""
+        ...
+
+    @property
+    def objects(self) -> Mapping[str, WorldThing]:
+        """Objects by name."""
+        ...
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(xmin, ymin, xmax, ymax)`` of the field."""
+        ...
+
+    @property
+    def seed(self) -> int:
+        """The seed the world was built with (skills seed their own planners from it)."""
+        ...
+
+    def now(self) -> float:
+        """The world's (simulated) time in seconds."""
+        ...
+
+    def ground_truth_obstacles(self, *, include_samples: bool = False) -> list[Obstacle2D]:
+        """Footprints of the obstacles lying in the world (held objects left out)."""
+        ...
+
+
+if TYPE_CHECKING:
+    from alica.worldsim.world import World
+
+    def _world_is_a_robot_world(world: World) -> RobotWorld:
+        return world  # mypy proves that World satisfies the robot interface
