@@ -7,6 +7,8 @@ raises; only this module turns errors into messages and exit codes.
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -114,22 +116,50 @@ def _cmd_render(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _cmd_convert(args: argparse.Namespace) -> int:
-    from alica.io import Loader, dump_document, format_of, read_text
+def _relocated(imports: Sequence[str], source: Path, target: Path) -> list[str]:
+    """Relative imports of a file at ``source`` rewritten for a copy at ``target``: the same files, found from there."""
+    src, dst = Path(os.path.abspath(source)).parent, Path(os.path.abspath(target)).parent
+    out = []
+    for entry in imports:
+        if Path(entry).is_absolute() or src == dst:
+            out.append(entry)
+            continue
+        try:
+            out.append(Path(os.path.relpath(src / entry, dst)).as_posix())
+        except ValueError:  # another drive: no relative path exists
+            out.append((src / entry).as_posix())
+    return out
 
-    fmt = format_of(args.output)
-    if fmt is None or format_of(args.input) is None:
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from alica.io import Loader, format_of, read_text
+    from alica.io.dump import document_data
+    from alica.io.loader import parse_text
+    from alica.io.xml_write import write_xml
+    from alica.io.yaml_format import write_yaml
+
+    fmt, in_fmt = format_of(args.output), format_of(args.input)
+    if fmt is None or in_fmt is None:
         raise AlicaError("convert needs files ending in .yaml, .yml or .xml, e.g. 'alica convert roles.yaml roles.xml'")
+    source, target = Path(args.input), Path(args.output)
     loader = Loader()
     if not args.no_validate:
-        loader.load(args.input)
-    document = loader.document(args.input)
-    text = dump_document(document, fmt)
+        loader.load(source)
+    document = loader.document(source)
+    tree, _ = parse_text(source.read_bytes().decode("utf-8-sig"), str(source), in_fmt)
+    data = document_data(document, tree)
+    imports = _relocated(document.imports, source, target)
+    if imports:
+        data["imports"] = imports
+    text = write_xml(data) if fmt == "xml" else write_yaml(data)
     again, problems = read_text(text, args.output, fmt)
-    if problems or again != document:
+    if problems or again != dataclasses.replace(document, imports=tuple(imports)):
         raise AlicaError(f"internal error: {args.output} would not read back as the same plans; please report this")
-    Path(args.output).write_text(text, encoding="utf-8")
-    print(f"wrote {args.output} ({fmt})")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    target.write_text(text, encoding="utf-8")
+    moved = sum(a != b for a, b in zip(imports, document.imports, strict=True))
+    note = f"; {moved} import(s) rewritten for its folder" if moved else ""
+    print(f"wrote {args.output} ({fmt}){note}")
     return EXIT_OK
 
 
