@@ -87,23 +87,38 @@ def _cmd_show(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _output_names(files: Sequence[Path]) -> dict[Path, str]:
+    """Each plan file's name in the output: its path below the files' common folder, extension kept.
+
+    ``mission.yaml`` and ``mission.xml``, or ``lunar/mission.yaml`` and
+    ``blocksworld/mission.yaml``, get different names, so no file overwrites another's.
+    """
+    resolved = [Path(os.path.abspath(f)) for f in files]
+    if not resolved:
+        return {}
+    common = Path(os.path.commonpath([r.parent for r in resolved]))
+    return {f: r.relative_to(common).as_posix() for f, r in zip(files, resolved, strict=True)}
+
+
 def _cmd_render(args: argparse.Namespace) -> int:
     import shutil
 
     from alica.app.render import dot_graph, svg, text_tree
     from alica.io import Loader, plan_files
 
-    files, problems = plan_files(args.paths)
-    loader = Loader()
+    found, problems = plan_files(args.paths)
     if problems:
         raise PlanFormatError(problems)
+    files = list({Path(os.path.abspath(f)): f for f in found}.values())  # each file once
+    names = _output_names(files)
+    loader = Loader()
     out = Path(args.out)
     has_dot = shutil.which("dot") is not None
     count = 0
     for path in files:
         library, entry = _load(path, loader)
         for root in _roots(library, entry, None):
-            stem = out / f"{path.stem}.{root}"
+            stem = out / f"{names[path]}.{root}"
             stem.parent.mkdir(parents=True, exist_ok=True)
             Path(f"{stem}.txt").write_text(text_tree(library, root) + "\n", encoding="utf-8")
             dot = dot_graph(library, root)
@@ -218,7 +233,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "render",
         help="render every plan tree under folders to text, dot and svg files",
-        description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed).",
+        description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed): one set of files per plan tree, named FOLDER/FILE.ROOT.txt after the plan file (its folder below the common folder of the inputs, its extension kept) and the tree's root plan.",
     )
     p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
     p.add_argument("--out", default="build/plans", help="output folder (default build/plans)")
