@@ -242,7 +242,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "convert",
         help="convert a plan file between YAML and XML",
-        description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first.",
+        description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first. "
+        "Every value the input wrote is kept (defaults included), and relative imports are rewritten for the output's "
+        "folder, so the output imports the same files wherever it is written.",
     )
     p.add_argument("input", metavar="IN")
     p.add_argument("output", metavar="OUT")

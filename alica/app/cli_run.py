@@ -304,7 +304,11 @@ def _waiting(engine: Any) -> str | None:
 
 def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
     failed = any(a["status"] == "failure" for a in summary["agents"].values())
-    verdict = "success" if summary["success"] else ("not finished" if not summary["done"] else "failed" if failed else "ended")
+    verdict = (
+        "success"
+        if summary["success"]
+        else ("not finished" if not summary["done"] else "failed" if failed else "ended")
+    )
     print(
         f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}"
     )
