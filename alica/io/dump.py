@@ -111,7 +111,8 @@ class _Dumper:
         return frozenset(node.value)
 
     def document(self, doc: Document) -> Data:
-        written = frozenset(self.source.value) if self.source is not None and self.source.is_mapping else _NONE
+        top = self.source.value if self.source is not None else None
+        written = frozenset(top) if isinstance(top, dict) else _NONE
         out: Data = {}
         _put(out, "imports", list(doc.imports), written)
         _put(out, "tasks", [self.task(t) for t in doc.tasks], written)

@@ -238,7 +238,7 @@ class _Counter:
         self.steps[agent] = self.steps.get(agent, 0) + 1
         self.tasks.setdefault(agent, set()).add(step.task)
 
-    def finish(self, team: Any, facts: Iterable[tuple[str, ...]]) -> None:
+    def finish(self, team: Any, facts: Iterable[tuple[object, ...]]) -> None:
         """Count the steps still running at the end whose effects hold in the world (the goal came true mid-step)."""
         from alica.lang import literals
 
@@ -304,7 +304,7 @@ def run_demo(
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
     counter = _Counter(library.abstract(PROBLEM).elements)  # type: ignore[union-attr]
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
-    watchers = [counter, *observers, *([trace] if trace is not None else [])]
+    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = EngineConfig(frequency=config.frequency)
     perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
     registry = default_registry()
