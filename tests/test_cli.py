@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import dataclasses
+import re
+import shutil
+import subprocess
 from pathlib import Path
 
 import pytest
 
 from alica.app import render
 from alica.app.cli import main
-from alica.io import load_document
+from alica.io import load_document, plan_files
 from tests.conftest import PLANS
 
 MISSION = PLANS / "lunar" / "mission.yaml"
@@ -92,7 +96,71 @@ def test_show_broken_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) ->
 def test_render_writes_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, _out, err = run(capsys, "render", str(PLANS / "lunar"), "--out", str(tmp_path))
     assert code == 0, err
-    assert list(tmp_path.glob("mission.LunarMission.txt")) and list(tmp_path.glob("*.dot"))
+    assert list(tmp_path.glob("mission.yaml.LunarMission.txt")) and list(tmp_path.glob("*.dot"))
+
+
+def test_render_writes_one_set_of_files_per_plan_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # plans/blocksworld holds mission.yaml and mission.xml, with the same root plans
+    code, out, err = run(capsys, "render", str(PLANS), str(PLANS / "lunar"), "--out", str(tmp_path))
+    assert code == 0, err
+    match = re.match(r"rendered (\d+) plan tree\(s\) from (\d+) file\(s\)", out)
+    assert match, out
+    trees, files = int(match.group(1)), int(match.group(2))
+    assert files == len(plan_files([PLANS])[0])  # plans/lunar is inside plans/: its files count once
+    assert len(list(tmp_path.rglob("*.txt"))) == trees and len(list(tmp_path.rglob("*.dot"))) == trees
+    for ending in ("yaml", "xml"):
+        assert (tmp_path / "blocksworld" / f"mission.{ending}.BlocksWorldMission.dot").is_file()
+
+
+NODE = re.compile(r'^\s*"([^"]+)" \[')
+EDGE = re.compile(r'^\s*"([^"]+)" -> "([^"]+)"(?: \[(.*)\])?;$')
+
+
+def dot_parts(dot: str) -> tuple[dict[str, str | None], list[tuple[str, str, str]]]:
+    """The nodes of dot text with the cluster each is declared in, and its edges (tail, head, attributes)."""
+    nodes: dict[str, str | None] = {}
+    edges: list[tuple[str, str, str]] = []
+    cluster: str | None = None
+    for line in dot.splitlines():
+        if line.startswith('  subgraph "cluster_'):
+            cluster = line.split('"')[1]
+        elif line == "  }":
+            cluster = None
+        elif edge := EDGE.match(line):
+            edges.append((edge.group(1), edge.group(2), edge.group(3) or ""))
+        elif node := NODE.match(line):
+            nodes[node.group(1)] = cluster
+    return nodes, edges
+
+
+@pytest.mark.parametrize("plan", [PLANS / "blocksworld" / "mission.yaml", MISSION, PLANS / "lunar" / "impera.yaml"])
+def test_dot_edges_end_at_real_nodes_and_clusters(capsys: pytest.CaptureFixture[str], plan: Path) -> None:
+    code, dot, err = run(capsys, "show", str(plan), "--format", "dot")
+    assert code == 0, err
+    assert "compound=true" in dot and "invis" not in dot
+    nodes, edges = dot_parts(dot)
+    into_clusters = 0
+    for tail, head, attributes in edges:
+        assert head in nodes, f"edge {tail} -> {head} ends at no node"
+        if nodes[head] is not None and nodes[head] != nodes.get(tail):
+            assert f'lhead="{nodes[head]}"' in attributes, (tail, head, attributes)
+            into_clusters += 1
+    assert into_clusters > 0
+
+
+def test_dot_labels_break_lines_without_showing_backslash_n(capsys: pytest.CaptureFixture[str]) -> None:
+    code, dot, _ = run(capsys, "show", str(PLANS / "blocksworld" / "mission.yaml"), "--format", "dot")
+    assert code == 0
+    assert 'label="problem StackBlocks\\ngoal: on(a, b)' in dot  # dot's line break: one backslash, then n
+    assert "\\\\n" not in dot  # an escaped backslash would show as a literal \n
+    assert 'label="TakeBlockFromTable\\nskill Pickup"' in dot  # and no raw line break inside a label
+
+
+@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz is not installed")
+def test_dot_renders_without_warnings(capsys: pytest.CaptureFixture[str]) -> None:
+    code, dot, _ = run(capsys, "show", str(PLANS / "blocksworld" / "mission.yaml"), "--format", "dot")
+    done = subprocess.run(["dot", "-Tsvg"], input=dot, capture_output=True, text=True, check=False)
+    assert code == 0 and done.returncode == 0 and done.stderr == ""
 
 
 def test_convert_both_ways(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -102,7 +170,9 @@ def test_convert_both_ways(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert run(capsys, "convert", str(src), str(xml), "--no-validate")[0] == 0
     assert xml.read_text().startswith("<?xml")
     assert run(capsys, "convert", str(xml), str(back), "--no-validate")[0] == 0
-    assert load_document(back) == load_document(src)
+    converted, original = load_document(back), load_document(src)
+    assert [(back.parent / i).resolve() for i in converted.imports] == [PLANS / i for i in original.imports]
+    assert dataclasses.replace(converted, imports=original.imports) == original
 
 
 def test_convert_refuses_invalid_input(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

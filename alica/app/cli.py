@@ -7,6 +7,8 @@ raises; only this module turns errors into messages and exit codes.
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -87,23 +89,38 @@ def _cmd_show(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
+def _output_names(files: Sequence[Path]) -> dict[Path, str]:
+    """Each plan file's name in the output: its path below the files' common folder, extension kept.
+
+    ``mission.yaml`` and ``mission.xml``, or ``lunar/mission.yaml`` and
+    ``blocksworld/mission.yaml``, get different names, so no file overwrites another's.
+    """
+    resolved = [Path(os.path.abspath(f)) for f in files]
+    if not resolved:
+        return {}
+    common = Path(os.path.commonpath([r.parent for r in resolved]))
+    return {f: r.relative_to(common).as_posix() for f, r in zip(files, resolved, strict=True)}
+
+
 def _cmd_render(args: argparse.Namespace) -> int:
     import shutil
 
     from alica.app.render import dot_graph, svg, text_tree
     from alica.io import Loader, plan_files
 
-    files, problems = plan_files(args.paths)
-    loader = Loader()
+    found, problems = plan_files(args.paths)
     if problems:
         raise PlanFormatError(problems)
+    files = list({Path(os.path.abspath(f)): f for f in found}.values())  # each file once
+    names = _output_names(files)
+    loader = Loader()
     out = Path(args.out)
     has_dot = shutil.which("dot") is not None
     count = 0
     for path in files:
         library, entry = _load(path, loader)
         for root in _roots(library, entry, None):
-            stem = out / f"{path.stem}.{root}"
+            stem = out / f"{names[path]}.{root}"
             stem.parent.mkdir(parents=True, exist_ok=True)
             Path(f"{stem}.txt").write_text(text_tree(library, root) + "\n", encoding="utf-8")
             dot = dot_graph(library, root)
@@ -116,22 +133,50 @@ def _cmd_render(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _cmd_convert(args: argparse.Namespace) -> int:
-    from alica.io import Loader, dump_document, format_of, read_text
+def _relocated(imports: Sequence[str], source: Path, target: Path) -> list[str]:
+    """Relative imports of a file at ``source`` rewritten for a copy at ``target``: the same files, found from there."""
+    src, dst = Path(os.path.abspath(source)).parent, Path(os.path.abspath(target)).parent
+    out = []
+    for entry in imports:
+        if Path(entry).is_absolute() or src == dst:
+            out.append(entry)
+            continue
+        try:
+            out.append(Path(os.path.relpath(src / entry, dst)).as_posix())
+        except ValueError:  # another drive: no relative path exists
+            out.append((src / entry).as_posix())
+    return out
 
-    fmt = format_of(args.output)
-    if fmt is None or format_of(args.input) is None:
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from alica.io import Loader, format_of, read_text
+    from alica.io.dump import document_data
+    from alica.io.loader import parse_text
+    from alica.io.xml_write import write_xml
+    from alica.io.yaml_format import write_yaml
+
+    fmt, in_fmt = format_of(args.output), format_of(args.input)
+    if fmt is None or in_fmt is None:
         raise AlicaError("convert needs files ending in .yaml, .yml or .xml, e.g. 'alica convert roles.yaml roles.xml'")
+    source, target = Path(args.input), Path(args.output)
     loader = Loader()
     if not args.no_validate:
-        loader.load(args.input)
-    document = loader.document(args.input)
-    text = dump_document(document, fmt)
+        loader.load(source)
+    document = loader.document(source)
+    tree, _ = parse_text(source.read_bytes().decode("utf-8-sig"), str(source), in_fmt)
+    data = document_data(document, tree)
+    imports = _relocated(document.imports, source, target)
+    if imports:
+        data["imports"] = imports
+    text = write_xml(data) if fmt == "xml" else write_yaml(data)
     again, problems = read_text(text, args.output, fmt)
-    if problems or again != document:
+    if problems or again != dataclasses.replace(document, imports=tuple(imports)):
         raise AlicaError(f"internal error: {args.output} would not read back as the same plans; please report this")
-    Path(args.output).write_text(text, encoding="utf-8")
-    print(f"wrote {args.output} ({fmt})")
+    target.parent.mkdir(parents=True, exist_ok=True)
+    target.write_text(text, encoding="utf-8")
+    moved = sum(a != b for a, b in zip(imports, document.imports, strict=True))
+    note = f"; {moved} import(s) rewritten for its folder" if moved else ""
+    print(f"wrote {args.output} ({fmt}){note}")
     return EXIT_OK
 
 
@@ -192,7 +237,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "render",
         help="render every plan tree under folders to text, dot and svg files",
-        description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed).",
+        description="Render the plan trees of every plan file to text and dot files (and SVG when Graphviz is installed): one set of files per plan tree, named FOLDER/FILE.ROOT.txt after the plan file (its folder below the common folder of the inputs, its extension kept) and the tree's root plan.",
     )
     p.add_argument("paths", nargs="+", metavar="PATH", help="plan files or folders")
     p.add_argument("--out", default="build/plans", help="output folder (default build/plans)")
@@ -201,7 +246,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "convert",
         help="convert a plan file between YAML and XML",
-        description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first.",
+        description="Convert a plan file between YAML and XML, chosen by the file endings. The input is validated first. "
+        "Every value the input wrote is kept (defaults included), and relative imports are rewritten for the output's "
+        "folder, so the output imports the same files wherever it is written.",
     )
     p.add_argument("input", metavar="IN")
     p.add_argument("output", metavar="OUT")

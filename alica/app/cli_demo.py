@@ -161,5 +161,13 @@ def _print_summary(result: Any) -> None:
         f"blocksworld: {state} after {result.sim_time_s:.2f} s simulated, {result.wall_time_s:.2f} s wall ({result.real_time_factor:.1f}x real time)"
     )
     print(f"start {result.start}  goal {result.goal}  goal literals {result.satisfied}/{result.goal_literals}")
-    print(f"plan length {result.plan_length}, replans {result.replans}, messages sent {result.messages}")
-    print("tasks done: " + ", ".join(f"{agent} {count}" for agent, count in result.tasks.items()))
+    print(
+        f"steps executed {result.steps_executed}, plans made {result.plans} (the last: {result.plan_length} step(s)), "
+        f"replans {result.replans}, messages sent {result.messages}"
+    )
+    print(
+        "carried out: "
+        + ", ".join(
+            f"{agent} {result.steps.get(agent, 0)} step(s) in {count} task(s)" for agent, count in result.tasks.items()
+        )
+    )

@@ -31,7 +31,9 @@ def add_parser(sub: Any) -> None:
         "With --stand-ins, skills without an implementation (or, without --world, those that act on a robot) "
         "are scripted stand-ins: they run for their duration parameter (Idle until its state is left when it is 0), "
         "others succeed after a while and write their post-condition. "
-        "Exit 0 when the run ends well, 1 when the plan failed or the time ran out.",
+        "Exit 0 when the root plan succeeded (for every agent that has not crashed); 1 when it failed, when it did not "
+        "finish within the limit (--ticks N or --max-time S: both are limits), or on wrong input. "
+        "The summary gives each agent's last failure or allocation problem when the run does not succeed.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
     p.add_argument(
@@ -44,9 +46,13 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
     p.add_argument("--seed", type=int, default=0, help="seed of the network and the agents (default 0)")
     length = p.add_mutually_exclusive_group()
-    length.add_argument("--ticks", type=int, metavar="N", help="run N engine ticks")
     length.add_argument(
-        "--until-done", action="store_true", help="run until every agent's root plan ended (the default)"
+        "--ticks", type=int, metavar="N", help="run N engine ticks at most (unfinished after N ticks exits 1)"
+    )
+    length.add_argument(
+        "--until-done",
+        action="store_true",
+        help="run until every agent's root plan ended, up to --max-time (the default)",
     )
     p.add_argument(
         "--max-time",
@@ -208,7 +214,8 @@ def _run_team(
     from alica.lang import literals
     from alica.testing import default_fallback
 
-    observers: list[Any] = []
+    reasons = _Reasons()
+    observers: list[Any] = [reasons]
     trace = JsonlTrace(args.trace) if args.trace else None
     if trace is not None:
         observers.append(trace)
@@ -258,13 +265,12 @@ def _run_team(
             trace.close()
     summary = team.summary()
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": args.world}
+    for name, agent in summary["agents"].items():
+        agent["reason"] = reasons.of(team, name, agent["status"])
     if args.json:
         print(json.dumps(summary, indent=2, sort_keys=True))
     else:
         _print_summary(summary, args.trace)
-    failed = any(a["status"] == "failure" for a in summary["agents"].values())
-    if args.ticks is not None:
-        return 1 if failed else 0
     return 0 if summary["success"] else 1
 
 
@@ -284,8 +290,70 @@ def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running
         changed.clear()
 
 
+class _Reasons:
+    """A trace observer that keeps, per agent, the last failure or allocation problem the engine reported."""
+
+    def __init__(self) -> None:
+        self.last: dict[str, str] = {}
+
+    def __call__(self, event: dict[str, Any]) -> None:
+        kind = event["event"]
+        if kind == "allocation" and event.get("outcome") == "none":
+            text = f"{event.get('why') or 'no valid assignment'} (in {event.get('key')})"
+        elif kind == "failure":
+            text = f"plan '{event.get('plan')}' failed: {event.get('reason') or 'no reason given'}"
+        elif kind == "behaviour" and event.get("status") == "failure":
+            text = f"behaviour '{event.get('behaviour')}' failed: {event.get('reason') or 'no reason given'}"
+        elif kind == "fault" and event.get("fault") in ("crash", "recover"):
+            text = f"{event['fault']}ed at {event['t']:g} s"
+        else:
+            return
+        self.last[event["agent"]] = f"{text} at t={event['t']:.2f} s" if kind != "fault" else text
+
+    def of(self, team: Any, name: str, status: str) -> str | None:
+        """Why agent ``name`` has not succeeded: what it waits for, or the last problem reported; ``None`` on success."""
+        if status == "success":
+            return None
+        last = self.last.get(name)
+        if status == "running":
+            waiting = _waiting(team.engines[name])
+            if waiting:
+                return f"{waiting}; last problem: {last}" if last else waiting
+        return last or ("not started" if status == "running" else None)
+
+
+def _waiting(engine: Any) -> str | None:
+    """What a running agent waits for: a child's reason (e.g. no valid assignment), else its state's transitions."""
+    node = engine.root
+    if node is None:
+        return None
+    while True:
+        stuck = [s for s in node.slots if s.reason and s.status.value != "success"]
+        if stuck:
+            return f"{stuck[0].name} in {node.plan.name}:{node.state}: {stuck[0].reason}"
+        child = next((s.node for s in node.slots if s.node is not None), None)
+        if child is None:
+            break
+        node = child
+    if node.state is None:
+        return f"{node.plan.name}: no state entered yet"
+    where = f"in {node.plan.name}:{node.state}"
+    children = [f"{s.name} {s.status.value}" for s in node.slots]
+    if children:
+        where += f" ({', '.join(children)})"
+    conditions = [t.condition.text if t.condition else "always" for t in node.plan.out_transitions(node.state)]
+    if not conditions:
+        return f"{where}, a state with no transition out that is not terminal"
+    return f"{where}, waiting for one of: {'; '.join(conditions)}"
+
+
 def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
-    verdict = "success" if summary["success"] else ("ended" if summary["done"] else "not finished")
+    failed = any(a["status"] == "failure" for a in summary["agents"].values())
+    verdict = (
+        "success"
+        if summary["success"]
+        else ("not finished" if not summary["done"] else "failed" if failed else "ended")
+    )
     print(
         f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}"
     )
@@ -303,6 +371,10 @@ def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
         print(f"scripted stand-ins (--stand-ins): {', '.join(skills['stand_ins'])}")
     m = summary["messages"]
     print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
+    if not summary["success"]:
+        for name, a in summary["agents"].items():
+            if a["reason"]:
+                print(f"why {name}: {a['reason']}")
     if summary["faults"]:
         print("faults: " + "; ".join(summary["faults"]))
     if trace:

@@ -94,7 +94,12 @@ def _child(library: PlanLibrary, name: str, indent: str, lines: list[str], shown
 
 
 def dot_graph(library: PlanLibrary, root: str) -> str:
-    """The plan tree below ``root`` as a Graphviz digraph: one cluster per plan."""
+    """The plan tree below ``root`` as a Graphviz digraph: one cluster per plan.
+
+    An edge to a plan ends at the border of the plan's cluster: it points at
+    the plan's first entry point with ``lhead`` naming the cluster (the graph
+    is ``compound``).
+    """
     out = ["digraph alica {", "  compound=true; rankdir=LR; node [fontname=Helvetica fontsize=10];"]
     done: set[str] = set()
     _dot(library, library.abstract(root), out, done)
@@ -103,7 +108,8 @@ def dot_graph(library: PlanLibrary, root: str) -> str:
 
 
 def _q(text: str) -> str:
-    return '"' + text.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """A dot string; a line break in ``text`` becomes dot's centred line break ``\\n``."""
+    return '"' + text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
 
 
 def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[str]) -> None:
@@ -119,21 +125,20 @@ def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[
         out.append(f"  {_q('t:' + element.name)} [shape=folder label={_q('plan type ' + element.name)}];")
         for name in element.plans:
             _dot(library, library.abstract(name), out, done)
-            out.append(f"  {_q('t:' + element.name)} -> {_q(_node_id(library, name))} [style=dashed];")
+            out.append(_edge(library, "t:" + element.name, name, "style=dashed"))
         return
     if isinstance(element, PlanningProblem):
-        label = f"problem {element.name}\\ngoal: {element.goal.text}"
+        label = f"problem {element.name}\ngoal: {element.goal.text}"
         out.append(f"  {_q('o:' + element.name)} [shape=hexagon label={_q(label)}];")
         for name, style in [
             *((n, "dotted") for n in element.elements),
             *((n, "dashed") for n in (element.wait_plan, element.alternative_plan) if n),
         ]:
             _dot(library, library.abstract(name), out, done)
-            out.append(f"  {_q('o:' + element.name)} -> {_q(_node_id(library, name))} [style={style}];")
+            out.append(_edge(library, "o:" + element.name, name, f"style={style}"))
         return
     plan: Plan = element
     out.append(f"  subgraph {_q('cluster_' + plan.name)} {{ label={_q('plan ' + plan.name)}; style=rounded;")
-    out.append(f"    {_q('p:' + plan.name)} [shape=point style=invis];")
     for ep in plan.entry_points:
         ep_id = f"e:{plan.name}:{ep.name}"
         out.append(f"    {_q(ep_id)} [shape=cds label={_q(f'{ep.task} [{ep.min}..{format_cardinality(ep.max)}]')}];")
@@ -152,15 +157,18 @@ def _dot(library: PlanLibrary, element: AbstractPlan, out: list[str], done: set[
         for child in state.children:
             target = library.abstract(child.name)
             _dot(library, target, out, done)
-            out.append(
-                f"  {_q(f's:{plan.name}:{state.name}')} -> {_q(_node_id(library, child.name))} [style=dashed arrowhead=open];"
-            )
+            out.append(_edge(library, f"s:{plan.name}:{state.name}", child.name, "style=dashed arrowhead=open"))
 
 
-def _node_id(library: PlanLibrary, name: str) -> str:
+def _edge(library: PlanLibrary, source: str, name: str, attributes: str) -> str:
+    """An edge from node ``source`` to element ``name``; to a plan, it ends at the plan's cluster."""
     element = library.abstract(name)
-    prefix = {Behaviour: "b:", PlanType: "t:", PlanningProblem: "o:", Plan: "p:"}[type(element)]
-    return prefix + name
+    if isinstance(element, Plan):
+        head = f"e:{name}:{element.entry_points[0].name}" if element.entry_points else f"p:{name}"
+        attributes += f" lhead={_q('cluster_' + name)}"
+    else:
+        head = {Behaviour: "b:", PlanType: "t:", PlanningProblem: "o:"}[type(element)] + name
+    return f"  {_q(source)} -> {_q(head)} [{attributes}];"
 
 
 def svg(dot_text: str) -> str:

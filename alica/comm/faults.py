@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Iterable
+from collections.abc import Collection, Iterable, Mapping
 from dataclasses import dataclass
+from typing import Any
 
 _REST = -1
 """Group index of the agents a partition does not list: they form one group together."""
@@ -120,3 +121,19 @@ def check_time(name: str, value: object, now: float) -> float:
     if value < now:
         raise ValueError(f"{name}={value} lies in the past (now is {now}); give a time >= now, or None for now")
     return float(value)
+
+
+def describe_fault(record: Mapping[str, Any]) -> str:
+    """One line for a fault record (``fault``, ``agent``, ``t``; a partition's ``groups``, ``start``, ``end``).
+
+    Times print as given, in the form of ``alica run``'s options:
+    ``crash scout@2``, ``partition scout|amparo,stummel@1-4`` (``@1`` alone when the cut lasts until healed).
+    """
+    kind = str(record.get("fault", "fault"))
+    if kind == "partition" and "start" in record:
+        groups = "|".join(",".join(group) for group in record.get("groups", ()))
+        end = record.get("end")
+        span = f"{record['start']:g}" + (f"-{end:g}" if end is not None else "")
+        return f"partition {groups}@{span}"
+    agent = record.get("agent", "-")
+    return f"{kind}{f' {agent}' if agent != '-' else ''}@{float(record.get('t', 0.0)):g}"

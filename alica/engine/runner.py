@@ -16,6 +16,7 @@ from typing import Any
 from alica.allocation import AgentSpec, assign_roles
 from alica.clock import ManualClock
 from alica.comm import Delay, SimNetwork
+from alica.comm.faults import describe_fault
 from alica.engine.agent import AgentEngine, Observer
 from alica.engine.behaviours import SkillBinder, SkillFactory
 from alica.engine.config import EngineConfig
@@ -379,7 +380,5 @@ class SimulatedTeam:
                 "delivered": stats.delivered,
                 "dropped": stats.dropped_loss + stats.dropped_partition + stats.dropped_crash,
             },
-            "faults": [
-                f["fault"] + (f" {f['agent']}" if f["agent"] != "-" else "") + f" @{f['t']}" for f in self.faults
-            ],
+            "faults": [describe_fault(f) for f in self.faults],
         }

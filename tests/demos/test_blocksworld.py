@@ -105,3 +105,39 @@ def test_the_same_seed_gives_the_same_trace(hash_seed, tmp_path):
         outputs.append(json.loads(out.read_text()))
     assert outputs[0] == outputs[1]
     assert any(e["event"] == "planner" for e in outputs[0])
+
+
+def test_small_demo_reports_the_steps_each_agent_carried_out(capsys):
+    from alica.app.cli import main
+
+    code = main(["demo", "blocksworld", "--agents", "2", "--blocks", "3", "--seed", "1", "--json", "--no-progress"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["success"], summary
+    # start [[a], [b, c]], goal [[a], [b], [c]]: one robot unstacks c and puts it down, as one task
+    assert summary["steps_executed"] == 2 and summary["plans"] == 1
+    assert sorted(summary["steps"].values()) == [0, 2] and sorted(summary["tasks"].values()) == [0, 1]
+    assert summary["steps"].keys() == summary["tasks"].keys() == {"r1", "r2"}
+
+
+def test_counter_counts_finished_steps_across_plans_and_not_aborted_ones():
+    from alica.app.demos.blocksworld import PROBLEM, _Counter
+
+    at = f"M/Stacking/{PROBLEM}"
+    counter = _Counter(["Pickup", "Stack"])
+    events = [
+        {"event": "allocation", "agent": "r1", "key": at, "plan": "G1", "entries": {"r1": "G1_T0", "r2": "Standby"}},
+        {"event": "planner", "agent": "r1", "key": at, "what": "plan", "generation": 1, "steps": 4},
+        {"event": "allocation", "agent": "r1", "key": f"{at}/S0/Pickup", "plan": "Pickup", "entries": {}},
+        {"event": "success", "agent": "r1", "key": f"{at}/S0/Pickup", "plan": "Pickup"},
+        {"event": "allocation", "agent": "r1", "key": f"{at}/S1/Stack", "plan": "Stack", "entries": {}},
+        {"event": "replan", "agent": "r1", "key": at},  # the Stack step is abandoned
+        {"event": "planner", "agent": "r1", "key": at, "what": "plan", "generation": 2, "steps": 1},
+        {"event": "allocation", "agent": "r1", "key": at, "plan": "G2", "entries": {"r1": "G2_T0"}},
+        {"event": "allocation", "agent": "r1", "key": f"{at}/S0/Stack", "plan": "Stack", "entries": {}},
+        {"event": "success", "agent": "r1", "key": f"{at}/S0/Stack", "plan": "Stack"},
+        {"event": "success", "agent": "o1", "key": "Opp/Pickup", "plan": "Pickup"},  # an opponent's
+    ]
+    for event in events:
+        counter(event)
+    assert counter.steps == {"r1": 2} and len(counter.tasks["r1"]) == 2
+    assert len(counter.plans) == 2 and counter.plan_length == 1 and counter.replans == 1

@@ -64,7 +64,13 @@ class DemoConfig:
 
 @dataclass(slots=True)
 class DemoResult:
-    """What a demo run gave (see :meth:`as_json` for the keys the CLI prints)."""
+    """What a demo run gave (see :meth:`as_json` for the keys the CLI prints).
+
+    ``steps`` and ``tasks`` count, per team robot, the plan steps it carried
+    out over the whole run and the tasks (entry points of generated plans)
+    those steps belonged to; ``plans`` is the number of plans made (one per
+    planning generation) and ``plan_length`` the length of the last one.
+    """
 
     success: bool
     sim_time_s: float
@@ -79,6 +85,13 @@ class DemoResult:
     satisfied: int
     plan_yaml: str = ""
     crashed: list[str] = field(default_factory=list)
+    steps: dict[str, int] = field(default_factory=dict)
+    plans: int = 0
+
+    @property
+    def steps_executed(self) -> int:
+        """Steps the team carried out over the whole run (over every plan made)."""
+        return sum(self.steps.values())
 
     @property
     def real_time_factor(self) -> float:
@@ -95,6 +108,9 @@ class DemoResult:
             "replans": self.replans,
             "messages": self.messages,
             "plan_length": self.plan_length,
+            "plans": self.plans,
+            "steps_executed": self.steps_executed,
+            "steps": self.steps,
             "tasks": self.tasks,
             "goal_literals": self.goal_literals,
             "satisfied": self.satisfied,
@@ -170,27 +186,79 @@ def _renamed(stacks: Stacks, names: Sequence[str]) -> Stacks:
     return [[mapping[b] for b in s] for s in stacks]
 
 
-class _Counter:
-    """Counts what the trace says: tasks finished per agent, replans, the latest plan's length."""
+@dataclass(slots=True)
+class _Step:
+    """A step an agent is executing: the key of its step plan's node, and the task it belongs to."""
 
-    def __init__(self) -> None:
-        self.tasks: dict[str, int] = {}
+    key: str
+    task: tuple[str, str]
+
+
+class _Counter:
+    """Counts what the trace says: the steps and tasks each agent carried out, plans made, replans.
+
+    A step starts when an agent allocates itself to one of the problem's
+    elements (``Pickup``, ``Stack``, ...) below the planning problem, and is
+    carried out when that step plan succeeds. A task is an entry point of a
+    generated plan; an agent carried it out when it carried out a step of it.
+    """
+
+    def __init__(self, elements: Iterable[str]) -> None:
+        self.elements = frozenset(elements)
+        self.steps: dict[str, int] = {}
+        self.tasks: dict[str, set[tuple[str, str]]] = {}
+        self.running: dict[str, _Step] = {}
+        self.task_of: dict[str, tuple[str, str]] = {}
+        self.plans: set[tuple[str, int]] = set()
         self.replans = 0
         self.plan_length = 0
 
     def __call__(self, event: dict[str, Any]) -> None:
         kind = event["event"]
-        if (
-            kind == "transition"
-            and str(event.get("plan", "")).startswith(f"{PROBLEM}_g")
-            and str(event.get("target", "")).endswith("_Done")
-        ):
-            agent = str(event["agent"])
-            self.tasks[agent] = self.tasks.get(agent, 0) + 1
+        agent = str(event.get("agent"))
+        key = str(event.get("key", ""))
+        if kind == "allocation" and "plan" in event:
+            plan = str(event["plan"])
+            if key.rsplit("/", 1)[-1] == PROBLEM:  # the plan that runs under the problem: the task is its entry
+                self.task_of[agent] = (plan, str(event.get("entries", {}).get(agent, "")))
+                self.running.pop(agent, None)
+            elif plan in self.elements and f"/{PROBLEM}/" in key and agent in self.task_of:
+                self.running[agent] = _Step(key, self.task_of[agent])
+        elif kind == "success" and event.get("plan") in self.elements:
+            step = self.running.get(agent)
+            if step is not None and step.key == key:
+                self._carried_out(agent, self.running.pop(agent))
         elif kind == "replan":
             self.replans += 1
         elif kind == "planner" and event.get("what") == "plan":
+            self.plans.add((key, int(event.get("generation", 0))))
             self.plan_length = int(event.get("steps", 0))
+
+    def _carried_out(self, agent: str, step: _Step) -> None:
+        self.steps[agent] = self.steps.get(agent, 0) + 1
+        self.tasks.setdefault(agent, set()).add(step.task)
+
+    def finish(self, team: Any, facts: Iterable[tuple[object, ...]]) -> None:
+        """Count the steps still running at the end whose effects hold in the world (the goal came true mid-step)."""
+        from alica.lang import literals
+
+        holds = set(facts)
+        for agent, step in sorted(self.running.items()):
+            engine = team.engines.get(agent)
+            node = next((n for n in engine.index.values() if n.key_text == step.key), None) if engine else None
+            signature = node.plan.signature if node is not None else None
+            if node is None or signature is None or signature.effect is None:
+                continue
+            values: dict[str, object] = {
+                v.name: node.env.get(v.name.lstrip("?"), agent if v.type == "robot" else None)
+                for v in signature.parameters
+            }
+            effect = [
+                (positive, pred, tuple(values.get(str(a), a) for a in args))
+                for positive, pred, args in literals(signature.effect.text)
+            ]
+            if all(((pred, *args) in holds) == positive for positive, pred, args in effect):
+                self._carried_out(agent, self.running.pop(agent))
 
 
 def run_demo(
@@ -234,9 +302,9 @@ def run_demo(
     if gui:
         extra["gui"] = True
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
-    counter = _Counter()
+    counter = _Counter(library.abstract(PROBLEM).elements)  # type: ignore[union-attr]
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
-    watchers = [counter, *observers, *([trace] if trace is not None else [])]
+    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = EngineConfig(frequency=config.frequency)
     perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
     registry = default_registry()
@@ -299,6 +367,7 @@ def run_demo(
             if now >= config.time_limit:
                 break
         wall = time.perf_counter() - wall
+        counter.finish(team, perception.facts)
         if on_second is not None:
             on_second(world.now(), satisfied, len(wanted), counter.replans)
         created = next(iter(e.plan_board.latest.values()), None) if (e := _leader(team)) is not None else None
@@ -314,7 +383,9 @@ def run_demo(
             plan_length=counter.plan_length,
             replans=counter.replans,
             messages=team.network.stats.sent,
-            tasks={name: counter.tasks.get(name, 0) for name in team.engines},
+            tasks={name: len(counter.tasks.get(name, ())) for name in team.engines},
+            steps={name: counter.steps.get(name, 0) for name in team.engines},
+            plans=len(counter.plans),
             start=start,
             goal=goal,
             goal_literals=len(wanted),
