@@ -214,7 +214,7 @@ def test_no_reason_on_success(playground, capsys):
 
 
 def test_crashed_agent_and_fault_times_print_as_given(capsys):
-    argv = ["run", LUNAR, "--agents", "scout,stummel,amparo", "--max-time", "3", "--crash", "scout@2"]
+    argv = ["run", LUNAR, "--stand-ins", "--agents", "scout,stummel,amparo", "--max-time", "3", "--crash", "scout@2"]
     assert main([*argv, "--partition", "scout|stummel,amparo@1-2.5", "--recover", "scout@2.5"]) == 1
     out = capsys.readouterr().out
     assert "faults: partition scout|amparo,stummel@1-2.5; crash scout@2; recover scout@2.5" in out
