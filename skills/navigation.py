@@ -80,6 +80,29 @@ def planning_checker(world: RobotWorld, radius: float) -> GridChecker:
 
 #: Seconds to wait before planning again when another robot stands on the goal.
 GOAL_WAIT = 1.0
+#: Radial step in metres of the search for a drivable point near a goal inside an obstacle's clearance.
+GOAL_SEARCH_STEP = 0.02
+
+
+def drivable_goal(checker: GridChecker, goal: tuple[float, float], tolerance: float) -> tuple[float, float] | None:
+    """The drivable point nearest to ``goal`` within ``tolerance`` metres, or ``None`` when there is none.
+
+    A goal within an obstacle's clearance (the robot's radius plus margin) cannot
+    be reached by the robot's centre; any point within the skill's tolerance
+    counts as arrived, as a navigation stack's goal tolerance does. Rings of
+    growing radius are searched, 64 directions each, the nearest valid point wins.
+    """
+    if checker.valid_xy(*goal):
+        return goal
+    steps = int(tolerance / GOAL_SEARCH_STEP)
+    for k in range(1, steps + 1):
+        r = k * GOAL_SEARCH_STEP
+        for i in range(64):
+            a = 2 * math.pi * i / 64
+            point = (goal[0] + r * math.cos(a), goal[1] + r * math.sin(a))
+            if checker.valid_xy(*point):
+                return point
+    return None
 
 
 class MoveToPosition(WorldSkill):
@@ -100,7 +123,9 @@ class MoveToPosition(WorldSkill):
         self.reason = ""
         self.path_length = 0.0
         self.wait_until = 0.0
-        self._plan(self.goal)
+        # a goal within an obstacle's clearance: drive to the nearest drivable point within the tolerance
+        self.target = drivable_goal(planning_checker(self.world, self.robot.spec.radius), self.goal, self.tolerance)
+        self._plan(self.target or self.goal)
 
     def _others(self) -> list[tuple[float, float, float]]:
         return [
@@ -155,15 +180,15 @@ class MoveToPosition(WorldSkill):
                 robot.stop()
                 return self.fail(f"the path to {self.goal} stays blocked after {MAX_REPLANS} replans")
             robot.stop()
-            self._plan(self.goal)
+            self._plan(self.target or self.goal)
             return self.running("path blocked by another robot or a new obstacle: replanning")
         if done:
             robot.stop()
             if self.escaping:
                 self.escaping = False
-                self._plan(self.goal)
+                self._plan(self.target or self.goal)
                 return self.running("out of the tight spot: replanning")
-            self._plan(self.goal)  # the follower ended short of the goal: plan the rest
+            self._plan(self.target or self.goal)  # the follower ended short of the goal: plan the rest
             return self.running("close to the goal: planning the last part")
         robot.drive(v, w)
         return self.running(f"driving to {self.goal}")
@@ -174,7 +199,7 @@ class MoveToPosition(WorldSkill):
         if self.job is None:
             if now < self.wait_until:
                 return self.running(f"waiting for another robot to clear the goal ({self.reason})")
-            self._plan(self.goal)
+            self._plan(self.target or self.goal)
         job = self.job
         assert job is not None  # _plan submitted one
         if not job.done():

@@ -246,3 +246,54 @@ def test_an_escape_turns_on_the_spot_before_it_drives(blocks_world, skill_run):
     assert run.ok, (run.reason, run.trace[-4:])
     v, w, done = escapes[0]
     assert v == 0.0 and w < 0.0 and not done  # it turns right on the spot first
+
+
+def _goal_in_a_rocks_clearance(world, robot):
+    """A point where the robot's centre may not be (too close to a rock) with a drivable point within 0.3 m."""
+    from alica.skills.navigation import drivable_goal, planning_checker
+
+    checker = planning_checker(world, world.robots[robot].spec.radius)
+    x0, y0, _ = world.robots[robot].pose
+    rocks = sorted(
+        (o for o in world.objects.values() if o.kind == "rock"), key=lambda o: math.dist(o.position()[:2], (x0, y0))
+    )
+    for rock in rocks:
+        x, y = rock.position()[:2]
+        for k in range(1, 60):
+            goal = (x + 0.05 * k, y)
+            if not checker.valid_xy(*goal):
+                continue
+            inside = (goal[0] - 0.06, y)  # just inside the clearance
+            if not checker.valid_xy(*inside) and drivable_goal(checker, inside, 0.3) is not None:
+                return inside
+            break
+    raise AssertionError("no rock with free space beside it")
+
+
+def test_move_to_position_drives_next_to_a_goal_within_a_rocks_clearance(lunar_world, skill_run):
+    from alica.skills.navigation import drivable_goal, planning_checker
+
+    goal = _goal_in_a_rocks_clearance(lunar_world, "scout")
+    run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": list(goal), "tolerance": 0.3})
+    assert run.ok, (run.reason, run.trace[-5:])
+    x, y, _ = lunar_world.robots["scout"].pose
+    assert math.hypot(x - goal[0], y - goal[1]) <= 0.3
+    assert not lunar_world.robots["scout"].bumped
+    # with a smaller tolerance than the clearance asks for, the goal stays out of reach
+    checker = planning_checker(lunar_world, lunar_world.robots["scout"].spec.radius)
+    assert drivable_goal(checker, goal, 0.01) is None
+
+
+def test_drivable_goal_is_the_nearest_valid_point_within_the_tolerance():
+    from alica.skills.motion import GridChecker
+    from alica.skills.navigation import drivable_goal
+    from alica.worldsim.grid import Obstacle2D, OccupancyGrid
+
+    grid = OccupancyGrid.from_obstacles([Obstacle2D("circle", 0.0, 0.0, radius=0.5)], (-3.0, -3.0, 3.0, 3.0))
+    checker = GridChecker(grid, 0.3, margin=0.0)
+    assert drivable_goal(checker, (2.0, 0.0), 0.3) == (2.0, 0.0)  # valid: kept as it is
+    goal = (0.75, 0.0)  # 0.25 m from the rock's edge, the robot needs 0.3 m
+    point = drivable_goal(checker, goal, 0.3)
+    assert point is not None and checker.valid_xy(*point)
+    assert 0.0 < math.dist(point, goal) <= 0.3 and point[0] > goal[0]
+    assert drivable_goal(checker, (0.0, 0.0), 0.3) is None  # the rock's centre: nothing within the tolerance
