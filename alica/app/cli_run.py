@@ -147,8 +147,9 @@ def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset
 def cmd_run(args: argparse.Namespace) -> int:
     """Run the ``run`` subcommand; returns the exit code."""
     from alica.app.cli import _load, _roots
-    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
+    from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
+    from alica.prophet import engine_config
     from alica.testing import default_fallback
 
     if not 0 <= args.loss < 1:
@@ -180,7 +181,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         plan,
         roles,
         seed=args.seed,
-        config=EngineConfig(frequency=args.frequency),
+        config=engine_config(frequency=args.frequency),  # planning problems run with pRoPhEt MAS
         roleset=args.roleset,
         loss=args.loss,
         delay=args.delay / 1000.0,
