@@ -32,7 +32,9 @@ from alica.prophet.pddl.model import Equals
 from alica.prophet.pddl.normal import dnf, expand
 from alica.prophet.pddl.reach import Fixpoint, GroundAction, fact_text
 
-Fact = tuple[str, ...]
+#: A grounded PDDL atom as a flat tuple ``(predicate, *objects)``: a node of the grounding, not a
+#: :class:`alica.lang.fact.Fact` of the world model (flat tuples keep the grounding fast).
+GroundAtom = tuple[str, ...]
 
 
 @dataclass(frozen=True, slots=True)
@@ -177,9 +179,9 @@ def _ground(domain: Domain, problem: Problem) -> GroundTask:
 
 def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple, reason: str | None) -> GroundTask:
     fluent = fix.fluent
-    negated: set[Fact] = set()
-    goal_pos: list[Fact] = []
-    goal_neg: list[Fact] = []
+    negated: set[GroundAtom] = set()
+    goal_pos: list[GroundAtom] = []
+    goal_neg: list[GroundAtom] = []
     for positive, atom in goal_literals:
         if isinstance(atom, Equals):
             continue
@@ -198,7 +200,7 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     taken = {p.name for p in domain.predicates}
     not_names = {pred: _not_name(pred, taken) for pred in sorted({f[0] for f in negated})}
 
-    def nf(fact: Fact) -> Fact:
+    def nf(fact: GroundAtom) -> GroundAtom:
         return (not_names[fact[0]], *fact[1:])
 
     init = init_fluent | {nf(f) for f in negated if f not in init_fluent}
@@ -234,7 +236,7 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
 
 
 def _build_positive(
-    problem: Problem, fix: Fixpoint, init: set[Fact], goal_facts: list[Fact], reason: str | None
+    problem: Problem, fix: Fixpoint, init: set[GroundAtom], goal_facts: list[GroundAtom], reason: str | None
 ) -> GroundTask:
     """The task when no action has a negative precondition or a when-effect and no goal is negated.
 
@@ -253,7 +255,7 @@ def _build_positive(
     ids = {text: i for i, text in enumerate(names)}
     final = {f: ids[text_of[f]] for f in reached}
 
-    def ids_of(facts: tuple[Fact, ...]) -> tuple[int, ...]:
+    def ids_of(facts: tuple[GroundAtom, ...]) -> tuple[int, ...]:
         if len(facts) == 1:
             return (final[facts[0]],)
         return tuple(sorted({final[f] for f in facts}))
@@ -264,6 +266,7 @@ def _build_positive(
         add_ids = ids_of(action.add)  # an action's adds are reached, and so are its preconditions
         pre_ids = ids_of(action.pos)
         delete = action.delete
+        del_ids: tuple[int, ...]
         if len(delete) == 1:
             i = final.get(delete[0])
             del_ids = () if i is None or i in add_ids else (i,)
@@ -292,24 +295,24 @@ _FIRST_FOUR = itemgetter(slice(0, 4))
 
 
 class _Facts:
-    """Fact tuples numbered in the order first seen (ids local to one grounding)."""
+    """Ground atoms numbered in the order first seen (ids local to one grounding)."""
 
     __slots__ = ("ids",)
 
     def __init__(self) -> None:
-        self.ids: dict[Fact, int] = {}
+        self.ids: dict[GroundAtom, int] = {}
 
     @property
-    def facts(self) -> list[Fact]:
+    def facts(self) -> list[GroundAtom]:
         """The facts by id."""
         return list(self.ids)
 
-    def id(self, fact: Fact) -> int:
+    def id(self, fact: GroundAtom) -> int:
         """The id of ``fact`` (a new one the first time)."""
         ids = self.ids
         return ids.setdefault(fact, len(ids))
 
-    def ids_of(self, facts: set[Fact] | frozenset[Fact]) -> frozenset[int]:
+    def ids_of(self, facts: set[GroundAtom] | frozenset[GroundAtom]) -> frozenset[int]:
         """The ids of ``facts``."""
         ids = self.ids
         new = ids.setdefault
@@ -351,7 +354,9 @@ def _operators(kept: list[tuple[GroundAction, Compiled]], final: list[int]) -> t
     return _ordered(operators)
 
 
-def _compile(action: GroundAction, negated: set[Fact], nf: Callable[[Fact], Fact], table: _Facts) -> Compiled:
+def _compile(
+    action: GroundAction, negated: set[GroundAtom], nf: Callable[[GroundAtom], GroundAtom], table: _Facts
+) -> Compiled:
     """Pre, add, delete and conditional effects with ``not-`` facts kept up to date, as local fact ids."""
     if not negated and not action.conditional:  # the common case: nothing to keep up to date
         ids = table.ids
@@ -425,8 +430,8 @@ def _reachable(n_facts: int, init: set[int], compiled: list[Compiled]) -> tuple[
             if reached[fact]:
                 continue
             reached[fact] = True
-            for record in waiting[fact]:
-                record[0] -= 1
-                if record[0] == 0:
-                    ready.append(record)
+            for waiter in waiting[fact]:
+                waiter[0] -= 1
+                if waiter[0] == 0:
+                    ready.append(waiter)
     return reached, [i for i, ok in enumerate(fired) if ok]

@@ -12,12 +12,15 @@ the world model; Goal is the problem's ``goal``.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING
 
 from alica.errors import AlicaError, PlannerError
 from alica.lang import literals
+from alica.lang.fact import Fact
 from alica.model import PlanLibrary, PlanningProblem
 
-Fact = tuple[str, tuple[str, ...]]
+if TYPE_CHECKING:
+    from alica.prophet.pddl import Domain, Problem
 
 
 def _symbol(name: str) -> str:
@@ -134,12 +137,12 @@ def offline_world(problem: PlanningProblem) -> tuple[dict[str, str], list[Fact]]
             f"the world of '{problem.name}' lists facts that hold; leave out the ones that do not (closed world)"
         )
     objects = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
-    return objects, [(n, tuple(str(a) for a in args)) for _, n, args in found]
+    return objects, [Fact(n, tuple(str(a) for a in args)) for _, n, args in found]
 
 
 def to_pddl(
     problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]
-) -> tuple[object, object]:
+) -> tuple[Domain, Problem]:
     """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world."""
     from alica.prophet.pddl import parse_domain, parse_problem
 

@@ -13,8 +13,8 @@ gets a :class:`ProblemRuntime` for it, which says which plan the child runs:
 
 The **leader** is the lowest alive agent in the state; when it crashes the
 next lowest takes over. The leader reads World (:func:`alica.prophet.world.read_world`),
-runs the planner as an anytime search, a budget per tick
-(``EngineConfig.planner_expansions``), and shares:
+runs the planner as an anytime search (:func:`alica.prophet.pipeline.plan_problem`),
+a budget per tick (:class:`alica.prophet.plugin.Planning`), and shares:
 
 * a ``searching`` share when it starts (the team runs the WaitPlan);
 * the first plan as soon as it is found and validated;
@@ -32,24 +32,33 @@ Every UpdateTime it repeats its latest share (for agents that come late) and,
 while the team executes, checks that what is left of the plan still reaches
 the goal from the current world (:func:`alica.prophet.world.remaining_fits`); twice
 in a row not, it replans. A step that fails sends its agent back to the
-WaitPlan and asks the leader to replan (:class:`ReplanRequest`); so does a
-change of goal or world by the operator (:meth:`AgentEngine.set_problem`).
+WaitPlan and asks the leader to replan (:class:`~alica.prophet.board.ReplanRequest`); so does a
+change of goal or world by the operator (``AgentEngine.set_problem``, read through the host).
+
+The runtime sees the engine only through the child-runtime seam
+(:mod:`alica.engine.child`): the agent's :class:`~alica.engine.child.ChildHost`,
+its :class:`~alica.engine.child.ChildSlot` and the
+:class:`~alica.engine.child.RunningPlan` there. Progress in a generated plan
+is read from the plan's :attr:`~alica.prophet.tasks.CreatedTasks.places`
+(state -> task, step, kind), never from state names.
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING
 
-from alica.engine.status import ChildStatus
-from alica.engine.team import PlanKey, key_text
+from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanKey, RunningPlan, key_text
 from alica.errors import AlicaError, PlannerError
+from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
-from alica.prophet.planner import Done, Improved, PlanStatus, PlanStep
-from alica.prophet.planner import Plan as StepPlan
-from alica.prophet.tasks import STEP_DONE, CreatedTasks, conjunction, create_tasks, holds, state_step, step_token
+from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
+from alica.prophet.pipeline import Found, ProblemEvent, Rejected, ValidPlan, plan_problem
+from alica.prophet.planner import Done, PlanStatus
+from alica.prophet.problem import predicate_types
+from alica.prophet.tasks import STEP_DONE, CreatedTasks, Literal, StepKind, conjunction, create_tasks, holds, step_token
 from alica.prophet.world import (
     PlanningWorld,
     TaskProgress,
@@ -59,68 +68,24 @@ from alica.prophet.world import (
     remaining_fits,
 )
 
-if TYPE_CHECKING:
-    from collections.abc import Iterable, Iterator, Sequence
-
-    from alica.engine.agent import AgentEngine
-    from alica.engine.node import PlanNode
-    from alica.engine.slot import Slot
-    from alica.prophet.planner import SearchEvent
-
-Fact = tuple[str, tuple[str, ...]]
-Literal = tuple[bool, Fact]
-
-SEARCHING, PLAN, FAILED, DONE = "searching", "plan", "failed", "done"
+SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareStatus.FAILED, ShareStatus.DONE
 
 
 @dataclass(frozen=True, slots=True)
-class PlanShare:
-    """What the leader tells the team about a planning problem.
+class SearchBudget:
+    """How much the leader searches per tick.
 
     Attributes:
-        key: the planning problem's instance (its plan key).
-        generation: counts the plannings of this instance (each replan starts a new one).
-        version: counts the plans shared within a generation (anytime improvements).
-        leader: who shares it.
-        status: ``searching``, ``plan``, ``failed`` or ``done``.
-        steps: the single-agent plan (status ``plan``).
-        cost: its cost.
-        world: the facts it was planned from.
-        robots: the robots it was planned with (the alive members in the state).
-        entry_task: the task through which the team runs the problem (for Eq. 9).
-        reason: why it failed, or why the leader replans.
-        goal: the goal literals the plan reaches when robots outside the team hold
-            objects of the goal (the rest of the goal); empty: the whole goal.
+        expansions: the search budget per tick, in expansions (deterministic: the same run plans the same way).
+        seconds: a wall-time budget per tick instead (for real robots); ``None`` uses ``expansions``.
     """
 
-    key: PlanKey
-    generation: int
-    version: int
-    leader: str
-    status: str
-    steps: tuple[PlanStep, ...] = ()
-    cost: float = 0.0
-    world: tuple[Fact, ...] = ()
-    robots: tuple[str, ...] = ()
-    entry_task: str = ""
-    reason: str = ""
-    goal: tuple[Literal, ...] = ()
+    expansions: int = 1000
+    seconds: float | None = None
 
-    def supersedes(self, other: PlanShare) -> bool:
-        """Newer generation, then newer version; the lower leader wins a tie (a partition healed)."""
-        mine, theirs = (self.generation, self.version), (other.generation, other.version)
-        return mine > theirs or (mine == theirs and self.leader < other.leader)
-
-
-@dataclass(frozen=True, slots=True)
-class ReplanRequest:
-    """A teammate asks the leader to replan: a step of generation ``generation`` failed."""
-
-    key: PlanKey
-    generation: int
-    sender: str
-    reason: str
-    is_request: bool = True
+    def __post_init__(self) -> None:
+        if self.expansions < 1 or (self.seconds is not None and self.seconds <= 0):
+            raise ValueError("the planner's budget needs expansions >= 1 and seconds > 0 (or None)")
 
 
 @dataclass
@@ -129,13 +94,10 @@ class _Search:
 
     generation: int
     world: PlanningWorld
-    events: Iterator[SearchEvent]
-    domain: object
-    problem: object
+    events: Iterator[ProblemEvent]
     started: float
-    names: dict[str, str]
     expansions: int = 0
-    best: StepPlan | None = None
+    best: ValidPlan | None = None
     shared_cost: float | None = None
     version: int = 0
     goal: tuple[Literal, ...] = ()
@@ -145,17 +107,25 @@ class ProblemRuntime:
     """One agent's runtime of one planning problem child (see the module docstring).
 
     Args:
+        host: what the agent's engine offers.
         slot: the child of the state that holds the planning problem.
+        board: the agent's plan board.
+        budget: the leader's search budget per tick.
+
+    Raises:
+        TypeError: the child is not a planning problem.
     """
 
-    def __init__(self, slot: Slot) -> None:
-        parent = slot.parent
-        self.slot = slot
-        self.engine: AgentEngine = parent.engine
+    def __init__(self, host: ChildHost, slot: ChildSlot, board: PlanBoard, budget: SearchBudget) -> None:
         element = slot.element
-        assert isinstance(element, PlanningProblem)
+        if not isinstance(element, PlanningProblem):
+            raise TypeError(f"pRoPhEt MAS runs planning problems, not {element!r}")
+        self.host = host
+        self.slot = slot
+        self.board = board
+        self.budget = budget
         self.model = element
-        self.key: PlanKey = (*parent.key, parent.state or "", slot.name)
+        self.key: PlanKey = slot.key
         self.share: PlanShare | None = None
         self.created: CreatedTasks | None = None
         self.revision = 0
@@ -169,14 +139,13 @@ class ProblemRuntime:
         self.pending: tuple[float, str] | None = None
         self.blocked: set[Fact] | None = None
         self.predicates: dict[str, tuple[str, ...]] | None = None
-        self.overrides = dict(self.engine.problem_overrides.get(self.model.name, {}))
-        now = self.engine.now()
-        board = self.engine.plan_board
-        known = board.shares.get(self.key)
-        fresh = known is not None and now - board.received_at[self.key] <= 2 * self.model.update_time
-        self.stale = None if fresh else known
-        if fresh:
-            self._adopt(known, now)
+        self.overrides = dict(host.override(self.model.name))
+        now = host.now()
+        # a share received lately is current (the leader repeats it every UpdateTime); an older one is stale
+        fresh = board.fresh(self.key, now, 2 * self.model.update_time)
+        self.stale = board.shares.get(self.key) if fresh is None else None
+        if fresh is not None:
+            self._adopt(fresh, now)
 
     # -- what the slot runs --------------------------------------------------
 
@@ -206,7 +175,7 @@ class ProblemRuntime:
     def wanted(self) -> tuple[Plan, ...]:
         """The plan the child runs now (none when done or failed)."""
         phase = self.phase()
-        plans = self.engine.library.plans
+        plans = self.host.library.plans
         if phase == "wait":
             return (plans[self.model.wait_plan],) if self.model.wait_plan else ()
         if phase == "plan":
@@ -229,7 +198,11 @@ class ProblemRuntime:
         """Whether ``plan`` is the generated plan this runtime made."""
         return self.created is not None and plan is self.created.plan
 
-    def child_status(self, node: PlanNode) -> ChildStatus:
+    def may_retry_in(self, plan: Plan) -> bool:
+        """A step of the generated plan is not retried: its failure goes up at once, and the problem replans."""
+        return not self.is_generated(plan)
+
+    def child_status(self, node: RunningPlan) -> ChildStatus:
         """The child's status from its running plan: the WaitPlan never ends it; the generated plan only with the goal."""
         plan = node.plan
         if self.is_generated(plan):
@@ -240,16 +213,15 @@ class ProblemRuntime:
             return ChildStatus.RUNNING
         return node.status
 
-    def _goal_believed(self, node: PlanNode) -> bool:
-        engine = self.engine
-        return engine.formulas.holds(self.problem.goal.text, engine.belief_for(node), node.env)
+    def _goal_believed(self, node: RunningPlan) -> bool:
+        return self.host.holds(self.problem.goal.text, node)
 
     # -- the tick --------------------------------------------------------------
 
     def update(self, now: float) -> None:
         """Take in shares, lead when this agent is the leader, repeat a pending replan request."""
-        engine = self.engine
-        latest = engine.plan_board.shares.get(self.key)
+        host = self.host
+        latest = self.board.shares.get(self.key)
         if (
             latest is not None
             and latest is not self.share
@@ -258,7 +230,7 @@ class ProblemRuntime:
             and (self.share is None or latest.supersedes(self.share))
         ):
             self._adopt(latest, now)
-        overrides = engine.problem_overrides.get(self.model.name, {})
+        overrides = host.override(self.model.name)
         changed = overrides != self.overrides
         if changed:
             self.overrides = dict(overrides)
@@ -269,9 +241,9 @@ class ProblemRuntime:
         else:
             if self.search is not None:
                 self.search = None
-                engine.emit("planner", key=key_text(self.key), what="handed over")
+                host.emit("planner", key=key_text(self.key), what="handed over")
             if self.request is not None and now >= self.next_update:
-                engine.publish_plan(self.request)
+                host.publish(self.request)
                 self.next_update = now + self.model.update_time
         if self.request is not None and self.share is not None and self.share.generation > self.request.generation:
             self.request = None
@@ -280,33 +252,32 @@ class ProblemRuntime:
     def _mark_done(self) -> None:
         """Write ``step_done`` for the steps this agent finished in the generated plan (later steps wait for them)."""
         node, created = self.slot.node, self.created
-        if node is None or created is None or node.plan is not created.plan or node.ep is None or node.state is None:
+        if node is None or created is None or node.plan is not created.plan or node.ep is None:
             return
-        i = next((j for j, ep in enumerate(created.task_entry_points) if ep.name == node.ep), None)
-        if i is None:
+        place = created.place(node.state)
+        if place is None:
             return  # standing by
-        steps = created.tasks[i]
-        world_model = self.engine.world_model
-        for step in steps[: state_step(node.state, len(steps))]:
+        world = self.host.world
+        for step in created.tasks[place.task][: place.step]:
             token = step_token(created.plan.name, step.index)
             if token not in self.marked:
                 self.marked.add(token)
-                world_model.assert_fact(STEP_DONE, token)
+                world.assert_fact(STEP_DONE, token)
 
     def stop(self) -> None:
         """The agent leaves the state: stop planning, forget the generated plan."""
         self.search = None
         if self.created is not None:
-            self.engine.unregister_generated(self.created.plan.name)
+            self.host.unregister_plan(self.created.plan.name)
 
     def _is_leader(self) -> bool:
-        members = self.engine.members_of(self.slot.parent)
-        return bool(members) and members[0] == self.engine.name
+        members = self.slot.members()
+        return bool(members) and members[0] == self.host.name
 
     # -- shares ---------------------------------------------------------------
 
     def _adopt(self, share: PlanShare, now: float) -> None:
-        engine = self.engine
+        host = self.host
         current = self.share
         if current is not None and (current.generation, current.version) == (share.generation, share.version):
             self.share = share  # the same plan, repeated by another leader
@@ -318,22 +289,22 @@ class ProblemRuntime:
                 created = create_tasks(
                     name,
                     share.steps,
-                    engine.library,
+                    host.library,
                     share.world,
                     share.robots,
-                    engine.base_roleset,
+                    host.roleset,
                     share.entry_task,
                     standby=self.model.wait_plan,
                 )
             except (PlannerError, AlicaError) as exc:
-                engine.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
+                host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
                 return
         if self.created is not None:
-            engine.unregister_generated(self.created.plan.name)
+            host.unregister_plan(self.created.plan.name)
         self.created = created
         if created is not None:
-            engine.register_generated(created.plan, created.roleset, created.pins())
-            engine.plan_board.latest[self.key] = created
+            host.register_plan(created.plan, created.priorities(), created.pins())
+            self.board.latest[self.key] = created
         self.share = share
         self.revision += 1
         self.reason = share.reason
@@ -343,45 +314,39 @@ class ProblemRuntime:
             fields.update(plan=created.plan.name, steps=len(share.steps), tasks=len(created.tasks), cost=share.cost)
         if share.reason:
             fields["reason"] = share.reason
-        engine.emit("problem", key=key_text(self.key), phase=self.phase(), **fields)
+        host.emit("problem", key=key_text(self.key), phase=self.phase(), **fields)
 
     def _publish(self, share: PlanShare, now: float) -> None:
-        engine = self.engine
-        engine.plan_board.receive(share, now)
-        engine.publish_plan(share)
+        self.board.receive(share, now)
+        self.host.publish(share)
         if share is not self.share and (self.share is None or share.supersedes(self.share)):
             self._adopt(share, now)
 
     def _entry_task(self) -> str:
-        parent = self.slot.parent
-        return parent.plan.entry_point(parent.ep).task if parent.ep is not None else ""
+        return self.slot.entry_task
 
     # -- failures --------------------------------------------------------------
 
-    def execution_failed(self, node: PlanNode, now: float) -> None:
+    def execution_failed(self, node: RunningPlan, now: float) -> None:
         """A step of the generated plan failed here: back to the WaitPlan; the leader replans."""
         share = self.share
         assert share is not None
         reason = f"a step of {node.plan.name} failed: {node.reason}"
         self.failed_generation = share.generation
         self.revision += 1
-        self.engine.emit("problem", key=key_text(self.key), phase="wait", generation=share.generation, reason=reason)
+        self.host.emit("problem", key=key_text(self.key), phase="wait", generation=share.generation, reason=reason)
         if self._is_leader():
             self._replan(now, reason, settle=True)
         else:
-            self.request = ReplanRequest(self.key, share.generation, self.engine.name, reason)
-            self.engine.publish_plan(self.request)
+            self.request = ReplanRequest(self.key, share.generation, self.host.name, reason)
+            self.host.publish(self.request)
             self.next_update = now + self.model.update_time
 
     # -- the leader ----------------------------------------------------------
 
     def _lead(self, now: float) -> None:
         share = self.share
-        requests = [
-            r
-            for r in self.engine.plan_board.take_requests(self.key)
-            if share is None or r.generation >= share.generation
-        ]
+        requests = [r for r in self.board.take_requests(self.key) if share is None or r.generation >= share.generation]
         if requests and share is not None and share.status == PLAN:
             self._replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
             return
@@ -412,40 +377,37 @@ class ProblemRuntime:
         if self.search is None and share.status == PLAN:
             self._check_execution(now, share)
         if self.share is share:
-            self._publish(share if share.leader == self.engine.name else replace(share, leader=self.engine.name), now)
+            me = self.host.name
+            self._publish(share if share.leader == me else replace(share, leader=me), now)
 
     def _replan(self, now: float, reason: str, settle: bool = False) -> None:
         """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step)."""
-        self.engine.stats["replans"] += 1
-        self.engine.emit("replan", key=key_text(self.key), reason=reason)
+        self.host.counters["replans"] += 1
+        self.host.emit("replan", key=key_text(self.key), reason=reason)
         self.search = None
         if not settle:
             self._start_search(now, reason)
             return
-        engine = self.engine
         generation = self._next_generation()
         self.pending = (now + self.model.update_time, reason)
         self._publish(
-            PlanShare(self.key, generation, 0, engine.name, SEARCHING, entry_task=self._entry_task(), reason=reason),
+            PlanShare(self.key, generation, 0, self.host.name, SEARCHING, entry_task=self._entry_task(), reason=reason),
             now,
         )
 
     def _next_generation(self) -> int:
         """One more than any generation this agent has seen for the problem."""
-        board = self.engine.plan_board
+        board = self.board
         return (
             max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0)
             + 1
         )
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
-        from alica.prophet.planners import get_planner
-        from alica.prophet.problem import to_pddl
-
-        engine = self.engine
+        host = self.host
         if generation is None:
             generation = self._next_generation()
-        me = engine.name
+        me = host.name
         task = self._entry_task()
         problem = self.problem
         try:
@@ -474,19 +436,15 @@ class ProblemRuntime:
                     self.next_update = now + self.model.update_time
                     return
                 problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
-            domain, pddl = to_pddl(problem, engine.library, world.object_types(), world.facts)
-            planner = get_planner(problem.planner, **({"progress_every": 100} if problem.planner == "builtin" else {}))
-            events = planner.search(domain, pddl, anytime=True)
+            options = {"progress_every": 100} if problem.planner == "builtin" else {}
+            events = plan_problem(problem, host.library, world, options=options).search(anytime=True)
         except (PlannerError, AlicaError) as exc:
-            engine.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
+            host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
-        names = {name.lower(): name for name, _ in world.objects}
-        self.search = _Search(
-            generation, world, events, domain, pddl, now, names, goal=partial if partial != goal else ()
-        )
+        self.search = _Search(generation, world, events, now, goal=partial if partial != goal else ())
         extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
-        engine.emit(
+        host.emit(
             "planner",
             key=key_text(self.key),
             what="started",
@@ -514,7 +472,7 @@ class ProblemRuntime:
 
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
         """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
-        self.engine.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
+        self.host.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
         self.blocked = set(world.facts)
         if self.share is None or self.share.status != SEARCHING:
             self._publish(
@@ -522,7 +480,7 @@ class ProblemRuntime:
                     self.key,
                     generation,
                     0,
-                    self.engine.name,
+                    self.host.name,
                     SEARCHING,
                     world=world.facts,
                     robots=world.robots,
@@ -532,35 +490,40 @@ class ProblemRuntime:
                 now,
             )
 
-    def _read_world(self, problem: PlanningProblem, facts: Iterable[object] | None = None) -> PlanningWorld:
+    def _read_world(self, problem: PlanningProblem, facts: Iterable[Fact] | None = None) -> PlanningWorld:
         """The planning world from the world model (``facts``: its facts, when the caller read them already)."""
-        engine = self.engine
-        world_model = engine.world_model
+        world = self.host.world
         if facts is None:
-            facts = world_model.facts() if hasattr(world_model, "facts") else ()
-        typed = {t: world_model.objects(t) for t in world_model.types()} if hasattr(world_model, "types") else {}
-        return read_world(problem, engine.library, facts, engine.members_of(self.slot.parent), typed)
+            facts = world.facts()
+        typed = {t: world.objects(t) for t in world.types()}
+        return read_world(problem, self.host.library, facts, self.slot.members(), typed)
 
     def _step_search(self, now: float) -> None:
         search = self.search
         assert search is not None
-        config = self.engine.config
+        budget = self.budget
         start_expansions = search.expansions
-        deadline = time.perf_counter() + config.planner_seconds if config.planner_seconds is not None else None
+        deadline = time.perf_counter() + budget.seconds if budget.seconds is not None else None
         finished: Done | None = None
         for event in search.events:
             search.expansions = event.expansions
-            if isinstance(event, Improved):
+            if isinstance(event, Found):
                 search.best = event.plan
                 if search.shared_cost is None:
                     break  # share the first plan at once
+            elif isinstance(event, Rejected):
+                self.host.emit(
+                    "warning",
+                    key=key_text(self.key),
+                    message=f"the planner's plan is invalid and not shared: {event.reason}",
+                )
             elif isinstance(event, Done):
                 finished = event
                 break
             if deadline is not None:
                 if time.perf_counter() >= deadline:
                     break
-            elif search.expansions - start_expansions >= config.planner_expansions:
+            elif search.expansions - start_expansions >= budget.expansions:
                 break
         else:
             finished = Done(PlanStatus.SOLVED if search.best is not None else PlanStatus.UNSOLVABLE, search.expansions)
@@ -574,13 +537,13 @@ class ProblemRuntime:
                 finished = finished or Done(
                     PlanStatus.SOLVED, search.expansions, "the world changed: execution has begun"
                 )
-            elif best is not None and best.cost < search.shared_cost:
+            elif best is not None and best.plan.cost < search.shared_cost:
                 self._share_plan(now, search, best)
         if self.search is not search:
             return
         if finished is not None:
             self.search = None
-            self.engine.emit(
+            self.host.emit(
                 "planner",
                 key=key_text(self.key),
                 what="done",
@@ -604,7 +567,7 @@ class ProblemRuntime:
                         self.key,
                         search.generation,
                         1,
-                        self.engine.name,
+                        self.host.name,
                         FAILED,
                         entry_task=self._entry_task(),
                         reason=message,
@@ -616,13 +579,13 @@ class ProblemRuntime:
             if now - search.started > self.model.timeout:
                 self.search = None
                 reason = f"no plan within the timeout of {self.model.timeout:g} s"
-                self.engine.emit("planner", key=key_text(self.key), what="timeout", expansions=search.expansions)
+                self.host.emit("planner", key=key_text(self.key), what="timeout", expansions=search.expansions)
                 self._publish(
                     PlanShare(
                         self.key,
                         search.generation,
                         1,
-                        self.engine.name,
+                        self.host.name,
                         FAILED,
                         entry_task=self._entry_task(),
                         reason=reason,
@@ -635,9 +598,7 @@ class ProblemRuntime:
     def _predicates(self) -> dict[str, tuple[str, ...]]:
         """The domain's predicates (they depend on the problem's elements only), worked out once."""
         if self.predicates is None:
-            from alica.prophet.problem import predicate_types
-
-            self.predicates = predicate_types(self.model, self.engine.library)
+            self.predicates = predicate_types(self.model, self.host.library)
         return self.predicates
 
     def _executing(self) -> bool:
@@ -645,29 +606,22 @@ class ProblemRuntime:
         node, created = self.slot.node, self.created
         if node is None or created is None or node.plan is not created.plan:
             return False
-        return any(state is not None and "_S" in state for _, state in node.believed.values())
+        return any(
+            (place := created.place(state)) is not None and place.kind is StepKind.RUN
+            for _, state in node.believed.values()
+        )
 
-    def _share_plan(self, now: float, search: _Search, plan: StepPlan) -> None:
-        from alica.prophet.validate import validate_plan
-
-        result = validate_plan((search.domain, search.problem), plan)
-        if not result.valid:
-            self.engine.emit(
-                "warning",
-                key=key_text(self.key),
-                message=f"the planner's plan is invalid and not shared: {result.reason}",
-            )
-            return
-        steps = tuple(PlanStep(s.action, tuple(search.names.get(a, a) for a in s.args)) for s in plan.steps)
+    def _share_plan(self, now: float, search: _Search, plan: ValidPlan) -> None:
+        steps = plan.steps
         search.version += 1
-        search.shared_cost = plan.cost
-        self.engine.emit(
+        search.shared_cost = plan.plan.cost  # the cost as the planner gave it (the trace shows it)
+        self.host.emit(
             "planner",
             key=key_text(self.key),
             what="plan",
             generation=search.generation,
             version=search.version,
-            cost=plan.cost,
+            cost=plan.plan.cost,
             steps=len(steps),
             expansions=search.expansions,
             after_s=round(now - search.started, 6),
@@ -676,10 +630,10 @@ class ProblemRuntime:
             self.key,
             search.generation,
             search.version,
-            self.engine.name,
+            self.host.name,
             PLAN,
             steps,
-            plan.cost,
+            plan.plan.cost,
             search.world.facts,
             search.world.robots,
             self._entry_task(),
@@ -700,26 +654,28 @@ class ProblemRuntime:
                 progress.append(TaskProgress(None, len(steps), done=True))
                 continue
             holders = sorted(
-                (state_step(state, len(steps)), agent, state)
+                (place.step if place is not None else 0, agent, place is not None and place.kind is StepKind.RUN)
                 for agent, (entry, state) in node.believed.items()
                 if entry == ep.name and state
+                for place in (created.place(state),)
             )
             if holders:
-                k, agent, state = holders[0]
-                progress.append(TaskProgress(agent, k, running="_S" in state))
+                k, agent, running = holders[0]
+                progress.append(TaskProgress(agent, k, running=running))
             else:
                 progress.append(TaskProgress(None, 0))
         predicates = self._predicates()
-        world_model = self.engine.world_model
-        believed = list(world_model.facts())
-        facts = [(f.predicate, tuple(str(a) for a in f.args)) for f in believed if f.predicate.lower() in predicates]
+        believed = self.host.world.facts()
+        facts = [
+            Fact(f.predicate, tuple(str(a) for a in f.args)) for f in believed if f.predicate.lower() in predicates
+        ]
         goal = goal_literals(self.problem)
         world = self._read_world(self.problem, believed)
         reachable = reachable_goal(goal, world.outside)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         order = [[step.index for step in steps] for steps in created.tasks]
-        members = self.engine.members_of(self.slot.parent)
+        members = self.slot.members()
         reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(
             progress, order, created.allowed, members
         )
@@ -778,7 +734,8 @@ def _stalled(
     ]
     if not waiting:
         return None
-    may = set(allowed[first] if first < len(allowed) and allowed[first] is not None else members) & set(members)
+    pinned = allowed[first] if first < len(allowed) else None
+    may = set(pinned if pinned is not None else members) & set(members)
     if any(p.agent in may and not p.done and (p.running or position(i) < start) for i, p in enumerate(progress)):
         return None
     return f"task T{first} has nobody, and the agent of task T{max(waiting)} waits for it"

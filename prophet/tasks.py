@@ -43,10 +43,12 @@ that frees up just as an idle agent would.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from enum import Enum
 
 from alica.errors import PlannerError
 from alica.lang import literals
+from alica.lang.fact import Fact
 from alica.model import (
     Binding,
     ChildRef,
@@ -66,7 +68,8 @@ from alica.model import (
 )
 from alica.prophet.planner import PlanStep
 
-Fact = tuple[str, tuple[str, ...]]
+#: A ground literal: whether the fact holds (``True``) or not.
+Literal = tuple[bool, Fact]
 #: The robot parameter of skill signatures: the agent that runs the skill.
 ROBOT = "?r"
 
@@ -78,8 +81,8 @@ class Step:
     index: int
     skill: Plan
     bindings: tuple[tuple[str, str], ...]
-    pre: tuple[tuple[bool, Fact], ...]
-    effect: tuple[tuple[bool, Fact], ...]
+    pre: tuple[Literal, ...]
+    effect: tuple[Literal, ...]
     robot: str = ""
     """The robot the planner chose for the step (its ``?r``)."""
 
@@ -88,6 +91,35 @@ class Step:
         """``Pickup(a)``."""
         args = ", ".join(v for k, v in self.bindings)
         return f"{self.skill.name}({args})"
+
+
+class StepKind(Enum):
+    """What an agent does in a state of a generated plan."""
+
+    WAIT = "wait"
+    """Waits until its step can run (the step's precondition, the earlier steps on the same objects)."""
+    RUN = "run"
+    """Runs its step's skill plan."""
+    DONE = "done"
+    """Finished every step of its task (a success state)."""
+    FAILED = "failed"
+    """A step of its task failed (a failure state)."""
+
+
+@dataclass(frozen=True, slots=True)
+class Place:
+    """Where a state of a generated plan is in the tasks: the task, the step, and what the agent does there.
+
+    Attributes:
+        task: the task's index.
+        step: the index (in the task's steps) of the first step not finished: the step that waits or runs,
+            the number of steps when the task is done, 0 in the failure state (the runtime replans anyway).
+        kind: waiting, running, done or failed.
+    """
+
+    task: int
+    step: int
+    kind: StepKind
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,6 +132,8 @@ class CreatedTasks:
         task_defs: the new tasks of the task repository.
         roleset: the role set with priorities for the new tasks.
         allowed: per task, the robots that may take it (``None``: any).
+        places: state name -> where it is in the tasks, for every state of a task
+            (the standby state is in none); the runtime reads progress from it.
     """
 
     tasks: tuple[tuple[Step, ...], ...]
@@ -107,11 +141,21 @@ class CreatedTasks:
     task_defs: tuple[Task, ...]
     roleset: RoleSet
     allowed: tuple[tuple[str, ...] | None, ...] = ()
+    places: Mapping[str, Place] = field(default_factory=dict)
 
     @property
     def task_entry_points(self) -> tuple[EntryPoint, ...]:
         """The entry points of the tasks, in task order (the standby entry point left out)."""
         return self.plan.entry_points[: len(self.tasks)]
+
+    def place(self, state: str | None) -> Place | None:
+        """Where ``state`` is in the tasks (``None``: not a state of a task, e.g. standing by)."""
+        return self.places.get(state) if state is not None else None
+
+    def priorities(self) -> dict[str, tuple[Priority, ...]]:
+        """Role -> the priorities of the generated plan's tasks (Eq. 9), for the engine's allocation."""
+        tasks = {ep.task for ep in self.plan.entry_points}
+        return {role.name: tuple(p for p in role.priorities if p.task in tasks) for role in self.roleset.roles}
 
     def pins(self) -> dict[str, tuple[str, ...]]:
         """Entry point name -> the robots allowed to take it, for the pinned tasks."""
@@ -122,12 +166,12 @@ class CreatedTasks:
         }
 
 
-def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[tuple[bool, Fact], ...]:
+def _ground(text: str | None, subst: Mapping[str, str], where: str) -> tuple[Literal, ...]:
     if not text:
         return ()
     out = []
     for positive, name, args in literals(text):
-        out.append((positive, (name, tuple(subst.get(str(a), str(a)) for a in args))))
+        out.append((positive, Fact(name, tuple(subst.get(str(a), str(a)) for a in args))))
     return tuple(out)
 
 
@@ -168,12 +212,12 @@ def steps_of(plan_steps: Sequence[PlanStep], library: PlanLibrary, robots: str |
     return out
 
 
-def holds(literals_: Iterable[tuple[bool, Fact]], state: set[Fact] | frozenset[Fact]) -> bool:
+def holds(literals_: Iterable[Literal], state: set[Fact] | frozenset[Fact]) -> bool:
     """Whether every literal holds in the closed world ``state``."""
     return all((fact in state) == positive for positive, fact in literals_)
 
 
-def apply_effect(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
+def apply_effect(state: set[Fact], effect: Iterable[Literal]) -> None:
     """Apply an effect to ``state``: deletes first, then adds."""
     for positive, fact in effect:
         if not positive:
@@ -183,10 +227,11 @@ def apply_effect(state: set[Fact], effect: Iterable[tuple[bool, Fact]]) -> None:
             state.add(fact)
 
 
-def for_robot(literal_set: Iterable[tuple[bool, Fact]], robot: str, other: str) -> list[tuple[bool, Fact]]:
+def for_robot(literal_set: Iterable[Literal], robot: str, other: str) -> list[Literal]:
     """The literals with ``robot`` replaced by ``other``."""
     return [
-        (positive, (name, tuple(other if a == robot else a for a in args))) for positive, (name, args) in literal_set
+        (positive, Fact(name, tuple(other if a == robot else a for a in args)))
+        for positive, (name, args) in literal_set
     ]
 
 
@@ -294,22 +339,22 @@ def step_token(plan: str, index: int) -> str:
     return f"{plan}_s{index}"
 
 
-def conjunction(literal_set: Iterable[tuple[bool, Fact]]) -> str:
+def conjunction(literal_set: Iterable[Literal]) -> str:
     """Ground literals as a formula: ``on(a, b) and not clear(c)``."""
     return " and ".join(
-        ("" if positive else "not ") + (f"{name}({', '.join(args)})" if args else name)
+        ("" if positive else "not ") + (f"{name}({', '.join(str(a) for a in args)})" if args else name)
         for positive, (name, args) in literal_set
     )
 
 
-def _condition(pre: Sequence[tuple[bool, Fact]], robot: str, after: Sequence[str] = ()) -> Condition | None:
+def _condition(pre: Sequence[Literal], robot: str, after: Sequence[str] = ()) -> Condition | None:
     parts = [conjunction(for_robot(pre, robot, "self"))] if pre else []
     parts.extend(f"{STEP_DONE}({token})" for token in after)
     return Condition(ConditionKind.TRANSITION, " and ".join(parts)) if parts else None
 
 
 def _objects(step: Step) -> set[str]:
-    return {a for _, (_, args) in step.pre + step.effect for a in args if a != step.robot}
+    return {str(a) for _, (_, args) in step.pre + step.effect for a in args if a != step.robot}
 
 
 def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
@@ -334,9 +379,14 @@ def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
 
 def build_plan(
     name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None, standby: str | None = None
-) -> tuple[Plan, tuple[Task, ...]]:
-    """The multi-agent plan of the tasks (see the module docstring); ``standby`` names the WaitPlan."""
+) -> tuple[Plan, tuple[Task, ...], dict[str, Place]]:
+    """The multi-agent plan of the tasks (see the module docstring); ``standby`` names the WaitPlan.
+
+    Returns:
+        The plan, its tasks, and where each state of a task is (:attr:`CreatedTasks.places`).
+    """
     entry_points, states, transitions, task_defs = [], [], [], []
+    places: dict[str, Place] = {}
     after = _predecessors(tasks)
     for i, task in enumerate(tasks):
         task_name = f"{name}_T{i}"
@@ -349,6 +399,8 @@ def build_plan(
         for k, step in enumerate(task):
             wait, run = f"T{i}_Wait{k}", f"T{i}_S{k}_{step.skill.name}"
             following = f"T{i}_Wait{k + 1}" if k + 1 < len(task) else f"T{i}_Done"
+            places[wait] = Place(i, k, StepKind.WAIT)
+            places[run] = Place(i, k, StepKind.RUN)
             states.append(State(wait, description=f"wait until {step.label} can run"))
             bind = tuple(Binding(var, value) for var, value in step.bindings)
             states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
@@ -368,6 +420,8 @@ def build_plan(
             )
         states.append(State(f"T{i}_Done", StateKind.SUCCESS))
         states.append(State(f"T{i}_Failed", StateKind.FAILURE))
+        places[f"T{i}_Done"] = Place(i, len(task), StepKind.DONE)
+        places[f"T{i}_Failed"] = Place(i, 0, StepKind.FAILED)
     if standby is not None:
         task_name = f"{name}_{STANDBY}"
         task_defs.append(Task(task_name, description=f"stand by in {standby} while no task needs the agent"))
@@ -381,21 +435,7 @@ def build_plan(
         utility=generic_utility(len(tasks), standby is not None),
         description=f"generated by pRoPhEt MAS from a plan of {sum(len(t) for t in tasks)} steps in {len(tasks)} task(s)",
     )
-    return plan, tuple(task_defs)
-
-
-def state_step(state: str, length: int) -> int:
-    """The first unfinished step of a task (of ``length`` steps) whose agent is in ``state`` of a generated plan.
-
-    ``T1_Wait2`` and ``T1_S2_Stack`` give 2 (step 2 waits or runs), ``T1_Done``
-    gives ``length``; the failure state gives 0 (the runtime replans anyway).
-    """
-    _, _, rest = state.partition("_")
-    if rest.startswith("Wait"):
-        return int(rest[4:])
-    if rest.startswith("S"):
-        return int(rest[1:].split("_", 1)[0])
-    return length if rest == "Done" else 0
+    return plan, tuple(task_defs), places
 
 
 def role_priorities(
@@ -448,13 +488,14 @@ def create_tasks(
     team = _robots(robots)
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _parallelise(steps, init, team)
-    plan, task_defs = build_plan(name, tasks, standby=standby)
+    plan, task_defs, places = build_plan(name, tasks, standby=standby)
     return CreatedTasks(
         tuple(tuple(t) for t in tasks),
         plan,
         task_defs,
         role_priorities(roleset, tasks, task_defs, entry_task),
         tuple(allowed),
+        places,
     )
 
 

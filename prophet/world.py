@@ -27,13 +27,10 @@ from dataclasses import dataclass
 
 from alica.errors import AlicaError, PlannerError
 from alica.lang import literals
-from alica.lang.fact import Fact as WorldFact
+from alica.lang.fact import Fact
 from alica.model import PlanLibrary, PlanningProblem
 from alica.prophet.problem import offline_world, predicate_types
-from alica.prophet.tasks import apply_effect, for_robot, holds
-
-Fact = tuple[str, tuple[str, ...]]
-Literal = tuple[bool, Fact]
+from alica.prophet.tasks import Literal, Step, apply_effect, for_robot, holds
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,13 +72,13 @@ def goal_literals(problem: PlanningProblem) -> tuple[Literal, ...]:
         raise PlannerError(
             f"the goal of '{problem.name}' must be a conjunction of literals to be planned with: {exc}"
         ) from None
-    return tuple((positive, (name, tuple(str(a) for a in args))) for positive, name, args in found if name != "=")
+    return tuple((positive, Fact(name, tuple(str(a) for a in args))) for positive, name, args in found if name != "=")
 
 
 def read_world(
     problem: PlanningProblem,
     library: PlanLibrary,
-    facts: Iterable[WorldFact | tuple[object, ...]],
+    facts: Iterable[Fact | tuple[object, ...]],
     team: Iterable[str],
     typed_objects: Mapping[str, Iterable[object]] | None = None,
 ) -> PlanningWorld:
@@ -90,8 +87,8 @@ def read_world(
     Args:
         problem: the planning problem.
         library: holds its elements' signatures.
-        facts: true facts (the world model's :meth:`facts`, or flat ``(predicate, *args)``
-            tuples); ignored when the problem has its own ``world``.
+        facts: true facts (:class:`~alica.lang.fact.Fact` values, or the world model's flat
+            ``(predicate, *args)`` tuples); ignored when the problem has its own ``world``.
         team: the alive team members: the robots of the plan.
         typed_objects: type -> objects, e.g. from the world model.
 
@@ -104,7 +101,7 @@ def read_world(
     declared: dict[str, str] = {}
     if offline:
         declared, given = offline_world(problem)
-        source: Iterable[WorldFact | tuple[object, ...]] = (WorldFact(name, tuple(args)) for name, args in given)
+        source: Iterable[Fact | tuple[object, ...]] = given
     else:
         source = facts
     members = tuple(sorted(set(team)))
@@ -113,7 +110,7 @@ def read_world(
     outside: set[str] = set()
     others: set[str] = set()
     for item in source:
-        fact = WorldFact.of(item)
+        fact = Fact.of(item)
         name = fact.predicate
         args = tuple(str(a) for a in fact.args)
         arity = predicates.get(name.lower())
@@ -129,7 +126,7 @@ def read_world(
                 left_out += 1
                 outside.update(arg for arg, kind in zip(args, arity, strict=True) if kind != robot_type)
             continue
-        kept.add((name, args))
+        kept.add(Fact(name, args))
     types: dict[str, str] = dict(sorted(declared.items()))
     if not offline and robot_type is not None:
         types.update(dict.fromkeys(members, robot_type))
@@ -137,18 +134,21 @@ def read_world(
         for obj in objects:
             if offline or type_name != robot_type:
                 types.setdefault(str(obj), type_name)
-    for _, (name, args) in goal_literals(problem):
-        for arg, type_name in zip(args, predicates.get(name.lower(), ()), strict=False):
-            types.setdefault(arg, type_name)
-    for name, args in sorted(kept):
-        for arg, type_name in zip(args, predicates[name.lower()], strict=True):
-            types.setdefault(arg, type_name)
+    for _, goal_fact in goal_literals(problem):
+        for value, type_name in zip(goal_fact.args, predicates.get(goal_fact.predicate.lower(), ()), strict=False):
+            types.setdefault(str(value), type_name)
+    for fact in sorted(kept):
+        for value, type_name in zip(fact.args, predicates[fact.predicate.lower()], strict=True):
+            types.setdefault(str(value), type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
     if not offline:
         # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
-        mentioned = {a for _, args in kept for a in args}
+        mentioned = {str(a) for fact in kept for a in fact.args}
         outside.update(
-            a for _, (_, args) in goal_literals(problem) for a in args if a not in mentioned and a not in members
+            str(a)
+            for _, goal_fact in goal_literals(problem)
+            for a in goal_fact.args
+            if str(a) not in mentioned and a not in members
         )
     return PlanningWorld(
         tuple(sorted(types.items())),
@@ -176,7 +176,7 @@ def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Lit
     while grew:
         grew = False
         for literal in goal:
-            names = set(literal[1][1])
+            names = {str(a) for a in literal[1][1]}
             if names & tied and not names <= tied:
                 tied |= names
                 grew = True
@@ -211,7 +211,7 @@ class TaskProgress:
 
 
 def remaining_fits(
-    tasks: Sequence[Sequence[object]],
+    tasks: Sequence[Sequence[Step]],
     progress: Sequence[TaskProgress],
     facts: Iterable[Fact],
     start_world: Iterable[Fact],
@@ -221,7 +221,7 @@ def remaining_fits(
     """Whether what is left of a generated plan still reaches the goal from ``facts``.
 
     Args:
-        tasks: the steps of each task (:class:`alica.prophet.tasks.Step`).
+        tasks: the steps of each task.
         progress: one entry per task.
         facts: the facts that hold now.
         start_world: the world the plan was made from (gives a fresh robot's facts).
@@ -235,7 +235,7 @@ def remaining_fits(
     """
     state = set(facts)
     start = tuple(start_world)
-    remaining: list[tuple[int, object, str, bool]] = []
+    remaining: list[tuple[int, Step, str, bool]] = []
     for i, (task, where) in enumerate(zip(tasks, progress, strict=True)):
         if where.done or where.next_step >= len(task):
             continue
@@ -244,13 +244,13 @@ def remaining_fits(
             # nobody holds the task yet: a robot as it was at the start, the planned one if it could start the task
             who = f"~T{i}"
             first = task[where.next_step]
-            planned = first.robot  # type: ignore[attr-defined]
+            planned = first.robot
             options = [planned, *(r for r in robots if r != planned)]
             own = (
-                {(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args}
+                {Fact(name, tuple(who if a == r else a for a in args)) for name, args in start if r in args}
                 for r in options
             )
-            mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]  # type: ignore[attr-defined]
+            mine = [lit for lit in for_robot(first.pre, planned, who) if who in lit[1][1]]
             fresh = next((facts for facts in own if holds(mine, facts)), None)
             if fresh is None:
                 # no robot as it was at the start could: the planned robot will, once its earlier steps are done
@@ -259,14 +259,14 @@ def remaining_fits(
             else:
                 state.update(fresh)
         for k in range(where.next_step, len(task)):
-            remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))  # type: ignore[attr-defined]
+            remaining.append((task[k].index, task[k], who, where.running and k == where.next_step))
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):
-        pre = for_robot(step.pre, step.robot, who)  # type: ignore[attr-defined]
-        effect = for_robot(step.effect, step.robot, who)  # type: ignore[attr-defined]
+        pre = for_robot(step.pre, step.robot, who)
+        effect = for_robot(step.effect, step.robot, who)
         if holds(pre, state):
             apply_effect(state, effect)
         elif not (running and holds(effect, state)):
-            return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"  # type: ignore[attr-defined]
+            return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"
     if not holds(goal, state):
         return f"the plan no longer reaches the goal: {_unmet(goal, state)} would not hold"
     return None
@@ -274,4 +274,4 @@ def remaining_fits(
 
 def _unmet(wanted: Sequence[Literal], state: set[Fact]) -> str:
     positive, (name, args) = next(item for item in wanted if (item[1] in state) != item[0])
-    return f"{'' if positive else 'not '}{name}({', '.join(args)})"
+    return f"{'' if positive else 'not '}{name}({', '.join(str(a) for a in args)})"

@@ -110,23 +110,23 @@ def cmd_plan(args: argparse.Namespace) -> int:
         result = planner.solve(args.domain, args.problem, time_limit=args.time_limit, anytime=args.anytime)
     else:
         result = planner.solve(domain, problem, time_limit=args.time_limit, anytime=args.anytime)
-    return _report(args, planner.name, (domain, problem), result)
+    return _report(args, planner.name, result, lambda plan: _validated_cost(planner.name, (domain, problem), plan))
 
 
 def _report(
     args: argparse.Namespace,
     name: str,
-    task: tuple[Any, Any],
     result: PlanResult,
+    cost_of: Callable[[Plan], float],
     extra: Callable[[], dict[str, Any]] | None = None,
 ) -> int:
-    """Validate and print the result; ``extra`` adds fields (and lines) once the plan is valid."""
+    """Print the result; ``cost_of`` validates the plan (raising when it is not valid); ``extra`` adds fields (and lines)."""
     if result.status is PlanStatus.ERROR and result.plan is None:
         raise AlicaError(f"planner '{name}' failed: {result.message or 'no reason given'}")
     cost = None
     more: dict[str, Any] = {}
     if result.plan is not None:
-        cost = _validated_cost(name, task, result.plan)
+        cost = cost_of(result.plan)
         more = extra() if extra is not None else {}
     if args.json:
         print(json.dumps({**_summary(result, cost), **more}))
@@ -147,8 +147,7 @@ def _plan_file(args: argparse.Namespace) -> int:
 
     from alica.io import load_library
     from alica.model import Condition, ConditionKind
-    from alica.prophet.planners import get_planner
-    from alica.prophet.problem import to_pddl
+    from alica.prophet.pipeline import plan_problem
     from alica.prophet.tasks import create_tasks, emit_yaml
     from alica.prophet.world import read_world
 
@@ -178,18 +177,14 @@ def _plan_file(args: argparse.Namespace) -> int:
             f"planning problem '{name}' has no 'world' (it is read from the world model at run time): give one with --world"
         )
     world = read_world(problem, library, (), ())
-    domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
-    planner = get_planner(args.planner)
-    result = planner.solve(domain, pddl, time_limit=args.time_limit, anytime=args.anytime)
+    planning = plan_problem(problem, library, world, planner=args.planner)
+    result = planning.solve(time_limit=args.time_limit, anytime=args.anytime)  # PlannerError: an invalid plan
 
     def tasks() -> dict[str, Any]:
         assert result.plan is not None
-        if not result.plan.steps:
+        steps = result.plan.steps
+        if not steps:
             return {"tasks": []}
-        names = {o.lower(): o for o, _ in world.objects}
-        from alica.prophet.planner import PlanStep
-
-        steps = [PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in result.plan.steps]
         roleset = next(iter(sorted(library.rolesets.items())))[1] if library.rolesets else None
         if roleset is None:
             raise AlicaError(f"{args.domain}: the generated plan needs a role set for its task priorities; import one")
@@ -213,7 +208,11 @@ def _plan_file(args: argparse.Namespace) -> int:
             **({"emitted": str(args.emit_plan)} if args.emit_plan else {}),
         }
 
-    return _report(args, planner.name, (domain, pddl), result, tasks)
+    def cost_of(_: Plan) -> float:
+        assert result.plan is not None  # validated by the pipeline
+        return result.plan.cost
+
+    return _report(args, planning.planner.name, result.run, cost_of, tasks)
 
 
 def _relative(path: Path, out: Path) -> str:

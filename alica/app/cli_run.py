@@ -210,8 +210,9 @@ def cmd_run(args: argparse.Namespace) -> int:
 def _run_team(
     args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], wiring: Any, world: Any, perception: Any
 ) -> int:
-    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam, running_tree
+    from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
+    from alica.prophet import engine_config
     from alica.testing import default_fallback
 
     reasons = _Reasons()
@@ -229,7 +230,7 @@ def _run_team(
         plan,
         roles,
         seed=args.seed,
-        config=EngineConfig(frequency=args.frequency),
+        config=engine_config(frequency=args.frequency),  # planning problems run with pRoPhEt MAS
         roleset=args.roleset,
         loss=args.loss,
         delay=args.delay / 1000.0,

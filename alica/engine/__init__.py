@@ -6,10 +6,14 @@
   network with faults (loss, delay, partitions, crashes).
 * Behaviours are py_trees behaviours built from skills
   (:mod:`alica.engine.behaviours`); :mod:`alica.testing` has scripted doubles.
+* A child whose plans are only known at run time (a planning problem) runs
+  what a child runtime decides (:mod:`alica.engine.child`); implementations
+  such as pRoPhEt MAS are given through :attr:`EngineConfig.children`.
 """
 
 from alica.engine.agent import AgentEngine
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext, SkillFactory
+from alica.engine.child import ChildFactory, ChildHost, ChildKind, ChildRuntime, ChildSlot, RunningPlan
 from alica.engine.config import EngineConfig
 from alica.engine.runner import SimulatedTeam, pick_roleset
 from alica.engine.show import running_tree
@@ -20,10 +24,16 @@ from alica.engine.trace import JsonlTrace, TraceRecorder
 __all__ = [
     "AgentEngine",
     "BehaviourRunner",
+    "ChildFactory",
+    "ChildHost",
+    "ChildKind",
+    "ChildRuntime",
+    "ChildSlot",
     "ChildStatus",
     "Claim",
     "EngineConfig",
     "JsonlTrace",
+    "RunningPlan",
     "SimulatedTeam",
     "SkillBinder",
     "SkillContext",

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from alica.engine.child import ChildKind
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,10 +30,10 @@ class EngineConfig:
         authority_min: the first authority window, in seconds.
         authority_max: the longest authority window.
         authority_growth: the factor by which each new conflict grows the window.
-        planner_expansions: the planning leader's search budget per tick, in
-            expansions (deterministic: the same run plans the same way).
-        planner_seconds: a wall-time budget per tick instead (for real robots);
-            ``None`` uses ``planner_expansions``.
+        children: model element type -> the child runtime that decides what a
+            child of that type runs (:mod:`alica.engine.child`); e.g.
+            ``{PlanningProblem: alica.prophet.PLANNING}``. A plan tree that
+            reaches an element of a type not given here cannot run.
     """
 
     frequency: float = 30.0
@@ -43,8 +48,7 @@ class EngineConfig:
     authority_min: float = 1.0
     authority_max: float = 16.0
     authority_growth: float = 2.0
-    planner_expansions: int = 1000
-    planner_seconds: float | None = None
+    children: Mapping[type, ChildKind] = field(default_factory=dict, hash=False)
 
     def __post_init__(self) -> None:
         positive = ("frequency", "broadcast_interval", "team_timeout", "cycle_window", "authority_min")
@@ -54,10 +58,11 @@ class EngineConfig:
         for name in ("min_broadcast_gap", "assignment_protection"):
             if getattr(self, name) < 0:
                 raise ValueError(f"EngineConfig.{name} must be >= 0, got {getattr(self, name)}")
-        if self.planner_expansions < 1 or (self.planner_seconds is not None and self.planner_seconds <= 0):
-            raise ValueError("EngineConfig.planner_expansions must be at least 1 and planner_seconds > 0 (or None)")
         if self.max_rule_applications < 1 or self.cycle_count < 1:
             raise ValueError("EngineConfig.max_rule_applications and cycle_count must be at least 1")
+        for element_type in self.children:
+            if not isinstance(element_type, type):
+                raise ValueError(f"EngineConfig.children is keyed by model element type, got {element_type!r}")
         if self.authority_max < self.authority_min or self.authority_growth < 1:
             raise ValueError("EngineConfig needs authority_max >= authority_min and authority_growth >= 1")
 

@@ -81,12 +81,17 @@ class PlanNode:
     def __repr__(self) -> str:
         return f"<PlanNode {self.key_text} {self.ep}/{self.state} {self.status.value}>"
 
+    @property
+    def failed(self) -> bool:
+        """Whether the plan failed for this agent (its status may change during a visit: read it again)."""
+        return self.status is ChildStatus.FAILURE
+
     # -- team ----------------------------------------------------------
 
     def members(self) -> tuple[str, ...]:
         """Alive agents believed to be in the parent state (all alive agents for the root), sorted."""
         if self._members is None:
-            self._members = self.engine.members_of(self.slot.parent if self.slot is not None else None)
+            self._members = self.engine.allocator.members(self.slot.parent if self.slot is not None else None)
         return self._members
 
     def invalidate(self) -> None:
@@ -250,8 +255,8 @@ class PlanNode:
         if self.dirty:
             self.dirty = False
             self.integrate(now)
-            engine.reallocate(self, now)
-            if self.status is ChildStatus.FAILURE:
+            engine.allocator.reallocate(self, now)
+            if self.failed:
                 return
         for slot in list(self.slots):
             slot.visit(now)
@@ -275,16 +280,18 @@ class PlanNode:
                 name=transition.name,
             )
             self.enter_state(transition.target, now)
-        if self.status is ChildStatus.FAILURE:
+        if self.failed:
             return
         self._abort_rule(fired)
-        if self.status is not ChildStatus.FAILURE:
+        if not self.failed:
             self._check_success()
 
     def _transition_rule(self, now: float) -> Transition | None:
         engine = self.engine
+        state = self.state
+        assert state is not None  # the rules run in a state
         belief = engine.belief_for(self)
-        for transition in engine.out_transitions(self.plan, self.state):
+        for transition in engine.out_transitions(self.plan, state):
             condition = transition.condition.text if transition.condition else None
             holds = engine.formulas.holds(condition, belief, self.env)
             if transition.synchronisation is None:

@@ -28,8 +28,8 @@ from alica.model import PlanLibrary, RoleSet
 from alica.worldmodel import WorldModel
 
 
-def pick_roleset(library: PlanLibrary, roles: Iterable[str], name: str | None = None) -> RoleSet:
-    """The role set to allocate with: ``name``, or the one holding every given role.
+def pick_roleset(library: PlanLibrary, roles: Iterable[str | None], name: str | None = None) -> RoleSet:
+    """The role set to allocate with: ``name``, or the one holding every given role (``None``: no role given).
 
     Raises:
         AlicaError: no such role set, or none (or several) fit.

@@ -21,7 +21,9 @@ from alica.prophet.pddl.errors import PddlError
 from alica.prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
 from alica.prophet.pddl.normal import Clause, dnf, expand, flatten_effect
 
-Fact = tuple[str, ...]
+#: A grounded PDDL atom as a flat tuple ``(predicate, *objects)``: a node of the grounding, not a
+#: :class:`alica.lang.fact.Fact` of the world model (flat tuples keep the grounding fast).
+GroundAtom = tuple[str, ...]
 Arg = int | str
 """A parameter slot (int) or an object name (str)."""
 
@@ -36,7 +38,7 @@ def _getter(slots: tuple[int, ...]) -> Callable[[Sequence[str | None]], tuple]:
     return itemgetter(*slots)
 
 
-def fact_text(fact: Fact) -> str:
+def fact_text(fact: GroundAtom) -> str:
     """``("on", "a", "b")`` as ``(on a b)``."""
     return f"({' '.join(fact)})"
 
@@ -58,11 +60,13 @@ class GroundAction:
 
     action: str
     args: tuple[str, ...]
-    pos: tuple[Fact, ...]
-    neg: tuple[Fact, ...]
-    add: tuple[Fact, ...]
-    delete: tuple[Fact, ...]
-    conditional: tuple[tuple[tuple[Fact, ...], tuple[Fact, ...], tuple[Fact, ...], tuple[Fact, ...]], ...]
+    pos: tuple[GroundAtom, ...]
+    neg: tuple[GroundAtom, ...]
+    add: tuple[GroundAtom, ...]
+    delete: tuple[GroundAtom, ...]
+    conditional: tuple[
+        tuple[tuple[GroundAtom, ...], tuple[GroundAtom, ...], tuple[GroundAtom, ...], tuple[GroundAtom, ...]], ...
+    ]
     cost: int
 
 
@@ -104,9 +108,9 @@ class Fixpoint:
             self.objects[name] = kind
         self._domain = domain
         self._types: dict[str, tuple[str, ...]] = {}
-        self.init: set[Fact] = set()
-        self._init_order: list[Fact] = []
-        self.values: dict[Fact, int | float] = {}
+        self.init: set[GroundAtom] = set()
+        self._init_order: list[GroundAtom] = []
+        self.values: dict[GroundAtom, int | float] = {}
         predicates = {p.name: p.arity for p in domain.predicates}
         for item in problem.init:
             if isinstance(item, FluentValue):
@@ -129,9 +133,9 @@ class Fixpoint:
                     self._schemas.append(schema)
         self.actions: list[GroundAction] = []
         self._seen: set[tuple] = set()
-        self._reached: set[Fact] = set()
-        self._queue: deque[Fact] = deque()
-        self._watch: dict[Fact, list[list]] = {}
+        self._reached: set[GroundAtom] = set()
+        self._queue: deque[GroundAtom] = deque()
+        self._watch: dict[GroundAtom, list[list]] = {}
         self._known: dict[str, list[tuple[str, ...]]] = {}
         self._known_sets: dict[str, set[tuple[str, ...]]] = {}
         self._stats: dict[str, tuple[int, list[int]]] = {}
@@ -331,7 +335,7 @@ class Fixpoint:
                 if ok and all(getter(binding) in known for known, getter in checks):
                     self._join(schema, steps, 0, binding, unbound)
 
-    def _reach(self, fact: Fact) -> None:
+    def _reach(self, fact: GroundAtom) -> None:
         if fact in self._reached:
             return
         self._reached.add(fact)
@@ -429,11 +433,13 @@ class Fixpoint:
                 return
         self._seen.add(key)
         pos = [(pred, *getter(ext)) for pred, getter in fast_pos]
-        add: list[Fact] = []
-        delete: list[Fact] = []
+        add: list[GroundAtom] = []
+        delete: list[GroundAtom] = []
         for positive, pred, getter in plain:
             (add if positive else delete).append((pred, *getter(ext)))
-        conditional: dict[tuple[tuple[Fact, ...], tuple[Fact, ...]], tuple[list[Fact], list[Fact]]] = {}
+        conditional: dict[
+            tuple[tuple[GroundAtom, ...], tuple[GroundAtom, ...]], tuple[list[GroundAtom], list[GroundAtom]]
+        ] = {}
         for cond, positive, (pred, spec) in schema.effects:
             if cond is None:
                 continue
@@ -470,11 +476,11 @@ class Fixpoint:
                 for fact in missing:
                     self._watch.setdefault(fact, []).append(record)
 
-    def _ground_condition(self, cond, value) -> list[tuple[tuple[Fact, ...], tuple[Fact, ...]]]:  # type: ignore[no-untyped-def]
+    def _ground_condition(self, cond, value) -> list[tuple[tuple[GroundAtom, ...], tuple[GroundAtom, ...]]]:  # type: ignore[no-untyped-def]
         out = []
         for clause in cond:
-            c_pos: list[Fact] = []
-            c_neg: list[Fact] = []
+            c_pos: list[GroundAtom] = []
+            c_neg: list[GroundAtom] = []
             possible = True
             for positive, pred, spec in clause:
                 if pred == "=":

@@ -216,8 +216,11 @@ problems:
 
 
 def test_a_planning_problem_runs_its_wait_plan_until_a_plan_exists(tmp_path):
+    from alica.prophet import engine_config
+
     lib = library(tmp_path, PROBLEM)
-    sim, _ = team(lib, "Top", {"w": "Worker", "h": "Helper"}, {"Wait": scripted(["running"])})
+    config = engine_config(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    sim, _ = team(lib, "Top", {"w": "Worker", "h": "Helper"}, {"Wait": scripted(["running"])}, config=config)
     sim.run(ticks=1)  # the leader has only started its planner (tests/prophet/test_runtime.py goes on)
     for agent in ("w", "h"):
         assert where(sim, agent, 1) == ("Watch", "Parked")

@@ -9,9 +9,10 @@ from typing import Any
 import py_trees
 from py_trees.common import Status
 
-from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
+from alica.engine import SimulatedTeam, TraceRecorder
 from alica.io import load_library
 from alica.model import PlanLibrary
+from alica.prophet import engine_config
 from alica.prophet.planner import Feature, Planner, Progress, SearchEvent
 from tests.conftest import PLANS
 
@@ -125,7 +126,7 @@ SUSSMAN = [["a", "c"], ["b"]]
 def blocks_team(
     agents: Iterable[str], skills: BlockSkills, stacks=SUSSMAN, seed: int = 0, **config: Any
 ) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[no-untyped-def]
-    """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model."""
+    """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model (``config``: engine settings)."""
     names = list(agents)
     recorder = TraceRecorder()
     settings = {
@@ -140,7 +141,7 @@ def blocks_team(
         "BlocksWorldMission",
         dict.fromkeys(names, "Manipulator"),
         seed=seed,
-        config=EngineConfig(**settings),
+        config=engine_config(**settings),
         skills=skills.mapping(),
         observers=[recorder],
     )

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 
-from alica.engine import EngineConfig
+from alica.prophet import engine_config
 from alica.prophet.planners import PLANNERS
 from alica.testing import scripted
 from tests.engine.helpers import library, team, where
@@ -228,7 +228,7 @@ problems:
 def problem_team(tmp_path, planner="builtin", alternative=True):
     text = PROBLEM.replace("PLANNER", planner).replace("ALTERNATIVE", "alternative_plan: Home" if alternative else "")
     lib = library(tmp_path, text)
-    config = EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    config = engine_config(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
     return team(
         lib,
         "Top",

@@ -217,3 +217,28 @@ def test_the_kept_part_of_the_goal_shares_no_object_with_the_left_out_part(raw, 
     assert not kept_names & set(outside)
     assert not kept_names & {a for _, (_, args) in dropped for a in args}
     assert [literal for literal in goal if literal in kept] == list(kept)  # in the goal's order
+
+
+def test_the_generated_plan_says_where_each_state_is_in_the_tasks(blocks):
+    from alica.prophet.tasks import STANDBY, Place, StepKind
+
+    roleset = next(iter(blocks.rolesets.values()))
+    created = create_tasks("Gen", PLAN, blocks, SUSSMAN, "r", roleset, "Default", standby="DriveToFreePosition")
+    plan = created.plan
+    assert created.place(STANDBY) is None and created.place(None) is None
+    assert set(created.places) == {s.name for s in plan.states} - {STANDBY}
+    # follow each task's chain by its transitions: the places come from the plan's making, not from the names
+    for i, (ep, task) in enumerate(zip(created.task_entry_points, created.tasks, strict=True)):
+        state = ep.state
+        for k in range(len(task)):
+            assert created.place(state) == Place(i, k, StepKind.WAIT)
+            (start,) = plan.out_transitions(state)
+            assert created.place(start.target) == Place(i, k, StepKind.RUN)
+            ends = {t.condition.text: t.target for t in plan.out_transitions(start.target)}
+            assert created.place(ends["failed"]) == Place(i, 0, StepKind.FAILED)
+            state = ends["succeeded"]
+        assert created.place(state) == Place(i, len(task), StepKind.DONE)
+    # the priorities the engine's allocation gets: each role's priorities of the generated tasks only
+    tasks = {ep.task for ep in plan.entry_points}
+    for role, priorities in created.priorities().items():
+        assert {p.task for p in priorities} == tasks, role

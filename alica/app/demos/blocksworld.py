@@ -284,9 +284,10 @@ def run_demo(
     Raises:
         AlicaError: a bad configuration.
     """
-    from alica.engine import EngineConfig, JsonlTrace, SimulatedTeam
+    from alica.engine import JsonlTrace, SimulatedTeam
     from alica.io import load_library
     from alica.lang.skill_plugins import default_registry
+    from alica.prophet import engine_config, latest_plans
     from alica.skills.motion import configure_ompl
     from alica.worldsim.perception import FactPerception
     from alica.worldsim.scenarios import blocks_facts, blocksworld
@@ -305,7 +306,7 @@ def run_demo(
     counter = _Counter(library.abstract(PROBLEM).elements)  # type: ignore[union-attr]
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
-    settings = EngineConfig(frequency=config.frequency)
+    settings = engine_config(frequency=config.frequency)
     perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
     registry = default_registry()
     team = SimulatedTeam(
@@ -370,7 +371,7 @@ def run_demo(
         counter.finish(team, perception.facts)
         if on_second is not None:
             on_second(world.now(), satisfied, len(wanted), counter.replans)
-        created = next(iter(e.plan_board.latest.values()), None) if (e := _leader(team)) is not None else None
+        created = next(iter(latest_plans(e).values()), None) if (e := _leader(team)) is not None else None
         plan_yaml = _plan_yaml(created, out) if created is not None else ""
         if out is not None:
             _picture(world, out / "final.png")
@@ -400,7 +401,9 @@ def run_demo(
 
 
 def _leader(team: Any) -> Any:
-    running = [e for e in team.running() if e.plan_board.latest]
+    from alica.prophet import latest_plans
+
+    running = [e for e in team.running() if latest_plans(e)]
     return running[0] if running else None
 
 

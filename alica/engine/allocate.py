@@ -1,0 +1,307 @@
+"""One agent's allocation rules: who takes which entry point of a plan, computed from the team view.
+
+* **Initial allocation** (:meth:`Allocator.start`): the agents of a state are
+  allocated to one of the plans a child may run; teammates already in the plan
+  keep their entry points (their claims trump predictions).
+* **Dynamic allocation** (:meth:`Allocator.reallocate`): while a plan runs,
+  its agents are allocated again when the team or the world changed, and the
+  plan switches to a better assignment (or a better plan of the child's plan
+  type) when the utility gains more than the plan's threshold; then agents
+  whose task succeeded take success-required tasks nobody has done.
+* **Conflicts** flipping an allocation back and forth are settled by
+  authority: the lowest agent imposes its assignment for a window
+  (:meth:`Allocator.apply_authority` takes in such claims).
+
+Every agent computes the same result from the same view, so the team agrees
+without a central controller (:mod:`alica.allocation` solves the problems).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from alica.allocation import AllocationProblem, Assignment, allocate, utility
+from alica.engine.node import PlanNode
+from alica.engine.status import ChildStatus
+from alica.engine.team import PlanKey
+from alica.errors import AlicaError
+from alica.model import Plan, StateKind, Summand
+from alica.model.plan import EntryPoint
+
+if TYPE_CHECKING:
+    from alica.engine.agent import AgentEngine
+    from alica.engine.slot import Slot
+
+
+class Allocator:
+    """The allocation rules of one agent's engine (see the module docstring).
+
+    Args:
+        engine: the agent's engine (its team view, belief, formulas, plans and trace).
+    """
+
+    def __init__(self, engine: AgentEngine) -> None:
+        self.engine = engine
+
+    def members(self, parent: PlanNode | None) -> tuple[str, ...]:
+        """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""
+        engine = self.engine
+        alive = engine.team.alive()
+        if parent is None:
+            return alive
+        believed, state = parent.believed, parent.state
+        return tuple(a for a in alive if a == engine.name or (believed.get(a) or (None, None))[1] == state)
+
+    def _summand_fn(
+        self, node_env: Mapping[str, object], context: PlanNode | None
+    ) -> Callable[[Plan, Summand, str, EntryPoint], float]:
+        engine = self.engine
+        pins = engine.generated.pins
+
+        def summand(plan: Plan, term: Summand, agent: str, ep: EntryPoint) -> float:
+            pinned = pins.get(plan.name)
+            if pinned and ep.name in pinned and agent not in pinned[ep.name]:
+                return -1.0  # a generated task only some robots can start
+            env = dict(node_env)
+            env.update({"self": agent, "task": ep.task, "entry": ep.name})
+            if context is not None:
+                engine.belief.node = context
+            try:
+                value = engine.formulas.value(term.expression, engine.belief, env)
+            except AlicaError as exc:
+                engine.formula_error(term.expression, str(exc))
+                return 0.0
+            return float(value)  # type: ignore[arg-type]
+
+        return summand
+
+    def _problem(
+        self,
+        agents: tuple[str, ...],
+        plans: tuple[Plan, ...],
+        successes: Mapping[str, Mapping[str, int]],
+        old: Assignment | None,
+        env: Mapping[str, object],
+        context: PlanNode | None,
+    ) -> AllocationProblem:
+        engine = self.engine
+        roles = engine.team.roles
+        needs_summands = any(p.utility.summands for p in plans)
+        return AllocationProblem(
+            agents=agents,
+            roles={a: roles[a] for a in agents},
+            roleset=engine.roleset,
+            plans=plans,
+            successes=successes,
+            old=old,
+            summand=self._summand_fn(env, context) if needs_summands else None,
+            allow_idle=engine.config.allow_idle,
+        )
+
+    def start(self, slot: Slot | None, plans: tuple[Plan, ...], env: dict[str, object], now: float) -> PlanNode | None:
+        """Allocate the agents of ``slot``'s state (the team, for the root) to one of ``plans`` and start it.
+
+        Returns:
+            The new plan node, or ``None`` when there is no valid assignment (``slot.reason`` says why).
+        """
+        engine = self.engine
+        parent = slot.parent if slot is not None else None
+        key: PlanKey = (*slot.parent.key, slot.parent.state or "", slot.name) if slot is not None else (plans[0].name,)
+        members = self.members(parent)
+        # Teammates already in this plan keep their entry points (their claims trump predictions).
+        fixed: dict[str, tuple[str | None, str | None]] = {}
+        successes: dict[str, dict[str, int]] = {}
+        names = {p.name for p in plans}
+        chosen: str | None = None
+        for agent in members:
+            claim = engine.team.claim(agent, key) if agent != engine.name else None
+            if claim is not None and claim.plan in names and (chosen is None or claim.plan == chosen):
+                chosen = claim.plan
+                fixed[agent] = (claim.entry, claim.state)
+                counts = successes.setdefault(claim.plan, {})
+                if claim.entry is not None:
+                    counts[claim.entry] = counts.get(claim.entry, 0) + 1
+        if chosen is not None:
+            plans = tuple(p for p in plans if p.name == chosen)
+        agents = tuple(a for a in members if a not in fixed)
+        result = allocate(self._problem(agents, plans, successes, None, env, parent))
+        engine.stats["allocations"] += 1
+        assignment = result.assignment
+        if assignment is None:
+            engine.emit("allocation", key="/".join(key), outcome="none", why=result.why)
+            if slot is not None:
+                slot.reason = f"no valid assignment: {result.why}"
+            return None
+        plan = engine.plan_named(assignment.plan)
+        node = PlanNode(engine, key, slot, plan, env, now)
+        engine.index[key] = node
+        for agent, entry in fixed.items():
+            node.believed[agent] = entry
+        for agent, ep in assignment.entries:
+            if agent != engine.name:
+                node.believed[agent] = (ep, plan.entry_point(ep).state if ep is not None else None)
+                node.predicted_at[agent] = now
+        engine.emit(
+            "allocation",
+            key=node.key_text,
+            plan=plan.name,
+            reason="initial",
+            utility=round(assignment.utility, 9),
+            entries=assignment.as_dict(),
+        )
+        node.set_entry(assignment.entry_of(engine.name), now)
+        return node
+
+    def reallocate(self, node: PlanNode, now: float) -> None:
+        """The dynamic allocation rule, then the reuse of agents whose task succeeded."""
+        if node.status is not ChildStatus.RUNNING or now < node.overridden_until:
+            return
+        self._reallocate(node, now)
+        if node.status is ChildStatus.RUNNING:
+            self._reuse_succeeded(node, now)
+
+    def _reuse_succeeded(self, node: PlanNode, now: float) -> None:
+        """Agents whose task succeeded take success-required tasks nobody has done or is doing.
+
+        Every agent computes this from the same view, like any allocation: the
+        free agents (in success states) are allocated, by the same utility, to
+        the entry points that need a success and have nobody working on them.
+        """
+        plan = node.plan
+        successes = node.successes()
+        free, busy = [], set()
+        for agent in node.members():
+            entry = node.believed.get(agent)
+            if entry is None or entry[1] is None:
+                continue
+            kind = plan.state(entry[1]).kind
+            if kind is StateKind.SUCCESS:
+                free.append(agent)
+            elif kind is StateKind.NORMAL and entry[0] is not None:
+                busy.add(entry[0])
+        if not free:
+            return
+        needy = tuple(
+            replace(ep, min=0, max=max(1, ep.max - successes.get(ep.name, 0)))
+            for ep in plan.entry_points
+            if ep.success_required and successes.get(ep.name, 0) < max(ep.min, 1) and ep.name not in busy
+        )
+        if not needy:
+            return
+        reduced = replace(plan, entry_points=needy)
+        result = allocate(
+            self._problem(tuple(free), (reduced,), {}, None, node.env, node.slot.parent if node.slot else None)
+        )
+        best = result.assignment
+        if best is None or all(ep is None for _, ep in best.entries):
+            return
+        moves = tuple((a, ep) for a, ep in best.entries if ep is not None)
+        self.engine.emit("allocation", key=node.key_text, plan=plan.name, reason="reuse", entries=dict(moves))
+        node.apply(Assignment(plan.name, moves, best.utility), now, "reuse")
+
+    def _reallocate(self, node: PlanNode, now: float) -> None:
+        engine = self.engine
+        plan = node.plan
+        members = node.members()
+        current: dict[str, str | None] = {}
+        agents = []
+        for agent in members:
+            entry = node.believed.get(agent)
+            if entry is not None and entry[1] is not None and plan.state(entry[1]).terminal:
+                continue  # done here: counted in the successes
+            agents.append(agent)
+            current[agent] = entry[0] if entry is not None else None
+        agents_t = tuple(agents)
+        plans: tuple[Plan, ...] = (
+            (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan)
+        )
+        if plan not in plans:
+            plans = (plan, *plans)
+        successes = {plan.name: node.successes()}
+        old = Assignment(plan.name, tuple(sorted(current.items())), 0.0)
+        problem = self._problem(agents_t, plans, successes, old, node.env, node.slot.parent if node.slot else None)
+        now_utility = utility(problem, plan, current) if agents_t else 0.0
+        result = allocate(problem)
+        engine.stats["allocations"] += 1
+        best = result.assignment
+        if best is None:
+            if now_utility <= -1:
+                node.fail(f"no valid assignment any more: {result.why}")
+            return
+        gain = best.utility - now_utility
+        if now_utility > -1 and gain <= plan.utility.threshold:
+            return
+        same = best.plan == plan.name and all(best.entry_of(a) == current[a] for a in agents_t)
+        if same:
+            return
+        engine.emit(
+            "allocation",
+            key=node.key_text,
+            plan=best.plan,
+            reason="utility",
+            utility=round(best.utility, 9),
+            previous=round(now_utility, 9),
+            entries=best.as_dict(),
+        )
+        if best.plan != plan.name and node.slot is not None:
+            slot = node.slot
+            node.stop()
+            slot.node = None
+            slot.start(now, only=engine.plan_named(best.plan))
+            return
+        node.apply(best, now, "utility")
+        self._check_conflicts(node, now)
+
+    def _check_conflicts(self, node: PlanNode, now: float) -> None:
+        engine = self.engine
+        config = engine.config
+        contested = node.conflicts(now, config.cycle_window) >= config.cycle_count
+        if not contested:
+            contested = any(
+                (c := engine.team.claim(a, node.key)) is not None and c.contested
+                for a in node.members()
+                if a != engine.name
+            )
+        if not contested or now < node.authority_until:
+            return
+        if node.members()[0] == engine.name:
+            window = (
+                config.authority_min
+                if node.authority_window == 0
+                else min(config.authority_max, node.authority_window * config.authority_growth)
+            )
+            node.authority_window = window
+            node.authority_until = now + window
+            node.history.clear()
+            engine.emit(
+                "authority",
+                key=node.key_text,
+                window=window,
+                entries=dict(sorted((a, e[0]) for a, e in node.believed.items())),
+            )
+            engine.tree_changed()
+        else:
+            node.contested_until = now + config.authority_min
+            engine.tree_changed()
+
+    def apply_authority(self, now: float) -> None:
+        """Adopt the assignments that lower agents impose by authority on plans this agent runs."""
+        engine = self.engine
+        for sender, claim in engine.team.authority_claims():
+            if sender >= engine.name or claim.until <= now:
+                continue
+            node = engine.index.get(claim.key)
+            if node is None or node.plan.name != claim.plan or node.status is not ChildStatus.RUNNING:
+                continue
+            node.overridden_until = claim.until
+            entries = dict(claim.entries)
+            if engine.name not in entries:
+                continue
+            if all(node.believed.get(a, (None, None))[0] == ep for a, ep in entries.items()):
+                continue
+            engine.emit(
+                "allocation", key=node.key_text, plan=claim.plan, reason="authority", by=sender, entries=entries
+            )
+            node.apply(Assignment(claim.plan, tuple(sorted(entries.items())), 0.0), now, "authority")

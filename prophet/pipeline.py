@@ -1,0 +1,171 @@
+"""One pipeline from a planning problem to a validated plan: World + problem -> PDDL -> planner -> validated plan.
+
+Both callers go through :func:`plan_problem`:
+
+* ``alica plan FILE.yaml`` plans a problem offline, in its own ``world``, and
+  runs the planner to the end (:meth:`ProblemPlanning.solve`);
+* the runtime of a planning problem (:mod:`alica.prophet.runtime`) plans in
+  the world read from the world model, as an anytime search that it steps a
+  budget per tick (:meth:`ProblemPlanning.search`).
+
+:func:`plan_problem` writes the problem's PDDL domain (from its elements'
+signatures) and problem (the world's typed objects and facts, the goal) and
+picks the planner. Every plan the planner returns is checked with
+:func:`alica.prophet.validate.validate_plan` before anyone uses it, and comes
+back as a :class:`ValidPlan` whose steps name the objects as the world writes
+them (PDDL is case-insensitive: the planner answers in lower case). Task
+creation (:func:`alica.prophet.tasks.create_tasks`) takes it from there.
+
+Example::
+
+    world = read_world(problem, library, facts=(), team=())  # the problem's own world
+    result = plan_problem(problem, library, world).solve(time_limit=10)
+    print(result.plan.steps if result.plan else result.run.status)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+
+from alica.errors import PlannerError
+from alica.model import PlanLibrary, PlanningProblem
+from alica.prophet.pddl import Domain, Problem
+from alica.prophet.planner import Done, Improved, Plan, Planner, PlanResult, PlanStep, Progress
+from alica.prophet.planners import get_planner
+from alica.prophet.problem import to_pddl
+from alica.prophet.validate import validate_plan
+from alica.prophet.world import PlanningWorld
+
+
+@dataclass(frozen=True, slots=True)
+class ValidPlan:
+    """A plan the validator accepted.
+
+    Attributes:
+        steps: its actions, with the objects named as the world names them.
+        cost: its cost, as the validator computed it.
+        plan: the plan as the planner returned it (PDDL names).
+    """
+
+    steps: tuple[PlanStep, ...]
+    cost: float
+    plan: Plan
+
+
+@dataclass(frozen=True, slots=True)
+class Found:
+    """The search found a plan better than every earlier one, and it is valid."""
+
+    plan: ValidPlan
+    expansions: int
+
+
+@dataclass(frozen=True, slots=True)
+class Rejected:
+    """The planner returned a plan the validator refused (a planner's bug): it is not used."""
+
+    reason: str
+    expansions: int
+
+
+#: What :meth:`ProblemPlanning.search` yields: progress, each better valid plan, refused plans, the end.
+ProblemEvent = Progress | Found | Rejected | Done
+
+
+@dataclass(frozen=True, slots=True)
+class ProblemResult:
+    """What planning a problem to the end gave.
+
+    Attributes:
+        run: the planner's run (status, times, expansions; its plan as the planner returned it).
+        plan: that plan, validated; ``None`` without a plan.
+    """
+
+    run: PlanResult
+    plan: ValidPlan | None
+
+
+@dataclass(frozen=True, slots=True)
+class ProblemPlanning:
+    """A planning problem in a world, as PDDL, with the planner that plans it (made by :func:`plan_problem`).
+
+    Attributes:
+        problem: the planning problem (with the goal planned for).
+        world: the world it is planned in.
+        domain: the PDDL domain of the problem's elements.
+        pddl: the PDDL problem of the world and the goal.
+        planner: the planner.
+    """
+
+    problem: PlanningProblem
+    world: PlanningWorld
+    domain: Domain
+    pddl: Problem
+    planner: Planner
+
+    def validated(self, plan: Plan) -> ValidPlan:
+        """``plan`` checked against the PDDL, with the world's object names.
+
+        Raises:
+            PlannerError: the plan is not valid (the message names the planner and the reason).
+        """
+        check = validate_plan((self.domain, self.pddl), plan)
+        if not check.valid:
+            raise PlannerError(f"planner '{self.planner.name}' returned an invalid plan: {check.reason}")
+        names = {name.lower(): name for name, _ in self.world.objects}
+        steps = tuple(PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in plan.steps)
+        return ValidPlan(steps, check.cost, plan)
+
+    def search(self, *, anytime: bool = True) -> Iterator[ProblemEvent]:
+        """The planner's search as events, each better plan validated (a caller budgets it between events).
+
+        Raises:
+            PlannerError: the planner does not support what the problem needs (raised at once).
+        """
+        events = self.planner.search(self.domain, self.pddl, anytime=anytime)
+        return self._validate_events(events)
+
+    def _validate_events(self, events: Iterator[Progress | Improved | Done]) -> Iterator[ProblemEvent]:
+        for event in events:
+            if isinstance(event, Improved):
+                try:
+                    yield Found(self.validated(event.plan), event.expansions)
+                except PlannerError as exc:
+                    yield Rejected(str(exc), event.expansions)
+            else:
+                yield event
+
+    def solve(self, *, time_limit: float = 60.0, anytime: bool = False) -> ProblemResult:
+        """Run the planner to the end or for ``time_limit`` wall seconds; the best plan, validated.
+
+        Raises:
+            PlannerError: the planner's best plan is not valid.
+        """
+        run = self.planner.solve(self.domain, self.pddl, time_limit=time_limit, anytime=anytime)
+        return ProblemResult(run, self.validated(run.plan) if run.plan is not None else None)
+
+
+def plan_problem(
+    problem: PlanningProblem,
+    library: PlanLibrary,
+    world: PlanningWorld,
+    *,
+    planner: str | None = None,
+    options: Mapping[str, object] | None = None,
+) -> ProblemPlanning:
+    """Make the PDDL of ``problem`` in ``world`` and pick its planner (see the module docstring).
+
+    Args:
+        problem: the planning problem, with the goal to plan for.
+        library: holds the skill plans of its elements.
+        world: the world to plan from (:func:`alica.prophet.world.read_world`).
+        planner: the planner back-end (default: the problem's own ``planner``).
+        options: options of the back-end's constructor.
+
+    Raises:
+        PlannerError: the problem cannot be written as PDDL, or the planner is unknown.
+    """
+    domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
+    chosen = get_planner(planner or problem.planner, **dict(options or {}))
+    return ProblemPlanning(problem, world, domain, pddl, chosen)

@@ -1,0 +1,118 @@
+"""pRoPhEt MAS plugged into the engine: the child kind for planning problems, and the conveniences to use it.
+
+The engine knows nothing of planning: it is given :data:`PLANNING` (or a
+:class:`Planning` with another search budget) for the model element type
+:class:`~alica.model.PlanningProblem` through its configuration, and runs
+every planning-problem child through the seam of :mod:`alica.engine.child`::
+
+    from alica.prophet import engine_config
+
+    team = SimulatedTeam(library, "BlocksWorldMission", agents, config=engine_config(frequency=10.0))
+
+Each agent's engine attaches the kind once and gets a :class:`PlanningAgent`:
+the agent's :class:`~alica.prophet.board.PlanBoard` (fed with every message on
+:data:`~alica.prophet.board.PLAN_TOPIC`) and the factory of a
+:class:`~alica.prophet.runtime.ProblemRuntime` for each planning-problem child
+the agent enters.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from typing import Any, Protocol
+
+from alica.engine.child import ChildHost, ChildSlot, PlanKey
+from alica.engine.config import EngineConfig
+from alica.model import PlanningProblem
+from alica.prophet.board import PLAN_TOPIC, PlanBoard
+from alica.prophet.runtime import ProblemRuntime, SearchBudget
+from alica.prophet.tasks import CreatedTasks
+
+
+@dataclass(frozen=True, slots=True)
+class Planning:
+    """pRoPhEt MAS as the engine's child kind for planning problems (an :class:`alica.engine.child.ChildKind`).
+
+    Attributes:
+        budget: how much the leader searches per tick.
+        topic: the team topic of plan shares and replan requests.
+    """
+
+    budget: SearchBudget = field(default_factory=SearchBudget)
+    topic: str | None = PLAN_TOPIC
+
+    def __call__(self, host: ChildHost) -> PlanningAgent:
+        """Attach to one agent's engine."""
+        return PlanningAgent(host, self.budget)
+
+
+class PlanningAgent:
+    """One agent's pRoPhEt MAS: its plan board, and the runtimes of the planning problems it enters.
+
+    Args:
+        host: what the agent's engine offers.
+        budget: the leader's search budget per tick.
+    """
+
+    def __init__(self, host: ChildHost, budget: SearchBudget) -> None:
+        self.host = host
+        self.budget = budget
+        self.board = PlanBoard()
+        host.counters.setdefault("replans", 0)
+
+    def __call__(self, slot: ChildSlot) -> ProblemRuntime:
+        """The runtime of a planning-problem child (the agent enters its state)."""
+        return ProblemRuntime(self.host, slot, self.board, self.budget)
+
+    def receive(self, payload: object, now: float) -> None:
+        """A plan share or a replan request arrived."""
+        self.board.receive(payload, now)
+
+
+#: pRoPhEt MAS with the default search budget (1000 expansions per tick).
+PLANNING = Planning()
+
+
+def engine_config(
+    config: EngineConfig | None = None,
+    *,
+    planner_expansions: int = 1000,
+    planner_seconds: float | None = None,
+    **settings: Any,
+) -> EngineConfig:
+    """An engine configuration with pRoPhEt MAS plugged in for planning problems.
+
+    Args:
+        config: the configuration to extend (default: the engine's defaults).
+        planner_expansions: the leader's search budget per tick, in expansions
+            (deterministic: the same run plans the same way).
+        planner_seconds: a wall-time budget per tick instead (for real robots);
+            ``None`` uses ``planner_expansions``.
+        **settings: other :class:`~alica.engine.config.EngineConfig` settings.
+
+    Raises:
+        ValueError: a setting is out of range.
+    """
+    base = config or EngineConfig()
+    planning = Planning(SearchBudget(planner_expansions, planner_seconds))
+    return replace(base, children={**base.children, PlanningProblem: planning}, **settings)
+
+
+class _Children(Protocol):
+    def factory(self, element_type: type) -> object | None: ...
+
+
+class _Engine(Protocol):
+    @property
+    def children(self) -> _Children: ...
+
+
+def latest_plans(engine: _Engine) -> Mapping[PlanKey, CreatedTasks]:
+    """The latest plan generated for each planning problem an agent's engine ran (kept after it ended).
+
+    Args:
+        engine: an agent's engine (:class:`alica.engine.AgentEngine`).
+    """
+    agent = engine.children.factory(PlanningProblem)
+    return agent.board.latest if isinstance(agent, PlanningAgent) else {}
