@@ -32,6 +32,7 @@ from alica.testing import ScriptedSkill, scripted
 from tests.engine.helpers import library, team
 
 PROBLEM = """
+predicates: [done/0]
 behaviours:
   - {name: Hold, skill: Wait}
   - {name: Job, skill: Work}
