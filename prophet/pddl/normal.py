@@ -65,7 +65,7 @@ def substitute(formula: Formula | Effect, mapping: Mapping[str, str]) -> Formula
     if isinstance(formula, Not):
         return Not(substitute(formula.formula, mapping))  # type: ignore[arg-type]
     if isinstance(formula, And):
-        return And(tuple(substitute(p, mapping) for p in formula.parts))  # type: ignore[misc]
+        return And(tuple(substitute(p, mapping) for p in formula.parts))  # type: ignore[arg-type]  # parts stay formulas
     if isinstance(formula, Or):
         return Or(tuple(substitute(p, mapping) for p in formula.parts))  # type: ignore[misc]
     if isinstance(formula, Imply):

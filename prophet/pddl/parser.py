@@ -180,7 +180,8 @@ def _declarations(source: Source, section: SList, types: dict[str, str], what: s
             raise source.error(decl.offset, f"duplicate {what} '{name}'")
         out.append(Predicate(name, tuple(p for p, _ in params)))
         index += 1
-        if functions and index < len(items) and isinstance(items[index], Symbol) and items[index].text == "-":
+        dash = items[index] if index < len(items) else None
+        if functions and isinstance(dash, Symbol) and dash.text == "-":
             kind = items[index + 1] if index + 1 < len(items) else items[index]
             if not isinstance(kind, Symbol) or kind.text != "number":
                 raise source.error(kind.offset, f"unsupported construct: function '{name}' must be '- number'")

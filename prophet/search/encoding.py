@@ -234,9 +234,9 @@ def compile_task(task: Any) -> CompiledTask:
         r_pre.append(fpre)
         r_add.append(tuple(f for f in op.add if fluent[f]))
         r_of.append(k)
-        for cond, cadd, _cdel in op.conditional:
-            if usable(cond):
-                r_pre.append(tuple(sorted(set(fpre) | {f for f in cond if fluent[f]})))
+        for when, cadd, _cdel in op.conditional:
+            if usable(when):
+                r_pre.append(tuple(sorted(set(fpre) | {f for f in when if fluent[f]})))
                 r_add.append(tuple(f for f in cadd if fluent[f]))
                 r_of.append(k)
     reached = _reachable(n, init_set, r_pre, r_add)

@@ -75,7 +75,7 @@ class Relaxed:
         self._npre = [len(p) for p in r_pre]
         self._neg = [-1] * n
         self._inf = [INF] * n
-        self._zero_a = [0] * len(r_pre)
+        self._zero_a: list[float] = [0] * len(r_pre)
 
     # ------------------------------------------------------------------ FF
     def ff(self, state: int) -> tuple[float, list[int]]:
@@ -216,7 +216,7 @@ class Relaxed:
             heap.append((0, f))
             s ^= low
         for a in self.zero:
-            c = r_cost[a]
+            c: float = r_cost[a]
             for g in r_add[a]:
                 if c < cost[g]:
                     cost[g] = c

@@ -34,6 +34,11 @@ class BuiltinPlanner(Planner):
 
     def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
         from alica.prophet.ground import ground  # lazy: the grounding is only needed here
+        from alica.prophet.pddl import Domain, Problem
 
+        if not isinstance(domain, Domain) or not isinstance(problem, Problem):
+            raise TypeError(
+                f"the builtin planner takes a pddl Domain and Problem, got {type(domain).__name__}, {type(problem).__name__}"
+            )
         task = ground(domain, problem)
         yield from search_task(task, anytime=anytime, weights=self.weights, progress_every=self.progress_every)

@@ -17,6 +17,7 @@ limit passes.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -338,7 +339,7 @@ def run_demo(
             step_world=False,
         )
     for when, action in actions:
-        team.at(when, "demo action", lambda action=action: action(team))
+        team.at(when, "demo action", functools.partial(action, team))
     wanted = set(goal_facts(goal))
     if out is not None:
         _picture(world, out / "initial.png")
