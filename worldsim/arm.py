@@ -23,7 +23,7 @@ from alica.worldsim._quiet import quiet_stdout
 from alica.worldsim.errors import WorldError
 from alica.worldsim.geometry import pose_multiply, quat_multiply, yaw_to_quat
 from alica.worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, GripperMixin
-from alica.worldsim.objects import ARM_GROUP, MOVABLE_GROUP, WorldObject
+from alica.worldsim.objects import ARM_GROUP, MOVABLE_GROUP
 
 if TYPE_CHECKING:
     from alica.worldsim.robots import Robot
@@ -63,17 +63,11 @@ class Arm(GripperMixin):
         "_client",
         "_com_local",
         "_com_quat",
-        "_fingers",
-        "_grasp",
-        "_held",
-        "_joints_dirty",
-        "_moved",
         "_path",
         "_q",
         "_reset_joints",
         "_reset_pose",
         "_seg",
-        "_slip_at",
         "_t",
         "_times",
         "body_id",
@@ -137,9 +131,9 @@ class Arm(GripperMixin):
         self._times: np.ndarray | None = None
         self._t = 0.0
         self._seg = 0
-        self._held: WorldObject | None = None
-        self._grasp: tuple[Any, Any] | None = None
-        self._slip_at: float | None = None
+        self._held = None
+        self._grasp = None
+        self._slip_at = None
         self._base_dirty = True
         self._moved = True
         self._joints_dirty = True
@@ -160,7 +154,7 @@ class Arm(GripperMixin):
     def ee_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]:
         """World position and quaternion ``(x, y, z, w)`` of the end-effector (between the fingertips)."""
         state = self._client.getLinkState(self.body_id, self.ee_link, computeForwardKinematics=1)
-        return np.asarray(state[4], dtype=float), tuple(state[5])  # type: ignore[return-value]
+        return np.asarray(state[4], dtype=float), tuple(state[5])
 
     def finger_opening(self) -> float:
         """The gap between the fingers in metres."""

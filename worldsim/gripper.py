@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from alica.worldsim.errors import WorldError
 from alica.worldsim.geometry import pose_inverse, pose_multiply
@@ -37,20 +38,31 @@ WAKE_RADIUS = 0.3
 
 
 class GripperMixin:
-    """Gripper methods of :class:`~alica.worldsim.arm.Arm` (which holds the state they use)."""
+    """Gripper methods of :class:`~alica.worldsim.arm.Arm`.
 
-    __slots__ = ()
+    The gripper's own state is in this class's slots; :class:`~alica.worldsim.arm.Arm`
+    sets it up and provides the robot, the body and the pose of the end-effector.
+    """
+
+    __slots__ = ("_fingers", "_grasp", "_held", "_joints_dirty", "_moved", "_slip_at")
+
+    #: The opening of each finger (m).
+    _fingers: float
+    #: The object in the gripper, or ``None``.
+    _held: WorldObject | None
+    #: The pose of the held object in the end-effector frame, or ``None``.
+    _grasp: tuple[tuple[float, float, float], tuple[float, float, float, float]] | None
+    #: The world time at which the grasp slips (see :mod:`alica.worldsim.faults`), or ``None``.
+    _slip_at: float | None
+    #: Whether the arm moved since the last step (its bodies must be re-posed).
+    _moved: bool
+    #: Whether the joints must be reset in pybullet.
+    _joints_dirty: bool
 
     if TYPE_CHECKING:
         robot: Robot
         body_id: int
         _client: Any
-        _fingers: float
-        _held: WorldObject | None
-        _grasp: tuple[Any, Any] | None
-        _slip_at: float | None
-        _moved: bool
-        _joints_dirty: bool
 
         def ee_pose(self) -> tuple[np.ndarray, tuple[float, float, float, float]]: ...
         def _sync(self) -> None: ...
@@ -189,7 +201,7 @@ def _half_width(obj: WorldObject) -> float:
     return obj.radius
 
 
-def _aabb_distance(point: Sequence[float], lo: np.ndarray, hi: np.ndarray) -> float:
+def _aabb_distance(point: Sequence[float] | npt.NDArray[np.float64], lo: np.ndarray, hi: np.ndarray) -> float:
     """Distance from a point to a box (0 inside)."""
     p = np.asarray(point, dtype=float)
     return float(np.linalg.norm(np.maximum(np.maximum(lo - p, p - hi), 0.0)))

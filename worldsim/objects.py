@@ -153,7 +153,7 @@ class WorldObject:
     def pose(self) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
         """Position and quaternion ``(x, y, z, w)`` of the body."""
         pos, quat = self._client.getBasePositionAndOrientation(self.body_id)
-        return tuple(pos), tuple(quat)  # type: ignore[return-value]
+        return tuple(pos), tuple(quat)
 
     def position(self) -> np.ndarray:
         """The body position as a numpy array of 3."""

@@ -13,6 +13,7 @@ import numpy as np
 from alica.worldsim.grid import Obstacle2D
 
 if TYPE_CHECKING:
+    from alica.worldsim.interface import RobotWorld
     from alica.worldsim.robots import Robot
     from alica.worldsim.world import World
 
@@ -33,14 +34,17 @@ def obstacles(world: World, *, include_samples: bool = False) -> list[Obstacle2D
     return out
 
 
-def blocker(world: World, x: float, y: float, radius: float) -> str | None:
-    """What a circle at ``(x, y)`` would overlap: a robot, a rock, table, block or sample; or ``None``."""
+def blocker(world: RobotWorld, x: float, y: float, radius: float) -> str | None:
+    """What a circle at ``(x, y)`` would overlap: a robot, a rock, table, block or sample; or ``None``.
+
+    It reads only the robot interface, so skills may ask it of any :class:`~alica.worldsim.interface.RobotWorld`.
+    """
     for other in world.robots.values():
         if math.hypot(x - other.pose[0], y - other.pose[1]) < radius + other.spec.radius:
             return f"robot '{other.name}'"
-    held = world._held_bodies()
+    held = {r.arm.held.name for r in world.robots.values() if r.arm is not None and r.arm.held is not None}
     for obj in world.objects.values():
-        if obj.kind in ("rock", "table", "block", "sample") and obj.body_id not in held:
+        if obj.kind in ("rock", "table", "block", "sample") and obj.name not in held:
             fp = obj.footprint()
             if fp is not None and float(fp.distance(np.array(x), np.array(y))) < radius:
                 return f"{obj.kind} '{obj.name}'"

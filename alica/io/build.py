@@ -359,11 +359,7 @@ def _state(node: Node, plan: str, problems: Problems) -> tuple[State, list[Trans
     try:
         kind = StateKind(kind_text)
     except ValueError:
-        problems.add(
-            f.get("kind").span if f.get("kind") else f.span,
-            f"unknown state kind '{kind_text}'",
-            "use normal, success or failure",
-        )  # type: ignore[union-attr]
+        problems.add(f.span_of("kind"), f"unknown state kind '{kind_text}'", "use normal, success or failure")
         kind = StateKind.NORMAL
     children = tuple(_child(n, f, problems) for n in f.items("children"))
     transitions = [_transition(n, plan, name, problems) for n in f.items("transitions")]
@@ -538,13 +534,11 @@ def _problem(node: Node, problems: Problems) -> PlanningProblem:
     update_time = f.number("update_time", 1.0)
     if not math.isfinite(update_time) or update_time <= 0:
         problems.add(
-            f.get("update_time").span, f"'update_time' of {f.what} must be a positive number of seconds", "use e.g. 1.0"
-        )  # type: ignore[union-attr]
+            f.span_of("update_time"), f"'update_time' of {f.what} must be a positive number of seconds", "use e.g. 1.0"
+        )
     timeout = f.number("timeout", 60.0)
     if not math.isfinite(timeout) or timeout <= 0:
-        problems.add(
-            f.get("timeout").span, f"'timeout' of {f.what} must be a positive number of seconds", "use e.g. 60"
-        )  # type: ignore[union-attr]
+        problems.add(f.span_of("timeout"), f"'timeout' of {f.what} must be a positive number of seconds", "use e.g. 60")
     return PlanningProblem(
         f.name(),
         tuple(n for n, _ in f.names("elements", required=True, hint="list the skill plans the planner may use")),

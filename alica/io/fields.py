@@ -79,6 +79,11 @@ class Fields:
         """The raw node of ``key``, if written."""
         return self.values.get(key)
 
+    def span_of(self, key: str) -> SourceSpan:
+        """Where ``key`` was written, or where the element starts when it was not."""
+        node = self.values.get(key)
+        return node.span if node is not None else self.span
+
     def _missing(self, key: str, hint: str) -> None:
         self.problems.add(self.span, f"{self.what} has no '{key}'", hint or f"add '{key}:'")
 

@@ -11,12 +11,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from pathlib import Path
+from typing import Protocol, TypeVar
 
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
 from alica.lang import ENGINE_VARIABLES, Registry, Vocabulary, check, default_vocabulary, literals, parse
 from alica.lang.skills import SkillRegistry
 from alica.model import (
+    AbstractPlan,
     Behaviour,
     Condition,
     Declaration,
@@ -29,6 +31,19 @@ from alica.model import (
     format_cardinality,
 )
 from alica.source import SourceSpan
+
+
+class _Element(Protocol):
+    """A model element as :meth:`Validator._unique` reads it: a name and where it was written."""
+
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def span(self) -> SourceSpan | None: ...
+
+
+_E = TypeVar("_E", bound=_Element)
 
 #: How far utility weights may stray from summing to 1.
 WEIGHT_TOLERANCE = 1e-6
@@ -74,7 +89,12 @@ class Validator:
         self.bound: frozenset[str] = ENGINE_VARIABLES
         self.tasks = self._unique("task", (t for d in documents for t in d.tasks))
         self.rolesets = self._unique("role set", (r for d in documents for r in d.rolesets))
-        abstract = [e for d in documents for e in (*d.behaviours, *d.plans, *d.plantypes, *d.problems)]
+        abstract: list[AbstractPlan] = []
+        for d in documents:
+            abstract.extend(d.behaviours)
+            abstract.extend(d.plans)
+            abstract.extend(d.plantypes)
+            abstract.extend(d.problems)
         self.abstract = self._unique("behaviour, plan, plan type or planning problem", abstract)
 
     def run(self) -> None:
@@ -95,8 +115,8 @@ class Validator:
 
     # -- helpers -----------------------------------------------------------
 
-    def _unique(self, kind: str, elements: Iterable) -> dict:  # type: ignore[type-arg]
-        seen: dict = {}  # type: ignore[type-arg]
+    def _unique(self, kind: str, elements: Iterable[_E]) -> dict[str, _E]:
+        seen: dict[str, _E] = {}
         for element in elements:
             if not element.name:
                 continue
@@ -112,7 +132,7 @@ class Validator:
             seen[element.name] = element
         return seen
 
-    def _unique_in(self, owner: str, kind: str, items: Iterable) -> set[str]:  # type: ignore[type-arg]
+    def _unique_in(self, owner: str, kind: str, items: Iterable[_Element]) -> set[str]:
         names: set[str] = set()
         for item in items:
             if item.name in names:
@@ -324,16 +344,16 @@ class Validator:
                     "list the transitions that must fire together",
                 )
             for name in sync.transitions:
-                t = transitions.get(name)
-                if t is None:
+                listed = transitions.get(name)
+                if listed is None:
                     self.problems.add(
                         sync.span,
                         f"synchronisation '{sync.name}' of {what} lists unknown transition '{name}'",
                         suggest(name, transitions) or "transition names default to 'Source->Target'",
                     )
-                elif t.synchronisation != sync.name:
+                elif listed.synchronisation != sync.name:
                     self.problems.add(
-                        t.span,
+                        listed.span,
                         f"transition '{name}' is listed by synchronisation '{sync.name}' but does not say 'sync: {sync.name}'",
                         f"add 'sync: {sync.name}' to the transition",
                     )

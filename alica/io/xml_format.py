@@ -571,7 +571,7 @@ class _Reader:
         pieces += [(child.tail, self.span(child)) for child in children]
         for text, span in pieces:
             if not _blank(text):
-                shown = " ".join(text.split())  # type: ignore[union-attr]
+                shown = " ".join(text.split())
                 shown = shown if len(shown) <= 30 else shown[:27] + "..."
                 self.problem(
                     span,

@@ -223,7 +223,7 @@ def resolve_scalar(text: str) -> str | int | float | bool | None:
     except (ValueError, ArithmeticError, yaml.YAMLError):
         return text
     if isinstance(value, (bool, int, float)) or value is None:
-        return value  # type: ignore[no-any-return]
+        return value
     return text
 
 

@@ -45,6 +45,8 @@ class _Reader:
             return self._mapping(node, span)
         if isinstance(node, yaml.SequenceNode):
             return Node([self.convert(item) for item in node.value], span)
+        if not isinstance(node, yaml.ScalarNode):  # PyYAML composes only scalar, sequence and mapping nodes
+            raise TypeError(f"unexpected YAML node {type(node).__name__}")
         value = self.constructor.construct_object(node, deep=True)
         if isinstance(value, (datetime.date, datetime.datetime)):
             value = str(node.value)

@@ -546,7 +546,7 @@ def holds(
         FormulaError: when text does not parse.
         EvaluationError: when evaluation fails or the value is not a bool.
     """
-    return _compiled(node_or_text, registry, True)(belief, _env(env))  # type: ignore[no-any-return]
+    return _compiled(node_or_text, registry, True)(belief, _env(env))
 
 
 def compile_formula(

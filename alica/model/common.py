@@ -18,7 +18,7 @@ UNBOUNDED = math.inf
 
 def span_field() -> SourceSpan | None:
     """A ``span`` field: where the element was written, ignored by ``==``."""
-    return field(default=None, compare=False, repr=False, kw_only=True)  # type: ignore[return-value]
+    return field(default=None, compare=False, repr=False, kw_only=True)
 
 
 class StateKind(Enum):

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Protocol, TypeVar
 
 from alica.model.behaviour import Behaviour
 from alica.model.declaration import Declaration
@@ -24,6 +25,19 @@ SECTIONS: tuple[tuple[str, type], ...] = (
     ("plantypes", PlanType),
     ("problems", PlanningProblem),
 )
+
+
+class _Named(Protocol):
+    @property
+    def name(self) -> str: ...
+
+
+_N = TypeVar("_N", bound=_Named)
+
+
+def _by_name(sections: Iterable[tuple[_N, ...]]) -> dict[str, _N]:
+    """Name -> element of the elements in ``sections`` (one section of every document)."""
+    return {e.name: e for section in sections for e in section}
 
 
 def children_of(element: AbstractPlan) -> tuple[str, ...]:
@@ -85,35 +99,32 @@ class PlanLibrary:
     @cached_property
     def tasks(self) -> dict[str, Task]:
         """Task name -> task."""
-        return self._index("tasks")
+        return _by_name(d.tasks for d in self.documents)
 
     @cached_property
     def rolesets(self) -> dict[str, RoleSet]:
         """Role set name -> role set."""
-        return self._index("rolesets")
+        return _by_name(d.rolesets for d in self.documents)
 
     @cached_property
     def behaviours(self) -> dict[str, Behaviour]:
         """Behaviour name -> behaviour."""
-        return self._index("behaviours")
+        return _by_name(d.behaviours for d in self.documents)
 
     @cached_property
     def plans(self) -> dict[str, Plan]:
         """Plan name -> plan."""
-        return self._index("plans")
+        return _by_name(d.plans for d in self.documents)
 
     @cached_property
     def plantypes(self) -> dict[str, PlanType]:
         """Plan type name -> plan type."""
-        return self._index("plantypes")
+        return _by_name(d.plantypes for d in self.documents)
 
     @cached_property
     def problems(self) -> dict[str, PlanningProblem]:
         """Planning problem name -> problem."""
-        return self._index("problems")
-
-    def _index(self, section: str) -> dict:  # type: ignore[type-arg]
-        return {e.name: e for doc in self.documents for e in getattr(doc, section)}
+        return _by_name(d.problems for d in self.documents)
 
     def abstract(self, name: str) -> AbstractPlan:
         """The behaviour, plan, plan type or problem called ``name``.
@@ -123,7 +134,7 @@ class PlanLibrary:
         """
         for index in (self.plans, self.behaviours, self.plantypes, self.problems):
             if name in index:
-                return index[name]  # type: ignore[no-any-return]
+                return index[name]
         raise KeyError(f"no behaviour, plan, plan type or planning problem named '{name}'")
 
     def children(self, element: AbstractPlan) -> tuple[str, ...]:
@@ -144,7 +155,11 @@ class PlanLibrary:
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, PlanLibrary):
             return NotImplemented
-        return all(self._index(s) == other._index(s) for s, _ in SECTIONS)
+        return self._sections() == other._sections()
+
+    def _sections(self) -> tuple[Mapping[str, object], ...]:
+        """Name -> element of every section, in :data:`SECTIONS` order."""
+        return (self.tasks, self.rolesets, self.behaviours, self.plans, self.plantypes, self.problems)
 
     def __hash__(self) -> int:
         return hash(tuple(sorted(self.plans)))

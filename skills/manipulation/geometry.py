@@ -28,7 +28,7 @@ def as_vec3(v: Sequence[float], name: str = "vector") -> Vec3:
         raise ValueError(f"{name} must be three numbers, got {v!r}") from exc
     if len(out) != 3 or not all(math.isfinite(x) for x in out):
         raise ValueError(f"{name} must be three finite numbers, got {v!r}")
-    return out  # type: ignore[return-value]
+    return out
 
 
 def as_quat(q: Sequence[float], name: str = "quaternion") -> Quat:

@@ -110,8 +110,8 @@ def read_arm_model(c: BulletClient, body: int) -> ArmModel:
 
     com_pos, com_quat = c.getBasePositionAndOrientation(body)
     dyn = c.getDynamicsInfo(body, -1)
-    inertial: Pose = (tuple(dyn[3]), tuple(dyn[4]))  # type: ignore[assignment]
-    base_frame = pose_multiply((tuple(com_pos), tuple(com_quat)), pose_inverse(inertial))  # type: ignore[arg-type]
+    inertial: Pose = (tuple(dyn[3]), tuple(dyn[4]))
+    base_frame = pose_multiply((tuple(com_pos), tuple(com_quat)), pose_inverse(inertial))
     shoulder = pose_multiply(pose_inverse(base_frame), (tuple(frames[arm[1]]), (0.0, 0.0, 0.0, 1.0)))[0]
 
     g_lo = [infos[j][8] for j in gripper]

@@ -235,7 +235,7 @@ class ArmScene:
     def base_pose(self) -> Pose:
         """Current world pose of the base link's URDF frame (as ``loadURDF``'s ``basePosition``)."""
         pos, quat = self._c.getBasePositionAndOrientation(self._robot)  # centre of mass frame
-        return pose_multiply((tuple(pos), tuple(quat)), pose_inverse(self._model.base_inertial))  # type: ignore[arg-type]
+        return pose_multiply((tuple(pos), tuple(quat)), pose_inverse(self._model.base_inertial))
 
     # ----------------------------------------------------------------- world edits
     def set_base_pose(self, pose: Pose) -> None:
@@ -307,7 +307,7 @@ class ArmScene:
             raise TypeError(f"held must be a Box or None, got {held!r}")
         return self.collides(arr, held)
 
-    def collides(self, q: Sequence[float], held: Box | None = None) -> bool:
+    def collides(self, q: Sequence[float] | np.ndarray, held: Box | None = None) -> bool:
         """:meth:`in_collision` without argument checks (for planners' inner loops)."""
         self._reset_joints(self._robot, self._arm_joints, [[float(v)] for v in q])
         if held is None:
@@ -334,14 +334,14 @@ class ArmScene:
         # and the ground are not tested against each other, so one query covers everything.
         return any(cp[8] < 0.0 for cp in self._contacts())
 
-    def set_joints(self, q: Sequence[float]) -> None:
+    def set_joints(self, q: Sequence[float] | np.ndarray) -> None:
         """Set the 7 arm joints of the planning body (no checks; for inner loops)."""
         self._reset_joints(self._robot, self._model.arm_joints, [[float(v)] for v in q])
 
     def current_tool_pose(self) -> Pose:
         """World pose of :attr:`ee_link` at the joint values last set (forward kinematics recomputed)."""
         state = self._link_state(self._robot, self._model.ee_link, computeForwardKinematics=True)
-        return tuple(state[4]), tuple(state[5])  # type: ignore[return-value]
+        return tuple(state[4]), tuple(state[5])
 
     def close(self) -> None:
         """Disconnect the scene's client (idempotent)."""
@@ -350,7 +350,7 @@ class ArmScene:
                 self._c.disconnect()
             except pybullet.error:  # already disconnected
                 pass
-            self._c = None  # type: ignore[assignment]
+            self._c = None
 
     def __enter__(self) -> Self:
         return self

@@ -110,7 +110,7 @@ class PathFollower:
         if len(self._seg) == 0:
             return (float(self.path[0, 0]), float(self.path[0, 1]))
         s = min(max(s, 0.0), self.total_length)
-        k = int(min(np.searchsorted(self._cum, s, side="right") - 1, len(self._seg) - 1))
+        k = min(int(np.searchsorted(self._cum, s, side="right")) - 1, len(self._seg) - 1)
         frac = 0.0 if self._seg_len[k] == 0.0 else (s - self._cum[k]) / self._seg_len[k]
         p = self.path[k] + self._seg[k] * frac
         return (float(p[0]), float(p[1]))
@@ -120,7 +120,7 @@ class PathFollower:
         if len(self._seg) == 0:
             return self._s
         window = max(2.0 * self.lookahead, 1.0)
-        k0 = int(min(np.searchsorted(self._cum, self._s, side="right") - 1, len(self._seg) - 1))
+        k0 = min(int(np.searchsorted(self._cum, self._s, side="right")) - 1, len(self._seg) - 1)
         k1 = int(np.searchsorted(self._cum, self._s + window, side="right"))
         k1 = min(max(k1, k0 + 1), len(self._seg))
         a = self.path[k0:k1]
@@ -362,9 +362,9 @@ def escape_goal(
     t = np.linspace(0.0, 1.0, samples)[None, :]
     for start in range(0, order.size, 256):
         batch = order[start : start + 256]
-        tx, ty = xs[cand_i[batch]], ys[cand_j[batch]]
-        lx = px + (tx[:, None] - px) * t
-        ly = py + (ty[:, None] - py) * t
+        bx, by = xs[cand_i[batch]], ys[cand_j[batch]]
+        lx = px + (bx[:, None] - px) * t
+        ly = py + (by[:, None] - py) * t
         li = np.floor((lx - origin[0]) / res).astype(np.intp)
         lj = np.floor((ly - origin[1]) / res).astype(np.intp)
         skip = (np.abs(li - (ci - i0)) <= 1) & (np.abs(lj - (cj - j0)) <= 1)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import numpy.typing as npt
 
 __all__ = ["coarse_reachable"]
 
@@ -21,7 +22,9 @@ def _coarse_free(blocked: np.ndarray, factor: int) -> np.ndarray:
     hh, ww = math.ceil(h / factor), math.ceil(w / factor)
     padded = np.ones((hh * factor, ww * factor), dtype=bool)
     padded[:h, :w] = blocked
-    return ~padded.reshape(hh, factor, ww, factor).all(axis=(1, 3))
+    # ``all`` over some axes is typed as possibly a scalar; over two of four axes it is a 2-d array
+    coarse_blocked: npt.NDArray[np.bool_] = np.asarray(padded.reshape(hh, factor, ww, factor).all(axis=(1, 3)))
+    return ~coarse_blocked
 
 
 def coarse_reachable(
