@@ -28,6 +28,7 @@ demo: $(STAMP)
 	$(BIN)/alica demo blocksworld --agents 3 --blocks 5 --seed 1 --out build/blocks
 
 test: $(STAMP)
+	$(BIN)/python tools/quality.py
 	$(BIN)/python -m pytest
 
 # The quality gates: ruff (lint, format), mypy, the import-linter layer contracts.
