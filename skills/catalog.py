@@ -305,6 +305,18 @@ def _semantic_perception(registry: SkillRegistry) -> None:
     )
 
 
+def _facts(registry: SkillRegistry) -> None:
+    """The facts the implemented skills write to the world model, so any plan may read them undeclared."""
+    registry.declare_predicate("holding", 2, "holding(r, x): robot r holds object x (Pickup, Unstack, Putdown, Stack)")
+    registry.declare_predicate("handempty", 1, "handempty(r): robot r holds nothing")
+    registry.declare_predicate("onground", 1, "onground(x): object x lies on the ground (Putdown)")
+    registry.declare_predicate("on", 2, "on(x, y): block x stands on block y (Stack, Unstack; blocks-world perception)")
+    registry.declare_predicate("ontable", 1, "ontable(x): block x stands on the table (Putdown)")
+    registry.declare_predicate("clear", 1, "clear(x): nothing stands on block x")
+    registry.declare_function("pos", 1, "pos(r): the position [x, y] a robot reached (MoveToPosition)")
+    registry.declare_function("attempts", 1, "attempts(r): grasp attempts of robot r so far (Pickup)")
+
+
 def declare_all(registry: SkillRegistry) -> None:
     """Declare every skill the shipped plans use.
 
@@ -318,6 +330,7 @@ def declare_all(registry: SkillRegistry) -> None:
     _navigation(registry)
     _manipulation(registry)
     _directed_vision(registry)
+    _facts(registry)
     _semantic_perception(registry)
 
 

@@ -142,9 +142,9 @@ def test_an_xml_file_imports_the_declarations_of_a_yaml_file(tmp_path: Path) -> 
 
 
 def test_a_name_declared_as_predicate_and_function_is_reported(tmp_path: Path) -> None:
-    text = plan_yaml("succeeded", "predicates: [pos/1]\nfunctions: [pos/1]\n")
+    text = plan_yaml("succeeded", "predicates: [heat/1]\nfunctions: [heat/1]\n")
     (found,) = problems(tmp_path, {"plan.yaml": text})
-    assert "'pos' is declared as a predicate" in found.message
+    assert "'heat' is declared as a predicate" in found.message
     assert found.span.line == 2
 
 
