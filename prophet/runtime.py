@@ -316,6 +316,11 @@ class ProblemRuntime:
             fields["reason"] = share.reason
         host.emit("problem", key=key_text(self.key), phase=self.phase(), **fields)
 
+    def _publish_failure(self, now: float, generation: int, reason: str) -> None:
+        """Tell the team that planning ``generation`` failed: it runs the AlternativePlan."""
+        share = PlanShare(self.key, generation, 1, self.host.name, FAILED, entry_task=self._entry_task(), reason=reason)
+        self._publish(share, now)
+
     def _publish(self, share: PlanShare, now: float) -> None:
         self.board.receive(share, now)
         self.host.publish(share)
@@ -562,36 +567,14 @@ class ProblemRuntime:
                     )
                     self._wait_for_world(now, search.world, search.generation, reason)
                     return
-                self._publish(
-                    PlanShare(
-                        self.key,
-                        search.generation,
-                        1,
-                        self.host.name,
-                        FAILED,
-                        entry_task=self._entry_task(),
-                        reason=message,
-                    ),
-                    now,
-                )
+                self._publish_failure(now, search.generation, message)
             return
         if search.shared_cost is None:
             if now - search.started > self.model.timeout:
                 self.search = None
                 reason = f"no plan within the timeout of {self.model.timeout:g} s"
                 self.host.emit("planner", key=key_text(self.key), what="timeout", expansions=search.expansions)
-                self._publish(
-                    PlanShare(
-                        self.key,
-                        search.generation,
-                        1,
-                        self.host.name,
-                        FAILED,
-                        entry_task=self._entry_task(),
-                        reason=reason,
-                    ),
-                    now,
-                )
+                self._publish_failure(now, search.generation, reason)
             elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
                 self._replan(now, "the world changed while planning")
 
