@@ -1,7 +1,8 @@
 """The tutorial docs/tutorial_skill.md works as written.
 
-Its example files are the page's code blocks whose first line names the file
-(``# my_skills.py``; ``# my_skills.py, continued`` appends to it). They are
+Its example files are the page's code blocks whose title names the file
+(```` ```python title="my_skills.py" ````; a title ``my_skills.py
+(continued)`` appends to the file, after two blank lines). They are
 written to a fresh folder, every ``alica`` command of the page runs there
 through :func:`alica.app.cli.main` and must print what the page shows after
 it (a ``...`` line stands for any lines), and the page's unit test runs with
@@ -25,29 +26,28 @@ from alica.app.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = (ROOT / "docs" / "tutorial_skill.md").read_text(encoding="utf-8")
-BLOCK = re.compile(r"^```(\w*)\n(.*?)^```\s*$", re.DOTALL | re.MULTILINE)
-MARKER = re.compile(r"^# (\S+\.(?:py|yaml))(, continued)?$")
+BLOCK = re.compile(r"^```(\w*)([^\n]*)\n(.*?)^```\s*$", re.DOTALL | re.MULTILINE)
+TITLE = re.compile(r'title="(\S+\.(?:py|yaml))( \(continued\))?"')
 BUDGET = 60
 PYTEST_TIMEOUT = 300  # seconds of wall time for one pytest run of the page's test
 
 
-def blocks() -> list[tuple[str, str]]:
-    """The page's fenced code blocks as ``(language, text)``, in order."""
-    return [(lang, text) for lang, text in BLOCK.findall(PAGE)]
+def blocks() -> list[tuple[str, str, str]]:
+    """The page's fenced code blocks as ``(language, attributes, text)``, in order."""
+    return [(lang, attributes.strip(), text) for lang, attributes, text in BLOCK.findall(PAGE)]
 
 
 def example_files() -> dict[str, str]:
     """The example files by relative path, as the page builds them."""
     files: dict[str, str] = {}
-    for _, text in blocks():
-        first, _, rest = text.partition("\n")
-        found = MARKER.match(first)
+    for _, attributes, text in blocks():
+        found = TITLE.fullmatch(attributes)
         if found is None:
             continue
         name, continued = found.groups()
         if continued:
-            assert name in files, f"'{first}' continues a file the page has not started"
-            files[name] += rest
+            assert name in files, f"'{attributes}' continues a file the page has not started"
+            files[name] += "\n\n" + text
         else:
             assert name not in files, f"the page starts {name} twice"
             files[name] = text
@@ -57,7 +57,7 @@ def example_files() -> dict[str, str]:
 def commands() -> list[tuple[str, str]]:
     """Each ``alica`` command of the page with the output the page shows after it."""
     found = []
-    for (lang, text), (next_lang, output) in pairwise(blocks()):
+    for (lang, _, text), (next_lang, _, output) in pairwise(blocks()):
         if lang == "sh" and text.startswith("alica ") and next_lang == "text":
             assert text.count("\n") == 1, f"one command per block: {text!r}"
             found.append((text.strip(), output))
@@ -83,7 +83,7 @@ def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
     sys.modules.pop("my_skills", None)
 
 
-def test_the_example_is_four_files_within_the_line_budget() -> None:
+def test_the_example_is_three_files_within_the_line_budget() -> None:
     files = example_files()
     assert sorted(files) == ["my_skills.py", "plans/face.yaml", "test_face.py"]
     lines = sum(len(text.splitlines()) for text in files.values())
@@ -123,7 +123,7 @@ def pytest_run(folder: Path) -> subprocess.CompletedProcess[str]:
 
 
 def test_the_unit_test_passes_and_catches_a_broken_skill(folder: Path) -> None:
-    assert "python -m pytest -q test_face.py" in [text.strip() for lang, text in blocks() if lang == "sh"]
+    assert "python -m pytest -q test_face.py" in [text.strip() for lang, _, text in blocks() if lang == "sh"]
     done = pytest_run(folder)
     assert done.returncode == 0 and "1 passed" in done.stdout, done.stdout + done.stderr
     skill = folder / "my_skills.py"
