@@ -16,7 +16,7 @@ With pytest, the fixtures of :mod:`alica.skills.pytest_plugin` (``lunar_world``,
 from __future__ import annotations
 
 import random
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -105,6 +105,7 @@ def run_skill(
     rate: float = 10.0,
     seed: int = 0,
     registry: SkillRegistry | None = None,
+    skills: Iterable[str] | str = (),
     world_model: WorldModelLike | None = None,
     on_tick: Callable[[World, Behaviour], None] | None = None,
 ) -> SkillRun:
@@ -113,18 +114,25 @@ def run_skill(
     The skill is built from the registry's implementation, ticked ``rate``
     times per simulated second, and the world steps between ticks.
     ``on_tick(world, behaviour)``, if given, runs before every tick (to inject
-    faults at the right moment, say).
+    faults at the right moment, say). The skill is looked up in ``registry``,
+    or else in the installed plug-ins and the plug-in modules named in
+    ``skills`` (as ``--skills`` does on the command line, e.g.
+    ``skills=["my_skills"]``).
 
     Raises:
         SkillError: bad parameters, no such robot, or no implementation.
         UnknownSkillError: no skill of that name.
+        SkillPluginError: a module of ``skills`` cannot be loaded.
     """
     from py_trees.common import Status
 
     from alica.engine.behaviours import SkillContext
     from alica.worldmodel import WorldModel
 
-    registry = registry or default_registry()
+    if registry is not None and skills:
+        raise SkillError("run_skill takes a registry or plug-in modules (skills=...), not both")
+    modules = [skills] if isinstance(skills, str) else list(skills)
+    registry = registry if registry is not None else default_registry(modules)
     spec = registry.get(name)
     values = checked_params(spec, params or {})
     if robot not in world.robots:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -224,7 +224,13 @@ class SkillRegistry:
         return SkillRegistry(dict(self._specs), self.origin)
 
     def load(self, name: str) -> Callable[..., Any]:
-        """Import and return the implementation of ``name``.
+        """Import and return the implementation of ``name``, as a factory ``(name, params, context)``.
+
+        The parameters the factory is given are completed with the declared
+        defaults (those that are not ``None``) of the parameters a plan leaves
+        out, so a skill reads ``params["tolerance"]`` whether it runs in a
+        team (``alica run``) or alone (:func:`alica.skills.testing.run_skill`).
+        A skill that declares no such default gets its implementation itself.
 
         Raises:
             UnknownSkillError: no such skill, no implementation declared, or
@@ -234,7 +240,7 @@ class SkillRegistry:
         if spec.implementation is None:
             raise UnknownSkillError(f"skill '{name}' is declared but has no implementation yet")
         if not isinstance(spec.implementation, str):
-            return spec.implementation
+            return _with_defaults(spec.implementation, spec)
         module_name, _, attribute = spec.implementation.partition(":")
         try:
             module = importlib.import_module(module_name)
@@ -243,6 +249,22 @@ class SkillRegistry:
                 f"skill '{name}' needs module '{module_name}', which cannot be imported: {exc}"
             ) from exc
         try:
-            return getattr(module, attribute)
+            implementation = getattr(module, attribute)
         except AttributeError:
             raise UnknownSkillError(f"skill '{name}': module '{module_name}' has no '{attribute}'") from None
+        return _with_defaults(implementation, spec)
+
+
+def _with_defaults(implementation: Callable[..., Any], spec: SkillSpec) -> Callable[..., Any]:
+    """``implementation``, given ``spec``'s declared defaults for the parameters left out."""
+    defaults = {p.name: p.default for p in spec.params if not p.required and p.default is not None}
+    if not defaults:
+        return implementation
+
+    def build(name: str, params: Mapping[str, object], context: Any) -> Any:
+        return implementation(name, {**defaults, **params}, context)
+
+    build.__name__ = build.__qualname__ = getattr(implementation, "__name__", spec.name)
+    build.__doc__ = getattr(implementation, "__doc__", None)
+    build.__wrapped__ = implementation  # type: ignore[attr-defined]
+    return build

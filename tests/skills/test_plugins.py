@@ -7,6 +7,7 @@ import sys
 import textwrap
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -282,3 +283,15 @@ def test_a_project_with_its_own_skills_package_runs_pytest_with_the_fixtures(tmp
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "1 passed" in done.stdout
+
+
+def test_run_skill_finds_plug_in_modules(project: Path, monkeypatch: pytest.MonkeyPatch, blocks_world: Any) -> None:
+    from alica.errors import SkillError
+    from alica.skills.testing import run_skill
+
+    monkeypatch.syspath_prepend(str(project))
+    run = run_skill("CountTicks", blocks_world, "r1", {"times": 2}, skills=["count_skill"])
+    assert run.ok and run.holds("counted", "r1") and run.ticks == 2
+    assert run_skill("CountTicks", blocks_world, "r2", skills="count_skill").ticks == 3
+    with pytest.raises(SkillError, match="not both"):
+        run_skill("CountTicks", blocks_world, "r1", registry=SkillRegistry(), skills=["count_skill"])

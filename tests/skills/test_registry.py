@@ -83,3 +83,26 @@ def test_load_imports_by_name() -> None:
     import json
 
     assert registry.load("Json") is json.dumps
+
+
+def test_load_completes_params_with_the_declared_defaults() -> None:
+    seen: list[dict[str, object]] = []
+
+    def build(name: str, params: dict[str, object], context: object) -> str:
+        seen.append(dict(params))
+        return name
+
+    registry = SkillRegistry()
+    registry.declare(
+        "Turn",
+        ParamSpec("angle", "float"),
+        ParamSpec("tolerance", "float", required=False, default=0.05),
+        ParamSpec("target", "object", required=False),
+        implementation=build,
+    )
+    factory = registry.load("Turn")
+    assert factory("a", {"angle": 1.0}, None) == "a"
+    assert factory("b", {"angle": 1.0, "tolerance": 0.2}, None) == "b"
+    assert seen == [{"angle": 1.0, "tolerance": 0.05}, {"angle": 1.0, "tolerance": 0.2}]
+    registry.declare("Plain", ParamSpec("angle", "float"), implementation=build)
+    assert registry.load("Plain") is build  # nothing to complete: the implementation itself
