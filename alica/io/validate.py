@@ -233,7 +233,9 @@ class Validator:
                     "declare it under 'variables:' or fix the name",
                 )
         if b.skill not in self.skills:
-            hint = suggest(b.skill, self.skills.names()) or "run 'alica list-skills' to see the registered skills"
+            hint = suggest(b.skill, self.skills.names()) or (
+                "run 'alica list-skills' to see the registered skills; a plug-in's skills need --skills MODULE"
+            )
             self.problems.add(b.span, f"{what} binds unknown skill '{b.skill}'", hint)
             return
         spec = self.skills.get(b.skill)

@@ -136,7 +136,7 @@ class _Checker:
             self.report(
                 node,
                 f"unknown {wanted} '{name}'{mean}",
-                f"declare it, e.g. under '{wanted}s:' as {name}/{count}, or import the file that declares it",
+                f"declare it, e.g. under '{wanted}s:' as {name}/{count}, or import the file (or name with --skills the plug-in) that declares it",
             )
             return
         symbol = self.vocabulary.get(name, count)
