@@ -37,6 +37,7 @@ _EXPORTS = {
     "set_sensor_noise": "alica.worldsim.faults",
     "blocksworld": "alica.worldsim.scenarios",
     "blocks_facts": "alica.worldsim.scenarios",
+    "blocks_perception": "alica.worldsim.scenarios",
     "lunar": "alica.worldsim.scenarios",
 }
 
@@ -53,6 +54,7 @@ __all__ = [
     "WorldError",
     "WorldObject",
     "blocks_facts",
+    "blocks_perception",
     "blocksworld",
     "crash",
     "lidar_scan",

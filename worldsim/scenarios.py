@@ -15,6 +15,7 @@ import numpy as np
 from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import RobotWorld
 from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.perception import FactPerception
 from alica.worldsim.world import World
 
 __all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "random_stacks", "sample_names"]
@@ -231,6 +232,15 @@ def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple
         if x not in covered:
             facts.add(("clear", x))
     return facts
+
+
+#: The IPC facts the blocks world's perception writes into every agent's world model.
+BLOCKS_PREDICATES = ("on", "ontable", "clear", "holding", "handempty")
+
+
+def blocks_perception(every: float = 0.2) -> FactPerception:
+    """The blocks world's team perception: :func:`blocks_facts` every ``every`` simulated seconds."""
+    return FactPerception(blocks_facts, every=every, predicates=BLOCKS_PREDICATES)
 
 
 def sample_names(count: int) -> list[str]:

@@ -13,9 +13,6 @@ from alica.errors import AlicaError
 from alica.lang.skills import SkillRegistry, SkillSpec
 from alica.model import Behaviour, PlanLibrary, PlanningProblem
 
-#: Facts the blocks world's perception writes into every agent's world model.
-BLOCKS_PREDICATES = ("on", "ontable", "clear", "holding", "handempty")
-
 
 def plan_skills(library: PlanLibrary, plan: str) -> list[str]:
     """The skills the behaviours under ``plan`` run, sorted.
@@ -161,10 +158,9 @@ def run_world(args: argparse.Namespace, agents: Sequence[str]) -> Iterator[tuple
     try:
         perception = None
         if args.world == "blocks":
-            from alica.worldsim.perception import FactPerception
-            from alica.worldsim.scenarios import blocks_facts
+            from alica.worldsim.scenarios import blocks_perception
 
-            perception = FactPerception(blocks_facts, every=0.2, predicates=BLOCKS_PREDICATES)
+            perception = blocks_perception()
         yield world, perception
     finally:
         with _c_prints_to_stderr():

@@ -5,10 +5,10 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from alica.lang.skill_plugins import default_registry
-from alica.lang.skills import SkillRegistry
+if TYPE_CHECKING:
+    from alica.lang.skills import SkillRegistry
 
 #: Origin of the shipped catalogue's declarations (its entry point's module).
 SHIPPED = "alica.skills.catalog"
@@ -34,6 +34,8 @@ def skill_registry(args: argparse.Namespace) -> SkillRegistry:
     Raises:
         SkillPluginError: a module cannot be loaded (the message names it).
     """
+    from alica.lang.skill_plugins import default_registry  # here: the parser is built for every command
+
     modules = list(getattr(args, "skills", None) or [])
     if modules:
         here = os.getcwd()

@@ -20,7 +20,6 @@ imports the skills layer.
 from __future__ import annotations
 
 import importlib
-import importlib.metadata
 from collections.abc import Callable, Iterable
 from types import ModuleType
 from typing import Any
@@ -94,6 +93,8 @@ def load_entry_points(registry: SkillRegistry, group: str = ENTRY_POINT_GROUP) -
     Raises:
         SkillPluginError: an entry point cannot be loaded or its ``register`` fails.
     """
+    import importlib.metadata  # here: reading the installed metadata costs ~25 ms at start-up
+
     found: Any = importlib.metadata.entry_points(group=group)
     for entry in sorted(found, key=lambda e: (e.name, e.value)):
         where = entry.value.partition(":")[0].strip()

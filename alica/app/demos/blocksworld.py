@@ -290,8 +290,7 @@ def run_demo(
     from alica.lang.skill_plugins import default_registry
     from alica.prophet import engine_config, latest_plans
     from alica.skills.motion import configure_ompl
-    from alica.worldsim.perception import FactPerception
-    from alica.worldsim.scenarios import blocks_facts, blocksworld
+    from alica.worldsim.scenarios import blocks_perception, blocksworld
 
     configure_ompl(config.seed)  # OMPL's generator is per process: seed it before any planner exists
     if config.agents < 1 or config.opponents < 0:
@@ -308,7 +307,7 @@ def run_demo(
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = engine_config(frequency=config.frequency)
-    perception = FactPerception(blocks_facts, every=0.2, predicates=("on", "ontable", "clear", "holding", "handempty"))
+    perception = blocks_perception()
     registry = default_registry()
     team = SimulatedTeam(
         library,
