@@ -45,6 +45,7 @@ class SkillRun:
         ticks: skill ticks.
         trace: ``{"t", "status", "feedback"}`` whenever the feedback or status changed.
         facts: the world-model facts after the run (the outcome facts the skill wrote), sorted.
+        values: the world-model function values after the run, such as ``values[Fact("pos", ("r1",))]``.
     """
 
     skill: str
@@ -55,6 +56,7 @@ class SkillRun:
     ticks: int
     trace: list[dict[str, object]] = field(default_factory=list)
     facts: list[Fact] = field(default_factory=list)
+    values: dict[Fact, object] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
@@ -171,4 +173,5 @@ def run_skill(
         world.step(period)
     reason = behaviour.feedback_message or ("" if status != "timeout" else f"still running after {timeout:.0f} s")
     facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
-    return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts)
+    written = {Fact(key, args): value for key, args, value in wm.values()}
+    return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts, written)

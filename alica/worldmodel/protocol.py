@@ -63,3 +63,7 @@ class WorldModelLike(Protocol):
     def facts(self) -> list[Fact]:
         """True facts and set memberships, sorted."""
         ...
+
+    def values(self) -> list[tuple[str, tuple[object, ...], object]]:
+        """Live function values (not truth values) as ``(name, args, value)``, sorted."""
+        ...
