@@ -141,3 +141,20 @@ def test_counter_counts_finished_steps_across_plans_and_not_aborted_ones():
         counter(event)
     assert counter.steps == {"r1": 2} and len(counter.tasks["r1"]) == 2
     assert len(counter.plans) == 2 and counter.plan_length == 1 and counter.replans == 1
+
+
+def test_counter_keeps_a_step_when_the_agent_reports_a_teammates_allocation():
+    from alica.app.demos.blocksworld import PROBLEM, _Counter
+
+    at = f"M/Stacking/{PROBLEM}"
+    counter = _Counter(["Unstack", "Putdown"])
+    events = [
+        {"event": "allocation", "agent": "r3", "key": at, "plan": "G1", "entries": {"r2": "G1_T1", "r3": "G1_T2"}},
+        {"event": "allocation", "agent": "r3", "key": f"{at}/T2_S0/Unstack", "plan": "Unstack", "entries": {}},
+        # r3 sees r1 take task T3 while its own Unstack runs: r3's step and task stay
+        {"event": "allocation", "agent": "r3", "key": at, "plan": "G1", "entries": {"r1": "G1_T3"}},
+        {"event": "success", "agent": "r3", "key": f"{at}/T2_S0/Unstack", "plan": "Unstack"},
+    ]
+    for event in events:
+        counter(event)
+    assert counter.steps == {"r3": 1} and counter.tasks["r3"] == {("G1", "G1_T2")}

@@ -221,8 +221,12 @@ class _Counter:
         if kind == "allocation" and "plan" in event:
             plan = str(event["plan"])
             if key.rsplit("/", 1)[-1] == PROBLEM:  # the plan that runs under the problem: the task is its entry
-                self.task_of[agent] = (plan, str(event.get("entries", {}).get(agent, "")))
-                self.running.pop(agent, None)
+                entries = event.get("entries", {})
+                if (
+                    agent in entries
+                ):  # (an agent also reports teammates' allocations: those leave its own task as it is)
+                    self.task_of[agent] = (plan, str(entries[agent]))
+                    self.running.pop(agent, None)
             elif plan in self.elements and f"/{PROBLEM}/" in key and agent in self.task_of:
                 self.running[agent] = _Step(key, self.task_of[agent])
         elif kind == "success" and event.get("plan") in self.elements:
