@@ -80,7 +80,22 @@ class _Checker:
     def report(self, node: Node, message: str, hint: str = "") -> None:
         self.errors.append(FormulaError(message, node.column, self.text, hint))
 
-    def visit(self, node: Node, boolean: bool) -> None:
+    def visit(self, root: Node, boolean: bool) -> None:
+        """Check ``root`` and its sub-formulas in pre-order, with an explicit stack (no recursion)."""
+        outer = self.bound
+        stack: list[tuple[Node, bool, frozenset[str]]] = [(root, boolean, outer)]
+        while stack:
+            node, boolean, self.bound = stack.pop()
+            self.check_node(node, boolean)
+            if isinstance(node, Quantified):
+                stack.append((node.body, True, self.bound | {var for var, _ in node.binders}))
+                continue
+            logical = isinstance(node, (Not, And, Or, Implies, Iff))
+            stack.extend((child, logical, self.bound) for child in reversed(children(node)))
+        self.bound = outer
+
+    def check_node(self, node: Node, boolean: bool) -> None:
+        """The checks of one node (``boolean``: a truth value is needed here)."""
         if boolean and isinstance(node, (Number, String, Binary, Unary)):
             self.report(
                 node,
@@ -112,15 +127,6 @@ class _Checker:
                         f"'{unparse(operand)}' is {_describe(operand)}, which cannot be ordered",
                         "use = or != to compare truth values",
                     )
-        logical = isinstance(node, (Not, And, Or, Implies, Iff, Quantified))
-        if isinstance(node, Quantified):
-            outer = self.bound
-            self.bound = outer | {var for var, _ in node.binders}
-            self.visit(node.body, True)
-            self.bound = outer
-            return
-        for child in children(node):
-            self.visit(child, logical)
 
     def check_declared(self, node: Name | Call, count: int, boolean: bool) -> None:
         """A name read as a predicate (``boolean``) or a function must be registered or declared."""

@@ -232,64 +232,87 @@ class _Compiler:
         return fact
 
     def v_attr(self, node: Attr) -> Closure:
-        get = self.value(node.obj)
-        name = node.name
-        index = _XYZ.get(name)
-        private = name.startswith("_")
+        # a.b.c...: one loop over the chain, however long
+        chain: list[Attr] = []
+        inner: Node = node
+        while isinstance(inner, Attr):
+            chain.append(inner)
+            inner = inner.obj
+        get = self.value(inner)
+        chain.reverse()
+        if len(chain) == 1:
+            return lambda b, e: _attribute(node, get(b, e))
 
-        def attr(b: BeliefBase, e: Env) -> Any:
+        def attrs(b: BeliefBase, e: Env) -> Any:
             obj = get(b, e)
-            if isinstance(obj, Mapping):
-                if name in obj:
-                    return obj[name]
-            elif not private:
-                try:
-                    return getattr(obj, name)
-                except AttributeError:
-                    pass
-                if index is not None and not isinstance(obj, (str, bytes)):
-                    try:
-                        return obj[index]
-                    except (TypeError, IndexError, KeyError):
-                        pass
-            raise _fail(node, f"{_show(obj)} has no attribute '{name}'")
+            for link in chain:
+                obj = _attribute(link, obj)
+            return obj
 
-        return attr
+        return attrs
 
     def v_unary(self, node: Unary) -> Closure:
-        get = self.value(node.operand)
-
-        def negate(b: BeliefBase, e: Env) -> Any:
-            value = get(b, e)
-            if _is_number(value):
-                return -value
-            raise _fail(node, f"cannot negate {_show(value)}")
-
-        return negate
+        return self.power_chain(node)
 
     def v_binary(self, node: Binary) -> Closure:
-        left, right = self.value(node.left), self.value(node.right)
-        op = node.op
-        fn = _ARITH[op]
+        if node.op == "^":
+            return self.power_chain(node)
+        # a + b - c * ...: the left spine of + - * / % in one loop
+        spine: list[Binary] = []
+        inner: Node = node
+        while isinstance(inner, Binary) and inner.op != "^":
+            spine.append(inner)
+            inner = inner.left
+        first = self.value(inner)
+        spine.reverse()
+        steps = tuple((link, self.value(link.right)) for link in spine)
+        if len(steps) == 1:
+            right = steps[0][1]
+            return lambda b, e: _arith(node, first(b, e), right(b, e))
 
         def arith(b: BeliefBase, e: Env) -> Any:
-            x = left(b, e)
-            y = right(b, e)
-            if not (_is_number(x) and _is_number(y)):
-                raise _fail(node, f"cannot apply '{op}' to {_show(x)} and {_show(y)}")
-            if op == "^" and type(x) is int and type(y) is int and y * x.bit_length() > 4096:
-                x = float(x)  # keep exact powers small; huge ones overflow as floats
-            try:
-                result = fn(x, y)
-            except ZeroDivisionError:
-                raise _fail(node, "division by zero") from None
-            except (OverflowError, ValueError) as exc:
-                raise _fail(node, f"arithmetic error: {exc}") from None
-            if type(result) is complex:
-                raise _fail(node, "result is not a real number")
-            return result
+            x = first(b, e)
+            for link, right in steps:
+                x = _arith(link, x, right(b, e))
+            return x
 
         return arith
+
+    def power_chain(self, node: Unary | Binary) -> Closure:
+        """``a ^ -b ^ c ...`` and ``- - x``: the right spine of ``^`` and unary minus in one loop.
+
+        The bases are evaluated first, left to right, then the innermost
+        operand, then the operators from the inside out.
+        """
+        links: list[Unary | Binary] = []
+        inner: Node = node
+        while True:
+            if isinstance(inner, Unary):
+                links.append(inner)
+                inner = inner.operand
+            elif isinstance(inner, Binary) and inner.op == "^":
+                links.append(inner)
+                inner = inner.right
+            else:
+                break
+        bases = tuple(self.value(link.left) if isinstance(link, Binary) else None for link in links)
+        last = self.value(inner)
+        if len(links) == 1:
+            base = bases[0]
+            if base is None:
+                return lambda b, e: _negate(node, last(b, e))
+            return lambda b, e: _arith(node, base(b, e), last(b, e))
+        pairs = tuple(zip(links, bases, strict=True))
+        backwards = tuple(reversed(pairs))
+
+        def chain(b: BeliefBase, e: Env) -> Any:
+            values = [None if base is None else base(b, e) for _, base in pairs]
+            x = last(b, e)
+            for i, (link, base) in enumerate(backwards, 1):
+                x = _negate(link, x) if base is None else _arith(link, values[-i], x)
+            return x
+
+        return chain
 
     # -- truths --------------------------------------------------------
 
@@ -372,7 +395,14 @@ class _Compiler:
         return order
 
     def t_not(self, node: Not) -> Closure:
-        get = self.truth(node.operand)
+        count = 0
+        inner: Node = node
+        while isinstance(inner, Not):
+            count += 1
+            inner = inner.operand
+        get = self.truth(inner)
+        if count % 2 == 0:
+            return get
         return lambda b, e: not get(b, e)
 
     def t_and(self, node: And) -> Closure:
@@ -398,12 +428,46 @@ class _Compiler:
         return disjunction
 
     def t_implies(self, node: Implies) -> Closure:
-        left, right = self.truth(node.left), self.truth(node.right)
-        return lambda b, e: (not left(b, e)) or right(b, e)
+        # a -> b -> c ... is right-nested: true at the first false premise
+        premises: list[Closure] = []
+        inner: Node = node
+        while isinstance(inner, Implies):
+            premises.append(self.truth(inner.left))
+            inner = inner.right
+        last = self.truth(inner)
+        if len(premises) == 1:
+            left = premises[0]
+            return lambda b, e: (not left(b, e)) or last(b, e)
+        chain = tuple(premises)
+
+        def implication(b: BeliefBase, e: Env) -> bool:
+            for premise in chain:
+                if not premise(b, e):
+                    return True
+            return bool(last(b, e))
+
+        return implication
 
     def t_iff(self, node: Iff) -> Closure:
-        left, right = self.truth(node.left), self.truth(node.right)
-        return lambda b, e: left(b, e) == right(b, e)
+        # a <-> b <-> c ... is left-nested: one loop from the left
+        rights: list[Node] = []
+        inner: Node = node
+        while isinstance(inner, Iff):
+            rights.append(inner.right)
+            inner = inner.left
+        first = self.truth(inner)
+        steps = tuple(self.truth(right) for right in reversed(rights))
+        if len(steps) == 1:
+            right = steps[0]
+            return lambda b, e: first(b, e) == right(b, e)
+
+        def equivalence(b: BeliefBase, e: Env) -> bool:
+            x = first(b, e)
+            for step in steps:
+                x = x == step(b, e)
+            return bool(x)
+
+        return equivalence
 
     def t_quantified(self, node: Quantified) -> Closure:
         body = self.truth(node.body)
@@ -442,6 +506,50 @@ class _Compiler:
             return universal
 
         return several
+
+
+def _attribute(node: Attr, obj: object) -> Any:
+    """``obj.name`` as the formula language reads it (mapping key, attribute, x/y/z index)."""
+    name = node.name
+    if isinstance(obj, Mapping):
+        if name in obj:
+            return obj[name]
+    elif not name.startswith("_"):
+        try:
+            return getattr(obj, name)
+        except AttributeError:
+            pass
+        index = _XYZ.get(name)
+        if index is not None and not isinstance(obj, (str, bytes)):
+            try:
+                return obj[index]  # type: ignore[index]
+            except (TypeError, IndexError, KeyError):
+                pass
+    raise _fail(node, f"{_show(obj)} has no attribute '{name}'")
+
+
+def _negate(node: Unary | Binary, value: object) -> Any:
+    if _is_number(value):
+        return -value  # type: ignore[operator]
+    raise _fail(node, f"cannot negate {_show(value)}")
+
+
+def _arith(node: Unary | Binary, x: Any, y: Any) -> Any:
+    """``x op y`` for the operator of ``node``, with the language's errors."""
+    op = node.op
+    if not (_is_number(x) and _is_number(y)):
+        raise _fail(node, f"cannot apply '{op}' to {_show(x)} and {_show(y)}")
+    if op == "^" and type(x) is int and type(y) is int and y * x.bit_length() > 4096:
+        x = float(x)  # keep exact powers small; huge ones overflow as floats
+    try:
+        result = _ARITH[op](x, y)
+    except ZeroDivisionError:
+        raise _fail(node, "division by zero") from None
+    except (OverflowError, ValueError) as exc:
+        raise _fail(node, f"arithmetic error: {exc}") from None
+    if type(result) is complex:
+        raise _fail(node, "result is not a real number")
+    return result
 
 
 def _missing(node: Call, values: tuple[Any, ...]) -> EvaluationError:

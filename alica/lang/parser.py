@@ -20,6 +20,13 @@ Grammar, lowest precedence first::
     args       := (formula (',' formula)*)?
 
 A quantifier's body extends as far right as possible.
+
+Chains of operators (``a + b + ...``, ``a.b.c``, ``a -> b -> ...``,
+``not not a``, ``- - x``, ``a ^ b ^ ...``) are read by loops, so their length
+is not limited by Python's stack. Real nesting (parentheses, call arguments
+and quantifier bodies) is recursive and capped at :data:`MAX_DEPTH` levels,
+with an error at the opening that goes too deep; every later walk over a tree
+either loops or recurses only through that nesting.
 """
 
 from __future__ import annotations
@@ -48,8 +55,8 @@ from alica.lang.ast import (
 )
 from alica.lang.lexer import Token, tokenize
 
-#: How deeply parentheses, calls, negations and right-nested operators may nest.
-MAX_DEPTH = 40
+#: How deeply parentheses, call arguments and quantifier bodies may nest.
+MAX_DEPTH = 20
 
 _COMPARE = frozenset({"<", "<=", ">", ">=", "==", "!="})
 _TERM_HINT = "a term is a name, a number, a quoted string, a call like f(x) or a formula in parentheses"
@@ -87,12 +94,13 @@ class _Parser:
             return ""
         return f" after '{self.tokens[self.pos - 1].text}'"
 
-    def enter(self) -> None:
+    def enter(self, opening: Token) -> None:
+        """One level deeper at ``opening`` (a '(' or a quantifier)."""
         self.depth += 1
         if self.depth > MAX_DEPTH:
             raise self.error(
-                f"formula nested too deeply (more than {MAX_DEPTH} levels)",
-                self.tok,
+                f"formula nested deeper than {MAX_DEPTH} levels; simplify it",
+                opening,
                 "split the formula or remove redundant parentheses",
             )
 
@@ -133,15 +141,17 @@ class _Parser:
         return left
 
     def implies(self) -> Node:
-        start = self.tok.column
-        left = self.disjunction()
-        if self.tok.kind != "->":
-            return left
-        self.advance()
-        self.enter()
-        right = self.implies()
-        self.leave()
-        return Implies(left, right, start)
+        starts = [self.tok.column]
+        items = [self.disjunction()]
+        while self.tok.kind == "->":
+            self.advance()
+            starts.append(self.tok.column)
+            items.append(self.disjunction())
+        node = items.pop()
+        starts.pop()
+        while items:
+            node = Implies(items.pop(), node, starts.pop())
+        return node
 
     def disjunction(self) -> Node:
         start = self.tok.column
@@ -166,16 +176,13 @@ class _Parser:
         return And(tuple(items), start)
 
     def negation(self) -> Node:
-        token = self.tok
-        if token.kind == "not":
-            self.advance()
-            self.enter()
-            operand = self.negation()
-            self.leave()
-            return Not(operand, token.column)
-        if token.kind in ("forall", "exists"):
-            return self.quantified()
-        return self.comparison()
+        nots: list[Token] = []
+        while self.tok.kind == "not":
+            nots.append(self.advance())
+        node = self.quantified() if self.tok.kind in ("forall", "exists") else self.comparison()
+        while nots:
+            node = Not(node, nots.pop().column)
+        return node
 
     def quantified(self) -> Node:
         head = self.advance()
@@ -205,7 +212,7 @@ class _Parser:
                 self.tok,
                 f"write {head.text} x in Type: formula",
             )
-        self.enter()
+        self.enter(head)
         body = self.formula()
         self.leave()
         return Quantified(head.kind, tuple(binders), body, head.column)
@@ -242,25 +249,34 @@ class _Parser:
         return left
 
     def unary(self) -> Node:
-        token = self.tok
-        if token.kind == "-":
-            self.advance()
-            self.enter()
-            operand = self.unary()
-            self.leave()
-            return Unary("-", operand, token.column)
-        return self.power()
+        minus: list[Token] = []
+        while self.tok.kind == "-":
+            minus.append(self.advance())
+        node = self.power()
+        while minus:
+            node = Unary("-", node, minus.pop().column)
+        return node
 
     def power(self) -> Node:
+        # base ^ -...- base ^ ... : each exponent is a unary, read in this loop
+        links: list[tuple[int, Node, list[Token]]] = []
         start = self.tok.column
         base = self.postfix()
-        if self.tok.kind != "^":
-            return base
-        self.advance()
-        self.enter()
-        exponent = self.unary()
-        self.leave()
-        return Binary("^", base, exponent, start)
+        while self.tok.kind == "^":
+            self.advance()
+            minus: list[Token] = []
+            while self.tok.kind == "-":
+                minus.append(self.advance())
+            links.append((start, base, minus))
+            start = self.tok.column
+            base = self.postfix()
+        node = base
+        while links:
+            start, base, minus = links.pop()
+            while minus:
+                node = Unary("-", node, minus.pop().column)
+            node = Binary("^", base, node, start)
+        return node
 
     def postfix(self) -> Node:
         start = self.tok.column
@@ -290,7 +306,7 @@ class _Parser:
             return Name(token.text, token.column)
         if kind == "(":
             self.advance()
-            self.enter()
+            self.enter(token)
             node = self.formula()
             self.leave()
             self.close(token)
@@ -303,7 +319,7 @@ class _Parser:
 
     def arguments(self) -> tuple[Node, ...]:
         opening = self.advance()
-        self.enter()
+        self.enter(opening)
         args: list[Node] = []
         if self.tok.kind != ")":
             args.append(self.formula())
@@ -331,7 +347,10 @@ def _parse_cached(text: str) -> Node:
     try:
         return parser.parse()
     except RecursionError:
-        raise FormulaError("formula nested too deeply", 1, text, "split the formula into simpler parts") from None
+        # a safety net: the depth cap keeps the parser far below Python's limit
+        raise FormulaError(
+            "formula nested too deeply for this stack; simplify it", 1, text, "split the formula into simpler parts"
+        ) from None
 
 
 def parse(text: str) -> Node:

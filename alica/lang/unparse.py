@@ -83,44 +83,54 @@ def _binders(binders: tuple[tuple[str, str], ...]) -> str:
     return ", ".join(f"{', '.join(names)} in {type_name}" for names, type_name in groups)
 
 
-def _fmt(node: Node, minimum: int, tail: bool) -> str:
-    if _level(node) < minimum or (isinstance(node, Quantified) and not tail):
-        return "(" + _text(node, True) + ")"
-    return _text(node, tail)
+#: A piece of output: text as it is, or ``(node, minimum level, tail)`` to format.
+_Piece = str | tuple[Node, int, bool]
 
 
-def _text(node: Node, tail: bool) -> str:
+def _parts(node: Node, tail: bool) -> list[_Piece]:
+    """The text of ``node`` as pieces; sub-nodes are formatted later by :func:`unparse`."""
     if isinstance(node, Name):
-        return node.name
+        return [node.name]
     if isinstance(node, Number):
-        return format_number(node.value)
+        return [format_number(node.value)]
     if isinstance(node, String):
-        return quote(node.value)
+        return [quote(node.value)]
     if isinstance(node, Bool):
-        return "true" if node.value else "false"
+        return ["true" if node.value else "false"]
     if isinstance(node, Call):
-        return f"{node.name}({', '.join(_fmt(arg, _IFF, True) for arg in node.args)})"
+        pieces: list[_Piece] = [node.name + "("]
+        for i, arg in enumerate(node.args):
+            if i:
+                pieces.append(", ")
+            pieces.append((arg, _IFF, True))
+        pieces.append(")")
+        return pieces
     if isinstance(node, Attr):
-        return f"{_fmt(node.obj, _ATOM, False)}.{node.name}"
+        return [(node.obj, _ATOM, False), "." + node.name]
     if isinstance(node, Unary):
-        return node.op + _fmt(node.operand, _UNARY, False)
+        return [node.op, (node.operand, _UNARY, False)]
     if isinstance(node, Binary):
         _, left, right = _BINARY_PREC[node.op]
-        return f"{_fmt(node.left, left, False)} {node.op} {_fmt(node.right, right, False)}"
+        return [(node.left, left, False), f" {node.op} ", (node.right, right, False)]
     if isinstance(node, Compare):
-        return f"{_fmt(node.left, _ADD, False)} {node.op} {_fmt(node.right, _ADD, False)}"
+        return [(node.left, _ADD, False), f" {node.op} ", (node.right, _ADD, False)]
     if isinstance(node, Not):
-        return "not " + _fmt(node.operand, _NOT, tail)
+        return ["not ", (node.operand, _NOT, tail)]
     if isinstance(node, (And, Or)):
         word, minimum = (" and ", _NOT) if isinstance(node, And) else (" or ", _AND)
         last = len(node.items) - 1
-        return word.join(_fmt(item, minimum, tail and i == last) for i, item in enumerate(node.items))
+        pieces = []
+        for i, item in enumerate(node.items):
+            if i:
+                pieces.append(word)
+            pieces.append((item, minimum, tail and i == last))
+        return pieces
     if isinstance(node, Implies):
-        return f"{_fmt(node.left, _OR, False)} -> {_fmt(node.right, _IMPLIES, tail)}"
+        return [(node.left, _OR, False), " -> ", (node.right, _IMPLIES, tail)]
     if isinstance(node, Iff):
-        return f"{_fmt(node.left, _IFF, False)} <-> {_fmt(node.right, _IMPLIES, tail)}"
+        return [(node.left, _IFF, False), " <-> ", (node.right, _IMPLIES, tail)]
     if isinstance(node, Quantified):
-        return f"{node.kind} {_binders(node.binders)}: {_fmt(node.body, _IFF, True)}"
+        return [f"{node.kind} {_binders(node.binders)}: ", (node.body, _IFF, True)]
     raise TypeError(f"not a formula node: {node!r}")
 
 
@@ -133,4 +143,17 @@ def unparse(node: Node) -> str:
     Returns:
         Text that parses back to a tree equal to ``node``.
     """
-    return _text(node, True)
+    # an explicit stack instead of recursion: chains of any length unparse
+    out: list[str] = []
+    stack: list[_Piece] = [(node, _IFF, True)]
+    while stack:
+        piece = stack.pop()
+        if isinstance(piece, str):
+            out.append(piece)
+            continue
+        sub, minimum, tail = piece
+        if _level(sub) < minimum or (isinstance(sub, Quantified) and not tail):
+            stack.extend((")", (sub, _IFF, True), "("))
+        else:
+            stack.extend(reversed(_parts(sub, tail)))
+    return "".join(out)

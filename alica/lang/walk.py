@@ -92,11 +92,14 @@ def _term(node: Node, text: str) -> object:
 
 
 def _conjuncts(node: Node) -> Iterator[Node]:
-    if isinstance(node, And):
-        for item in node.items:
-            yield from _conjuncts(item)
-    elif not (isinstance(node, Bool) and node.value):
-        yield node
+    """The items of nested conjunctions, left to right, without ``true``."""
+    stack = [node]
+    while stack:
+        current = stack.pop()
+        if isinstance(current, And):
+            stack.extend(reversed(current.items))
+        elif not (isinstance(current, Bool) and current.value):
+            yield current
 
 
 def _literal(item: Node, text: str) -> tuple[bool, Node, Literal]:

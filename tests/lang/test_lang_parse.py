@@ -24,6 +24,7 @@ from alica.lang import (
     parse,
     unparse,
 )
+from alica.lang.parser import MAX_DEPTH
 
 a, b, c = Name("a"), Name("b"), Name("c")
 
@@ -262,16 +263,19 @@ def test_error_message_points_at_column() -> None:
     assert str(err).splitlines()[-1] == "  " + " " * 6 + "^"
 
 
-def test_deep_nesting_is_a_formula_error() -> None:
-    err = error_of("(" * 500 + "a" + ")" * 500)
-    assert "nested too deeply" in err.message
-    error_of("not " * 500 + "a")
-    error_of("-" * 500 + "1 > 0")
-    error_of("a -> " * 500 + "a")
+def test_deep_nesting_is_a_formula_error_at_the_opening_too_deep() -> None:
+    err = error_of("x and " + "(" * 500 + "a" + ")" * 500)
+    assert err.message == f"formula nested deeper than {MAX_DEPTH} levels; simplify it"
+    assert err.column == 7 + MAX_DEPTH
+    err = error_of("f(" * (MAX_DEPTH + 1) + "a" + ")" * (MAX_DEPTH + 1))
+    assert "nested deeper than" in err.message
+    assert err.column == 2 * MAX_DEPTH + 2  # the "(" of the call one level too deep
+    quantifiers = "forall x in T: " * (MAX_DEPTH + 1) + "a"
+    assert error_of(quantifiers).column == 15 * MAX_DEPTH + 1
 
 
 def test_moderate_nesting_is_fine() -> None:
-    assert parse("(" * 30 + "a" + ")" * 30) == a
+    assert parse("(" * MAX_DEPTH + "a" + ")" * MAX_DEPTH) == a
 
 
 def test_parse_rejects_non_strings() -> None:
