@@ -268,7 +268,10 @@ class SimulatedTeam:
             robot.recover()  # the body powers up again where it stopped
         old = self.engines[name]
         # a restarted agent listens for a broadcast interval before it allocates
-        self.engines[name] = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
+        engine = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
+        # the operator's settings are the robot's configuration, not its memory: the restart keeps them
+        engine.overrides = {problem: dict(values) for problem, values in old.overrides.items()}
+        self.engines[name] = engine
         self._fault("recover", agent=name)
 
     def partition(self, groups: Iterable[Iterable[str]], start: float | None = None, end: float | None = None) -> None:
