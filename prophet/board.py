@@ -11,6 +11,7 @@ it late still finds the latest plan.
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 from enum import Enum
 
@@ -54,6 +55,7 @@ class PlanShare:
         reason: why it failed, or why the leader replans.
         goal: the goal literals the plan reaches when robots outside the team hold
             objects of the goal (the rest of the goal); empty: the whole goal.
+        origin: the agent that made the plan (a leader repeating it keeps it).
     """
 
     key: PlanKey
@@ -68,6 +70,31 @@ class PlanShare:
     entry_task: str = ""
     reason: str = ""
     goal: tuple[Literal, ...] = ()
+    origin: str = ""
+
+    def plan_name(self, problem: str) -> str:
+        """The name of the plan generated from this share: unique to its content.
+
+        Two leaders may share plans of the same generation and version (a
+        restarted agent leads before it learns the team's generation; a
+        partition heals), so the name also holds who made the plan and a
+        digest of what it holds: agents that know a plan by a name know the
+        same plan.
+        """
+        content = repr((self.steps, self.world, self.robots, self.entry_task, self.goal, self.key))
+        digest = hashlib.blake2b(content.encode("utf-8"), digest_size=3).hexdigest()
+        who = self.origin or self.leader
+        return f"{problem}_g{self.generation}v{self.version}_{who}_{digest}"
+
+    def same_plan(self, other: PlanShare) -> bool:
+        """Whether ``other`` shares the same plan (a repeat, maybe by another leader)."""
+        return (
+            (self.generation, self.version, self.status) == (other.generation, other.version, other.status)
+            and self.steps == other.steps
+            and self.world == other.world
+            and self.robots == other.robots
+            and self.goal == other.goal
+        )
 
     def supersedes(self, other: PlanShare) -> bool:
         """Newer generation, then newer version; the lower leader wins a tie (a partition healed)."""
@@ -95,6 +122,8 @@ class PlanBoard:
         self.requests: dict[PlanKey, list[ReplanRequest]] = {}
         self.latest: dict[PlanKey, CreatedTasks] = {}
         """The latest generated plan per planning problem, kept after the problem's state is left."""
+        self.behind: set[PlanKey] = set()
+        """Problems whose leader shared an older plan than this board holds (a restarted leader): tell it."""
 
     def receive(self, payload: object, now: float) -> None:
         """Take in a share (kept if it supersedes the one known) or a replan request; ignore anything else."""
@@ -108,8 +137,13 @@ class PlanBoard:
             if current is None or payload.supersedes(current):
                 self.shares[key] = payload
                 self.received_at[key] = now
-            elif (payload.generation, payload.version) == (current.generation, current.version):
+            elif payload.same_plan(current):
                 self.received_at[key] = now  # the leader repeats it: still current
+            elif payload.leader != current.leader and (payload.generation, payload.version) < (
+                current.generation,
+                current.version,
+            ):
+                self.behind.add(key)  # its leader has not seen the latest plan: it restarted, or was cut off
 
     def _generation(self, key: PlanKey, generation: int) -> None:
         self.generations[key] = max(self.generations.get(key, 0), generation)

@@ -230,6 +230,12 @@ class ProblemRuntime:
             and (self.share is None or latest.supersedes(self.share))
         ):
             self._adopt(latest, now)
+        if self.key in self.board.behind:
+            # a teammate leads with an older plan than the team's (it restarted): tell it the latest
+            self.board.behind.discard(self.key)
+            known = self.board.shares.get(self.key)
+            if known is not None:
+                host.publish(known)
         overrides = host.override(self.model.name)
         changed = overrides != self.overrides
         if changed:
@@ -279,12 +285,18 @@ class ProblemRuntime:
     def _adopt(self, share: PlanShare, now: float) -> None:
         host = self.host
         current = self.share
-        if current is not None and (current.generation, current.version) == (share.generation, share.version):
+        if current is not None and current.same_plan(share):
             self.share = share  # the same plan, repeated by another leader
             return
+        search = self.search
+        if search is not None and share.leader != host.name and share.generation >= search.generation:
+            # another leader is ahead (this agent restarted, or a partition healed): its plan wins
+            self.search = None
+            self.pending = None
+            host.emit("planner", key=key_text(self.key), what="superseded", generation=search.generation)
         created = None
         if share.status == PLAN:
-            name = f"{self.model.name}_g{share.generation}v{share.version}"
+            name = share.plan_name(self.model.name)
             try:
                 created = create_tasks(
                     name,
@@ -621,6 +633,7 @@ class ProblemRuntime:
             search.world.robots,
             self._entry_task(),
             goal=search.goal,
+            origin=self.host.name,
         )
         self._publish(share, now)
 

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from alica.worldsim.robots import Robot
     from alica.worldsim.world import World
 
-__all__ = ["Faults", "SensorNoise", "crash", "set_grasp_slip", "set_sensor_noise"]
+__all__ = ["Faults", "SensorNoise", "crash", "recover", "set_grasp_slip", "set_sensor_noise"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,8 +70,12 @@ class Faults:
         self.grasp_slip = 0.0
 
     def crash(self, robot: Robot | str) -> None:
-        """Crash a robot: it stops and ignores every later command (drive, arm, gripper)."""
+        """Crash a robot (power loss): it stops, drops what it holds and ignores every later command."""
         self._robot(robot).crash()
+
+    def recover(self, robot: Robot | str) -> None:
+        """Power a crashed robot up again: it takes commands from where it stopped."""
+        self._robot(robot).recover()
 
     def set_grasp_slip(self, probability: float) -> None:
         """Each later successful attach slips with this probability: the object drops within a short time."""
@@ -108,8 +112,13 @@ class Faults:
 
 
 def crash(robot: Robot) -> None:
-    """Crash ``robot`` (it stops acting; commands are ignored)."""
+    """Crash ``robot`` (it stops acting and drops what it holds; commands are ignored)."""
     robot.crash()
+
+
+def recover(robot: Robot) -> None:
+    """Power ``robot`` up again after a crash."""
+    robot.recover()
 
 
 def set_grasp_slip(world: World, probability: float) -> None:

@@ -279,12 +279,26 @@ class Robot:
         self._w = 0.0
 
     def crash(self) -> None:
-        """Stop acting for good: base and arm stop, later commands are ignored."""
+        """Lose power: base and arm stop, the gripper lets go of what it holds, later commands are ignored.
+
+        The released object falls where it is (physics); :meth:`recover` powers the robot up again.
+        """
         self._crashed = True
         self.stop()
         if self.arm is not None:
             self.arm.stop()
+            dropped = self.arm.detach()
+            if dropped is not None:
+                logger.info("robot %s crashed and dropped '%s'", self.name, dropped.name)
         logger.info("robot %s crashed", self.name)
+
+    def recover(self) -> None:
+        """Power up after a crash: the robot stands where it stopped and takes commands again."""
+        if not self._crashed:
+            return
+        self._crashed = False
+        self.stop()
+        logger.info("robot %s recovered", self.name)
 
     # --------------------------------------------------------------- internals
     def _apply_pose(self) -> None:

@@ -6,11 +6,14 @@ Exit 0 when the goal holds, 1 when the time limit passed first or the input is b
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from alica.app.timed import timed
 from alica.errors import AlicaError
 
 
@@ -42,6 +45,20 @@ def add_parser(sub: Any) -> None:
     )
     b.add_argument(
         "--time-limit", type=float, default=600.0, metavar="S", help="simulated seconds before giving up (default 600)"
+    )
+    b.add_argument(
+        "--crash",
+        action="append",
+        default=[],
+        metavar="NAME@T",
+        help="crash team robot NAME (r1..rN) at simulated second T: it stops, drops what it holds and goes silent (repeatable)",
+    )
+    b.add_argument(
+        "--recover",
+        action="append",
+        default=[],
+        metavar="NAME@T",
+        help="restart team robot NAME at second T, with an empty memory (repeatable)",
     )
     b.add_argument("--out", metavar="DIR", help="write trace.jsonl, initial.png, final.png and plan.yaml here")
     b.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -142,9 +159,12 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         goal=goal,
         time_limit=args.time_limit,
     )
+    actions = fault_actions(args.crash, args.recover, args.agents)
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
     try:
-        result = run_demo(config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui)
+        result = run_demo(
+            config, on_second=progress, actions=actions, out=Path(args.out) if args.out else None, gui=args.gui
+        )
     finally:
         if progress is not None:
             progress.close()
@@ -153,6 +173,29 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
     else:
         _print_summary(result)
     return 0 if result.success else 1
+
+
+def fault_actions(
+    crashes: Sequence[str], recoveries: Sequence[str], agents: int
+) -> list[tuple[float, Callable[[Any], None]]]:
+    """The demo's timed faults from ``--crash NAME@T`` and ``--recover NAME@T``, in the order given.
+
+    Raises:
+        AlicaError: a value is not NAME@T, or NAME is not a team robot.
+    """
+    team = [f"r{i + 1}" for i in range(agents)]
+    actions: list[tuple[float, Callable[[Any], None]]] = []
+    for option, texts, method in (("--crash", crashes, "crash"), ("--recover", recoveries, "recover")):
+        for text in texts:
+            who, at, _ = timed(option, text)
+            if who not in team:
+                raise AlicaError(f"{option}: '{who}' is not a team robot; the team is {', '.join(team)}")
+            actions.append((at, functools.partial(_fault, method, who)))
+    return actions
+
+
+def _fault(method: str, who: str, team: Any) -> None:
+    getattr(team, method)(who)
 
 
 def _print_summary(result: Any) -> None:

@@ -16,9 +16,8 @@ import sys
 from typing import Any
 
 from alica.app.skill_options import add_skills_option
+from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
-
-_AT = re.compile(r"^(?P<what>.+)@(?P<start>[0-9.]+)(?:-(?P<end>[0-9.]+))?$")
 
 
 def add_parser(sub: Any) -> None:
@@ -144,15 +143,6 @@ def _agents(text: str) -> dict[str, str | frozenset[str] | None]:
     if not agents:
         raise AlicaError("--agents: give at least one agent, e.g. --agents scout:Scout")
     return agents
-
-
-def _timed(option: str, text: str, span: bool = False) -> tuple[str, float, float | None]:
-    match = _AT.match(text.strip())
-    if match is None or (match.group("end") is not None and not span):
-        form = "WHAT@T1-T2" if span else "WHAT@T"
-        raise AlicaError(f"{option}: '{text}' is not of the form {form} (T in simulated seconds)")
-    end = float(match.group("end")) if match.group("end") else None
-    return match.group("what").strip(), float(match.group("start")), end
 
 
 def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset: str | None) -> dict[str, Any]:

@@ -250,7 +250,7 @@ class SimulatedTeam:
         self.network.crash(name)
         robot = getattr(self.world, "robots", {}).get(name)
         if robot is not None:
-            robot.crash()  # the robot stops where it is (holding what it holds)
+            robot.crash()  # power loss: the robot stops where it is and drops what it holds
         self._fault("crash", agent=name)
 
     def recover(self, name: str, at: float | None = None) -> None:
@@ -263,9 +263,15 @@ class SimulatedTeam:
             return
         self.crashed.discard(name)
         self.network.recover(name)
+        robot = getattr(self.world, "robots", {}).get(name)
+        if robot is not None and hasattr(robot, "recover"):
+            robot.recover()  # the body powers up again where it stopped
         old = self.engines[name]
         # a restarted agent listens for a broadcast interval before it allocates
-        self.engines[name] = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
+        engine = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
+        # the operator's settings are the robot's configuration, not its memory: the restart keeps them
+        engine.overrides = {problem: dict(values) for problem, values in old.overrides.items()}
+        self.engines[name] = engine
         self._fault("recover", agent=name)
 
     def partition(self, groups: Iterable[Iterable[str]], start: float | None = None, end: float | None = None) -> None:

@@ -158,3 +158,71 @@ def test_counter_keeps_a_step_when_the_agent_reports_a_teammates_allocation():
     for event in events:
         counter(event)
     assert counter.steps == {"r3": 1} and counter.tasks["r3"] == {("G1", "G1_T2")}
+
+
+def _demo_cli(*options: str) -> tuple[subprocess.CompletedProcess[str], dict]:
+    run = subprocess.run(
+        [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", *options, "--json", "--no-progress"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    lines = [line for line in run.stdout.splitlines() if line.startswith("{")]
+    return run, json.loads(lines[-1]) if lines else {}
+
+
+def test_a_leader_restarted_while_the_team_plans_rejoins_and_the_goal_is_reached():
+    # the restarted r1 leads again before it knows the team's plans: it used to reuse a plan name
+    # (KeyError: "plan 'StackBlocks_g2v1' has no state 'T1_S0_Unstack'") or plan for the mission's own goal
+    run, summary = _demo_cli(
+        "--agents",
+        "3",
+        "--blocks",
+        "5",
+        "--seed",
+        "0",
+        "--time-limit",
+        "300",
+        "--crash",
+        "r1@3.5",
+        "--recover",
+        "r1@13.75",
+    )
+    assert "Traceback" not in run.stderr and run.returncode == 0, run.stderr[-2000:]
+    assert summary["success"] and summary["crashed"] == []
+    assert summary["steps"]["r1"] >= 1  # the recovered robot acts again
+
+
+def test_demo_fault_options_are_checked():
+    run, _ = _demo_cli("--agents", "2", "--crash", "r3@2")
+    assert run.returncode == 1 and "--crash: 'r3' is not a team robot; the team is r1, r2" in run.stderr
+    run, _ = _demo_cli("--recover", "r1")
+    assert run.returncode == 1 and "--recover: 'r1' is not of the form WHAT@T" in run.stderr
+    assert "Traceback" not in run.stderr
+
+
+def test_a_crashed_holder_drops_its_block_and_the_team_plans_again():
+    crashed: list[tuple[str, str]] = []
+    revived: list[bool] = []
+
+    def crash_a_holder(team):
+        if crashed:
+            return
+        for name in sorted(team.engines):
+            held = team.world.robots[name].arm.held
+            if held is not None:
+                crashed.append((name, held.name))
+                team.crash(name)  # power loss: the gripper opens
+                assert team.world.robots[name].arm.held is None
+                team.recover(name, at=team.now() + 10.0)
+                team.at(team.now() + 10.5, "check", lambda: revived.append(not team.world.robots[name].crashed))
+                return
+
+    result = run_demo(
+        DemoConfig(agents=3, blocks=5, seed=0, time_limit=300),
+        actions=[(5.0 + 0.5 * i, crash_a_holder) for i in range(60)],
+    )
+    assert len(crashed) == 1, "a robot held a block"
+    assert revived == [True]  # the recovered robot's body takes commands again
+    assert result.success and result.replans >= 1, result.as_json()

@@ -252,3 +252,32 @@ def test_samples_are_graspable(world: World, manipulator: Robot) -> None:
     arm.set_q(arm.home_q)
     assert sample.position()[2] > 0.3
     assert math.isfinite(sample.yaw())
+
+
+def test_a_crash_opens_the_gripper_and_the_held_block_falls(world: World, manipulator: Robot) -> None:
+    arm = manipulator.arm
+    block = world.add_block("b", (arm.mount_offset[0] + 0.5, 0.0))
+    _grasp(world, manipulator, "b")
+    arm.follow(arm.home_q[None, :], 2.0)
+    world.step(2.5)
+    assert block.position()[2] > 0.2  # lifted
+    version = world._version
+    world.faults.crash(manipulator.name)  # power loss
+    assert manipulator.crashed and arm.held is None and arm.grip_force() == 0.0
+    assert world._version > version  # the perception sees the world changed
+    world.step(2.0)
+    assert block.position()[2] == pytest.approx(0.025, abs=2e-3)  # fell where it was and rests on the ground
+    assert arm.attach("b") is False  # a crashed robot does not grasp
+
+
+def test_a_recovered_robot_takes_commands_again(world: World, manipulator: Robot) -> None:
+    world.faults.crash(manipulator.name)
+    manipulator.drive(0.5, 0.0)
+    world.step(1.0)
+    assert manipulator.velocity == (0.0, 0.0)
+    world.faults.recover(manipulator.name)
+    assert not manipulator.crashed
+    here = manipulator.pose
+    manipulator.drive(0.5, 0.0)
+    world.step(1.0)
+    assert manipulator.pose != here
