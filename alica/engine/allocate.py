@@ -120,9 +120,11 @@ class Allocator:
             if claim is not None and claim.plan in names and (chosen is None or claim.plan == chosen):
                 chosen = claim.plan
                 fixed[agent] = (claim.entry, claim.state)
+                # the teammate fills its entry point, and the tasks it already did count as done: a
+                # plan restarted while a teammate's task succeeded does not wait for that task again
                 counts = successes.setdefault(claim.plan, {})
-                if claim.entry is not None:
-                    counts[claim.entry] = counts.get(claim.entry, 0) + 1
+                for ep in sorted({*claim.success, *((claim.entry,) if claim.entry is not None else ())}):
+                    counts[ep] = counts.get(ep, 0) + 1
         if chosen is not None:
             plans = tuple(p for p in plans if p.name == chosen)
         agents = tuple(a for a in members if a not in fixed)
