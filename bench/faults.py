@@ -59,7 +59,16 @@ CASES: dict[str, list[str]] = {
     "crash+recover amparo 15-25": ["--crash", "amparo@15", "--recover", "amparo@25"],
     "loss 0.5 + crash scout@2": ["--loss", "0.5", "--crash", "scout@2"],
     "loss 0.8 + crash scout@2": ["--loss", "0.8", "--crash", "scout@2"],
-    "loss 0.3 + jitter + partition": ["--loss", "0.3", "--delay", "20", "--jitter", "80", "--partition", "amparo|scout,stummel@4-24"],
+    "loss 0.3 + jitter + partition": [
+        "--loss",
+        "0.3",
+        "--delay",
+        "20",
+        "--jitter",
+        "80",
+        "--partition",
+        "amparo|scout,stummel@4-24",
+    ],
     "loss 0.5 + crash+recover stummel": ["--loss", "0.5", "--crash", "stummel@6", "--recover", "stummel@14"],
 }
 
@@ -94,7 +103,9 @@ def _plan_facts() -> tuple[str, dict[str, str], dict[str, int], set[str]]:
     return plan.name, success_of, maxima, required
 
 
-def _duplicate_time(events: list[dict[str, Any]], root: str, maxima: dict[str, int], success_of: dict[str, str]) -> float:
+def _duplicate_time(
+    events: list[dict[str, Any]], root: str, maxima: dict[str, int], success_of: dict[str, str]
+) -> float:
     """The longest time two live agents held the same one-robot task (not in a terminal state)."""
     holding: dict[str, str | None] = {}
     since: dict[tuple[str, str, str], float] = {}
@@ -162,7 +173,11 @@ def run_one(case: str, seed: int, max_time: float, wall: float) -> Outcome:
             out.livelock = True
         else:
             out.stated = all(a["reason"] for a in live.values() if a["status"] != "success")
-    done_eps = {success_of[e["target"]] for e in events if e.get("event") == "transition" and e.get("key") == root and e.get("target") in success_of}
+    done_eps = {
+        success_of[e["target"]]
+        for e in events
+        if e.get("event") == "transition" and e.get("key") == root and e.get("target") in success_of
+    }
     reported = {e["agent"] for e in events if e.get("event") == "success" and e.get("key") == root}
     if reported and not required <= done_eps:
         out.disagreement = True
@@ -189,7 +204,9 @@ def main() -> None:
     with ThreadPoolExecutor(max_workers=args.jobs) as pool:
         results = list(pool.map(lambda job: run_one(job[0], job[1], args.max_time, args.wall), jobs))
     print(f"lunar team run, {args.seeds} seeds per case, limit {args.max_time:g} s simulated")
-    print("| case | runs | success | stated reason | tracebacks | livelocks | disagreements | dup > 1 s | longest dup (s) |")
+    print(
+        "| case | runs | success | stated reason | tracebacks | livelocks | disagreements | dup > 1 s | longest dup (s) |"
+    )
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     total = Outcome()
     counts = [0] * 7
