@@ -111,6 +111,10 @@ class AgentEngine:
         self.index: dict[PlanKey, PlanNode] = {}
         self.root: PlanNode | None = None
         self.root_repairs = Repairs()
+        self._failed_root: PlanNode | None = None
+        self._next_root_try = float("-inf")
+        self.carried: dict[PlanKey, tuple[str, dict[str, set[str]]]] = {}
+        """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
         self.allocator = Allocator(self)
         self.syncs: dict[tuple[PlanKey, str], SyncProcess] = {}
         self._transitions: dict[tuple[str, str], tuple[Transition, ...]] = {}
@@ -161,15 +165,18 @@ class AgentEngine:
             if topic == TEAM_TOPIC and isinstance(payload, TeamMessage):
                 changed, revived = self.team.integrate(payload, now)
                 if revived:
-                    self.emit("team", change="back", who=payload.sender)
-                    self._invalidate_all()
-                    self._publish(WORLD_TOPIC, self.world_model.snapshot(), QoS.RELIABLE)
+                    self._welcome(payload.sender)
+                if changed and self.root is None:
+                    self._next_root_try = now  # a teammate's plans changed: maybe the root can start now
                 for key in changed:
                     node = self.index.get(key)
                     if node is not None:
                         node.invalidate()
                 authority = authority or bool(payload.authority)
-            elif topic == SYNC_TOPIC and isinstance(payload, SyncTalk):
+                continue
+            if self.team.heard(envelope.sender, envelope.sent_at, now):
+                self._welcome(envelope.sender)  # any message is a sign of life
+            if topic == SYNC_TOPIC and isinstance(payload, SyncTalk):
                 self._receive_sync(payload, now)
             elif topic == WORLD_TOPIC:
                 self.world_model.merge(payload)
@@ -177,6 +184,13 @@ class AgentEngine:
                 self.children.routes[topic].receive(payload, now)
         if authority:
             self.allocator.apply_authority(now)
+
+    def _welcome(self, who: str) -> None:
+        """A teammate taken out spoke again: take it back into the assignments and send it the world."""
+        self.emit("team", change="back", who=who)
+        self._invalidate_all()
+        self._next_root_try = self.now()
+        self._publish(WORLD_TOPIC, self.world_model.snapshot(), QoS.RELIABLE)
 
     def step(self) -> None:
         """Rules, then behaviours, then messages (see :mod:`alica.engine.node`)."""
@@ -196,7 +210,11 @@ class AgentEngine:
                 if node.plan.utility.summands:
                     node.invalidate()
         if self.root is None and now >= self.start_at:
-            self._start_root(now)
+            failed = self._failed_root
+            if failed is not None and self.root_repairs.waited_out(now, self.config.rejoin_wait):
+                self._give_up_root(failed)
+            elif now >= self._next_root_try:
+                self._start_root(now)
         root = self.root
         if root is not None and root.status is ChildStatus.RUNNING:
             root.visit(now)
@@ -214,12 +232,27 @@ class AgentEngine:
         node = self.allocator.start(None, (self.root_plan,), {"self": self.name}, now)
         if node is not None:
             self.root = node
+            self._failed_root = None
+            self.root_repairs.waiting_since = None
+        else:
+            # try again when a teammate comes back or speaks, at the latest after a heartbeat
+            self._next_root_try = now + self.config.broadcast_interval
+
+    def _give_up_root(self, failed: PlanNode) -> None:
+        """The root plan found no valid assignment for ``rejoin_wait`` seconds: the mission failed."""
+        failed.reason += f" (no valid assignment for {self.config.rejoin_wait:g} s)"
+        self.emit("repair", key=failed.key_text, stage="propagate", plan=failed.plan.name, reason=failed.reason)
+        self.root = failed
+        self._failed_root = None
 
     def _root_failed(self, root: PlanNode, now: float) -> None:
         """The root plan failed: the repair stages of :mod:`alica.engine.slot` (the root has no alternative)."""
 
         def restart(only: Plan | None) -> bool:
             self.root = None
+            self._failed_root = root
+            if self.root_repairs.waiting_since is None:
+                self.root_repairs.waiting_since = now  # a restart that finds no assignment waits, for a while
             self._start_root(now)
             return self.root is not None
 

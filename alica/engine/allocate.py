@@ -120,11 +120,20 @@ class Allocator:
             if claim is not None and claim.plan in names and (chosen is None or claim.plan == chosen):
                 chosen = claim.plan
                 fixed[agent] = (claim.entry, claim.state)
+                # the teammate fills its entry point, and the tasks it already did count as done: a
+                # plan restarted while a teammate's task succeeded does not wait for that task again
                 counts = successes.setdefault(claim.plan, {})
-                if claim.entry is not None:
-                    counts[claim.entry] = counts.get(claim.entry, 0) + 1
+                for ep in sorted({*claim.success, *((claim.entry,) if claim.entry is not None else ())}):
+                    counts[ep] = counts.get(ep, 0) + 1
         if chosen is not None:
             plans = tuple(p for p in plans if p.name == chosen)
+        # what this agent knew had succeeded in the instance before it restarted for want of agents
+        carried = engine.carried.get(key)
+        if carried is not None and carried[0] in {p.name for p in plans}:
+            counts = successes.setdefault(carried[0], {})
+            for ep, done in sorted(carried[1].items()):
+                if engine.name in done:
+                    counts[ep] = counts.get(ep, 0) + 1
         agents = tuple(a for a in members if a not in fixed)
         result = allocate(self._problem(agents, plans, successes, None, env, parent))
         engine.stats["allocations"] += 1
@@ -137,6 +146,10 @@ class Allocator:
         plan = engine.plan_named(assignment.plan)
         node = PlanNode(engine, key, slot, plan, env, now)
         engine.index[key] = node
+        carried = engine.carried.pop(key, None)
+        if carried is not None and carried[0] == plan.name:
+            for ep, done in carried[1].items():
+                node.succeeded.setdefault(ep, set()).update(done)
         for agent, entry in fixed.items():
             node.believed[agent] = entry
         for agent, ep in assignment.entries:
@@ -228,6 +241,7 @@ class Allocator:
         best = result.assignment
         if best is None:
             if now_utility <= -1:
+                node.understaffed = True
                 node.fail(f"no valid assignment any more: {result.why}")
             return
         gain = best.utility - now_utility

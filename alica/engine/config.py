@@ -20,7 +20,16 @@ class EngineConfig:
         min_broadcast_gap: seconds between two team messages at least, when the
             agent's plan tree keeps changing.
         team_timeout: an agent silent for longer than this is taken out of every
-            assignment until it speaks again.
+            assignment until it speaks again. Every message of the agent counts
+            (team messages are its heartbeat, sent at least every
+            ``broadcast_interval``); the timeout must span at least two heartbeats
+            and should span many more, so that a few lost messages never take a
+            live teammate out (the default, 3 s, is 15 heartbeats: at a loss of 0.5
+            a false loss needs 15 lost messages in a row).
+        rejoin_wait: a plan that fails for want of agents (no valid assignment
+            with the teammates alive now) is restarted as soon as the team allows,
+            without using up its repair stages, for this many seconds; after that
+            the failure propagates.
         assignment_protection: for this long after a plan starts, teammates that
             were allocated to it are not removed for missing from their messages.
         max_rule_applications: rule rounds per plan and tick (chains of transitions).
@@ -39,7 +48,8 @@ class EngineConfig:
     frequency: float = 30.0
     broadcast_interval: float = 0.2
     min_broadcast_gap: float = 0.0
-    team_timeout: float = 1.0
+    team_timeout: float = 3.0
+    rejoin_wait: float = 30.0
     assignment_protection: float = 0.5
     max_rule_applications: int = 20
     allow_idle: bool = True
@@ -55,7 +65,13 @@ class EngineConfig:
         for name in positive:
             if getattr(self, name) <= 0:
                 raise ValueError(f"EngineConfig.{name} must be > 0, got {getattr(self, name)}")
-        for name in ("min_broadcast_gap", "assignment_protection"):
+        if self.team_timeout < 2 * self.broadcast_interval:
+            raise ValueError(
+                f"EngineConfig.team_timeout ({self.team_timeout} s) must span at least two heartbeats "
+                f"(2 x broadcast_interval = {2 * self.broadcast_interval} s): a teammate would be taken out "
+                "for one lost message"
+            )
+        for name in ("min_broadcast_gap", "assignment_protection", "rejoin_wait"):
             if getattr(self, name) < 0:
                 raise ValueError(f"EngineConfig.{name} must be >= 0, got {getattr(self, name)}")
         if self.max_rule_applications < 1 or self.cycle_count < 1:

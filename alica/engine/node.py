@@ -76,6 +76,8 @@ class PlanNode:
         self.authority_until = -1.0
         self.authority_window = 0.0
         self.overridden_until = -1.0
+        self.understaffed = False
+        """The plan failed for want of agents (no valid assignment with the teammates alive now)."""
         self._members: tuple[str, ...] | None = None
 
     def __repr__(self) -> str:

@@ -36,11 +36,17 @@ if TYPE_CHECKING:
 class Repairs:
     """What one child (or the root) remembers of its plans' failures, and the repair stages of the module docstring."""
 
-    __slots__ = ("dropped", "failures")
+    __slots__ = ("dropped", "failures", "waiting_since")
 
     def __init__(self) -> None:
         self.failures: dict[str, int] = {}
         self.dropped: list[str] = []
+        self.waiting_since: float | None = None
+        """Since when the plan waits for agents to restart it (``None``: it does not)."""
+
+    def waited_out(self, now: float, limit: float) -> bool:
+        """Whether the plan has waited for agents for ``limit`` seconds: its failure then propagates."""
+        return self.waiting_since is not None and now - self.waiting_since >= limit
 
     def repair(
         self,
@@ -64,6 +70,18 @@ class Repairs:
         engine = node.engine
         plan = node.plan
         node.stop()
+        now = engine.now()
+        if node.understaffed and not self.waited_out(now, engine.config.rejoin_wait):
+            # a teammate is missing (lost messages, a partition, a crash): not the plan's fault. Restart it
+            # when the team allows, keeping what succeeded, without using up a repair stage
+            if self.waiting_since is None:
+                self.waiting_since = now
+            engine.carried[node.key] = (plan.name, {ep: set(agents) for ep, agents in node.succeeded.items()})
+            engine.emit("repair", key=node.key_text, stage="wait", plan=plan.name, reason=node.reason)
+            start(plan)
+            return True
+        if node.understaffed:
+            node.reason += f" (no valid assignment for {engine.config.rejoin_wait:g} s)"
         count = self.failures[plan.name] = self.failures.get(plan.name, 0) + 1
         if count == 1 and may_retry:
             engine.emit("repair", key=node.key_text, stage="retry", plan=plan.name, reason=node.reason)
@@ -192,6 +210,7 @@ class Slot:
         self.node = node
         self.status = ChildStatus.RUNNING
         self.reason = ""
+        self.repairs.waiting_since = None
 
     def _wait(self, now: float, reason: str) -> None:
         """Not startable now: try again after a broadcast interval (teammates or the world may change)."""
@@ -211,7 +230,10 @@ class Slot:
         if self.status is ChildStatus.FAILURE:
             return
         if self.node is None:
-            if now >= self.next_try:
+            if self.repairs.waited_out(now, self.parent.engine.config.rejoin_wait):
+                self.status = ChildStatus.FAILURE
+                self.reason = f"no valid assignment for {self.parent.engine.config.rejoin_wait:g} s: {self.reason}"
+            elif now >= self.next_try:
                 self.start(now)
             return
         node = self.node

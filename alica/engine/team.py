@@ -3,7 +3,8 @@
 Every agent broadcasts a :class:`TeamMessage` with one :class:`Claim` per plan
 it runs (plan instance, entry point, state). Teammates' claims override what
 an agent predicted for them. An agent silent for longer than the team timeout
-is taken out of every assignment; when it speaks again it is taken back.
+is taken out of every assignment; when it speaks again it is taken back. Any
+message counts as a sign of life, from the time it was sent.
 """
 
 from __future__ import annotations
@@ -154,11 +155,7 @@ class TeamView:
         mate = self.mates.get(message.sender)
         if mate is None:  # not in our team
             return set(), False
-        mate.last_heard = now
-        revived = not mate.alive
-        if revived:
-            mate.alive = True
-            self._alive_cache = None
+        revived = self.heard(message.sender, message.sent_at, now)
         mate.authority = message.authority
         new = {c.key: c for c in message.claims}
         old = mate.claims or {}
@@ -168,6 +165,25 @@ class TeamView:
         mate.changed_at = now
         changed = {k for k in new.keys() | old.keys() if new.get(k) != old.get(k)}
         return changed, revived
+
+    def heard(self, sender: str, sent_at: float, now: float) -> bool:
+        """Any message of ``sender`` sent at ``sent_at`` shows it was alive then; returns whether it came back.
+
+        A message counts from when it was sent (never later than ``now``): a late
+        reliable message of an agent that has since crashed does not bring it back.
+        """
+        mate = self.mates.get(sender)
+        if mate is None:
+            return False
+        heard = min(sent_at, now)
+        if heard <= mate.last_heard:
+            return False
+        mate.last_heard = heard
+        if mate.alive or now - heard > self.timeout:
+            return False
+        mate.alive = True
+        self._alive_cache = None
+        return True
 
     def update(self, now: float) -> list[str]:
         """Mark teammates silent for longer than the timeout as lost; returns them."""

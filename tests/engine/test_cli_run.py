@@ -42,7 +42,7 @@ def test_json_summary_and_trace(tmp_path, capsys):
             "--agents",
             "scout:Scout,stummel:Stummel,amparo:Amparo",
             "--ticks",
-            "150",
+            "240",
             "--crash",
             "scout@1",
             "--loss",
@@ -54,9 +54,9 @@ def test_json_summary_and_trace(tmp_path, capsys):
             "--json",
         ]
     )
-    assert code == 1  # not finished within --ticks 150
+    assert code == 1  # not finished within --ticks 240
     summary = json.loads(capsys.readouterr().out)
-    assert summary["ticks"] == 150 and summary["agents"]["scout"]["status"] == "crashed"
+    assert summary["ticks"] == 240 and summary["agents"]["scout"]["status"] == "crashed"
     assert summary["agents"]["stummel"]["tasks"][0] == "Explore"
     assert set(summary) >= {"plan", "seed", "sim_time_s", "success", "agents", "messages", "faults"}
     events = [json.loads(line) for line in trace.read_text().splitlines()]
