@@ -117,13 +117,14 @@ class Limits:
         """Whether the deadline has passed."""
         return self.deadline is not None and self.clock() >= self.deadline
 
-    def check(self, stage: str, estimate_bytes: float = 0.0, done: str = "") -> None:
+    def check(self, stage: str, estimate_bytes: float = 0.0, done: str = "", reserve: float = 0.0) -> None:
         """Raise :class:`LimitReached` past the deadline, or when ``estimate_bytes`` passes the bound.
 
         Args:
             stage: what is running, for the message (``grounding``).
             estimate_bytes: the memory the stage is estimated to need so far.
             done: how far it got, for the message (``120000 ground actions``).
+            reserve: seconds the stage needs to give up (freeing what it built): it stops that much earlier.
         """
         bound = self.memory_bytes
         more = f" ({done})" if done else ""
@@ -133,7 +134,7 @@ class Limits:
                 stage,
                 "memory",
             )
-        if self.deadline is not None and self.clock() >= self.deadline:
+        if self.deadline is not None and self.clock() + reserve >= self.deadline:
             shown = f"{self.seconds:g} s " if self.seconds is not None else ""
             raise LimitReached(f"time limit {shown}reached while {stage}{more}", stage, "time")
 
@@ -300,6 +301,9 @@ class Planner(ABC):
                 break
             if limits.expired():
                 status = PlanStatus.SOLVED if best is not None else PlanStatus.TIMEOUT
+                if best is None:
+                    shown = f"{limits.seconds:g} s " if limits.seconds is not None else ""
+                    message = f"time limit {shown}reached while searching"
                 break
         return PlanResult(status, best, self.name, first, time.perf_counter() - start, expansions, message)
 
