@@ -21,6 +21,7 @@ import argparse
 import json
 import os
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -113,12 +114,13 @@ def _megabytes(text: str) -> float:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     """Run ``alica plan``; returns the exit code."""
+    start = time.monotonic()
     limits = Limits(args.time_limit, args.memory_limit)
     try:
         return _plan(args, limits)
-    except LimitReached as exc:
-        print(f"alica: {exc}", file=sys.stderr)
-        return EXIT_TIMEOUT
+    except LimitReached as exc:  # while reading or before the planner ran: reported as the planner's own limits are
+        result = PlanResult(exc.status, None, args.planner, None, time.monotonic() - start, 0, str(exc))
+        return _report(args, args.planner, result, lambda plan: plan.cost)
 
 
 def _plan(args: argparse.Namespace, limits: Limits) -> int:
