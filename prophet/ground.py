@@ -12,6 +12,11 @@ Those ``not-`` facts and when-effects need a second, ground relaxed exploration
 Rovers) skips it, since the fixpoint's exploration is then exact. The garbage
 collector is paused while grounding (many objects, no cycles).
 
+With :class:`~alica.prophet.planner.Limits`, grounding checks the deadline and
+its estimated memory (:mod:`alica.prophet.pddl.reach`) inside the fixpoint and
+every few thousand actions after it, and raises
+:class:`~alica.prophet.planner.LimitReached` (stage ``grounding``).
+
 >>> from alica.prophet.pddl import parse_domain, parse_problem
 >>> d = parse_domain("(define (domain d) (:predicates (p ?x) (q ?x)) (:action a :parameters (?x) :precondition (p ?x) :effect (q ?x)))")
 >>> task = ground(d, parse_problem("(define (problem x) (:domain d) (:objects o) (:init (p o)) (:goal (q o)))", domain=d))
@@ -30,7 +35,8 @@ from operator import itemgetter
 from alica.prophet.pddl import Domain, PddlError, Problem
 from alica.prophet.pddl.model import Equals
 from alica.prophet.pddl.normal import dnf, expand
-from alica.prophet.pddl.reach import Fixpoint, GroundAction, fact_text
+from alica.prophet.pddl.reach import CHECK_EVERY, Fixpoint, GroundAction, fact_text
+from alica.prophet.planner import LimitReached, Limits
 
 #: A grounded PDDL atom as a flat tuple ``(predicate, *objects)``: a node of the grounding, not a
 #: :class:`alica.lang.fact.Fact` of the world model (flat tuples keep the grounding fast).
@@ -130,12 +136,13 @@ def _not_name(predicate: str, taken: set[str]) -> str:
     return name
 
 
-def ground(domain: Domain, problem: Problem) -> GroundTask:
+def ground(domain: Domain, problem: Problem, limits: Limits | None = None) -> GroundTask:
     """Ground ``problem`` over ``domain``.
 
     Args:
         domain: the lifted domain.
         problem: a problem of that domain.
+        limits: a deadline and memory bound, checked while grounding.
 
     Returns:
         The reachable positive task. When a goal fact is unreachable (relaxed) or a
@@ -145,9 +152,15 @@ def ground(domain: Domain, problem: Problem) -> GroundTask:
         PddlError: the problem uses names the domain lacks, a cost is missing or
             not a non-negative integer, a goal is disjunctive, or conditional
             effects make a negative precondition impossible to compile.
+        LimitReached: a limit was reached while grounding (the message says how far it got).
     """
     with _collector_paused():
-        return _ground(domain, problem)
+        try:
+            return _ground(domain, problem, limits)
+        except LimitReached as exc:
+            # Drop the frames, and with them the abandoned grounding, while the collector is still
+            # paused: with it running, freeing millions of objects took longer than building them.
+            raise exc.with_traceback(None) from None
 
 
 @contextmanager
@@ -166,9 +179,10 @@ def _collector_paused() -> Iterator[None]:
             gc.enable()
 
 
-def _ground(domain: Domain, problem: Problem) -> GroundTask:
-    fix = Fixpoint(domain, problem)
+def _ground(domain: Domain, problem: Problem, limits: Limits | None) -> GroundTask:
+    fix = Fixpoint(domain, problem, limits)
     fix.run()
+    fix.check()
     goal_clauses = [c for c in dnf(expand(problem.goal, fix.objects_of)) if fix.clause_possible(c)]
     if len(goal_clauses) > 1:
         raise PddlError("unsupported construct: a disjunctive goal (or, exists, imply) cannot be grounded")
@@ -205,7 +219,11 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
 
     init = init_fluent | {nf(f) for f in negated if f not in init_fluent}
     table = _Facts()
-    compiled = [_compile(a, negated, nf, table) for a in fix.actions]
+    compiled = []
+    for k, a in enumerate(fix.actions, 1):
+        compiled.append(_compile(a, negated, nf, table))
+        if not k % CHECK_EVERY:
+            fix.check()
     init_ids = {table.id(f) for f in init}
     goal_facts = [*goal_pos, *(nf(f) for f in goal_neg)]
     goal_ids = [table.id(f) for f in goal_facts]
@@ -223,6 +241,7 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
         if reached[i]:
             final[i] = ids[text]
     goal_final = {ids[text_of[i]] for i in goal_ids}
+    fix.check()
     operators = _operators([(fix.actions[k], compiled[k]) for k in fired], final)
     return GroundTask(
         problem.name,
@@ -261,7 +280,9 @@ def _build_positive(
         return tuple(sorted({final[f] for f in facts}))
 
     operators: dict[tuple, GroundOperator] = {}
-    for action in fix.actions:
+    for k, action in enumerate(fix.actions, 1):
+        if not k % CHECK_EVERY:
+            fix.check()
         name = "(" + " ".join((action.action, *action.args)) + ")"
         add_ids = ids_of(action.add)  # an action's adds are reached, and so are its preconditions
         pre_ids = ids_of(action.pos)

@@ -31,7 +31,17 @@ from dataclasses import dataclass
 from alica.errors import PlannerError
 from alica.model import PlanLibrary, PlanningProblem
 from alica.prophet.pddl import Domain, Problem
-from alica.prophet.planner import Done, Improved, Plan, Planner, PlanResult, PlanStep, Progress
+from alica.prophet.planner import (
+    DEFAULT_MEMORY_MB,
+    Done,
+    Improved,
+    Limits,
+    Plan,
+    Planner,
+    PlanResult,
+    PlanStep,
+    Progress,
+)
 from alica.prophet.planners import get_planner
 from alica.prophet.problem import to_pddl
 from alica.prophet.validate import validate_plan
@@ -117,13 +127,20 @@ class ProblemPlanning:
         steps = tuple(PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in plan.steps)
         return ValidPlan(steps, check.cost, plan)
 
-    def search(self, *, anytime: bool = True) -> Iterator[ProblemEvent]:
+    def search(self, *, anytime: bool = True, limits: Limits | None = None) -> Iterator[ProblemEvent]:
         """The planner's search as events, each better plan validated (a caller budgets it between events).
+
+        ``limits`` bound the grounding (default: the problem's ``timeout`` from now and
+        :data:`~alica.prophet.planner.DEFAULT_MEMORY_MB`): a grounding that would take
+        longer or need more ends the events with ``Done(TIMEOUT)`` or ``Done(MEMORY)``
+        instead of blocking its caller's tick. The search after it is budgeted by the caller.
 
         Raises:
             PlannerError: the planner does not support what the problem needs (raised at once).
         """
-        events = self.planner.search(self.domain, self.pddl, anytime=anytime)
+        if limits is None:
+            limits = Limits(self.problem.timeout, DEFAULT_MEMORY_MB)
+        events = self.planner.search(self.domain, self.pddl, anytime=anytime, limits=limits)
         return self._validate_events(events)
 
     def _validate_events(self, events: Iterator[Progress | Improved | Done]) -> Iterator[ProblemEvent]:
@@ -136,13 +153,15 @@ class ProblemPlanning:
             else:
                 yield event
 
-    def solve(self, *, time_limit: float = 60.0, anytime: bool = False) -> ProblemResult:
+    def solve(self, *, time_limit: float = 60.0, anytime: bool = False, limits: Limits | None = None) -> ProblemResult:
         """Run the planner to the end or for ``time_limit`` wall seconds; the best plan, validated.
+
+        ``limits`` (instead of ``time_limit``) bound grounding and search, and may have started earlier.
 
         Raises:
             PlannerError: the planner's best plan is not valid.
         """
-        run = self.planner.solve(self.domain, self.pddl, time_limit=time_limit, anytime=anytime)
+        run = self.planner.solve(self.domain, self.pddl, time_limit=time_limit, anytime=anytime, limits=limits)
         return ProblemResult(run, self.validated(run.plan) if run.plan is not None else None)
 
 

@@ -5,14 +5,23 @@ now and then (so a caller can stop between two of them: per tick in
 simulation, by wall time on a robot), ``Improved`` for every better plan,
 and one final ``Done``. :meth:`Planner.solve` drives the iterator to the end
 or to a time limit and returns a :class:`PlanResult`.
+
+:class:`Limits` bound a whole planning run, reading and grounding included: a
+deadline on a clock and a memory bound. Whoever does work that can grow with
+the input (the PDDL reader, the grounding, the search) calls
+:meth:`Limits.check` every so many items; past the deadline, or when the
+estimated size passes the bound, it raises :class:`LimitReached`, whose
+message names the stage. :meth:`Planner.search` turns it into a final
+``Done`` (``TIMEOUT`` or ``MEMORY``), so a caller stepping the search never
+sees the exception.
 """
 
 from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
 from enum import Enum
 
 from alica.errors import PlannerError
@@ -48,6 +57,86 @@ class PlanStatus(Enum):
     """The budget ran out before a plan was found."""
     ERROR = "error"
     """The planner could not run (the message says why)."""
+    MEMORY = "memory"
+    """The memory bound (:class:`Limits`) was reached before a plan was found."""
+
+
+DEFAULT_MEMORY_MB = 2048
+"""The memory bound of planning when none is given (``alica plan``, the runtime's planning)."""
+
+
+class LimitReached(PlannerError):
+    """A planning limit was reached.
+
+    Attributes:
+        stage: what was running (``reading the problem``, ``grounding``, ``searching``).
+        kind: ``"time"`` or ``"memory"``.
+    """
+
+    def __init__(self, message: str, stage: str, kind: str) -> None:
+        super().__init__(message)
+        self.stage = stage
+        self.kind = kind
+
+    @property
+    def status(self) -> PlanStatus:
+        """``TIMEOUT`` or ``MEMORY``."""
+        return PlanStatus.TIMEOUT if self.kind == "time" else PlanStatus.MEMORY
+
+
+@dataclass(slots=True)
+class Limits:
+    """A deadline and a memory bound for one planning run.
+
+    Attributes:
+        seconds: the time limit (for messages); ``None``: no deadline.
+        memory_mb: the memory bound in MB; ``None``: none.
+        clock: the clock the deadline is on (injected in tests).
+        deadline: ``clock()`` at the start plus ``seconds``.
+    """
+
+    seconds: float | None = None
+    memory_mb: float | None = None
+    clock: Callable[[], float] = time.monotonic
+    deadline: float | None = field(default=None)
+
+    def __post_init__(self) -> None:
+        if self.deadline is None and self.seconds is not None:
+            self.deadline = self.clock() + self.seconds
+
+    @property
+    def memory_bytes(self) -> float | None:
+        """The memory bound in bytes."""
+        return None if self.memory_mb is None else self.memory_mb * 1024 * 1024
+
+    def remaining(self) -> float | None:
+        """Seconds left before the deadline (0 when past), ``None`` without one."""
+        return None if self.deadline is None else max(0.0, self.deadline - self.clock())
+
+    def expired(self) -> bool:
+        """Whether the deadline has passed."""
+        return self.deadline is not None and self.clock() >= self.deadline
+
+    def check(self, stage: str, estimate_bytes: float = 0.0, done: str = "", reserve: float = 0.0) -> None:
+        """Raise :class:`LimitReached` past the deadline, or when ``estimate_bytes`` passes the bound.
+
+        Args:
+            stage: what is running, for the message (``grounding``).
+            estimate_bytes: the memory the stage is estimated to need so far.
+            done: how far it got, for the message (``120000 ground actions``).
+            reserve: seconds the stage needs to give up (freeing what it built): it stops that much earlier.
+        """
+        bound = self.memory_bytes
+        more = f" ({done})" if done else ""
+        if bound is not None and estimate_bytes > bound:
+            raise LimitReached(
+                f"{stage} needs more than {self.memory_mb:g} MB{more}; raise --memory-limit or make the problem smaller",
+                stage,
+                "memory",
+            )
+        if self.deadline is not None and self.clock() + reserve >= self.deadline:
+            shown = f"{self.seconds:g} s " if self.seconds is not None else ""
+            raise LimitReached(f"time limit {shown}reached while {stage}{more}", stage, "time")
 
 
 @dataclass(frozen=True, slots=True)
@@ -141,13 +230,20 @@ class Planner(ABC):
 
     name: str = "planner"
     features: frozenset[Feature] = frozenset({Feature.STRIPS})
+    takes_limits: bool = False
+    """Whether :meth:`_search` takes ``limits`` (and checks them while it grounds and searches)."""
 
     def missing(self, needed: Iterable[Feature]) -> frozenset[Feature]:
         """The needed features this planner lacks."""
         return frozenset(needed) - self.features
 
-    def search(self, domain: object, problem: object, *, anytime: bool = True) -> Iterator[SearchEvent]:
+    def search(
+        self, domain: object, problem: object, *, anytime: bool = True, limits: Limits | None = None
+    ) -> Iterator[SearchEvent]:
         """The search as events, after checking that the planner supports the task.
+
+        With ``limits``, a limit reached (while grounding, say) ends the events with
+        ``Done(TIMEOUT)`` or ``Done(MEMORY)`` whose message names the stage.
 
         Raises:
             PlannerError: the task needs features the planner lacks (named in the message).
@@ -159,21 +255,38 @@ class Planner(ABC):
             raise PlannerError(
                 f"planner '{self.name}' does not support :{names}; use another planner (alica plan --planner ...)"
             )
-        return self._search(domain, problem, anytime=anytime)
+        if self.takes_limits:
+            events = self._search(domain, problem, anytime=anytime, limits=limits)  # type: ignore[call-arg]
+        else:
+            events = self._search(domain, problem, anytime=anytime)
+        return _limited(events)
 
     @abstractmethod
     def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
         """The planner's own search (see the module docstring for the events)."""
 
-    def solve(self, domain: object, problem: object, *, time_limit: float = 60.0, anytime: bool = False) -> PlanResult:
-        """Run the search until it ends or ``time_limit`` wall seconds pass; the best plan wins."""
+    def solve(
+        self,
+        domain: object,
+        problem: object,
+        *,
+        time_limit: float = 60.0,
+        anytime: bool = False,
+        limits: Limits | None = None,
+    ) -> PlanResult:
+        """Run the search until it ends or ``time_limit`` wall seconds pass; the best plan wins.
+
+        ``limits`` (when given, instead of ``time_limit``) may have started earlier, e.g. before reading.
+        """
+        if limits is None:
+            limits = Limits(time_limit)
         start = time.perf_counter()
         best: Plan | None = None
         first: float | None = None
         expansions = 0
         status = PlanStatus.TIMEOUT
         message = ""
-        for event in self.search(domain, problem, anytime=anytime):
+        for event in self.search(domain, problem, anytime=anytime, limits=limits):
             expansions = event.expansions
             if isinstance(event, Improved):
                 best = event.plan
@@ -181,12 +294,26 @@ class Planner(ABC):
                     first = time.perf_counter() - start
                 status = PlanStatus.SOLVED
             elif isinstance(event, Done):
-                status = (
-                    event.status if event.status is not PlanStatus.SOLVED or best is not None else PlanStatus.SOLVED
-                )
+                status = event.status
+                if best is not None and status in (PlanStatus.TIMEOUT, PlanStatus.MEMORY):
+                    status = PlanStatus.SOLVED  # a limit reached after a plan: that plan stands
                 message = event.message
                 break
-            if time.perf_counter() - start > time_limit:
+            if limits.expired():
                 status = PlanStatus.SOLVED if best is not None else PlanStatus.TIMEOUT
+                if best is None:
+                    shown = f"{limits.seconds:g} s " if limits.seconds is not None else ""
+                    message = f"time limit {shown}reached while searching"
                 break
         return PlanResult(status, best, self.name, first, time.perf_counter() - start, expansions, message)
+
+
+def _limited(events: Iterator[SearchEvent]) -> Iterator[SearchEvent]:
+    """``events``, a :class:`LimitReached` turned into the final ``Done``."""
+    expansions = 0
+    try:
+        for event in events:
+            expansions = event.expansions
+            yield event
+    except LimitReached as exc:
+        yield Done(exc.status, expansions, str(exc))

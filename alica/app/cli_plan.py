@@ -7,7 +7,12 @@ generated ALICA plan as a YAML plan file.
 
 Exit codes: 0 solved (the plan is valid), 1 input error or a failed planner
 (also: a back-end returned an invalid plan), 2 wrong usage, 3 proven
-unsolvable, 4 time limit reached without a plan.
+unsolvable, 4 time or memory limit reached without a plan.
+
+``--time-limit`` covers reading, grounding and search; ``--memory-limit``
+bounds the estimated size of the parse, the grounding and the search's
+tables. A limit reached prints one line on standard error naming the stage
+(``alica: time limit 10 s reached while grounding (...)``) and exits 4.
 """
 
 from __future__ import annotations
@@ -16,12 +21,13 @@ import argparse
 import json
 import os
 import sys
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from alica.errors import AlicaError
-from alica.prophet.planner import Plan, PlanResult, PlanStatus
+from alica.prophet.planner import DEFAULT_MEMORY_MB, LimitReached, Limits, Plan, PlanResult, PlanStatus
 
 EXIT_OK, EXIT_ERROR, EXIT_UNSOLVABLE, EXIT_TIMEOUT = 0, 1, 3, 4
 PLAN_FILE_SUFFIXES = (".yaml", ".yml", ".xml")
@@ -62,7 +68,18 @@ def add_parser(sub: Any) -> None:
         help="the back-end (default builtin; fd needs: pip install 'alica-teams[fd]')",
     )
     p.add_argument(
-        "--time-limit", type=_positive, default=60.0, metavar="S", help="wall seconds for the search (default 60)"
+        "--time-limit",
+        type=_positive,
+        default=60.0,
+        metavar="S",
+        help="wall seconds for reading, grounding and search (default 60)",
+    )
+    p.add_argument(
+        "--memory-limit",
+        type=_megabytes,
+        default=float(DEFAULT_MEMORY_MB),
+        metavar="MB",
+        help=f"the estimated memory planning may use, in MB (default {DEFAULT_MEMORY_MB})",
     )
     p.add_argument(
         "--anytime", action="store_true", help="keep improving the plan until the time limit or a proven optimum"
@@ -85,13 +102,33 @@ def _positive(text: str) -> float:
     return value
 
 
+def _megabytes(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of MB") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"the memory limit must be a positive number of MB, not {text}")
+    return value
+
+
 def cmd_plan(args: argparse.Namespace) -> int:
     """Run ``alica plan``; returns the exit code."""
+    start = time.monotonic()
+    limits = Limits(args.time_limit, args.memory_limit)
+    try:
+        return _plan(args, limits)
+    except LimitReached as exc:  # while reading or before the planner ran: reported as the planner's own limits are
+        result = PlanResult(exc.status, None, args.planner, None, time.monotonic() - start, 0, str(exc))
+        return _report(args, args.planner, result, lambda plan: plan.cost)
+
+
+def _plan(args: argparse.Namespace, limits: Limits) -> int:
     from alica.prophet.pddl import PddlError, read_domain, read_problem
     from alica.prophet.planners import get_planner
 
     if Path(args.domain).suffix.lower() in PLAN_FILE_SUFFIXES:
-        return _plan_file(args)
+        return _plan_file(args, limits)
     if args.problem is None:
         raise AlicaError(
             f"{args.domain}: a PDDL domain needs a PROBLEM file (or give a plan file with a planning problem)"
@@ -99,17 +136,17 @@ def cmd_plan(args: argparse.Namespace) -> int:
     if args.emit_plan or args.problem_name or args.world or args.goal:
         raise AlicaError("--problem, --world, --goal and --emit-plan go with a plan file, not with PDDL files")
     try:
-        domain = read_domain(args.domain)
-        problem = read_problem(args.problem, domain)
+        domain = read_domain(args.domain, limits)
+        problem = read_problem(args.problem, domain, limits)
     except PddlError as exc:
         print(str(exc), file=sys.stderr)
         return EXIT_ERROR
     planner = get_planner(args.planner)
     if getattr(planner, "reads_files", False):
         _check_features(planner, domain, problem)
-        result = planner.solve(args.domain, args.problem, time_limit=args.time_limit, anytime=args.anytime)
+        result = planner.solve(args.domain, args.problem, anytime=args.anytime, limits=limits)
     else:
-        result = planner.solve(domain, problem, time_limit=args.time_limit, anytime=args.anytime)
+        result = planner.solve(domain, problem, anytime=args.anytime, limits=limits)
     return _report(args, planner.name, result, lambda plan: _validated_cost(planner.name, (domain, problem), plan))
 
 
@@ -138,10 +175,11 @@ def _report(
         return EXIT_OK
     if result.status is PlanStatus.UNSOLVABLE:
         return EXIT_UNSOLVABLE
+    print(f"alica: {result.message or 'time limit reached'}", file=sys.stderr)
     return EXIT_TIMEOUT
 
 
-def _plan_file(args: argparse.Namespace) -> int:
+def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
     """Plan a planning problem of a plan file offline; print the plan and its tasks, maybe emit the generated plan."""
     from dataclasses import replace
 
@@ -178,7 +216,7 @@ def _plan_file(args: argparse.Namespace) -> int:
         )
     world = read_world(problem, library, (), ())
     planning = plan_problem(problem, library, world, planner=args.planner)
-    result = planning.solve(time_limit=args.time_limit, anytime=args.anytime)  # PlannerError: an invalid plan
+    result = planning.solve(anytime=args.anytime, limits=limits)  # PlannerError: an invalid plan
 
     def tasks() -> dict[str, Any]:
         assert result.plan is not None
@@ -260,7 +298,9 @@ def _summary(result: PlanResult, cost: float | None) -> dict[str, Any]:
 
 def _print_text(result: PlanResult, cost: float | None) -> None:
     if result.plan is None or cost is None:
-        why = "proven unsolvable" if result.status is PlanStatus.UNSOLVABLE else "time limit reached"
+        why = {PlanStatus.UNSOLVABLE: "proven unsolvable", PlanStatus.MEMORY: "memory limit reached"}.get(
+            result.status, "time limit reached"
+        )
         print(f"; no plan: {why} after {result.time_s:.3f} s ({result.planner}, {result.expansions} expansions)")
         if result.message:
             print(f"; {result.message}")

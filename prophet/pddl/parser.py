@@ -1,7 +1,18 @@
-"""Reading PDDL domains and problems (recursive descent over :mod:`alica.prophet.pddl.sexpr`)."""
+"""Reading PDDL domains and problems (recursive descent over :mod:`alica.prophet.pddl.sexpr`).
+
+Reading is linear in the text: duplicate checks go through sets, never list
+scans. With :class:`~alica.prophet.planner.Limits`, the reader checks the
+deadline every :data:`CHECK_EVERY` declarations, actions, objects or facts, and
+refuses a text whose estimated parse size (:data:`BYTES_PER_CHAR`) passes the
+memory bound. The garbage collector is paused while reading (many objects, no cycles).
+"""
 
 from __future__ import annotations
 
+import gc
+from collections import Counter
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from alica.prophet.pddl.errors import PddlError
@@ -29,7 +40,12 @@ from alica.prophet.pddl.model import (
     When,
 )
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
-from alica.prophet.planner import Feature
+from alica.prophet.planner import Feature, Limits
+
+CHECK_EVERY = 1024
+"""Items read between two checks of the limits."""
+BYTES_PER_CHAR = 48
+"""The memory estimate of reading, per character of the text (tokens and nodes; measured about 35)."""
 
 _FEATURES = {f"{f.value}": frozenset({f}) for f in Feature}
 _EXTRA = {
@@ -166,8 +182,11 @@ def _typed(
     return parse_typed_list(source, section.items[1:], variables=variables, types=types, what=what)
 
 
-def _declarations(source: Source, section: SList, types: dict[str, str], what: str, functions: bool) -> list[Predicate]:
+def _declarations(
+    source: Source, section: SList, types: dict[str, str], what: str, functions: bool, limits: Limits | None = None
+) -> list[Predicate]:
     out: list[Predicate] = []
+    names: set[str] = set()
     items = section.items[1:]
     index = 0
     while index < len(items):
@@ -176,9 +195,12 @@ def _declarations(source: Source, section: SList, types: dict[str, str], what: s
         if not name:
             raise source.error(decl.offset, f"expected a {what} name, found '()'")
         params = parse_typed_list(source, decl.items[1:], variables=True, types=types, what=f"parameters of '{name}'")
-        if any(p.name == name for p in out):
+        if name in names:
             raise source.error(decl.offset, f"duplicate {what} '{name}'")
+        names.add(name)
         out.append(Predicate(name, tuple(p for p, _ in params)))
+        if limits is not None and len(out) % CHECK_EVERY == 0:
+            limits.check("reading the domain", done=f"{len(out)} {what}s")
         index += 1
         dash = items[index] if index < len(items) else None
         if functions and isinstance(dash, Symbol) and dash.text == "-":
@@ -218,10 +240,10 @@ def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
             typed = parse_typed_list(
                 source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'"
             )
-            names = [n for (n, _), _ in typed]
-            for (pname, _), offset in typed:
-                if names.count(pname) > 1:
-                    raise source.error(offset, f"duplicate parameter '{pname}' in '(:action {name}'")
+            counts = Counter(n for (n, _), _ in typed)
+            if len(counts) < len(typed):  # the first parameter written twice, at its first place
+                pname, offset = next((n, o) for (n, _), o in typed if counts[n] > 1)
+                raise source.error(offset, f"duplicate parameter '{pname}' in '(:action {name}'")
             parameters = tuple(p for p, _ in typed)
         elif key.text == ":precondition":
             precondition = _empty_or(value, lambda v, scope=dict(parameters): reader.formula(v, scope))
@@ -237,21 +259,33 @@ def _empty_or(node: Node, read):  # type: ignore[no-untyped-def]
     return read(node)
 
 
-def parse_domain(text: str, file: str = "<string>") -> Domain:
+def parse_domain(text: str, file: str = "<string>", limits: Limits | None = None) -> Domain:
     """Read a PDDL domain.
 
     Args:
         text: the domain text.
         file: the file name for error messages.
+        limits: a deadline and memory bound to check while reading.
 
     Returns:
         The domain.
 
     Raises:
         PddlError: the text is no valid domain (the message has ``FILE:LINE:COL``).
+        LimitReached: a limit was reached while reading.
     """
+    with _collector_paused():
+        return _parse_domain(text, file, limits)
+
+
+def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
+    stage = "reading the domain"
     source = Source(text, file)
+    if limits is not None:
+        limits.check(stage, len(text) * BYTES_PER_CHAR, f"{len(text)} characters")
     top = read_sexpr(source)
+    if limits is not None:
+        limits.check(stage)
     name = _check_header(source, top, "domain")
     allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action")
     features: set[Feature] = {Feature.STRIPS}
@@ -262,6 +296,7 @@ def parse_domain(text: str, file: str = "<string>") -> Domain:
     functions: list[Predicate] = []
     reader = FormulaReader(source, {}, {}, {}, types)
     actions: list[Action] = []
+    action_names: set[str] = set()
     for section in _sections(source, top, allowed):
         head = section.head()
         if head == ":requirements":
@@ -288,16 +323,19 @@ def parse_domain(text: str, file: str = "<string>") -> Domain:
                 reader.objects[const] = kind
                 constants.append((const, kind))
         elif head == ":predicates":
-            predicates.extend(_declarations(source, section, types, "predicate", functions=False))
+            predicates.extend(_declarations(source, section, types, "predicate", False, limits))
             reader.predicates.update((p.name, p) for p in predicates)
         elif head == ":functions":
-            functions.extend(_declarations(source, section, types, "function", functions=True))
+            functions.extend(_declarations(source, section, types, "function", True, limits))
             reader.functions.update((f.name, f) for f in functions)
         else:
             action = _action(source, section, reader)
-            if any(a.name == action.name for a in actions):
+            if action.name in action_names:
                 raise source.error(section.offset, f"duplicate action '{action.name}'")
+            action_names.add(action.name)
             actions.append(action)
+            if limits is not None and len(actions) % CHECK_EVERY == 0:
+                limits.check(stage, done=f"{len(actions)} actions")
     for action in actions:
         for part, in_effect in ((action.precondition, False), (action.effect, True)):
             more, more_extra = formula_features(part, in_effect=in_effect)
@@ -319,22 +357,36 @@ def parse_domain(text: str, file: str = "<string>") -> Domain:
     )
 
 
-def parse_problem(text: str, file: str = "<string>", domain: Domain | None = None) -> Problem:
+def parse_problem(
+    text: str, file: str = "<string>", domain: Domain | None = None, limits: Limits | None = None
+) -> Problem:
     """Read a PDDL problem, checked against ``domain`` when given.
 
     Args:
         text: the problem text.
         file: the file name for error messages.
         domain: the domain; with it, predicates, arities, objects, types and the domain name are checked.
+        limits: a deadline and memory bound to check while reading.
 
     Returns:
         The problem.
 
     Raises:
         PddlError: the text is no valid problem (the message has ``FILE:LINE:COL``).
+        LimitReached: a limit was reached while reading.
     """
+    with _collector_paused():
+        return _parse_problem(text, file, domain, limits)
+
+
+def _parse_problem(text: str, file: str, domain: Domain | None, limits: Limits | None) -> Problem:
+    stage = "reading the problem"
     source = Source(text, file)
+    if limits is not None:
+        limits.check(stage, len(text) * BYTES_PER_CHAR, f"{len(text)} characters")
     top = read_sexpr(source)
+    if limits is not None:
+        limits.check(stage)
     name = _check_header(source, top, "problem")
     sections = _sections(source, top, (":domain", ":requirements", ":objects", ":init", ":goal", ":metric"))
     if not sections or sections[0].head() != ":domain":
@@ -377,8 +429,13 @@ def parse_problem(text: str, file: str = "<string>", domain: Domain | None = Non
                     raise source.error(offset, f"duplicate object '{obj}'")
                 objects.append((obj, kind))
                 reader.objects[obj] = kind
+                if limits is not None and len(objects) % CHECK_EVERY == 0:
+                    limits.check(stage, done=f"{len(objects)} objects")
         elif head == ":init":
-            init.extend(_init_item(source, item, reader) for item in section.items[1:])
+            for item in section.items[1:]:
+                init.append(_init_item(source, item, reader))
+                if limits is not None and len(init) % CHECK_EVERY == 0:
+                    limits.check(stage, done=f"{len(init)} initial facts")
         elif head == ":goal":
             if len(section.items) != 2:
                 raise source.error(section.offset, "expected '(:goal formula)' with one formula")
@@ -427,22 +484,36 @@ def _metric(source: Source, section: SList, reader: FormulaReader) -> Metric:
     return Metric(section.items[1].text, reader.fluent(expression, {}))
 
 
-def read_domain(path: str | Path) -> Domain:
+def read_domain(path: str | Path, limits: Limits | None = None) -> Domain:
     """Read a domain file (see :func:`parse_domain`).
 
     Raises:
         PddlError: the file cannot be read or is no valid domain.
+        LimitReached: a limit was reached while reading.
     """
-    return parse_domain(_read(path), str(path))
+    return parse_domain(_read(path), str(path), limits)
 
 
-def read_problem(path: str | Path, domain: Domain | None = None) -> Problem:
+def read_problem(path: str | Path, domain: Domain | None = None, limits: Limits | None = None) -> Problem:
     """Read a problem file (see :func:`parse_problem`).
 
     Raises:
         PddlError: the file cannot be read or is no valid problem.
+        LimitReached: a limit was reached while reading.
     """
-    return parse_problem(_read(path), str(path), domain)
+    return parse_problem(_read(path), str(path), domain, limits)
+
+
+@contextmanager
+def _collector_paused() -> Iterator[None]:
+    """The cyclic garbage collector off while reading (its passes over the many new nodes cost more than the reading)."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _read(path: str | Path) -> str:

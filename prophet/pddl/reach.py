@@ -7,6 +7,11 @@ atom with the most bound arguments first, through hash indexes on the bound
 positions (built on first use and kept up to date). Negative preconditions on
 changing predicates count as true here (an over-approximation the ground
 pass of :mod:`alica.prophet.ground` tightens).
+
+With :class:`~alica.prophet.planner.Limits`, the fixpoint counts its work (facts
+taken, joins, ground actions) and every :data:`CHECK_EVERY` steps checks the
+deadline and the estimated size of what it grounded so far
+(:data:`BYTES_PER_ACTION`, :data:`BYTES_PER_FACT`), before allocating more.
 """
 
 from __future__ import annotations
@@ -20,6 +25,17 @@ from operator import itemgetter
 from alica.prophet.pddl.errors import PddlError
 from alica.prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
 from alica.prophet.pddl.normal import Clause, dnf, expand, flatten_effect
+from alica.prophet.planner import Limits
+
+CHECK_EVERY = 4096
+"""Steps of the fixpoint between two checks of the limits."""
+BYTES_PER_ACTION = 2048
+"""The memory estimate per ground action, to the end of the grounding (measured: about 1,800 bytes)."""
+BYTES_PER_FACT = 256
+"""The memory estimate per reached fact."""
+FREE_SHARE = 0.35
+"""Freeing an abandoned grounding takes about this share of the time spent building it (measured 0.2-0.3):
+the deadline check keeps that much time in reserve."""
 
 #: A grounded PDDL atom as a flat tuple ``(predicate, *objects)``: a node of the grounding, not a
 #: :class:`alica.lang.fact.Fact` of the world model (flat tuples keep the grounding fast).
@@ -100,7 +116,10 @@ class Fixpoint:
         has_costs: whether some action increases total-cost.
     """
 
-    def __init__(self, domain: Domain, problem: Problem) -> None:
+    def __init__(self, domain: Domain, problem: Problem, limits: Limits | None = None) -> None:
+        self._limits = limits
+        self._work = 0
+        self._started = limits.clock() if limits is not None else 0.0
         self.objects: dict[str, str] = {}
         for name, kind in (*domain.constants, *problem.objects):
             if kind != OBJECT and kind not in domain.types:
@@ -122,6 +141,7 @@ class Fixpoint:
             if fact not in self.init:
                 self.init.add(fact)
                 self._init_order.append(fact)
+        self._init_predicates = {f[0] for f in self._init_order}
         flat = {a.name: flatten_effect(a.effect, self.objects_of) for a in domain.actions}
         self.fluent = {item.atom.predicate for items, _ in flat.values() for item in items}
         self.has_costs = any(costs for _, costs in flat.values())
@@ -177,7 +197,7 @@ class Fixpoint:
             if isinstance(lit, Equals):
                 eqs.append((positive, arg(lit.left), arg(lit.right)))
             elif positive:
-                if lit.predicate not in self.fluent and not any(f[0] == lit.predicate for f in self._init_order):
+                if lit.predicate not in self.fluent and lit.predicate not in self._init_predicates:
                     return None
                 pos.append(atom(lit))
             else:
@@ -297,8 +317,33 @@ class Fixpoint:
             self._stats[pred] = (len(facts), [len({f[p] for f in facts}) for p in range(arity)])
         return self._stats[pred]
 
+    def estimate_bytes(self) -> int:
+        """The estimated memory of the grounding so far (see :data:`BYTES_PER_ACTION`)."""
+        return len(self.actions) * BYTES_PER_ACTION + len(self._reached) * BYTES_PER_FACT
+
+    def check(self) -> None:
+        """Check the limits (if any) now.
+
+        Raises:
+            LimitReached: past the deadline, or the estimate passes the memory bound.
+        """
+        limits = self._limits
+        if limits is not None:
+            limits.check(
+                "grounding",
+                self.estimate_bytes(),
+                f"{len(self.actions)} ground actions, {len(self._reached)} facts so far",
+                FREE_SHARE * (limits.clock() - self._started),
+            )
+
     def run(self) -> None:
-        """Find every reachable ground action."""
+        """Find every reachable ground action.
+
+        Raises:
+            LimitReached: a limit was reached (see the module docstring).
+        """
+        limited = self._limits is not None
+        self.check()
         for schema in self._schemas:
             schema.plans = tuple(self._plan(schema, i) for i in range(len(schema.pos)))
         for fact in self._init_order:
@@ -307,6 +352,10 @@ class Fixpoint:
             if not schema.pos:
                 self._finish(schema, [None] * len(schema.params), tuple(range(len(schema.params))))
         while self._queue:
+            if limited:
+                self._work += 1
+                if not self._work % CHECK_EVERY:
+                    self.check()
             fact = self._queue.popleft()
             pred, args = fact[0], fact[1:]
             self._known.setdefault(pred, []).append(args)
@@ -357,6 +406,10 @@ class Fixpoint:
         return tables[positions]
 
     def _join(self, schema: _Schema, steps: tuple, k: int, binding: list, unbound: tuple[int, ...]) -> None:
+        if self._limits is not None:
+            self._work += 1
+            if not self._work % CHECK_EVERY:
+                self.check()
         if k == len(steps):
             self._finish(schema, binding, unbound)
             return
@@ -389,7 +442,12 @@ class Fixpoint:
             self._emit(schema, tuple(binding[: len(schema.params)]))
             return
         pools = [schema.pools[i] for i in unbound]
+        limited = self._limits is not None
         for combo in itertools.product(*pools):
+            if limited:
+                self._work += 1
+                if not self._work % CHECK_EVERY:
+                    self.check()
             full = binding[: len(schema.params)]
             for slot, value in zip(unbound, combo, strict=True):
                 full[slot] = value
@@ -462,6 +520,10 @@ class Fixpoint:
             cost,
         )
         self.actions.append(action)
+        if self._limits is not None:
+            self._work += 1
+            if not self._work % CHECK_EVERY:
+                self.check()
         for fact in add:
             self._reach(fact)
         for (c_pos, _), (c_add, _) in conditional.items():

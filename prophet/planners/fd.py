@@ -32,7 +32,18 @@ from pathlib import Path
 from typing import IO
 
 from alica.errors import PlannerError
-from alica.prophet.planner import Done, Feature, Improved, Plan, Planner, PlanResult, PlanStatus, Progress, SearchEvent
+from alica.prophet.planner import (
+    Done,
+    Feature,
+    Improved,
+    Limits,
+    Plan,
+    Planner,
+    PlanResult,
+    PlanStatus,
+    Progress,
+    SearchEvent,
+)
 from alica.prophet.planners.planfile import parse_plan
 
 INSTALL_HINT = "pip install 'alica-teams[fd]'"
@@ -159,7 +170,9 @@ class FastDownward(Planner):
             raise PlannerError(f"Fast Downward is not installed: {INSTALL_HINT}")
         return found
 
-    def search(self, domain: object, problem: object, *, anytime: bool = True) -> Iterator[SearchEvent]:
+    def search(
+        self, domain: object, problem: object, *, anytime: bool = True, limits: Limits | None = None
+    ) -> Iterator[SearchEvent]:
         """The search as events (see :class:`~alica.prophet.planner.Planner`).
 
         Raises:
@@ -167,10 +180,21 @@ class FastDownward(Planner):
                 features it lacks.
         """
         self._driver()
-        return super().search(domain, problem, anytime=anytime)
+        return super().search(domain, problem, anytime=anytime, limits=limits)
 
-    def solve(self, domain: object, problem: object, *, time_limit: float = 60.0, anytime: bool = False) -> PlanResult:
-        """Run Fast Downward for at most ``time_limit`` wall seconds; the best plan wins."""
+    def solve(
+        self,
+        domain: object,
+        problem: object,
+        *,
+        time_limit: float = 60.0,
+        anytime: bool = False,
+        limits: Limits | None = None,
+    ) -> PlanResult:
+        """Run Fast Downward for at most ``time_limit`` wall seconds (or what ``limits`` leave); the best plan wins."""
+        left = limits.remaining() if limits is not None else None
+        if left is not None:
+            time_limit = max(left, 0.001)
         limit = time_limit if self.time_limit is None else min(time_limit, self.time_limit)
         run = copy.copy(self)
         run.time_limit = limit

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 
-from alica.prophet.planner import Feature, Planner, SearchEvent
+from alica.prophet.planner import Feature, Limits, Planner, SearchEvent
 from alica.prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+
+BYTES_PER_OPERATOR = 512
+"""The search's memory estimate per operator besides its masks (three masks of half the facts' bits on average)."""
 
 
 class BuiltinPlanner(Planner):
@@ -28,11 +31,15 @@ class BuiltinPlanner(Planner):
         }
     )
 
+    takes_limits = True
+
     def __init__(self, *, weights: Sequence[float] = DEFAULT_WEIGHTS, progress_every: int = 1000) -> None:
         self.weights = tuple(weights)
         self.progress_every = progress_every
 
-    def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
+    def _search(
+        self, domain: object, problem: object, *, anytime: bool, limits: Limits | None = None
+    ) -> Iterator[SearchEvent]:
         from alica.prophet.ground import ground  # lazy: the grounding is only needed here
         from alica.prophet.pddl import Domain, Problem
 
@@ -40,5 +47,12 @@ class BuiltinPlanner(Planner):
             raise TypeError(
                 f"the builtin planner takes a pddl Domain and Problem, got {type(domain).__name__}, {type(problem).__name__}"
             )
-        task = ground(domain, problem)
+        task = ground(domain, problem, limits)
+        if limits is not None:  # the search's bitsets: per operator, masks as wide as the facts
+            n_ops, n_facts = len(task.operators), len(task.facts)
+            limits.check(
+                "preparing the search",
+                n_ops * (BYTES_PER_OPERATOR + 3 * n_facts // 16),
+                f"{n_ops} ground operators over {n_facts} facts",
+            )
         yield from search_task(task, anytime=anytime, weights=self.weights, progress_every=self.progress_every)

@@ -1,0 +1,191 @@
+"""Bounded planning cost: the deadline and the memory bound over reading, grounding and search; linear reading.
+
+No test times anything: the clocks are injected (a deadline already past, or a clock that
+advances one second per reading), memory is an estimate from counts, and the reader's
+speed is counted in calls.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+from dataclasses import replace
+from types import FrameType
+from typing import Any
+
+import pytest
+
+from alica.io import load_library
+from alica.model import Condition, ConditionKind
+from alica.prophet import plan_problem
+from alica.prophet.ground import ground
+from alica.prophet.pddl import Domain, Problem, parse_domain, parse_problem
+from alica.prophet.pipeline import Found
+from alica.prophet.planner import Done, LimitReached, Limits, PlanStatus
+from alica.prophet.search.planner import BuiltinPlanner
+from alica.prophet.world import read_world
+from tests.conftest import PLANS
+
+BLOCKS = """(define (domain blocks)
+  (:predicates (on ?x ?y) (ontable ?x) (clear ?x) (handempty) (holding ?x))
+  (:action pick-up :parameters (?x)
+    :precondition (and (clear ?x) (ontable ?x) (handempty))
+    :effect (and (not (ontable ?x)) (not (clear ?x)) (not (handempty)) (holding ?x)))
+  (:action stack :parameters (?x ?y)
+    :precondition (and (holding ?x) (clear ?y))
+    :effect (and (not (holding ?x)) (not (clear ?y)) (clear ?x) (handempty) (on ?x ?y))))
+"""
+
+
+def _blocks_problem(n: int) -> str:
+    objects = " ".join(f"b{i}" for i in range(n))
+    init = " ".join(f"(ontable b{i}) (clear b{i})" for i in range(n))
+    return f"(define (problem p) (:domain blocks) (:objects {objects}) (:init (handempty) {init}) (:goal (on b0 b1)))"
+
+
+def _task(n: int) -> tuple[Domain, Problem]:
+    domain = parse_domain(BLOCKS)
+    return domain, parse_problem(_blocks_problem(n), domain=domain)
+
+
+def _past() -> Limits:
+    """A deadline already past: the first check stops the work."""
+    return Limits(deadline=0.0, clock=lambda: 1.0)
+
+
+class _Ticking:
+    """A clock that advances one second per reading."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        self.now += 1.0
+        return self.now
+
+
+def test_a_past_deadline_stops_reading_the_domain_and_the_problem() -> None:
+    with pytest.raises(LimitReached, match="reached while reading the domain") as caught:
+        parse_domain(BLOCKS, limits=_past())
+    assert caught.value.stage == "reading the domain" and caught.value.status is PlanStatus.TIMEOUT
+    with pytest.raises(LimitReached, match="reached while reading the problem"):
+        parse_problem(_blocks_problem(3), domain=parse_domain(BLOCKS), limits=_past())
+
+
+def test_reading_checks_the_deadline_every_so_many_objects() -> None:
+    clock = _Ticking()
+    limits = Limits(seconds=3.5, clock=clock)  # the deadline is 4.5: the third reading after the start passes it
+    with pytest.raises(LimitReached, match=r"reading the problem \(2048 objects\)"):
+        parse_problem(_blocks_problem(5000), domain=parse_domain(BLOCKS), limits=limits)
+
+
+def test_reading_a_text_too_large_for_the_memory_bound_is_refused_before_parsing() -> None:
+    with pytest.raises(LimitReached, match=r"reading the problem needs more than 0.5 MB") as caught:
+        parse_problem(_blocks_problem(2000), domain=parse_domain(BLOCKS), limits=Limits(memory_mb=0.5))
+    assert caught.value.status is PlanStatus.MEMORY
+
+
+def test_a_past_deadline_stops_grounding_at_its_first_check() -> None:
+    domain, problem = _task(50)
+    with pytest.raises(LimitReached, match=r"reached while grounding \(0 ground actions, 0 facts so far\)"):
+        ground(domain, problem, _past())
+
+
+def test_grounding_stops_at_the_deadline_long_before_its_end() -> None:
+    domain, problem = _task(200)  # 40,200 ground actions in all
+    assert len(ground(domain, problem).operators) == 40200
+    limits = Limits(seconds=4.5, clock=_Ticking())
+    with pytest.raises(LimitReached, match="grounding") as caught:
+        ground(domain, problem, limits)
+    done = int(str(caught.value).split("(")[1].split(" ground actions")[0])
+    assert done < 5 * 4096  # a check every 4096 steps; the fifth one stops it
+
+
+def test_grounding_stops_when_its_estimated_size_passes_the_memory_bound() -> None:
+    domain, problem = _task(200)  # about 80 MB at 2 KB per ground action
+    with pytest.raises(LimitReached, match=r"^grounding needs more than 20 MB \(\d+ ground actions") as caught:
+        ground(domain, problem, Limits(memory_mb=20))
+    assert caught.value.kind == "memory"
+    assert len(ground(domain, problem, Limits(memory_mb=500)).operators) == 40200  # within the bound: the same task
+
+
+def test_the_search_ends_with_done_naming_the_stage_instead_of_raising() -> None:
+    domain, problem = _task(20)
+    events = list(BuiltinPlanner().search(domain, problem, limits=_past()))
+    assert len(events) == 1 and isinstance(events[0], Done)
+    assert events[0].status is PlanStatus.TIMEOUT and "while grounding" in events[0].message
+    events = list(BuiltinPlanner().search(domain, problem, limits=Limits(memory_mb=0.05)))
+    assert isinstance(events[-1], Done) and events[-1].status is PlanStatus.MEMORY
+    result = BuiltinPlanner().solve(domain, problem, limits=Limits(memory_mb=0.05))
+    assert result.status is PlanStatus.MEMORY and result.plan is None and "needs more than" in result.message
+
+
+def test_the_runtimes_grounding_is_bounded_by_the_problems_timeout() -> None:
+    library = load_library(PLANS / "blocksworld" / "mission.yaml")
+    names = [f"b{i}" for i in range(30)]
+    world_text = " and ".join(["handempty(r)", *(f"ontable({b}) and clear({b})" for b in names)])
+    problem = replace(
+        library.problems["StackBlocks"],
+        world=Condition(ConditionKind.PRE, world_text),
+        goal=Condition(ConditionKind.POST, "on(b0, b1)"),
+        timeout=1e-9,  # no grounding fits: the search must end (the runtime then runs the AlternativePlan)
+    )
+    planning = plan_problem(problem, library, read_world(problem, library, (), ()))
+    events = list(planning.search(anytime=True))
+    assert not any(isinstance(e, Found) for e in events)
+    assert isinstance(events[-1], Done) and events[-1].status is PlanStatus.TIMEOUT
+    assert "while grounding" in events[-1].message
+    found = list(plan_problem(replace(problem, timeout=60.0), library, planning.world).search(anytime=False))
+    assert any(isinstance(e, Found) for e in found)  # the same problem plans within a real timeout
+
+
+def _calls_in_parser(read: Callable[[], Any]) -> int:
+    """Python calls (generator resumptions included) in the PDDL reader's own module while ``read`` runs."""
+    count = 0
+
+    def profile(frame: FrameType, event: str, _arg: object) -> None:
+        nonlocal count
+        if event == "call" and frame.f_code.co_filename.endswith("parser.py"):
+            count += 1
+
+    sys.setprofile(profile)
+    try:
+        read()
+    finally:
+        sys.setprofile(None)
+    return count
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda n: "(define (domain w) (:predicates " + " ".join(f"(p{i} ?x)" for i in range(n)) + "))",
+        lambda n: (
+            "(define (domain w) (:predicates (p ?x)) (:action a :parameters ("
+            + " ".join(f"?v{i}" for i in range(n))
+            + ") :precondition (p ?v0) :effect (not (p ?v1))))"
+        ),
+        lambda n: (
+            "(define (domain w) (:predicates (p ?x) (q ?x)) "
+            + " ".join(f"(:action a{i} :parameters (?x) :precondition (p ?x) :effect (q ?x))" for i in range(n))
+            + ")"
+        ),
+    ],
+    ids=["predicates", "parameters", "actions"],
+)
+def test_reading_many_declarations_is_linear(make: Callable[[int], str]) -> None:
+    small = _calls_in_parser(lambda: parse_domain(make(500)))
+    large = _calls_in_parser(lambda: parse_domain(make(2000)))
+    assert large <= 4 * small + 100, (small, large)  # quadratic duplicate checks made it about 16 times
+
+
+def test_duplicates_are_still_found() -> None:
+    with pytest.raises(Exception, match="duplicate predicate 'p'"):
+        parse_domain("(define (domain w) (:predicates (p ?x) (q) (p)))")
+    with pytest.raises(Exception, match="duplicate parameter '\\?x'"):
+        parse_domain("(define (domain w) (:predicates (p ?x)) (:action a :parameters (?y ?x ?x) :effect (p ?x)))")
+    with pytest.raises(Exception, match="duplicate action 'a'"):
+        parse_domain(
+            "(define (domain w) (:predicates (p)) (:action a :parameters () :effect (p)) "
+            "(:action a :parameters () :effect (p)))"
+        )
