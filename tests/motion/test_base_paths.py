@@ -99,8 +99,7 @@ def test_enclosed_goal_is_unreachable_quickly() -> None:
     # With a 30 s limit, anything but the flood-fill answer would end as "timeout" after 30 s.
     result = plan_path((*CORNER_A, 0.0), (5.0, 5.0), grid, RADIUS, time_limit=30.0)
     assert result.status == "unreachable"
-    assert "enclosed" in result.reason
-    assert result.plan_time_s < 30.0
+    assert "enclosed" in result.reason  # the flood fill's answer, not the 30 s timeout's
 
 
 def test_other_robot_in_the_way_is_avoided() -> None:

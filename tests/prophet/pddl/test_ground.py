@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import pytest
@@ -48,16 +47,14 @@ def test_rovers_static_facts_leave_preconditions() -> None:
     )
 
 
-@pytest.mark.parametrize(("names", "limit"), [([f"p{i:02d}" for i in range(1, 21)], 0.5), (["p30", "p40"], 15.0)])
-def test_rovers_ground_fast(names: list[str], limit: float) -> None:
+@pytest.mark.parametrize("names", [[f"p{i:02d}" for i in range(1, 21)], ["p30", "p40"]])
+def test_rovers_ground(names: list[str]) -> None:
+    # (how fast: bench/planners.py's grounding table; no wall-clock assertions in tests)
     domain = read_domain(BENCHMARKS / "rovers" / "domain.pddl")
     for name in names:
         problem = read_problem(BENCHMARKS / "rovers" / f"{name}.pddl", domain)
-        start = time.perf_counter()
         task = ground(domain, problem)
-        elapsed = time.perf_counter() - start
-        assert task.unsolvable_reason is None
-        assert elapsed < limit, f"{name} took {elapsed:.2f} s"
+        assert task.unsolvable_reason is None and task.operators
 
 
 NEG = """(define (domain neg) (:requirements :negative-preconditions :equality)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import pytest
@@ -32,14 +31,12 @@ def benchmark_sets() -> list[tuple[Path, list[Path]]]:
     return out
 
 
-def test_every_benchmark_parses_fast_and_round_trips() -> None:
-    start = time.perf_counter()
+def test_every_benchmark_parses_and_round_trips() -> None:
+    # (how fast: bench/planners.py and bench/planning_limits.py; no wall-clock assertions in tests)
     parsed = []
     for domain_path, problems in benchmark_sets():
         domain = read_domain(domain_path)
         parsed.append((domain, [read_problem(p, domain) for p in problems]))
-    elapsed = time.perf_counter() - start
-    assert elapsed < 3.0, f"reading the 75 benchmark files took {elapsed:.2f} s"
     for domain, problems in parsed:
         assert parse_domain(write_domain(domain)) == domain
         for problem in problems:
