@@ -122,7 +122,7 @@ from alica.io.xml_vocabulary import (
     resolve_scalar,
 )
 from alica.io.xml_write import write_xml
-from alica.source import Diagnostic, SourceSpan
+from alica.source import Diagnostic, SourceSpan, byte_place
 
 __all__ = ["read_xml", "resolve_scalar", "write_xml"]
 
@@ -265,9 +265,15 @@ def _decode(data: bytes, path: str) -> tuple[str | None, Diagnostic | None]:
     except LookupError:
         return None, Diagnostic(SourceSpan(path, 1, 1), f"unknown encoding '{encoding}'", "save the file as UTF-8")
     except (UnicodeError, ValueError) as exc:
-        at = f" (byte {exc.start})" if isinstance(exc, UnicodeDecodeError) else ""
+        span = SourceSpan(path, 1, 1)
+        if isinstance(exc, UnicodeDecodeError):
+            if encoding.lower().replace("_", "-") in ("utf-8", "utf8", "utf-8-sig", "ascii"):
+                span = byte_place(data, exc.start, path)  # lines end in b"\n" only in these encodings
+            at = f" (byte 0x{data[exc.start]:02x})" if exc.start < len(data) else ""
+        else:
+            at = ""
         message = f"the file is not valid {encoding} text{at}"
-        return None, Diagnostic(SourceSpan(path, 1, 1), message, "save the file as UTF-8")
+        return None, Diagnostic(span, message, "save the file as UTF-8")
 
 
 def _parser() -> etree.XMLParser:

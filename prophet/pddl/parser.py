@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from alica.prophet.pddl.errors import PddlError
+from alica.source import byte_place
 from alica.prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
 from alica.prophet.pddl.model import (
     OBJECT,
@@ -447,6 +448,13 @@ def read_problem(path: str | Path, domain: Domain | None = None) -> Problem:
 
 def _read(path: str | Path) -> str:
     try:
-        return Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
+        data = Path(path).read_bytes()
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
         raise PddlError(f"cannot read {path}: {error}") from error
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        place = byte_place(data, error.start, str(path))
+        raise PddlError(
+            f"the file is not UTF-8 text (byte 0x{data[error.start]:02x})", place, "save it as UTF-8"
+        ) from error
