@@ -137,7 +137,12 @@ class Fields:
         if node is None or node.value is None:
             return default
         value = to_number(node.value)
-        if value is None or not math.isfinite(value) or value != int(value):
+        if value is not None and not math.isfinite(value):
+            self.problems.add(
+                node.span, f"'{key}' of {self.what} must be a whole number, not {value:g}", "write a whole number"
+            )
+            return default
+        if value is None or value != int(value):
             self._wrong(key, node, "a whole number")
             return default
         if low is not None and value < low:
