@@ -170,3 +170,61 @@ def test_subfolders_and_shipped_plans_may_be_imported(tmp_path: Path, monkeypatc
     entry = tmp_path / "p.yaml"
     entry.write_text(f"imports: ['{shipped.as_posix()}']\nrolesets: []\n", encoding="utf-8")
     assert Loader().check(entry)[1] == []
+
+
+# --------------------------------------------------------------------------- many attributes
+
+
+class _CountingElement:
+    """An lxml element that counts how often attribute values are asked for."""
+
+    def __init__(self, element: object) -> None:
+        self.element = element
+        self.value_reads = 0
+        self.nsmap = getattr(element, "nsmap", {})
+
+    def keys(self) -> list[str]:
+        return self.element.keys()  # type: ignore[attr-defined,no-any-return]
+
+    def get(self, key: str) -> str | None:
+        self.value_reads += 1
+        return self.element.get(key)  # type: ignore[attr-defined,no-any-return]
+
+    @property
+    def attrib(self) -> object:
+        self.value_reads += 1_000_000  # items() and values() walk the list once per value
+        return self.element.attrib  # type: ignore[attr-defined]
+
+
+def test_attribute_values_are_read_from_the_text_not_by_lookup() -> None:
+    from lxml import etree
+
+    from alica.io import xml_format
+
+    attributes = " ".join(f'a{i}="v{i}"' for i in range(200))
+    text = f'<alica version="1"><task name="T" {attributes}/></alica>'
+    reader = xml_format._Reader(text, "a.xml")
+    root = etree.fromstring(text.encode("utf-8"))
+    reader.locate(root)
+    counting = _CountingElement(root[0])
+    reader.places[counting] = reader.places[root[0]]  # type: ignore[index]
+    values = [value for _, _, value, _, _ in reader.attributes(counting)]
+    assert values == ["T", *(f"v{i}" for i in range(200))]
+    assert counting.value_reads == 0
+
+
+def test_attribute_values_from_the_text_equal_the_parsers() -> None:
+    from lxml import etree
+
+    from alica.io.xml_format import read_xml
+
+    text = (
+        '<alica version="1">\n<task name="x&amp;y&#10;z&#x41;&lt;&gt;\tq\nr" '
+        "description='it&apos;s \"fine\" &quot;'/>\n</alica>\n"
+    )
+    tree, problems = read_xml(text, "a.xml")
+    assert tree is not None and problems == []
+    task = tree.value["tasks"].value[0].value  # type: ignore[index,union-attr]
+    parsed = etree.fromstring(text.encode("utf-8"))[0]
+    assert task["name"].value == parsed.get("name") == "x&y\nzA<> q r"
+    assert task["description"].value == parsed.get("description")
