@@ -200,7 +200,7 @@ def _attribute_value(raw: str) -> str:
         if ref is None:
             return " "
         if ref.startswith("#x"):
-            return chr(int(ref[2:], 16))
+            return chr(int("0" + ref[1:], 0))  # "#x41" -> "0x41"
         if ref.startswith("#"):
             return chr(int(ref[1:]))
         return _NAMED[ref]

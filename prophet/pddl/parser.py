@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from alica.prophet.pddl.errors import PddlError
-from alica.source import byte_place
 from alica.prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
 from alica.prophet.pddl.model import (
     OBJECT,
@@ -31,6 +30,7 @@ from alica.prophet.pddl.model import (
 )
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
 from alica.prophet.planner import Feature
+from alica.source import byte_place
 
 _FEATURES = {f"{f.value}": frozenset({f}) for f in Feature}
 _EXTRA = {

@@ -36,7 +36,7 @@ def plan(tmp_path: Path, capsys: pytest.CaptureFixture[str], domain: str | bytes
 def test_deep_formula_is_a_located_error(head: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code, err = plan(tmp_path, capsys, DOMAIN.format(pre=nested(head, 480), cost="1"))
     assert code == 1
-    assert f"domain.pddl:3:" in err and f"error: lists are nested more than {MAX_DEPTH} deep" in err
+    assert "domain.pddl:3:" in err and f"error: lists are nested more than {MAX_DEPTH} deep" in err
 
 
 @pytest.mark.parametrize("head", ["and", "or (q)", "imply (q)"])
