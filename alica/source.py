@@ -43,3 +43,15 @@ class Diagnostic:
         if self.hint:
             text += f" (fix: {self.hint})"
         return text
+
+
+def byte_place(data: bytes, offset: int, file: str) -> SourceSpan:
+    """The line and column of byte ``offset`` in ``data`` (UTF-8 text), for a decoding error.
+
+    The column counts the characters before the offset on its line (invalid bytes
+    count one each), so it matches what an editor shows.
+    """
+    offset = max(0, min(offset, len(data)))
+    line_start = data.rfind(b"\n", 0, offset) + 1
+    before = data[line_start:offset].decode("utf-8", errors="replace")
+    return SourceSpan(file, data.count(b"\n", 0, offset) + 1, len(before) + 1)

@@ -23,8 +23,9 @@ def test_readme_starts_with_the_two_commands() -> None:
     assert first.splitlines()[0].startswith("make demo") and first.splitlines()[1].startswith("make test")
 
 
-def test_readme_plan_example_is_valid(tmp_path: Path) -> None:
+def test_readme_plan_example_is_valid(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     shutil.copytree(PLANS, tmp_path / "plans")
+    monkeypatch.setenv("ALICA_PLAN_PATH", str(tmp_path / "plans"))  # the copy's '../' imports stay in plan folders
     example = tmp_path / "plans" / "lunar" / "fetch_sample.yaml"
     example.write_text(_blocks("yaml")[0], encoding="utf-8")
     problems = validate_paths([example])

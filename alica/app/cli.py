@@ -152,7 +152,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     from alica.io import Loader, format_of, read_text
     from alica.io.dump import document_data
     from alica.io.loader import parse_text
-    from alica.io.xml_write import write_xml
+    from alica.io.xml_write import unwritable_text, write_xml
     from alica.io.yaml_format import write_yaml
 
     fmt, in_fmt = format_of(args.output), format_of(args.input)
@@ -164,6 +164,10 @@ def _cmd_convert(args: argparse.Namespace) -> int:
         loader.load(source)
     document = loader.document(source)
     tree, _ = parse_text(source.read_bytes().decode("utf-8-sig"), str(source), in_fmt)
+    if fmt == "xml" and tree is not None:
+        unwritable = unwritable_text(tree)
+        if unwritable:
+            raise PlanFormatError(unwritable)
     data = document_data(document, tree)
     imports = _relocated(document.imports, source, target)
     if imports:

@@ -118,8 +118,11 @@ class Fields:
         if node is None or node.value is None:
             return default
         value = to_number(node.value)
-        if value is None:
+        if value is None or math.isnan(value):
             self._wrong(key, node, "a number")
+            return default
+        if math.isinf(value) and (low is not None or high is not None):
+            self.problems.add(node.span, f"'{key}' of {self.what} is too large", "use a finite value")
             return default
         if (low is not None and value < low) or (high is not None and value > high):
             bounds = f"[{low if low is not None else '-inf'}, {high if high is not None else 'inf'}]"
@@ -134,7 +137,12 @@ class Fields:
         if node is None or node.value is None:
             return default
         value = to_number(node.value)
-        if value is None or value != int(value) or math.isinf(value):
+        if value is not None and not math.isfinite(value):
+            self.problems.add(
+                node.span, f"'{key}' of {self.what} must be a whole number, not {value:g}", "write a whole number"
+            )
+            return default
+        if value is None or value != int(value):
             self._wrong(key, node, "a whole number")
             return default
         if low is not None and value < low:
@@ -202,11 +210,20 @@ class Fields:
 
 
 def to_number(value: object) -> float | None:
-    """``value`` as a float, accepting numeric text; ``None`` if it is not a number."""
+    """``value`` as a float, accepting numeric text; ``None`` if it is not a number.
+
+    A whole number too large for a float is an infinity of its sign (callers check
+    :func:`math.isfinite`); NaN is returned as NaN.
+    """
     if isinstance(value, bool):
         return None
-    if isinstance(value, (int, float)):
-        return float(value)
+    if isinstance(value, int):
+        try:
+            return float(value)
+        except OverflowError:  # more than about 300 digits
+            return math.inf if value > 0 else -math.inf
+    if isinstance(value, float):
+        return value
     if isinstance(value, str):
         try:
             return float(value.strip())

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,7 +21,7 @@ from alica.lang import Registry, default_registry
 from alica.lang.skill_plugins import default_registry as default_skills
 from alica.lang.skills import SkillRegistry
 from alica.model import Document, PlanLibrary
-from alica.source import Diagnostic, SourceSpan
+from alica.source import Diagnostic, SourceSpan, byte_place
 
 #: File name endings the loader reads, with their format.
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
@@ -91,25 +91,65 @@ def _import_nodes(tree: Node | None) -> list[Node]:
     return section.value if isinstance(section.value, list) else [section]
 
 
+#: Environment variable with more plan folders imports may reach (separated by ``os.pathsep``).
+PLAN_PATH_VARIABLE = "ALICA_PLAN_PATH"
+
+
 @dataclass
 class _Read:
     document: Document
     diagnostics: list[Diagnostic]
-    imports: list[tuple[Path, SourceSpan]]
+    imports: list[tuple[str, SourceSpan]]
+
+
+def _inside(path: Path, roots: Iterable[Path]) -> bool:
+    return any(path == root or path.is_relative_to(root) for root in roots)
+
+
+def _bad_character(text: str) -> str | None:
+    """The first control character of an import path, shown as ``U+XXXX``."""
+    for char in text:
+        if ord(char) < 0x20 or 0x7F <= ord(char) < 0xA0:
+            return f"U+{ord(char):04X}"
+    return None
+
+
+def default_search_path() -> list[Path]:
+    """The plan folders every import may reach: the shipped plans and ``ALICA_PLAN_PATH``."""
+    folders: list[Path] = []
+    try:
+        folders.append(plans_dir())
+    except FileNotFoundError:
+        pass
+    folders.extend(Path(p) for p in os.environ.get(PLAN_PATH_VARIABLE, "").split(os.pathsep) if p.strip())
+    return folders
 
 
 @dataclass
 class Loader:
     """Reads plan files once each and validates document sets.
 
+    Imports are confined: a file may import only files inside the folder of the
+    entry file given to :meth:`check` or :meth:`load` (and its subfolders) or
+    inside a folder of the plan search path; anything else is reported at the
+    import, without being read.
+
     Args:
         skills: skill declarations behaviours are checked against.
         functions: predicates and functions formulas may call.
+        search_path: more folders imports may reach, besides the entry's folder,
+            the shipped plans (:func:`plans_dir`) and the folders of the
+            ``ALICA_PLAN_PATH`` environment variable (read when the loader is made).
     """
 
     skills: SkillRegistry = field(default_factory=default_skills)
     functions: Registry = field(default_factory=default_registry)
+    search_path: Sequence[str | os.PathLike[str]] = ()
     _cache: dict[Path, _Read] = field(default_factory=dict)
+    _roots: list[Path] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._roots = [Path(p).resolve() for p in [*self.search_path, *default_search_path()]]
 
     def read(self, path: Path) -> _Read:
         """Read and build one file (cached)."""
@@ -131,10 +171,18 @@ class Loader:
         except OSError as exc:
             return failed(f"cannot read the file: {exc.strerror or exc}", "check the path and its permissions")
         except UnicodeDecodeError as exc:
-            return failed(f"the file is not UTF-8 text (byte {exc.start})", "save it as UTF-8")
+            data = exc.object if isinstance(exc.object, bytes) else b""
+            place = byte_place(data, exc.start, name)
+            result = _Read(
+                Document(path=name),
+                [Diagnostic(place, f"the file is not UTF-8 text (byte 0x{data[exc.start]:02x})", "save it as UTF-8")],
+                [],
+            )
+            self._cache[path] = result
+            return result
         tree, document, diagnostics = _build(text, name, fmt)
         imports = [
-            (path.parent / node.value.strip(), node.span)
+            (node.value.strip(), node.span)
             for node in _import_nodes(tree)
             if isinstance(node.value, str) and node.value.strip()
         ]
@@ -148,6 +196,7 @@ class Loader:
         diagnostics: list[Diagnostic] = []
         seen: set[Path] = set()
         todo = [entry.resolve()]
+        roots = [todo[0].parent, *self._roots]
         while todo:
             path = todo.pop(0)
             if path in seen:
@@ -156,7 +205,12 @@ class Loader:
             read = self.read(path)
             documents.append(read.document)
             diagnostics.extend(read.diagnostics)
-            for target, span in read.imports:
+            for raw, span in read.imports:
+                target, problem = self._target(path.parent, raw, span, roots)
+                if target is None:
+                    if problem is not None:
+                        diagnostics.append(problem)
+                    continue
                 if not target.is_file():
                     diagnostics.append(
                         Diagnostic(
@@ -177,6 +231,31 @@ class Loader:
                 else:
                     todo.append(target.resolve())
         return documents, diagnostics
+
+    def _target(
+        self, folder: Path, raw: str, span: SourceSpan, roots: list[Path]
+    ) -> tuple[Path | None, Diagnostic | None]:
+        """The file an import names, or the problem with it (a bad path, or one outside ``roots``)."""
+        shown_raw = raw if len(raw) <= 60 else raw[:57] + "..."
+        bad = _bad_character(raw)
+        if bad is not None:
+            return None, Diagnostic(
+                span, f"import path holds the control character {bad}", "write the file's path as plain text"
+            )
+        try:
+            target = (folder / raw).resolve()
+            target.is_file()
+        except (OSError, ValueError) as exc:
+            reason = getattr(exc, "strerror", None) or str(exc)
+            return None, Diagnostic(span, f"cannot use import path '{shown_raw}': {reason}", "fix the path")
+        if not _inside(target, roots):
+            return None, Diagnostic(
+                span,
+                f"import '{shown_raw}' is outside the plan folders",
+                "import files under the entry file's folder or the plan search path "
+                f"(Loader(search_path=...) or {PLAN_PATH_VARIABLE})",
+            )
+        return target, None
 
     def check(self, *entries: str | os.PathLike[str]) -> tuple[list[Document], list[Diagnostic]]:
         """Read and validate the document set of one or more entry files.

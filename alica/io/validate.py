@@ -538,7 +538,7 @@ class _Vocabularies:
 def _resolved(path: str) -> str:
     try:
         return str(Path(path).resolve())
-    except OSError:
+    except (OSError, ValueError):  # ValueError: a NUL byte in an import path
         return path
 
 

@@ -122,7 +122,7 @@ from alica.io.xml_vocabulary import (
     resolve_scalar,
 )
 from alica.io.xml_write import write_xml
-from alica.source import Diagnostic, SourceSpan
+from alica.source import Diagnostic, SourceSpan, byte_place
 
 __all__ = ["read_xml", "resolve_scalar", "write_xml"]
 
@@ -137,7 +137,7 @@ class _Tag:
     name: str
     start: int
     end: int  # index just after '>'
-    attributes: dict[str, tuple[int, int]]  # raw name -> (name index, value index)
+    attributes: dict[str, tuple[int, int, int]]  # raw name -> (name index, value index, closing quote index)
 
 
 _TAG_NAME = re.compile(r"[^\s/>]+")
@@ -165,14 +165,14 @@ def _scan_tags(text: str) -> list[_Tag]:
             if name is None:
                 return tags
             pos = name.end()
-            attributes: dict[str, tuple[int, int]] = {}
+            attributes: dict[str, tuple[int, int, int]] = {}
             while True:
                 attribute = _ATTRIBUTE.match(text, pos)
                 if attribute is not None:
                     end = text.find(attribute.group(2), attribute.end())
                     if end < 0:
                         return tags
-                    attributes.setdefault(attribute.group(1), (attribute.start(1), attribute.end()))
+                    attributes.setdefault(attribute.group(1), (attribute.start(1), attribute.end(), end))
                     pos = end + 1
                     continue
                 close = _TAG_CLOSE.match(text, pos)
@@ -182,6 +182,30 @@ def _scan_tags(text: str) -> list[_Tag]:
                 break
             tags.append(_Tag(name.group(), j, pos, attributes))
             i = pos
+
+
+_REFERENCE = re.compile(r"&(#x[0-9a-fA-F]+|#[0-9]+|lt|gt|amp|quot|apos);|[\t\n\r]")
+_NAMED = {"lt": "<", "gt": ">", "amp": "&", "quot": '"', "apos": "'"}
+
+
+def _attribute_value(raw: str) -> str:
+    """An attribute value as the parser reports it: references replaced, blanks normalised (XML 1.0, 3.3.3).
+
+    Reading values from the raw text keeps an element with 10^5 attributes linear:
+    lxml's ``el.attrib.items()`` (and ``el.get``) walk the attribute list for every value.
+    """
+
+    def replace(match: re.Match[str]) -> str:
+        ref = match.group(1)
+        if ref is None:
+            return " "
+        if ref.startswith("#x"):
+            return chr(int("0" + ref[1:], 0))  # "#x41" -> "0x41"
+        if ref.startswith("#"):
+            return chr(int(ref[1:]))
+        return _NAMED[ref]
+
+    return _REFERENCE.sub(replace, raw) if "&" in raw or "\t" in raw or "\n" in raw or "\r" in raw else raw
 
 
 def _prolog_declaration(text: str) -> int | None:
@@ -265,9 +289,15 @@ def _decode(data: bytes, path: str) -> tuple[str | None, Diagnostic | None]:
     except LookupError:
         return None, Diagnostic(SourceSpan(path, 1, 1), f"unknown encoding '{encoding}'", "save the file as UTF-8")
     except (UnicodeError, ValueError) as exc:
-        at = f" (byte {exc.start})" if isinstance(exc, UnicodeDecodeError) else ""
+        span = SourceSpan(path, 1, 1)
+        if isinstance(exc, UnicodeDecodeError):
+            if encoding.lower().replace("_", "-") in ("utf-8", "utf8", "utf-8-sig", "ascii"):
+                span = byte_place(data, exc.start, path)  # lines end in b"\n" only in these encodings
+            at = f" (byte 0x{data[exc.start]:02x})" if exc.start < len(data) else ""
+        else:
+            at = ""
         message = f"the file is not valid {encoding} text{at}"
-        return None, Diagnostic(SourceSpan(path, 1, 1), message, "save the file as UTF-8")
+        return None, Diagnostic(span, message, "save the file as UTF-8")
 
 
 def _parser() -> etree.XMLParser:
@@ -451,20 +481,23 @@ class _Reader:
         """``(name as written, namespace, value, name span, value span)`` in document order."""
         tag = self.places.get(el)
         start: int | None = None
-        for key, value in el.attrib.items():
+        for key in el.keys():  # keys(): linear; values are read from the raw text where it is located
             name, namespace = _raw_attribute(el, key)
             where = tag.attributes.get(name) if tag is not None else None
-            if where is None:  # best effort: 'name=' after the element's '<tag'
-                if start is None:
-                    span = self.span(el)
-                    start = self.line_starts[min(span.line, len(self.line_starts)) - 1] + span.column - 1
-                found = re.compile(rf"\s({re.escape(name)})\s*=\s*[\"']").search(self.text, start)
-                where = (found.start(1), found.end()) if found else None
-            if where is None:
+            if where is not None:
+                value = _attribute_value(self.text[where[1] : where[2]])
+                yield name, namespace, value, self.at(where[0]), self.at(where[1])
+                continue
+            value = el.get(key) or ""
+            if start is None:  # best effort: 'name=' after the element's '<tag'
+                span = self.span(el)
+                start = self.line_starts[min(span.line, len(self.line_starts)) - 1] + span.column - 1
+            found = re.compile(rf"\s({re.escape(name)})\s*=\s*[\"']").search(self.text, start)
+            if found is None:
                 span = self.span(el)
                 yield name, namespace, value, span, span
             else:
-                yield name, namespace, value, self.at(where[0]), self.at(where[1])
+                yield name, namespace, value, self.at(found.start(1)), self.at(found.end())
 
     # -- problems
 

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import datetime
 import math
+import re
 from typing import Any
 
 from lxml import etree
 
 from alica.io.build import DECLARED_NAME, TYPED_NAME
+from alica.io.tree import Node
 from alica.io.xml_vocabulary import (
     _ENTRIES,
     _SPECS,
@@ -20,8 +22,45 @@ from alica.io.xml_vocabulary import (
     _yaml_float,
     resolve_scalar,
 )
+from alica.source import Diagnostic, SourceSpan
 
 # --------------------------------------------------------------------------- writing
+
+#: Characters XML 1.0 cannot hold, not even as character references.
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def unwritable_text(tree: Node) -> list[Diagnostic]:
+    """Every key or text of a located tree that XML 1.0 cannot hold, at its place.
+
+    ``alica convert`` checks the tree before writing XML, so a control character
+    in a description is reported where it was written, not as a failed write.
+    """
+    problems: list[Diagnostic] = []
+    todo = [tree]
+    while todo:
+        node = todo.pop()
+        if isinstance(node.value, dict):
+            for key, child in node.value.items():
+                bad = _NOT_XML.search(key)
+                if bad is not None:
+                    problems.append(_unwritable(node.key_span(key), bad.group(), "key"))
+                todo.append(child)
+        elif isinstance(node.value, list):
+            todo.extend(node.value)
+        elif isinstance(node.value, str):
+            bad = _NOT_XML.search(node.value)
+            if bad is not None:
+                problems.append(_unwritable(node.text_span(bad.start() + 1), bad.group(), "text"))
+    return problems
+
+
+def _unwritable(span: SourceSpan, char: str, what: str) -> Diagnostic:
+    return Diagnostic(
+        span,
+        f"the {what} holds the character U+{ord(char):04X}, which XML cannot hold",
+        "remove it, or keep this file in YAML",
+    )
 
 
 def write_xml(data: dict[str, Any]) -> str:

@@ -2,7 +2,11 @@
 
 PyYAML's composer keeps a mark (line, column) on every node; we keep them on
 the tree so every later error can name its place. Duplicate keys, which
-PyYAML would silently overwrite, are reported, and alias expansion is capped.
+PyYAML would silently overwrite, are reported, alias expansion is capped, and
+so is nesting (a deeper file is reported at the first value past the limit,
+not with a Python traceback). Scalars PyYAML cannot construct (``!!int x``,
+a number with more digits than Python reads, a month 13) are reported at
+their place.
 """
 
 from __future__ import annotations
@@ -15,8 +19,22 @@ import yaml
 from alica.io.tree import Node
 from alica.source import Diagnostic, SourceSpan
 
-#: Largest number of tree nodes one file may expand to (guards against alias bombs).
-MAX_NODES = 200_000
+#: Largest number of values aliases may expand to in one file (guards against alias bombs).
+#: Only values reached again through an alias (``*name`` or ``<<: *name``) count; a big
+#: file without aliases is never refused by it.
+MAX_ALIAS_VALUES = 200_000
+
+#: Deepest nesting of mappings and lists a plan file may have (plans need about ten).
+MAX_DEPTH = 100
+
+_TAG_NAMES = {
+    "tag:yaml.org,2002:int": "a whole number",
+    "tag:yaml.org,2002:float": "a number",
+    "tag:yaml.org,2002:bool": "true or false",
+    "tag:yaml.org,2002:null": "null",
+    "tag:yaml.org,2002:timestamp": "a date",
+    "tag:yaml.org,2002:binary": "base64 data",
+}
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 
@@ -25,29 +43,49 @@ class _TooLarge(Exception):
     pass
 
 
+class _TooDeep(Exception):
+    def __init__(self, span: SourceSpan) -> None:
+        super().__init__(str(span))
+        self.span = span
+
+
 class _Reader:
     def __init__(self, text: str, path: str) -> None:
         self.path = path
         self.lines = text.splitlines()
         self.constructor = yaml.SafeLoader("")
-        self.count = 0
+        self.expanded = 0
+        self.seen: set[int] = set()
         self.diagnostics: list[Diagnostic] = []
 
     def span(self, mark: Any) -> SourceSpan:
         return SourceSpan(self.path, mark.line + 1, mark.column + 1)
 
-    def convert(self, node: yaml.Node) -> Node:
-        self.count += 1
-        if self.count > MAX_NODES:
-            raise _TooLarge
+    def convert(self, node: yaml.Node, depth: int = 0, aliased: bool = False) -> Node:
+        """The located tree of ``node``; ``aliased`` when reached again through an alias."""
+        # PyYAML hands out the same node object for every alias of an anchor: a node
+        # seen before (or inside one) is an alias expansion, and only those count.
+        if aliased or id(node) in self.seen:
+            aliased = True
+            self.expanded += 1
+            if self.expanded > MAX_ALIAS_VALUES:
+                raise _TooLarge
+        else:
+            self.seen.add(id(node))
         span = self.span(node.start_mark)
+        if isinstance(node, (yaml.MappingNode, yaml.SequenceNode)) and depth >= MAX_DEPTH:
+            raise _TooDeep(span)
         if isinstance(node, yaml.MappingNode):
-            return self._mapping(node, span)
+            return self._mapping(node, span, depth, aliased)
         if isinstance(node, yaml.SequenceNode):
-            return Node([self.convert(item) for item in node.value], span)
+            return Node([self.convert(item, depth + 1, aliased) for item in node.value], span)
         if not isinstance(node, yaml.ScalarNode):  # PyYAML composes only scalar, sequence and mapping nodes
             raise TypeError(f"unexpected YAML node {type(node).__name__}")
-        value = self.constructor.construct_object(node, deep=True)
+        try:
+            value = self.constructor.construct_object(node, deep=True)
+        except (ValueError, OverflowError, TypeError, yaml.YAMLError) as exc:
+            self.diagnostics.append(self._unreadable(node, span, exc))
+            return Node(None, span)
         if isinstance(value, (datetime.date, datetime.datetime)):
             value = str(node.value)
         elif isinstance(value, bytes):
@@ -56,7 +94,21 @@ class _Reader:
             return Node(value, span, text_offset=self._text_offset(node))
         return Node(value, span)
 
-    def _mapping(self, node: yaml.MappingNode, span: SourceSpan) -> Node:
+    def _unreadable(self, node: yaml.ScalarNode, span: SourceSpan, exc: Exception) -> Diagnostic:
+        """The problem of a scalar PyYAML cannot construct (``!!int x``, 5000 digits, month 13)."""
+        text = str(node.value)
+        shown = text if len(text) <= 30 else text[:27] + "..."
+        kind = _TAG_NAMES.get(node.tag, f"'{node.tag}'")
+        digits = sum(c.isdigit() for c in text)
+        if node.tag == "tag:yaml.org,2002:int" and digits > 4000:
+            reason = f"it has {digits} digits"
+            hint = "write a smaller number"
+        else:
+            reason = " ".join(str(getattr(exc, "problem", None) or exc).split())[:80]
+            hint = "write a valid value, or quote it to keep it as text"
+        return Diagnostic(span, f"cannot read '{shown}' as {kind}: {reason}", hint)
+
+    def _mapping(self, node: yaml.MappingNode, span: SourceSpan, depth: int, aliased: bool) -> Node:
         items: dict[str, Node] = {}
         key_spans: dict[str, SourceSpan] = {}
         explicit: set[str] = set()
@@ -88,7 +140,7 @@ class _Reader:
                     continue
                 if not from_merge:
                     explicit.add(key)
-                items[key] = self.convert(value_node)
+                items[key] = self.convert(value_node, depth + 1, aliased)
                 key_spans[key] = key_span
         return Node(items, span, key_spans)
 
@@ -143,8 +195,16 @@ def read_yaml(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
         return None, [
             Diagnostic(
                 SourceSpan(path, 1, 1),
-                f"the file expands to more than {MAX_NODES} values (anchors and aliases nested too deep)",
+                f"the file expands to more than {MAX_ALIAS_VALUES} values through aliases (anchors and aliases nested too deep)",
                 "write the data out instead of nesting aliases",
+            )
+        ]
+    except _TooDeep as exc:
+        return None, [
+            Diagnostic(
+                exc.span,
+                f"mappings and lists are nested more than {MAX_DEPTH} deep",
+                "flatten the data; plans need only a few levels",
             )
         ]
     except yaml.YAMLError as exc:
@@ -161,7 +221,13 @@ class _Dumper(yaml.SafeDumper):
         super().increase_indent(flow, False)
 
 
+#: Characters YAML reads as line breaks but PyYAML would write unescaped outside double quotes.
+_UNICODE_BREAKS = ("\x85", "\u2028", "\u2029")
+
+
 def _represent_str(dumper: yaml.SafeDumper, value: str) -> yaml.ScalarNode:
+    if any(c in value for c in _UNICODE_BREAKS):  # written raw they would read back as '\n'
+        return dumper.represent_scalar("tag:yaml.org,2002:str", value, style='"')
     if "\n" in value:
         return dumper.represent_scalar("tag:yaml.org,2002:str", value, style="|")
     return dumper.represent_scalar("tag:yaml.org,2002:str", value)

@@ -26,6 +26,9 @@ from alica.prophet.pddl.model import (
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol
 from alica.prophet.planner import Feature
 
+#: Largest magnitude of a number in PDDL text: sums of such costs stay exact as floats.
+MAX_NUMBER = 1e15
+
 _NUMBER = re.compile(r"-?(\d+(\.\d*)?|\.\d+)([eE][-+]?\d+)?")
 _NAME = re.compile(r"[a-z][a-z0-9_\-]*", re.IGNORECASE)
 _NUMERIC_COMPARISONS = frozenset({"<", ">", "<=", ">="})
@@ -36,15 +39,22 @@ def parse_number(source: Source, node: Node, what: str) -> int | float:
     """A number literal (an int when it has no fraction or exponent).
 
     Raises:
-        PddlError: the node is no number.
+        PddlError: the node is no number, or its magnitude exceeds :data:`MAX_NUMBER`.
     """
     if not isinstance(node, Symbol) or not _NUMBER.fullmatch(node.text):
         shown = node.text if isinstance(node, Symbol) else node.describe() + " ...)"
         raise source.error(node.offset, f"bad number '{shown}' for {what}")
     text = node.text
-    if re.fullmatch(r"-?\d+", text):
-        return int(text)
-    return float(text)
+    if re.fullmatch(r"-?\d+", text) and len(text.lstrip("-").lstrip("0")) <= 16:
+        value: int | float = int(text)
+    else:
+        value = float(text)  # the pattern admits only what float() reads; huge values give inf
+    if not abs(value) <= MAX_NUMBER:
+        shown = text if len(text) <= 30 else text[:27] + "..."
+        raise source.error(
+            node.offset, f"number '{shown}' for {what} is too large", f"use a number of at most {MAX_NUMBER:.0e}"
+        )
+    return value
 
 
 def expect_name(source: Source, node: Node, what: str) -> str:

@@ -41,6 +41,7 @@ from alica.prophet.pddl.model import (
 )
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
 from alica.prophet.planner import Feature, Limits
+from alica.source import byte_place
 
 CHECK_EVERY = 1024
 """Items read between two checks of the limits."""
@@ -518,6 +519,13 @@ def _collector_paused() -> Iterator[None]:
 
 def _read(path: str | Path) -> str:
     try:
-        return Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as error:
+        data = Path(path).read_bytes()
+    except (OSError, ValueError) as error:  # ValueError: a NUL byte in the path
         raise PddlError(f"cannot read {path}: {error}") from error
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        place = byte_place(data, error.start, str(path))
+        raise PddlError(
+            f"the file is not UTF-8 text (byte 0x{data[error.start]:02x})", place, "save it as UTF-8"
+        ) from error

@@ -36,6 +36,9 @@ SECTIONS = frozenset(
 )
 """Keywords that open a top-level part of ``(define ...)``."""
 
+MAX_DEPTH = 100
+"""Deepest nesting of lists the reader accepts; the recursive readers after it stay far from Python's limit."""
+
 
 @dataclass(slots=True)
 class Source:
@@ -116,7 +119,7 @@ def read_sexpr(source: Source) -> SList:
 
     Raises:
         PddlError: unbalanced parentheses, a section opened inside an unclosed one,
-            or text outside the top-level list.
+            lists nested more than :data:`MAX_DEPTH` deep, or text outside the top-level list.
     """
     tokens = source.tokens()
     stack: list[tuple[int, list[Node]]] = []
@@ -128,6 +131,12 @@ def read_sexpr(source: Source) -> SList:
             if top is not None:
                 raise source.error(
                     index, f"unexpected text after the end of '{top.describe()}' (opened at {source.where(top.offset)})"
+                )
+            if len(stack) >= MAX_DEPTH:
+                raise source.error(
+                    index,
+                    f"lists are nested more than {MAX_DEPTH} deep",
+                    "flatten the formula; PDDL needs a few levels",
                 )
             items = []
             stack.append((index, items))
