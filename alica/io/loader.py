@@ -114,6 +114,12 @@ def _bad_character(text: str) -> str | None:
     return None
 
 
+def _project(entry: Path) -> list[Path]:
+    """The working folder, when ``entry`` lies inside it: the project whose plans import each other."""
+    here = Path.cwd().resolve()
+    return [here] if entry.is_relative_to(here) and here != Path(here.anchor) else []
+
+
 def default_search_path() -> list[Path]:
     """The plan folders every import may reach: the shipped plans and ``ALICA_PLAN_PATH``."""
     folders: list[Path] = []
@@ -130,9 +136,11 @@ class Loader:
     """Reads plan files once each and validates document sets.
 
     Imports are confined: a file may import only files inside the folder of the
-    entry file given to :meth:`check` or :meth:`load` (and its subfolders) or
-    inside a folder of the plan search path; anything else is reported at the
-    import, without being read.
+    entry file given to :meth:`check` or :meth:`load` (and its subfolders), the
+    working folder when the entry file lies in it (the project: ``alica validate
+    plans/lunar/mission.yaml`` may import ``plans/tasks.yaml``), or a folder of
+    the plan search path; anything else is reported at the import, without
+    being read.
 
     Args:
         skills: skill declarations behaviours are checked against.
@@ -196,7 +204,7 @@ class Loader:
         diagnostics: list[Diagnostic] = []
         seen: set[Path] = set()
         todo = [entry.resolve()]
-        roots = [todo[0].parent, *self._roots]
+        roots = [todo[0].parent, *_project(todo[0]), *self._roots]
         while todo:
             path = todo.pop(0)
             if path in seen:

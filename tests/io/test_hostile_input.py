@@ -228,3 +228,17 @@ def test_attribute_values_from_the_text_equal_the_parsers() -> None:
     parsed = etree.fromstring(text.encode("utf-8"))[0]
     assert task["name"].value == parsed.get("name") == "x&y\nzA<> q r"
     assert task["description"].value == parsed.get("description")
+
+
+def test_imports_reach_the_project_folder_the_command_runs_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("ALICA_PLAN_PATH", raising=False)
+    project = tmp_path / "project"
+    (project / "plans").mkdir(parents=True)
+    (project / "plans" / "tasks.yaml").write_text("tasks: [Shared]\n", encoding="utf-8")
+    (tmp_path / "secret.yaml").write_text("tasks: [Secret]\n", encoding="utf-8")
+    entry = write_set(project / "plans" / "lunar", "../tasks.yaml")
+    assert "outside the plan folders" in Loader().check(entry)[1][0].message  # run from elsewhere
+    monkeypatch.chdir(project)
+    assert Loader().check(entry)[1] == []  # run in the project: plans/lunar may import plans/tasks.yaml
+    escaping = write_set(project / "plans" / "other", "../../../secret.yaml")
+    assert "outside the plan folders" in Loader().check(escaping)[1][0].message

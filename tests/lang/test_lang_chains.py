@@ -153,7 +153,10 @@ def _plans_with(tmp_path: Path, condition: str) -> Path:
     return mission
 
 
-def test_a_long_chain_validates_and_runs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_long_chain_validates_and_runs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # the copied plans are the project: their imports reach its folder
     mission = _plans_with(tmp_path, "found(a) and found(b) and " + chain(" + ", "1", 5000) + " > 0")
     assert main(["validate", str(mission)]) == 0, capsys.readouterr().err
     argv = ["run", str(mission), "--stand-ins", "--agents", "scout,stummel,amparo", "--ticks", "3"]
