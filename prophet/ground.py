@@ -26,9 +26,7 @@ every few thousand actions after it, and raises
 
 from __future__ import annotations
 
-import gc
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from operator import itemgetter
 
@@ -36,7 +34,7 @@ from alica.prophet.pddl import Domain, PddlError, Problem
 from alica.prophet.pddl.model import Equals
 from alica.prophet.pddl.normal import dnf, expand
 from alica.prophet.pddl.reach import CHECK_EVERY, Fixpoint, GroundAction, fact_text
-from alica.prophet.planner import LimitReached, Limits
+from alica.prophet.planner import LimitReached, Limits, collector_paused
 
 #: A grounded PDDL atom as a flat tuple ``(predicate, *objects)``: a node of the grounding, not a
 #: :class:`alica.lang.fact.Fact` of the world model (flat tuples keep the grounding fast).
@@ -154,29 +152,13 @@ def ground(domain: Domain, problem: Problem, limits: Limits | None = None) -> Gr
             effects make a negative precondition impossible to compile.
         LimitReached: a limit was reached while grounding (the message says how far it got).
     """
-    with _collector_paused():
+    with collector_paused():
         try:
             return _ground(domain, problem, limits)
         except LimitReached as exc:
             # Drop the frames, and with them the abandoned grounding, while the collector is still
             # paused: with it running, freeing millions of objects took longer than building them.
             raise exc.with_traceback(None) from None
-
-
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """The cyclic garbage collector off for a while (grounding makes many objects but no cycles).
-
-    Without this, the collector's full passes over every object of the process
-    take a good part of the grounding's time on large tasks.
-    """
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def _ground(domain: Domain, problem: Problem, limits: Limits | None) -> GroundTask:

@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from alica.app.timed import timed
+from alica.app.timed import add_fault_options, timed
 from alica.errors import AlicaError
 
 
@@ -46,19 +46,11 @@ def add_parser(sub: Any) -> None:
     b.add_argument(
         "--time-limit", type=float, default=600.0, metavar="S", help="simulated seconds before giving up (default 600)"
     )
-    b.add_argument(
-        "--crash",
-        action="append",
-        default=[],
-        metavar="NAME@T",
-        help="crash team robot NAME (r1..rN) at simulated second T: it stops, drops what it holds and goes silent (repeatable)",
-    )
-    b.add_argument(
-        "--recover",
-        action="append",
-        default=[],
-        metavar="NAME@T",
-        help="restart team robot NAME at second T, with an empty memory (repeatable)",
+    add_fault_options(
+        b,
+        crash="crash team robot NAME (r1..rN) at simulated second T: it stops, drops what it holds and goes silent "
+        "(repeatable)",
+        recover="restart team robot NAME at second T, with an empty memory (repeatable)",
     )
     b.add_argument("--out", metavar="DIR", help="write trace.jsonl, initial.png, final.png and plan.yaml here")
     b.add_argument("--json", action="store_true", help="print the summary as JSON")

@@ -16,6 +16,7 @@ import sys
 from typing import Any
 
 from alica.app.skill_options import add_skills_option
+from alica.app.timed import add_fault_options
 from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
 
@@ -72,15 +73,10 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--jitter", type=float, default=0.0, metavar="MS", help="random extra delay up to this many milliseconds"
     )
-    p.add_argument(
-        "--crash",
-        action="append",
-        default=[],
-        metavar="NAME@T",
-        help="crash agent NAME at simulated second T (repeatable)",
-    )
-    p.add_argument(
-        "--recover", action="append", default=[], metavar="NAME@T", help="restart agent NAME at second T (repeatable)"
+    add_fault_options(
+        p,
+        crash="crash agent NAME at simulated second T (repeatable)",
+        recover="restart agent NAME at second T (repeatable)",
     )
     p.add_argument(
         "--partition",

@@ -3,8 +3,16 @@
 from __future__ import annotations
 
 import re
+from typing import Any
 
 from alica.errors import AlicaError
+
+
+def add_fault_options(parser: Any, crash: str, recover: str) -> None:
+    """Add the repeatable ``--crash NAME@T`` and ``--recover NAME@T`` options; ``crash``/``recover`` are their help."""
+    for option, text in (("--crash", crash), ("--recover", recover)):
+        parser.add_argument(option, action="append", default=[], metavar="NAME@T", help=text)
+
 
 _AT = re.compile(r"^(?P<what>.+)@(?P<start>[0-9.]+)(?:-(?P<end>[0-9.]+))?$")
 

@@ -9,10 +9,7 @@ memory bound. The garbage collector is paused while reading (many objects, no cy
 
 from __future__ import annotations
 
-import gc
 from collections import Counter
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 from alica.prophet.pddl.errors import PddlError
@@ -40,7 +37,7 @@ from alica.prophet.pddl.model import (
     When,
 )
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol, read_sexpr
-from alica.prophet.planner import Feature, Limits
+from alica.prophet.planner import Feature, Limits, collector_paused
 from alica.source import byte_place
 
 CHECK_EVERY = 1024
@@ -275,7 +272,7 @@ def parse_domain(text: str, file: str = "<string>", limits: Limits | None = None
         PddlError: the text is no valid domain (the message has ``FILE:LINE:COL``).
         LimitReached: a limit was reached while reading.
     """
-    with _collector_paused():
+    with collector_paused():
         return _parse_domain(text, file, limits)
 
 
@@ -376,7 +373,7 @@ def parse_problem(
         PddlError: the text is no valid problem (the message has ``FILE:LINE:COL``).
         LimitReached: a limit was reached while reading.
     """
-    with _collector_paused():
+    with collector_paused():
         return _parse_problem(text, file, domain, limits)
 
 
@@ -503,18 +500,6 @@ def read_problem(path: str | Path, domain: Domain | None = None, limits: Limits 
         LimitReached: a limit was reached while reading.
     """
     return parse_problem(_read(path), str(path), domain, limits)
-
-
-@contextmanager
-def _collector_paused() -> Iterator[None]:
-    """The cyclic garbage collector off while reading (its passes over the many new nodes cost more than the reading)."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def _read(path: str | Path) -> str:
