@@ -16,13 +16,21 @@ each run is classified:
 * **disagreement**: an agent reported the root plan's success while a
   success-required entry point had no agent that reached one of its success
   states (from the trace), or live agents ended with different outcomes;
-* **duplicate claims**: the longest time two live agents held the same
-  one-robot (``max: 1``) task of the root plan in a non-terminal state
-  (from each agent's own allocations and transitions in the trace).
+* **duplicate claims**: the longest time two live agents that can reach each
+  other held the same one-robot (``max: 1``) task of the root plan in a
+  non-terminal state (from each agent's own allocations and transitions in
+  the trace). Two agents on different sides of a partition cannot know of
+  each other's claims, so that time is not counted; the time it takes them to
+  settle after the partition heals is. A second column counts only the time
+  while neither of the two took the other for lost: a duplicate while both
+  know of each other is the engine's own disagreement; one after a teammate
+  fell silent for longer than the team timeout (a real crash, or heavy loss)
+  is what the team timeout allows.
 
 It prints a markdown table per case: runs, successes, stated reasons,
-tracebacks, livelocks, disagreements, runs with a duplicate claim over 1 s and
-the longest duplicate claim.
+tracebacks, livelocks, disagreements, runs with a duplicate claim over 1 s,
+the longest duplicate claim, and the same two for duplicates while both
+agents believed each other alive.
 """
 
 from __future__ import annotations
@@ -70,6 +78,25 @@ CASES: dict[str, list[str]] = {
         "amparo|scout,stummel@4-24",
     ],
     "loss 0.5 + crash+recover stummel": ["--loss", "0.5", "--crash", "stummel@6", "--recover", "stummel@14"],
+    "crash scout@12": ["--crash", "scout@12"],
+    "crash stummel@20": ["--crash", "stummel@20"],
+    "crash amparo@20": ["--crash", "amparo@20"],
+    "crash amparo@30": ["--crash", "amparo@30"],
+    "crash scout@2 + stummel@20": ["--crash", "scout@2", "--crash", "stummel@20"],
+    "crash+recover amparo 2-6": ["--crash", "amparo@2", "--recover", "amparo@6"],
+    "crash+recover scout 12-20": ["--crash", "scout@12", "--recover", "scout@20"],
+    "crash+recover stummel 20-30": ["--crash", "stummel@20", "--recover", "stummel@30"],
+    "crash+recover amparo twice": [
+        *("--crash", "amparo@8", "--recover", "amparo@14"),
+        *("--crash", "amparo@20", "--recover", "amparo@26"),
+    ],
+    "partition scout + crash amparo@10": ["--partition", "scout|stummel,amparo@3-23", "--crash", "amparo@10"],
+    "loss 0.8 + partition amparo": ["--loss", "0.8", "--partition", "amparo|scout,stummel@6-26"],
+    "delay + crash+recover amparo 8-20": [
+        *("--delay", "50", "--jitter", "100"),
+        *("--crash", "amparo@8", "--recover", "amparo@20"),
+    ],
+    "loss 0.3 + crash amparo@20": ["--loss", "0.3", "--crash", "amparo@20"],
 }
 
 
@@ -83,6 +110,7 @@ class Outcome:
     livelock: bool = False
     disagreement: bool = False
     duplicate: float = 0.0
+    aware_duplicate: float = 0.0
 
 
 def _plan_facts() -> tuple[str, dict[str, str], dict[str, int], set[str]]:
@@ -103,15 +131,41 @@ def _plan_facts() -> tuple[str, dict[str, str], dict[str, int], set[str]]:
     return plan.name, success_of, maxima, required
 
 
+Partition = tuple[float, float, list[list[str]]]
+
+
+def _separated(a: str, b: str, t: float, partitions: list[Partition]) -> bool:
+    """Whether a partition keeps ``a`` and ``b`` apart at time ``t``."""
+    for start, end, groups in partitions:
+        if start <= t < end and not any(a in g and b in g for g in groups):
+            return True
+    return False
+
+
 def _duplicate_time(
     events: list[dict[str, Any]], root: str, maxima: dict[str, int], success_of: dict[str, str]
-) -> float:
-    """The longest time two live agents held the same one-robot task (not in a terminal state)."""
+) -> tuple[float, float]:
+    """The longest times two live agents that can reach each other held the same one-robot task.
+
+    Returns:
+        The longest such time overall, and the longest while neither agent took
+        the other for lost (silent for longer than the team timeout): a duplicate
+        of the second kind is the engine's own disagreement, not loss.
+    """
+    partitions: list[Partition] = [
+        (float(e["start"]), float(e["end"]), e["groups"])
+        for e in events
+        if e.get("event") == "fault" and e.get("fault") == "partition"
+    ]
+    # the partitions' edges are moments too: a pair's duplicate time starts when it heals
+    edges = [{"t": t} for start, end, _ in partitions for t in (start, end)]
+    timeline = sorted([*events, *edges], key=lambda e: float(e.get("t", 0.0)))
     holding: dict[str, str | None] = {}
-    since: dict[tuple[str, str, str], float] = {}
-    longest = 0.0
+    lost: set[tuple[str, str]] = set()
+    since: dict[tuple[str, str, str, bool], float] = {}
+    longest = {False: 0.0, True: 0.0}
     one_robot = {ep for ep, m in maxima.items() if m == 1}
-    for e in events:
+    for e in timeline:
         agent, kind, t = e.get("agent"), e.get("event"), float(e.get("t", 0.0))
         if kind == "allocation" and e.get("key") == root and isinstance(e.get("entries"), dict):
             if agent in e["entries"]:
@@ -124,21 +178,24 @@ def _duplicate_time(
             holding[agent] = None
         elif kind == "fault" and e.get("fault") in ("crash", "recover"):
             holding[agent] = None
+        elif kind == "team":
+            (lost.add if e.get("change") == "lost" else lost.discard)((str(agent), str(e.get("who"))))
         pairs = set()
         agents = sorted(a for a, ep in holding.items() if ep in one_robot)
         for i, a in enumerate(agents):
             for b in agents[i + 1 :]:
-                if holding[a] == holding[b]:
-                    pairs.add((a, b, str(holding[a])))
+                if holding[a] == holding[b] and not _separated(a, b, t, partitions):
+                    aware = (a, b) not in lost and (b, a) not in lost
+                    pairs.add((a, b, str(holding[a]), aware))
         for pair in list(since):
             if pair not in pairs:
-                longest = max(longest, t - since.pop(pair))
+                longest[pair[3]] = max(longest[pair[3]], t - since.pop(pair))
         for pair in pairs:
             since.setdefault(pair, t)
     end = float(events[-1]["t"]) if events else 0.0
-    for start in since.values():
-        longest = max(longest, end - start)
-    return longest
+    for pair, start in since.items():
+        longest[pair[3]] = max(longest[pair[3]], end - start)
+    return max(longest.values()), longest[True]
 
 
 def run_one(case: str, seed: int, max_time: float, wall: float) -> Outcome:
@@ -184,7 +241,7 @@ def run_one(case: str, seed: int, max_time: float, wall: float) -> Outcome:
     outcomes = {a["status"] for a in live.values()} - {"running"}
     if {"success", "failure"} <= outcomes:
         out.disagreement = True
-    out.duplicate = _duplicate_time(events, root, maxima, success_of)
+    out.duplicate, out.aware_duplicate = _duplicate_time(events, root, maxima, success_of)
     return out
 
 
@@ -205,11 +262,13 @@ def main() -> None:
         results = list(pool.map(lambda job: run_one(job[0], job[1], args.max_time, args.wall), jobs))
     print(f"lunar team run, {args.seeds} seeds per case, limit {args.max_time:g} s simulated")
     print(
-        "| case | runs | success | stated reason | tracebacks | livelocks | disagreements | dup > 1 s | longest dup (s) |"
+        "| case | runs | success | stated reason | tracebacks | livelocks | disagreements"
+        " | dup > 1 s | longest dup (s) | aware dup > 1 s | longest aware dup (s) |"
     )
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- " * 11 + "|")
     total = Outcome()
     counts = [0] * 7
+    aware_count = 0
     for case in cases:
         rows = [r for (c, _), r in zip(jobs, results, strict=True) if c == case]
         row = [
@@ -222,10 +281,17 @@ def main() -> None:
             sum(r.duplicate > 1.0 for r in rows),
         ]
         longest = max((r.duplicate for r in rows), default=0.0)
+        aware = [sum(r.aware_duplicate > 1.0 for r in rows), max((r.aware_duplicate for r in rows), default=0.0)]
         total.duplicate = max(total.duplicate, longest)
+        total.aware_duplicate = max(total.aware_duplicate, aware[1])
         counts = [a + b for a, b in zip(counts, row, strict=True)]
-        print(f"| {case} | " + " | ".join(map(str, row)) + f" | {longest:.2f} |")
-    print("| **all** | " + " | ".join(map(str, counts)) + f" | {total.duplicate:.2f} |")
+        aware_count += int(aware[0])
+        print(f"| {case} | " + " | ".join(map(str, row)) + f" | {longest:.2f} | {aware[0]} | {aware[1]:.2f} |")
+    print(
+        "| **all** | "
+        + " | ".join(map(str, counts))
+        + f" | {total.duplicate:.2f} | {aware_count} | {total.aware_duplicate:.2f} |"
+    )
 
 
 if __name__ == "__main__":
