@@ -302,10 +302,22 @@ class DriveToFreeSpace(MoveToPosition):
     With ``keep_away`` > 0 the place is also at least that far (centre to
     centre) from every movable object lying in the world (blocks, samples):
     a robot waiting there does not crowd the stacks others work on.
+
+    Any free place serves, so when another robot stands on the chosen one
+    (it got there first, or it is crashed there) the skill drives to the next
+    free place instead of waiting for it to leave (up to ``MAX_REPLANS``
+    times; then it waits as MoveToPosition does, until the timeout).
     """
 
     def initialise(self) -> None:
         """Find the free place, then drive there like MoveToPosition."""
+        self.spot = self._free_place()
+        self.params["goal"] = self.spot if self.spot is not None else self.robot.pose[:2]
+        self.params.setdefault("tolerance", 0.2)
+        self.moved_goal = 0
+        super().initialise()
+
+    def _free_place(self) -> tuple[float, float] | None:
         from alica.skills.motion import escape_goal
 
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
@@ -314,7 +326,7 @@ class DriveToFreeSpace(MoveToPosition):
         grid = planning_grid(self.world)
         lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
         sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
-        spot = escape_goal(
+        return escape_goal(
             grid,
             self.robot.pose,
             clearance=self.robot.spec.radius + clearance,
@@ -322,16 +334,26 @@ class DriveToFreeSpace(MoveToPosition):
             other_robots=self._others(),
             keep_away=sites,
         )
-        self.spot = spot
-        self.params["goal"] = spot if spot is not None else self.robot.pose[:2]
-        self.params.setdefault("tolerance", 0.2)
-        super().initialise()
 
     def update(self) -> Status:
-        """Fail when there is no free place, else drive there."""
+        """Fail when there is no free place, else drive there; a place another robot took is given up for another."""
         if self.spot is None:
             return self.fail(f"no free place with the clearance within {self.param('max_distance', 3.0)} m")
-        return super().update()
+        status = super().update()
+        if status == Status.RUNNING and self.job is None and self.now() < self.wait_until:
+            # any free place serves: waiting for the robot on this one could wait for good (it may be
+            # waiting itself, for what this robot does next, or be crashed)
+            spot = self._free_place()
+            if spot is not None and spot != self.spot and self.moved_goal < MAX_REPLANS:
+                self.moved_goal += 1
+                self.spot = spot
+                self.params["goal"] = spot
+                self.goal = spot
+                self.target = drivable_goal(planning_checker(self.world, self.robot.spec.radius), spot, self.tolerance)
+                self.wait_until = 0.0
+                self._plan(self.target or spot)
+                return self.running(f"another robot took the free place: driving to ({spot[0]:.2f}, {spot[1]:.2f})")
+        return status
 
 
 class Idle(WorldSkill):

@@ -224,6 +224,28 @@ def test_drive_to_free_space_keeps_away_from_the_blocks(blocks_world, skill_run)
     assert not blocks_world.robots["r1"].bumped
 
 
+def test_drive_to_free_space_gives_up_a_place_another_robot_took(blocks_world, skill_run):
+    # a robot that stands on the chosen place for good (crashed, or waiting itself for what this robot does
+    # next) made DriveToFreeSpace wait there until its timeout: an opponent holding a block stalled 60 s and
+    # the team waiting for that block with it (blocks demo, seed 1, one opponent, r3 crashed at 3.5 s)
+    blocks_world.robots["r1"].set_pose(0.0, -0.7, math.pi / 2)  # right next to the stacks: it must move
+    other = blocks_world.robots["r2"]
+    taken = []
+
+    def take_the_place(world, behaviour):
+        if not taken and getattr(behaviour, "follower", None) is not None:
+            taken.append(behaviour.spot)
+            other.set_pose(behaviour.spot[0], behaviour.spot[1], 0.0)  # and it stays there
+
+    params = {"clearance": 0.4, "max_distance": 5.0, "keep_away": 1.15}
+    run = skill_run("DriveToFreeSpace", blocks_world, "r1", params, on_tick=take_the_place)
+    assert taken
+    assert run.ok, (run.reason, run.trace[-4:])
+    x, y, _ = blocks_world.robots["r1"].pose
+    assert math.dist((x, y), taken[0]) > other.spec.radius + blocks_world.robots["r1"].spec.radius
+    assert run.sim_time_s < 20.0
+
+
 def test_an_escape_turns_on_the_spot_before_it_drives(blocks_world, skill_run):
     # a robot pressed against something refuses any move deeper into it, turning included, so an escape that
     # drove an arc towards free space 40 degrees off its heading stayed where it was (seed 7 of the 5-agent demo)
