@@ -20,6 +20,20 @@ KEYWORDS: frozenset[str] = frozenset({"and", "or", "not", "forall", "exists", "i
 #: Comparison operators as stored in :class:`Compare` nodes.
 COMPARE_OPS: frozenset[str] = frozenset({"<", "<=", ">", ">=", "==", "!="})
 
+#: The domain word of ``x in agents(Name)`` binders (kept as the type name ``'agents(Name)'``).
+AGENTS = "agents"
+
+#: Kinds of :class:`Quantified` nodes: two quantifiers (truth values) and one aggregate (a number).
+QUANTIFIER_KINDS: frozenset[str] = frozenset({"forall", "exists", "sum"})
+
+
+def agents_of(type_name: str) -> str | None:
+    """``'Explore'`` for the binder domain ``'agents(Explore)'``; ``None`` for a plain type name."""
+    if type_name.startswith(AGENTS + "(") and type_name.endswith(")"):
+        return type_name[len(AGENTS) + 1 : -1]
+    return None
+
+
 #: Arithmetic operators as stored in :class:`Binary` nodes.
 ARITH_OPS: frozenset[str] = frozenset({"+", "-", "*", "/", "%", "^"})
 
@@ -162,12 +176,15 @@ class Iff(BaseNode):
 
 @dataclass(frozen=True, slots=True)
 class Quantified(BaseNode):
-    """``forall``/``exists`` over typed variables.
+    """``forall``/``exists`` over typed variables, or the aggregate ``sum``.
 
     Attributes:
-        kind: ``'forall'`` or ``'exists'``.
-        binders: ``(variable, type name)`` pairs, in the order written.
-        body: the quantified formula.
+        kind: ``'forall'``, ``'exists'`` or ``'sum'`` (the sum of an arithmetic
+            body over all combinations: a number, not a truth value).
+        binders: ``(variable, type name)`` pairs, in the order written; the type
+            name ``'agents(E)'`` stands for the agents of entry point, task or
+            state ``E`` (:func:`agents_of`).
+        body: the quantified formula, or the summed term.
     """
 
     kind: str
@@ -180,8 +197,19 @@ Node: TypeAlias = (
     Number | String | Bool | Name | Call | Attr | Unary | Binary | Compare | Not | And | Or | Implies | Iff | Quantified
 )
 
-#: Node types whose value is a truth value by construction.
+#: Node types whose value is a truth value by construction (a ``sum`` :class:`Quantified` is not: see
+#: :func:`is_logical`).
 LOGICAL_TYPES: tuple[type, ...] = (Compare, Not, And, Or, Implies, Iff, Quantified, Bool)
+
+
+def is_aggregate(node: object) -> bool:
+    """Whether ``node`` is a ``sum`` aggregate (a number)."""
+    return isinstance(node, Quantified) and node.kind == "sum"
+
+
+def is_logical(node: object) -> bool:
+    """Whether ``node``'s value is a truth value by construction."""
+    return isinstance(node, LOGICAL_TYPES) and not is_aggregate(node)
 
 
 def children(node: Node) -> tuple[Node, ...]:

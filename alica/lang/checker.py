@@ -31,7 +31,6 @@ import difflib
 
 from alica.errors import FormulaError
 from alica.lang.ast import (
-    LOGICAL_TYPES,
     And,
     Binary,
     Bool,
@@ -48,6 +47,8 @@ from alica.lang.ast import (
     String,
     Unary,
     children,
+    is_aggregate,
+    is_logical,
 )
 from alica.lang.parser import parse
 from alica.lang.registry import Registry
@@ -64,6 +65,8 @@ def _describe(node: Node) -> str:
         return "a truth value"
     if isinstance(node, (Binary, Unary)):
         return "an arithmetic expression"
+    if is_aggregate(node):
+        return "a sum, a number"
     return "a logical formula"
 
 
@@ -88,7 +91,9 @@ class _Checker:
             node, boolean, self.bound = stack.pop()
             self.check_node(node, boolean)
             if isinstance(node, Quantified):
-                stack.append((node.body, True, self.bound | {var for var, _ in node.binders}))
+                # a quantifier's body is a truth value, a sum's a number
+                body_boolean = not is_aggregate(node)
+                stack.append((node.body, body_boolean, self.bound | {var for var, _ in node.binders}))
                 continue
             logical = isinstance(node, (Not, And, Or, Implies, Iff))
             stack.extend((child, logical, self.bound) for child in reversed(children(node)))
@@ -96,7 +101,7 @@ class _Checker:
 
     def check_node(self, node: Node, boolean: bool) -> None:
         """The checks of one node (``boolean``: a truth value is needed here)."""
-        if boolean and isinstance(node, (Number, String, Binary, Unary)):
+        if boolean and (isinstance(node, (Number, String, Binary, Unary)) or is_aggregate(node)):
             self.report(
                 node,
                 f"'{unparse(node)}' is {_describe(node)}, not a truth value",
@@ -104,6 +109,8 @@ class _Checker:
             )
         if isinstance(node, Call):
             self.check_call(node)
+            if node.name in self.bound and len(node.args) == 1:
+                return  # a variable with one value per agent, read for one of them: frontier(a)
             if self.vocabulary is not None:
                 self.check_declared(node, len(node.args), boolean)
         elif isinstance(node, Name):
@@ -113,7 +120,7 @@ class _Checker:
             self.check_binders(node)
         elif isinstance(node, (Binary, Unary)):
             for operand in children(node):
-                if isinstance(operand, (String, *LOGICAL_TYPES)):
+                if isinstance(operand, String) or is_logical(operand):
                     self.report(
                         operand,
                         f"'{unparse(operand)}' is {_describe(operand)}, not a number",
@@ -121,7 +128,7 @@ class _Checker:
                     )
         elif isinstance(node, Compare) and node.op not in ("==", "!="):
             for operand in (node.left, node.right):
-                if isinstance(operand, LOGICAL_TYPES):
+                if is_logical(operand):
                     self.report(
                         operand,
                         f"'{unparse(operand)}' is {_describe(operand)}, which cannot be ordered",

@@ -469,11 +469,9 @@ class _Compiler:
 
         return equivalence
 
-    def t_quantified(self, node: Quantified) -> Closure:
-        body = self.truth(node.body)
-        names = tuple(var for var, _ in node.binders)
+    def domains(self, node: Quantified) -> Callable[[BeliefBase], list[tuple[object, ...]]]:
+        """The objects of each binder's type, listed by the belief base."""
         types = tuple(type_name for _, type_name in node.binders)
-        universal = node.kind == "forall"
 
         def domains(b: BeliefBase) -> list[tuple[object, ...]]:
             try:
@@ -482,6 +480,41 @@ class _Compiler:
                 raise
             except Exception as exc:
                 raise _fail(node, f"cannot list objects: {type(exc).__name__}: {exc}") from exc
+
+        return domains
+
+    def v_quantified(self, node: Quantified) -> Closure:
+        if node.kind != "sum":
+            return self.t_quantified(node)
+        body = self.value(node.body)
+        names = tuple(var for var, _ in node.binders)
+        domains = self.domains(node)
+
+        def total(b: BeliefBase, e: Env) -> Any:
+            inner = dict(e)
+            result: Any = 0
+            for combination in product(*domains(b)):
+                inner.update(zip(names, combination, strict=True))
+                term = body(b, inner)
+                if not _is_number(term):
+                    raise _fail(node.body, f"a sum adds numbers, but '{unparse(node.body)}' is {_show(term)}")
+                result = result + term
+            return result
+
+        return total
+
+    def t_quantified(self, node: Quantified) -> Closure:
+        if node.kind == "sum":
+            get = self.v_quantified(node)
+
+            def check(b: BeliefBase, e: Env) -> bool:
+                return _truth(node, get(b, e))
+
+            return check
+        body = self.truth(node.body)
+        names = tuple(var for var, _ in node.binders)
+        universal = node.kind == "forall"
+        domains = self.domains(node)
 
         if len(names) == 1:
             var = names[0]
@@ -570,6 +603,7 @@ _VALUE: dict[type, Callable[[_Compiler, Any], Closure]] = {
     Attr: _Compiler.v_attr,
     Unary: _Compiler.v_unary,
     Binary: _Compiler.v_binary,
+    Quantified: _Compiler.v_quantified,
 }
 _TRUTH: dict[type, Callable[[_Compiler, Any], Closure]] = {
     Bool: _Compiler.t_bool,

@@ -8,7 +8,8 @@ Grammar, lowest precedence first::
     and        := not (('and' | '&&') not)*
     not        := ('not' | '!') not | quantified | comparison
     quantified := ('forall' | 'exists') binder (',' binder)* ':' formula
-    binder     := IDENT (',' IDENT)* 'in' IDENT
+    binder     := IDENT (',' IDENT)* 'in' domain
+    domain     := IDENT | 'agents' '(' IDENT ')'          the agents of an entry point, task or state
     comparison := sum (('<' | '<=' | '>' | '>=' | '==' | '=' | '!=') sum)?
     sum        := product (('+' | '-') product)*
     product    := unary (('*' | '/' | '%') unary)*
@@ -16,10 +17,17 @@ Grammar, lowest precedence first::
     power      := postfix (('^' | '**') unary)?                 right-assoc
     postfix    := atom ('.' IDENT)*
     atom       := NUM | STR | 'true' | 'false' | IDENT | IDENT '(' args ')'
-                | '(' formula ')'
+                | aggregate | '(' formula ')'
+    aggregate  := 'sum' binder (',' binder)* ':' sum          the sum of the term over the domains
     args       := (formula (',' formula)*)?
 
-A quantifier's body extends as far right as possible.
+A quantifier's body extends as far right as possible; an aggregate's body is
+an arithmetic term (``sum a in agents(Explore): gain(frontier(a)) > 3``
+compares the sum with 3). ``sum`` is a keyword only where an aggregate can
+start (``sum NAME in`` or ``sum NAME,``), so predicates and functions named
+``sum`` keep working. The domain ``agents(Explore)`` is kept as the type name
+``'agents(Explore)'``: the belief base lists its objects, the agents of entry
+point, task or state ``Explore`` of the plan the formula belongs to.
 
 Chains of operators (``a + b + ...``, ``a.b.c``, ``a -> b -> ...``,
 ``not not a``, ``- - x``, ``a ^ b ^ ...``) are read by loops, so their length
@@ -35,6 +43,7 @@ from functools import lru_cache
 
 from alica.errors import FormulaError
 from alica.lang.ast import (
+    AGENTS,
     KEYWORDS,
     And,
     Attr,
@@ -186,6 +195,22 @@ class _Parser:
 
     def quantified(self) -> Node:
         head = self.advance()
+        binders = self.binders(head.text)
+        self.enter(head)
+        body = self.formula()
+        self.leave()
+        return Quantified(head.kind, binders, body, head.column)
+
+    def aggregate(self) -> Node:
+        head = self.advance()
+        binders = self.binders(head.text)
+        self.enter(head)
+        body = self.sum()
+        self.leave()
+        return Quantified("sum", binders, body, head.column)
+
+    def binders(self, head: str) -> tuple[tuple[str, str], ...]:
+        """``x, y in Type, z in agents(Entry) :`` up to and including the colon."""
         binders: list[tuple[str, str]] = []
         while True:
             names = [self.expect_ident("a variable name")]
@@ -196,26 +221,38 @@ class _Parser:
                 raise self.error(
                     f"expected 'in'{self.after()}, found {self.tok.describe()}",
                     self.tok,
-                    f"write {head.text} x in Type: ...",
+                    f"write {head} x in Type: ...",
                 )
             self.advance()
-            type_name = self.expect_ident("a type name").text
+            domain = self.expect_ident("a type name")
+            type_name = domain.text
+            if type_name == AGENTS and self.tok.kind == "(":
+                opening = self.advance()
+                which = self.expect_ident("an entry point, task or state")
+                self.close(opening, "write agents(EntryPoint)")
+                type_name = f"{AGENTS}({which.text})"
             binders.extend((name.text, type_name) for name in names)
             if self.tok.kind == ",":
                 self.advance()
                 continue
             if self.tok.kind == ":":
                 self.advance()
-                break
+                return tuple(binders)
             raise self.error(
-                f"expected ':' after the variables of '{head.text}', found {self.tok.describe()}",
+                f"expected ':' after the variables of '{head}', found {self.tok.describe()}",
                 self.tok,
-                f"write {head.text} x in Type: formula",
+                f"write {head} x in Type: formula",
             )
-        self.enter(head)
-        body = self.formula()
-        self.leave()
-        return Quantified(head.kind, tuple(binders), body, head.column)
+
+    def starts_aggregate(self) -> bool:
+        """Whether ``sum`` here starts an aggregate (``sum x in`` or ``sum x,``), not a name."""
+        tokens, pos = self.tokens, self.pos
+        return (
+            self.tok.text == "sum"
+            and pos + 2 < len(tokens)
+            and tokens[pos + 1].kind == "IDENT"
+            and tokens[pos + 2].kind in ("in", ",")
+        )
 
     def comparison(self) -> Node:
         start = self.tok.column
@@ -300,6 +337,8 @@ class _Parser:
             self.advance()
             return Bool(kind == "true", token.column)
         if kind == "IDENT":
+            if self.starts_aggregate():
+                return self.aggregate()
             self.advance()
             if self.tok.kind == "(":
                 return Call(token.text, self.arguments(), token.column)

@@ -130,7 +130,8 @@ def _parts(node: Node, tail: bool) -> list[_Piece]:
     if isinstance(node, Iff):
         return [(node.left, _IFF, False), " <-> ", (node.right, _IMPLIES, tail)]
     if isinstance(node, Quantified):
-        return [f"{node.kind} {_binders(node.binders)}: ", (node.body, _IFF, True)]
+        body_level = _ADD if node.kind == "sum" else _IFF  # a sum's body is an arithmetic term
+        return [f"{node.kind} {_binders(node.binders)}: ", (node.body, body_level, True)]
     raise TypeError(f"not a formula node: {node!r}")
 
 
