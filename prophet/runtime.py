@@ -711,7 +711,7 @@ def _stalled(
     takes the free task by the engine's reuse rule, as a team smaller than
     its tasks works). An agent that may take the free task but waits in a
     step after it never will: with the free task pinned to it alone, that is
-    a deadlock.
+    a deadlock. So is a free task pinned only to agents that left the team.
     """
 
     def position(i: int) -> float:  # where the task's next step is in the plan (its last steps finished: after all)
@@ -723,6 +723,11 @@ def _stalled(
         return None
     first = min(free, key=position)
     start = position(first)
+    pinned = allowed[first] if first < len(allowed) else None
+    may = set(pinned if pinned is not None else members) & set(members)
+    if not may and pinned is not None:
+        # only robots that left the team (crashed, say, holding the block the task starts with) may start it
+        return f"task T{first} has nobody, and only {', '.join(sorted(pinned))} may start it, who is not in the team"
     waiting = [
         i
         for i, p in enumerate(progress)
@@ -730,8 +735,6 @@ def _stalled(
     ]
     if not waiting:
         return None
-    pinned = allowed[first] if first < len(allowed) else None
-    may = set(pinned if pinned is not None else members) & set(members)
     if any(p.agent in may and not p.done and (p.running or position(i) < start) for i, p in enumerate(progress)):
         return None
     return f"task T{first} has nobody, and the agent of task T{max(waiting)} waits for it"

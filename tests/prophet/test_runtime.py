@@ -409,6 +409,25 @@ def test_a_free_task_is_not_stuck_while_an_agent_that_may_take_it_finishes_an_ea
     assert "task T2 has nobody" in _stalled(progress, order, (None, None, ("r1", "r2"), ("r4",)), ("r4",))
 
 
+def test_a_free_task_pinned_to_a_crashed_agent_is_stuck_when_nobody_waits_for_it():
+    from alica.prophet.runtime import _stalled
+    from alica.prophet.world import TaskProgress
+
+    # seed 13, the leader r1 crashed at 25 s holding d: T3 = Stack(d, e) is pinned to r1; T0-T2 are done, so
+    # nobody waits for T3, and the team idled until its time limit instead of planning again
+    order = [[0, 1, 2], [3], [4, 5], [6]]
+    done = [TaskProgress(None, len(steps), done=True) for steps in order[:3]]
+    progress = [*done, TaskProgress(None, 0)]
+    members = ("r2", "r3")
+    allowed = (("r3",), ("r2",), None, ("r1",))
+    reason = _stalled(progress, order, allowed, members)
+    assert reason is not None and reason.startswith("task T3 has nobody, and only r1 may start it")
+    # r1 back in the team: it takes T3 by the engine's reuse rule, nothing is stuck
+    assert _stalled(progress, order, allowed, ("r1", "r2", "r3")) is None
+    # a free task anyone may take is not stuck either: the reuse rule gives it to a free agent
+    assert _stalled(progress, order, (("r3",), ("r2",), None, None), members) is None
+
+
 def test_a_free_task_pinned_to_an_agent_that_waits_for_it_in_an_earlier_task_is_stuck():
     from alica.prophet.runtime import _stalled
     from alica.prophet.world import TaskProgress
