@@ -494,7 +494,9 @@ class Validator:
     def _range(self, v: Variable, what: str) -> None:
         example = f"'{v.name} - {v.type}[-10, 10]' or 'range: [-10, 10]'"
         if v.low is None or v.high is None:
-            self.problems.add(v.span, f"{what} has no range", f"a {v.type} variable needs one: write {example}")
+            self.problems.add(
+                v.span, f"{what} has no range", f"{_article(v.type)} {v.type} variable needs one: write {example}"
+            )
         elif not (math.isfinite(v.low) and math.isfinite(v.high)):
             self.problems.add(v.span, f"the range [{v.low:g}, {v.high:g}] of {what} is not finite", "use finite bounds")
         elif v.low > v.high:
@@ -737,3 +739,7 @@ def _kind(cls: type) -> str:
     return {Behaviour: "behaviour", Plan: "plan", PlanType: "plan type", PlanningProblem: "planning problem"}.get(
         cls, cls.__name__
     )
+
+
+def _article(word: str) -> str:
+    return "an" if word[:1].lower() in "aeiou" else "a"
