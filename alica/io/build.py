@@ -171,12 +171,22 @@ def _typed_mapping(node: Node, f: Fields, key: str) -> Variable:
             )
         else:
             low, high = (_number_of(item, what, f.problems) for item in items)
+    for given, missing in (("min", "max"), ("max", "min")):
+        if g.has(given) and not g.has(missing) and table is None:
+            f.problems.add(g.span_of(given), f"{what} gives '{given}' but no '{missing}'", f"add '{missing}:'")
     candidates = g.text("candidates").strip() or None
     return Variable(name, g.text("type", default=ANY_TYPE), low, high, candidates, span=node.span)
 
 
+def _bound_number(value: object) -> float | None:
+    """A bound as a number; YAML's ``.inf`` and ``.nan`` are read in text too (the validator rejects them)."""
+    if isinstance(value, str) and value.strip().lower().lstrip("+-") in (".inf", ".nan"):
+        value = value.strip().replace(".", "", 1)
+    return to_number(value)
+
+
 def _number_of(node: Node, what: str, problems: Problems) -> float | None:
-    value = to_number(node.value)
+    value = _bound_number(node.value)
     if value is None:
         problems.add(node.span, f"bound '{node.value}' of {what} is not a number", "write the range as numbers")
     return value
@@ -201,7 +211,7 @@ def _range_text(node: Node, text: str, column: int, f: Fields, name: str) -> tup
     out: list[float | None] = []
     offset = column
     for part in parts:
-        value = to_number(part)
+        value = _bound_number(part)
         if value is None:
             lead = len(part) - len(part.lstrip())
             f.problems.add(

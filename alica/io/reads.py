@@ -72,7 +72,7 @@ def agent_domains(root: Node, text: str) -> list[AgentDomain]:
         node = stack.pop()
         if isinstance(node, Quantified):
             start = max(node.column - 1, 0)
-            for _, domain in node.binders:
+            for domain in dict.fromkeys(domain for _, domain in node.binders):  # a, b in agents(E): once
                 name = agents_of(domain)
                 if name is None:
                     continue

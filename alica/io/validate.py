@@ -494,6 +494,8 @@ class Validator:
     def _range(self, v: Variable, what: str) -> None:
         example = f"'{v.name} - {v.type}[-10, 10]' or 'range: [-10, 10]'"
         if v.low is None or v.high is None:
+            if v.low is not None or v.high is not None:
+                return  # one bound was given, or one did not read as a number: reported where it was read
             self.problems.add(
                 v.span, f"{what} has no range", f"{_article(v.type)} {v.type} variable needs one: write {example}"
             )
