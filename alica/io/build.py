@@ -14,6 +14,7 @@ from alica.io.fields import Fields, Problems, kind_of, to_number
 from alica.io.tree import Node
 from alica.lang.ast import KEYWORDS
 from alica.model import (
+    ANY_TYPE,
     UNBOUNDED,
     Behaviour,
     Binding,
@@ -42,6 +43,7 @@ from alica.model import (
     UtilityFunction,
     Variable,
 )
+from alica.source import SourceSpan
 
 #: Keys of the top level of a plan file.
 TOP_KEYS = (
@@ -61,6 +63,10 @@ TYPED_NAME = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*(?:-\s*([A-Za-z_][\w-]*))?\
 #: ``name/arity``, the short form of a predicate or function declaration.
 DECLARED_NAME = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*/\s*([0-9]+)\s*$")
 _IDENTIFIER = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+#: ``name - type[low, high]``: a variable with a range (real, int and point variables).
+RANGED_NAME = re.compile(r"^\s*(\??[A-Za-z_][\w-]*)\s*-\s*([A-Za-z_][\w-]*)\s*\[([^\[\]]*)\]\s*$")
+#: ``type`` or ``type[low, high]``, a type in the ``name: type`` form of a variable list.
+TYPE_RANGE = re.compile(r"^\s*([A-Za-z_][\w-]*)\s*(?:\[([^\[\]]*)\])?\s*$")
 
 
 def build_document(tree: Node, path: str, problems: Problems) -> Document:
@@ -126,18 +132,96 @@ def _condition(f: Fields, key: str, kind: ConditionKind) -> Condition | None:
 
 
 def _typed(node: Node, f: Fields, key: str) -> Variable | None:
-    """``name``, ``name - type`` or ``{name: x, type: t}``."""
+    """``name``, ``name - type``, ``name - type[low, high]`` or ``{name, type, range, min, max, candidates}``."""
     if node.is_mapping:
-        g = Fields(node, f"an entry of '{key}' in {f.what}", f.problems, ("name", "type"))
-        return Variable(g.name(), g.text("type", default="any"), span=node.span)
+        return _typed_mapping(node, f, key)
     if isinstance(node.value, str):
         match = TYPED_NAME.match(node.value)
         if match:
-            return Variable(match.group(1), match.group(2) or "any", span=node.span)
+            return Variable(match.group(1), match.group(2) or ANY_TYPE, span=node.span)
+        match = RANGED_NAME.match(node.value)
+        if match:
+            low, high = _range_text(node, match.group(3), match.start(3) + 1, f, match.group(1))
+            return Variable(match.group(1), match.group(2), low, high, span=node.span)
     f.problems.add(
-        node.span, f"'{node.value}' in '{key}' of {f.what} is not 'name' or 'name - type'", "write e.g. '?r - robot'"
+        node.span,
+        f"'{node.value}' in '{key}' of {f.what} is not 'name', 'name - type' or 'name - type[low, high]'",
+        "write e.g. '?r - robot' or 'x - real[-10, 10]'",
     )
     return None
+
+
+def _typed_mapping(node: Node, f: Fields, key: str) -> Variable:
+    keys = ("name", "type", "range", "min", "max", "candidates")
+    g = Fields(node, f"an entry of '{key}' in {f.what}", f.problems, keys)
+    name = g.name()
+    what = f"variable '{name}' in {f.what}"
+    low = _bound(g, "min", what)
+    high = _bound(g, "max", what)
+    table = g.get("range")
+    if table is not None and table.value is not None:
+        if g.has("min") or g.has("max"):
+            f.problems.add(table.span, f"{what} gives both 'range' and 'min'/'max'", "keep one of them")
+        items = table.value if isinstance(table.value, list) else None
+        if items is None or len(items) != 2:
+            f.problems.add(
+                table.span,
+                f"'range' of {what} must be a list of two numbers [low, high]",
+                "write e.g. range: [-10, 10]",
+            )
+        else:
+            low, high = (_number_of(item, what, f.problems) for item in items)
+    for given, missing in (("min", "max"), ("max", "min")):
+        if g.has(given) and not g.has(missing) and table is None:
+            f.problems.add(g.span_of(given), f"{what} gives '{given}' but no '{missing}'", f"add '{missing}:'")
+    candidates = g.text("candidates").strip() or None
+    return Variable(name, g.text("type", default=ANY_TYPE), low, high, candidates, span=node.span)
+
+
+def _bound_number(value: object) -> float | None:
+    """A bound as a number; YAML's ``.inf`` and ``.nan`` are read in text too (the validator rejects them)."""
+    if isinstance(value, str) and value.strip().lower().lstrip("+-") in (".inf", ".nan"):
+        value = value.strip().replace(".", "", 1)
+    return to_number(value)
+
+
+def _number_of(node: Node, what: str, problems: Problems) -> float | None:
+    value = _bound_number(node.value)
+    if value is None:
+        problems.add(node.span, f"bound '{node.value}' of {what} is not a number", "write the range as numbers")
+    return value
+
+
+def _bound(g: Fields, key: str, what: str) -> float | None:
+    node = g.get(key)
+    if node is None or node.value is None:
+        return None
+    return _number_of(node, what, g.problems)
+
+
+def _range_text(node: Node, text: str, column: int, f: Fields, name: str) -> tuple[float | None, float | None]:
+    """``low, high`` written inside the brackets of a short form, starting at 1-based ``column`` of ``node``."""
+    parts = text.split(",")
+    what = f"variable '{name}' in {f.what}"
+    if len(parts) != 2:
+        f.problems.add(
+            node.text_span(column), f"the range of {what} must be two numbers [low, high]", "write e.g. real[-10, 10]"
+        )
+        return None, None
+    out: list[float | None] = []
+    offset = column
+    for part in parts:
+        value = _bound_number(part)
+        if value is None:
+            lead = len(part) - len(part.lstrip())
+            f.problems.add(
+                node.text_span(offset + lead),
+                f"bound '{part.strip()}' of {what} is not a number",
+                "write the range as numbers, e.g. real[-10, 10]",
+            )
+        out.append(value)
+        offset += len(part) + 1
+    return out[0], out[1]
 
 
 def _typed_list(f: Fields, key: str) -> tuple[Variable, ...]:
@@ -145,7 +229,16 @@ def _typed_list(f: Fields, key: str) -> tuple[Variable, ...]:
     if node is not None and node.is_mapping:  # name: type
         out = []
         for name, value in node.value.items():  # type: ignore[union-attr]
-            out.append(Variable(name, str(value.value) if value.value is not None else "any", span=node.key_span(name)))
+            span = node.key_span(name)
+            if value.value is None:
+                out.append(Variable(name, ANY_TYPE, span=span))
+                continue
+            match = TYPE_RANGE.match(str(value.value)) if isinstance(value.value, str) else None
+            if match is None or match.group(2) is None:
+                out.append(Variable(name, str(value.value), span=span))
+                continue
+            low, high = _range_text(value, match.group(2), match.start(2) + 1, f, name)
+            out.append(Variable(name, match.group(1), low, high, span=span))
         return tuple(out)
     return tuple(v for v in (_typed(n, f, key) for n in f.items(key)) if v is not None)
 
@@ -472,16 +565,31 @@ def _utility(plan: Fields, problems: Problems) -> UtilityFunction:
 
 
 def _constraint(node: Node, plan: str, problems: Problems) -> Constraint:
-    f = _element(node, "constraints", problems, ("name", "formula", "variables"))
+    f = _element(node, "constraints", problems, ("name", "formula", "utility", "variables"))
     if f is None:
         return Constraint("", "", span=node.span)
     formula = f.get("formula")
+    utility = f.get("utility")
+    if not f.has("formula") and not f.has("utility"):
+        problems.add(
+            f.span,
+            f"{f.what} of plan '{plan}' has neither 'formula' nor 'utility'",
+            "write the hard constraint as 'formula:' (a truth value), the value to maximise as 'utility:', or both",
+        )
     return Constraint(
         f.name(),
-        f.text("formula", required=True, hint="write the constraint as a formula").strip(),
+        f.text("formula").strip(),
         tuple(n for n, _ in f.names("variables")),
-        span=formula.text_span(1) if formula is not None else node.span,
+        f.text("utility").strip(),
+        span=_text_start(formula) if formula is not None else node.span,
+        utility_span=_text_start(utility) if utility is not None else None,
     )
+
+
+def _text_start(node: Node) -> SourceSpan:
+    """Where the text of a formula starts once its leading blanks are stripped."""
+    text = node.value if isinstance(node.value, str) else ""
+    return node.text_span(1 + len(text) - len(text.lstrip()))
 
 
 def _signature(plan: Fields, problems: Problems) -> PlanningSignature | None:

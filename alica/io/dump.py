@@ -16,6 +16,7 @@ from alica.model import (
     Behaviour,
     ChildRef,
     Condition,
+    Constraint,
     Declaration,
     Document,
     EntryPoint,
@@ -66,8 +67,40 @@ def _cond(cond: Condition | None) -> str | None:
     return cond.text if cond is not None else None
 
 
-def _typed(variables: tuple[Variable, ...]) -> list[str]:
-    return [v.name if v.type == "any" else f"{v.name} - {v.type}" for v in variables]
+def _typed(variables: tuple[Variable, ...]) -> list[Any]:
+    """``name``, ``name - type``, ``name - type[low, high]``, or a mapping when there are candidates."""
+    return [_variable(v) for v in variables]
+
+
+def _variable(v: Variable) -> Any:
+    both = v.low is not None and v.high is not None
+    if v.candidates is None and (both or (v.low is None and v.high is None)):
+        text = v.name if v.type == "any" and not both else f"{v.name} - {v.type}"
+        return f"{text}[{_bound_text(v.low)}, {_bound_text(v.high)}]" if both else text
+    out: Data = {"name": v.name}
+    if v.type != "any":
+        out["type"] = v.type
+    if both:
+        out["range"] = [_bound_number(v.low), _bound_number(v.high)]
+    else:
+        _put(out, "min", _bound_number(v.low), _NONE)
+        _put(out, "max", _bound_number(v.high), _NONE)
+    _put(out, "candidates", v.candidates, _NONE)
+    return out
+
+
+def _bound_number(value: float | None) -> int | float | None:
+    """A bound as a whole number when it is one (and small enough to stay exact)."""
+    if value is None:
+        return None
+    return int(value) if math.isfinite(value) and value.is_integer() and abs(value) < 1e15 else value
+
+
+def _bound_text(value: float | None) -> str:
+    number = _bound_number(value)
+    if isinstance(number, float) and math.isinf(number):
+        return "inf" if number > 0 else "-inf"
+    return repr(number)
 
 
 def _declaration(d: Declaration) -> Any:
@@ -201,8 +234,11 @@ class _Dumper:
         _put(out, "summands", summands, written)
         return out
 
-    def constraint(self, c: Any) -> Data:
-        out: Data = {"name": c.name, "formula": c.text}
+    def constraint(self, c: Constraint) -> Data:
+        out: Data = {"name": c.name}
+        if c.text or not c.utility:
+            out["formula"] = c.text
+        _put(out, "utility", c.utility, _NONE, "")
         _put(out, "variables", list(c.variables), _NONE)
         return out
 

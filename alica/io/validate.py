@@ -9,17 +9,23 @@ the acyclic plan tree, numeric rules of the language, skills and formulas.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Protocol, TypeVar
 
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
+from alica.io.reads import Read, agent_domains, reads
 from alica.lang import ENGINE_VARIABLES, Registry, Vocabulary, check, default_vocabulary, literals, parse
+from alica.lang.ast import Node, is_logical
 from alica.lang.skills import SkillRegistry
 from alica.model import (
+    ANY_TYPE,
+    NUMERIC_TYPES,
     AbstractPlan,
     Behaviour,
+    Binding,
     Condition,
     Declaration,
     Document,
@@ -27,6 +33,7 @@ from alica.model import (
     PlanningProblem,
     PlanType,
     RoleSet,
+    Variable,
     children_of,
     format_cardinality,
 )
@@ -44,6 +51,9 @@ class _Element(Protocol):
 
 
 _E = TypeVar("_E", bound=_Element)
+
+#: A type name: real, int, point, any or an object type.
+_TYPE_NAME = re.compile(r"^[A-Za-z_][\w-]*$")
 
 #: How far utility weights may stray from summing to 1.
 WEIGHT_TOLERANCE = 1e-6
@@ -87,6 +97,11 @@ class Validator:
         self.vocabularies = _Vocabularies(documents, vocabulary or default_vocabulary(), problems)
         self.vocabulary: Vocabulary | None = None
         self.bound: frozenset[str] = ENGINE_VARIABLES
+        #: Within a plan: its entry points, tasks and states, the names agents(E) may use.
+        self.domains: frozenset[str] | None = None
+        #: The variables of the element being checked, and how messages name it.
+        self.variables: tuple[str, ...] = ()
+        self.owner = ""
         self.tasks = self._unique("task", (t for d in documents for t in d.tasks))
         self.rolesets = self._unique("role set", (r for d in documents for r in d.rolesets))
         abstract: list[AbstractPlan] = []
@@ -103,6 +118,7 @@ class Validator:
             self._roleset(rs)
         for element in self.abstract.values():
             self.vocabulary = self.vocabularies.of(element)
+            self.domains = None
             if isinstance(element, Behaviour):
                 self._behaviour(element)
             elif isinstance(element, Plan):
@@ -151,21 +167,68 @@ class Validator:
         effect: bool = False,
         boolean: bool = False,
         bound: Iterable[str] = (),
-    ) -> None:
+        constraint: bool = False,
+    ) -> Node | None:
+        """Check one formula; returns its tree, or None when it does not parse.
+
+        Within a plan, its ``agents(E)`` domains must name the plan's entry points,
+        tasks or states; in a constraint, ``x(a)`` for an agent ``a`` must read a
+        declared variable (or a registered or declared function).
+        """
+        node: Node | None = None
+        skip: set[int] = set()
         try:
             node = parse(text)
             names = self.bound | set(bound)
+            if self.domains is not None:
+                self._domains(node, text, span, what)
+            if constraint:
+                skip = self._per_agent_reads(node, text, span, what)
             issues = check(node, self.functions, text=text, boolean=boolean, vocabulary=self.vocabulary, bound=names)
             if effect:
                 literals(node)
         except FormulaError as exc:
             issues = [exc]
         for issue in issues:
+            if issue.column in skip and issue.message.startswith("unknown "):
+                continue  # reported as a per-agent read of an undeclared variable
             self.problems.add(
                 formula_span(span, text, issue.column),
                 f"{what}: {issue.message}",
                 issue.hint or "see the formula syntax in docs/plan_format.md",
             )
+        return node
+
+    def _domains(self, node: Node, text: str, span: SourceSpan | None, what: str) -> None:
+        """``agents(E)``: ``E`` must be an entry point, task or state of the plan."""
+        assert self.domains is not None
+        for domain in agent_domains(node, text):
+            if domain.name not in self.domains:
+                self.problems.add(
+                    formula_span(span, text, domain.column),
+                    f"{what}: agents({domain.name}) names no entry point, task or state of the plan",
+                    suggest(domain.name, self.domains)
+                    or "name one of: " + ", ".join(sorted(self.domains)) + " (agents(E) are the agents in E)",
+                )
+
+    def _per_agent_reads(self, node: Node, text: str, span: SourceSpan | None, what: str) -> set[int]:
+        """Report ``x(a)`` for an agent ``a`` where ``x`` is no variable and no known function; their columns."""
+        reported: set[int] = set()
+        for read in reads(node):
+            if not read.per_agent or not read.of_agent or read.name in self.bound:
+                continue
+            if read.name in self.functions or (self.vocabulary is not None and self.vocabulary.lookup(read.name)):
+                continue
+            reported.add(read.column)
+            close = suggest(read.name, self.variables)
+            self.problems.add(
+                formula_span(span, text, read.column),
+                f"{what}: '{read.name}(...)' reads per-agent variable '{read.name}', which {self.owner} does not declare",
+                close
+                or f"declare it under 'variables:' of {self.owner}, e.g. '{read.name} - real[0, 10]', "
+                f"or declare '{read.name}' as a function",
+            )
+        return reported
 
     def _condition(self, cond: Condition | None, what: str, *, effect: bool = False, bound: Iterable[str] = ()) -> None:
         if cond is not None:
@@ -222,6 +285,7 @@ class Validator:
     def _behaviour(self, b: Behaviour) -> None:
         what = f"behaviour '{b.name}'"
         self.bound = ENGINE_VARIABLES | {v.name for v in b.variables}
+        self._variables(b.variables, what)
         for kind, cond in (("pre", b.pre), ("run", b.run), ("post", b.post)):
             self._condition(cond, f"{kind} condition of {what}")
         variables = {v.name for v in b.variables}
@@ -265,6 +329,12 @@ class Validator:
     def _plan(self, plan: Plan) -> None:
         what = f"plan '{plan.name}'"
         self.bound = ENGINE_VARIABLES | {v.name for v in plan.variables}
+        self.domains = frozenset(
+            [ep.name for ep in plan.entry_points]
+            + [ep.task for ep in plan.entry_points]
+            + [s.name for s in plan.states]
+        )
+        self._variables(plan.variables, what)
         states = self._unique_in(what, "state", plan.states)
         self._unique_in(what, "entry point", plan.entry_points)
         self._unique_in(what, "transition", plan.transitions)
@@ -314,6 +384,8 @@ class Validator:
                         binding.span,
                         f"binding of '{binding.variable}' in state '{state.name}' of {what}",
                     )
+                    if isinstance(target, (Plan, Behaviour)):
+                        self._binding_types(binding, target, plan, f"state '{state.name}' of {what}")
             self._condition(state.post, f"post condition of state '{state.name}' of {what}")
         for t in plan.transitions:
             t_what = f"transition '{t.name}' of {what}"
@@ -372,9 +444,9 @@ class Validator:
                         "add a transition into it or remove it",
                     )
         self._utility(plan)
+        self._constraints(plan)
         declared = {v.name for v in plan.variables}
         for c in plan.constraints:
-            self._formula(c.text, c.span, f"constraint '{c.name}' of {what}", boolean=True)
             for var in c.variables:
                 if var not in declared:
                     self.problems.add(
@@ -388,6 +460,129 @@ class Validator:
             parameters = [v.name for v in sig.parameters]
             self._condition(sig.precondition, f"precondition of {what}", bound=parameters)
             self._condition(sig.effect, f"effect of {what}", effect=True, bound=parameters)
+
+    def _variables(self, variables: tuple[Variable, ...], what: str) -> None:
+        """Declarations: a known type, a finite range for real, int and point variables, candidates that parse."""
+        self.variables = tuple(v.name for v in variables)
+        self.owner = what
+        for v in variables:
+            v_what = f"variable '{v.name}' of {what}"
+            if not _TYPE_NAME.match(v.type):
+                self.problems.add(
+                    v.span,
+                    f"{v_what} has unknown type '{v.type}'",
+                    "use real, int, point, any, or the name of an object type such as Frontier",
+                )
+            elif not v.numeric and (v.low is not None or v.high is not None):
+                close = suggest(v.type, sorted(NUMERIC_TYPES))
+                self.problems.add(
+                    v.span,
+                    f"{v_what} has a range, but its type '{v.type}' is not real, int or point",
+                    close or "only real, int and point variables have a range; an object type has none",
+                )
+            if v.numeric:
+                self._range(v, v_what)
+            if v.candidates is not None:
+                if not v.object_type:
+                    self.problems.add(
+                        v.span,
+                        f"{v_what} has candidates, but its type is {v.type}",
+                        "candidates list the values of a variable of an object type, e.g. 'frontier - Frontier'",
+                    )
+                self._candidates(v, v_what)
+
+    def _range(self, v: Variable, what: str) -> None:
+        example = f"'{v.name} - {v.type}[-10, 10]' or 'range: [-10, 10]'"
+        if v.low is None or v.high is None:
+            if v.low is not None or v.high is not None:
+                return  # one bound was given, or one did not read as a number: reported where it was read
+            self.problems.add(
+                v.span, f"{what} has no range", f"{_article(v.type)} {v.type} variable needs one: write {example}"
+            )
+        elif not (math.isfinite(v.low) and math.isfinite(v.high)):
+            self.problems.add(v.span, f"the range [{v.low:g}, {v.high:g}] of {what} is not finite", "use finite bounds")
+        elif v.low > v.high:
+            self.problems.add(
+                v.span,
+                f"the range [{v.low:g}, {v.high:g}] of {what} is empty: low > high",
+                f"write the smaller bound first: [{v.high:g}, {v.low:g}]",
+            )
+        elif v.type == "int" and not (v.low.is_integer() and v.high.is_integer()):
+            self.problems.add(
+                v.span, f"the range [{v.low:g}, {v.high:g}] of int {what} has a fraction", "use whole numbers"
+            )
+
+    def _candidates(self, v: Variable, what: str) -> None:
+        """The candidates formula must parse and name known functions (reported at the variable)."""
+        text = v.candidates or ""
+        try:
+            issues = check(parse(text), self.functions, text=text, vocabulary=self.vocabulary, bound=self.bound)
+        except FormulaError as exc:
+            issues = [exc]
+        for issue in issues:
+            self.problems.add(
+                v.span,
+                f"candidates '{text}' of {what}: {issue.message} (column {issue.column})",
+                issue.hint or "write a formula whose value is the list of candidates, e.g. frontiers()",
+            )
+
+    def _constraints(self, plan: Plan) -> None:
+        """Constraint formulas are truth values, utilities numbers; a variable is read one way only."""
+        what = f"plan '{plan.name}'"
+        self.variables = tuple(v.name for v in plan.variables)
+        self.owner = what
+        declared = set(self.variables)
+        first: dict[tuple[str, bool], SourceSpan | None] = {}
+        for c in plan.constraints:
+            c_what = f"constraint '{c.name}' of {what}"
+            parts = []
+            if c.text or not c.utility:
+                node = self._formula(c.text, c.span, c_what, boolean=True, constraint=True)
+                parts.append((node, c.text, c.span))
+            if c.utility:
+                node = self._formula(c.utility, c.utility_span, f"utility of {c_what}", constraint=True)
+                if node is not None and is_logical(node):
+                    self.problems.add(
+                        c.utility_span,
+                        f"utility of {c_what}: '{c.utility}' is a truth value, not a number to maximise",
+                        "write a number, e.g. 'sum a in agents(E): gain(frontier(a))'; put conditions under 'formula:'",
+                    )
+                parts.append((node, c.utility, c.utility_span))
+            for node, text, span in parts:
+                if node is None:
+                    continue
+                for read in reads(node):
+                    if read.name not in declared:
+                        continue
+                    place = formula_span(span, text, read.column)
+                    key = (read.name, read.per_agent)
+                    other = (read.name, not read.per_agent)
+                    if key not in first:
+                        first[key] = place
+                        if other in first:
+                            self._mixed_read(read, place, first[other], c_what)
+
+    def _mixed_read(self, read: Read, place: SourceSpan | None, earlier: SourceSpan | None, what: str) -> None:
+        how, other = (f"{read.name}(a)", read.name) if read.per_agent else (read.name, f"{read.name}(a)")
+        where = f" at {earlier}" if earlier is not None else ""
+        self.problems.add(
+            place,
+            f"{what}: variable '{read.name}' is read as '{how}' here and as '{other}'{where}",
+            f"read it as '{read.name}(a)' everywhere for one value per agent, or as '{read.name}' for one team value",
+        )
+
+    def _binding_types(self, binding: Binding, target: Plan | Behaviour, plan: Plan, what: str) -> None:
+        """A child's variable bound to a parent's variable must have the same type (unless one is untyped)."""
+        child = next((v for v in target.variables if v.name == binding.variable), None)
+        parent = next((v for v in plan.variables if v.name == binding.value.strip()), None)
+        if child is None or parent is None or ANY_TYPE in (child.type, parent.type) or child.type == parent.type:
+            return
+        self.problems.add(
+            binding.span,
+            f"binding of '{binding.variable}' in {what}: '{binding.variable}' of '{target.name}' is {child.type}, "
+            f"but '{parent.name}' of plan '{plan.name}' is {parent.type}",
+            "bind variables of the same type, or leave the child's variable untyped",
+        )
 
     def _utility(self, plan: Plan) -> None:
         u = plan.utility
@@ -546,3 +741,7 @@ def _kind(cls: type) -> str:
     return {Behaviour: "behaviour", Plan: "plan", PlanType: "plan type", PlanningProblem: "planning problem"}.get(
         cls, cls.__name__
     )
+
+
+def _article(word: str) -> str:
+    return "an" if word[:1].lower() in "aeiou" else "a"

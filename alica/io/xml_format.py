@@ -36,7 +36,7 @@ the shape the table below gives it. Tags and attributes are the YAML keys
     <utility>        priority_weight similarity_weight  summand -> summands (list)
                      threshold
     <summand>        name weight                        its text -> expression
-    <constraint>     name                               variable -> variables (names), formula (text)
+    <constraint>     name                               variable -> variables (names), formula utility (text)
     <signature>      cost                               parameter -> parameters (list),
                                                         precondition effect (text)
     <entrypoint>     name task state min max
@@ -50,7 +50,8 @@ the shape the table below gives it. Tags and attributes are the YAML keys
     <plantype>       name description                   plan -> plans (names)
     <problem>        name wait_plan alternative_plan    element -> elements (names), object -> objects
                      update_time timeout planner description    (list), world goal (text)
-    <variable>, <parameter>, <object>: name type  (a typed name, ``{name, type}`` in YAML)
+    <variable>, <parameter>, <object>: name type min max candidates  (a typed name: ``name - type``,
+                     ``name - type[min, max]`` or ``{name, type, range: [min, max], candidates}`` in YAML)
     <predicate>, <function>: name arity doc  (``name/arity`` or ``{name, arity, doc}`` in YAML)
 
 Shapes:

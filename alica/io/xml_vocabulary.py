@@ -138,7 +138,7 @@ _SPECS: dict[str, _Spec] = {
             _text("post"),
         ),
     ),
-    "variable": _Spec(("name", "type"), typed=True),
+    "variable": _Spec(("name", "type", "min", "max", "candidates"), typed=True),
     "plan": _Spec(
         ("name", "frequency", "description"),
         (
@@ -159,7 +159,7 @@ _SPECS: dict[str, _Spec] = {
         (_Child("summand", "summands", LIST, "summand"),),
     ),
     "summand": _Spec(("name", "weight"), content="expression"),
-    "constraint": _Spec(("name",), (_Child("variable", "variables", NAMES), _text("formula"))),
+    "constraint": _Spec(("name",), (_Child("variable", "variables", NAMES), _text("formula"), _text("utility"))),
     "signature": _Spec(
         ("cost",),
         (_Child("parameter", "parameters", LIST, "variable"), _text("precondition"), _text("effect")),

@@ -9,7 +9,8 @@ from typing import Any
 
 from lxml import etree
 
-from alica.io.build import DECLARED_NAME, TYPED_NAME
+from alica.io.build import DECLARED_NAME, RANGED_NAME, TYPE_RANGE, TYPED_NAME
+from alica.io.fields import to_number
 from alica.io.tree import Node
 from alica.io.xml_vocabulary import (
     _ENTRIES,
@@ -132,17 +133,54 @@ def _listed(value: Any) -> list[Any]:
 
 
 def _typed_entry(item: Any) -> dict[str, Any]:
-    """``name`` or ``name - type`` as ``{name, type}``."""
+    """``name``, ``name - type`` or ``name - type[low, high]`` as ``{name, type, min, max}``.
+
+    A mapping's ``range: [low, high]`` becomes ``min`` and ``max``, the XML attributes.
+    """
     if isinstance(item, dict):
-        return item
+        if "range" not in item:
+            return item
+        out = {k: v for k, v in item.items() if k != "range"}
+        bounds = item["range"]
+        if not isinstance(bounds, (list, tuple)) or len(bounds) != 2:
+            raise ValueError(f"'range' of variable '{item.get('name')}' must be [low, high] to write it as XML")
+        out["min"], out["max"] = bounds
+        return out
     text = _scalar_text(item, "a typed name")
     match = TYPED_NAME.match(text)
     if match:
         return {"name": match.group(1), **({"type": match.group(2)} if match.group(2) else {})}
+    match = RANGED_NAME.match(text)
+    if match:
+        bounds = match.group(3).split(",")
+        if len(bounds) == 2:
+            low, high = (_bound_value(b) for b in bounds)
+            return {"name": match.group(1), "type": match.group(2), "min": low, "max": high}
     if " - " in text:
         name, kind = text.split(" - ", 1)
         return {"name": name.strip(), "type": kind.strip()}
     return {"name": text}
+
+
+def _bound_value(text: str) -> Any:
+    """A bound of a short-form range as a number (text when it is none: reading it back reports it)."""
+    value = to_number(text)
+    if value is None:
+        return text.strip()
+    return int(value) if math.isfinite(value) and value.is_integer() and abs(value) < 1e15 else value
+
+
+def _named_type(name: str, kind: Any) -> dict[str, Any]:
+    """One entry of the ``name: type`` form (the type perhaps with a range, ``point[-5, 5]``)."""
+    if kind is None:
+        return {"name": name}
+    match = TYPE_RANGE.match(kind) if isinstance(kind, str) else None
+    if match is not None and match.group(2) is not None:
+        bounds = match.group(2).split(",")
+        if len(bounds) == 2:
+            low, high = (_bound_value(b) for b in bounds)
+            return {"name": name, "type": match.group(1), "min": low, "max": high}
+    return {"name": name, "type": kind}
 
 
 def _declared_entry(item: Any) -> dict[str, Any]:
@@ -182,7 +220,7 @@ def _fill(el: Any, spec_name: str, data: dict[str, Any], where: str) -> None:
         elif child.shape == LIST:
             item_spec = _SPECS[child.spec]
             if isinstance(value, dict) and item_spec.typed:  # {name: type}
-                value = [{"name": k, **({"type": v} if v is not None else {})} for k, v in value.items()]
+                value = [_named_type(k, v) for k, v in value.items()]
             for item in _listed(value):
                 if item_spec.typed:
                     item = _typed_entry(item)

@@ -7,6 +7,8 @@ which ``==`` ignores, so a plan read from YAML equals the same plan read from XM
 
 from alica.model.behaviour import Behaviour, Param, ParamValue
 from alica.model.common import (
+    ANY_TYPE,
+    NUMERIC_TYPES,
     UNBOUNDED,
     Condition,
     ConditionKind,
@@ -34,6 +36,8 @@ from alica.model.planning import PlanningProblem
 from alica.model.roles import Priority, Role, RoleSet, Task
 
 __all__ = [
+    "ANY_TYPE",
+    "NUMERIC_TYPES",
     "SECTIONS",
     "UNBOUNDED",
     "AbstractPlan",

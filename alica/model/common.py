@@ -65,29 +65,72 @@ class Condition:
         return f"<{self.kind.value} {self.text!r}>"
 
 
+#: Variable types with a numeric range; any other type but ``any`` is an object type.
+NUMERIC_TYPES: frozenset[str] = frozenset({"real", "int", "point"})
+#: The type of a variable that is only bound by a parent, never solved on its own.
+ANY_TYPE = "any"
+
+
 @dataclass(frozen=True, slots=True)
 class Variable:
-    """A named value of a plan or behaviour, bound by a parent or solved by constraints."""
+    """A named value of a plan or behaviour, bound by a parent or solved by constraints.
+
+    Read in a formula as ``x`` it is a static variable (one value for the team);
+    read as ``x(a)`` with an agent ``a`` it is a per-agent variable (one value per
+    agent of the plan).
+
+    Args:
+        name: unique within its plan or behaviour.
+        type: ``any`` (bound by a parent only), ``real``, ``int``, ``point`` (a 2-D
+            point, both coordinates in the range), or an object type such as
+            ``Frontier`` (a finite set of values).
+        low: for real, int and point variables, the smallest value (point: of x and y).
+        high: the largest value.
+        candidates: for object types, a formula whose value is the list of candidate
+            values, e.g. ``frontiers()``; ``None`` means every object of the type.
+    """
 
     name: str
-    type: str = "any"
+    type: str = ANY_TYPE
+    low: float | None = None
+    high: float | None = None
+    candidates: str | None = None
     span: SourceSpan | None = span_field()
+
+    @property
+    def numeric(self) -> bool:
+        """Whether the variable is real, int or point, a value in a range."""
+        return self.type in NUMERIC_TYPES
+
+    @property
+    def object_type(self) -> bool:
+        """Whether the variable's values are objects of a type (a finite set)."""
+        return self.type != ANY_TYPE and self.type not in NUMERIC_TYPES
 
 
 @dataclass(frozen=True, slots=True)
 class Constraint:
-    """A formula over variables that the constraint solver must satisfy.
+    """A formula over variables that the constraint solver must satisfy, and a utility it maximises.
+
+    A constraint is active while its plan runs.
 
     Args:
         name: unique within its plan.
-        text: the formula, e.g. IMPERA Eq. 7.
+        text: the hard formula, a truth value, e.g. IMPERA Eq. 7; ``""`` when only
+            a utility is given.
         variables: the variables it constrains.
+        utility: a numeric formula the solver maximises, e.g. the information
+            gain of the chosen frontiers; ``""`` for none.
+        span: where the formula's text starts (else the constraint's).
+        utility_span: where the utility's text starts.
     """
 
     name: str
     text: str
     variables: tuple[str, ...] = ()
+    utility: str = ""
     span: SourceSpan | None = span_field()
+    utility_span: SourceSpan | None = span_field()
 
 
 def find_named(items: Iterable[T], name: str, owner: str, kind: str) -> T:

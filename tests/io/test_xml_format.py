@@ -82,7 +82,7 @@ plans:
     description: |
       explore, then bring sample a
       to the collection point g
-    variables: [a - sample, g]
+    variables: [a - sample, g, "x - real[-10, 10]", {name: f, type: Frontier, candidates: "frontiers()"}]
     pre: "true"
     run: "not aborted"
     frequency: 2.5
@@ -96,6 +96,7 @@ plans:
       - name: Spread
         formula: "forall f1, f2 in Frontier: MaximalDist(f1, f2, eps) or f1 = f2"
         variables: [f1, f2]
+      - {name: Gain, utility: "x < 3 and 2 * x > 1"}
     entry_points:
       - {task: Explore, state: Exploring, min: 1, max: "*"}
       - {task: Transport, state: WaitForSample, min: 1, max: 2, success_required: true}
