@@ -121,6 +121,9 @@ class Compiler:
     def _const(self, node: Node, env: dict[str, object], truth: bool) -> _Const:
         """A sub-formula without decision variables, by the exact evaluator (per combination)."""
         arrays = {k: v for k, v in env.items() if isinstance(v, np.ndarray)}
+        if arrays and _names(node).isdisjoint(arrays):
+            env = {k: v for k, v in env.items() if k not in arrays}
+            arrays = {}
         if not arrays:
             run = holds if truth else evaluate
             return _Const(run(node, self.reading, self.reading.env(env), self.registry))
@@ -262,7 +265,15 @@ class Compiler:
             for other in args[1:]:
                 result = self._op(node.name, result, self._num(other))
             return result
+        if all(isinstance(a, _Const) for a in args):
+            return self._const_call(node, args, truth=False)
         raise ProblemError(f"'{node}': {node.name} cannot be differentiated; only constants may be passed to it")
+
+    def _const_call(self, node: Call, args: list[Any], truth: bool) -> _Const:
+        """A call whose arguments are constants (finite values fixed outside), by the evaluator."""
+        names = [f"?{i}" for i in range(len(args))]
+        call = Call(node.name, tuple(Name(n) for n in names), node.column)
+        return self._const(call, dict(zip(names, (a.value for a in args))), truth)
 
     # -- truths --------------------------------------------------------
 
@@ -294,6 +305,8 @@ class Compiler:
         if isinstance(node, Compare):
             op = _FLIP[node.op] if negate else node.op
             left, right = self.value(node.left, env), self.value(node.right, env)
+            if isinstance(left, _Const) and isinstance(right, _Const):  # e.g. finite values fixed by the outer search
+                return _Const(_constant_compare(op, left.value, right.value))
             return self._compare(op, self._num(left), self._num(right))
         if isinstance(node, Quantified):
             return self._quantified(node, env, negate)
@@ -308,6 +321,12 @@ class Compiler:
                 d = self._op("sqrt", self._op("add", self._op("mul", dx, dx), self._op("mul", dy, dy)))
                 op = ">" if fn is maximal_dist else "<"
                 return self._compare(_FLIP[op] if negate else op, d, self._num(args[2]))
+            args = [self.value(arg, env) for arg in node.args]
+            if all(isinstance(a, _Const) for a in args):
+                const = self._const_call(node, args, truth=True).value
+                if negate:
+                    const = np.logical_not(const) if isinstance(const, np.ndarray) else not const
+                return _Const(const)
         if isinstance(node, (Bool, Number, String)):
             return _Const(bool(node.value) != negate)
         raise ProblemError(f"'{node}' is not a truth value the continuous solver can follow")
@@ -403,6 +422,20 @@ class Compiler:
                 return float(np.sum(np.broadcast_to(body, (1, len(combos)))))
         reducer = {"forall": "all", "exists": "any", "sum": "sum"}[kind]
         return self.graph.add(reducer, body, data=len(combos))
+
+
+def _constant_compare(op: str, left: Any, right: Any) -> Any:
+    """``left op right`` on constants (arrays element by element), as the evaluator compares."""
+
+    def one(x: Any, y: Any) -> bool:
+        if op in ("==", "!="):
+            same = isinstance(x, (bool, np.bool_)) == isinstance(y, (bool, np.bool_)) and bool(x == y)
+            return same if op == "==" else not same
+        return bool({"<": x < y, "<=": x <= y, ">": x > y, ">=": x >= y}[op])
+
+    if isinstance(left, np.ndarray) or isinstance(right, np.ndarray):
+        return np.frompyfunc(one, 2, 1)(left, right).astype(bool)
+    return one(left, right)
 
 
 @functools.lru_cache(maxsize=4096)
