@@ -4,7 +4,10 @@
 IMPERA paper: with ``p1 = Pos(a)`` and ``p2 = Pos(b)`` read from the belief
 base function ``Pos``, ``MaximalDist`` holds iff the Euclidean distance of
 ``p1`` and ``p2`` is greater than ``d`` and ``MinimalDist`` iff it is smaller.
-Both are false when either position is unknown. The paper's Eq. 1 spreads
+Both are false when either position is unknown. An argument that is a point
+itself (a pair ``(x, y)``, a mapping or an object with ``x``, ``y``; a solved
+point variable, say) is taken as its own position; ``dist`` takes object names
+(through ``Pos``) as well as points. The paper's Eq. 1 spreads
 frontier points apart with
 ``forall f1, f2 in Frontier: MaximalDist(f1, f2, eps) or f1 = f2``.
 """
@@ -56,12 +59,39 @@ def dist(p: object, q: object) -> float:
     return math.dist(a, b)
 
 
+def is_point(value: object) -> bool:
+    """Whether ``value`` is a point (not an object name): numbers in a sequence, a mapping or x/y attributes."""
+    if isinstance(value, (str, bytes)):
+        return False
+    if isinstance(value, Sequence):
+        return len(value) in (2, 3) and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+    if isinstance(value, Mapping):
+        return "x" in value and "y" in value
+    return hasattr(value, "x") and hasattr(value, "y")
+
+
+def position(belief: BeliefBase, a: object) -> object | None:
+    """Where ``a`` is: ``a`` itself when it is a point, else ``Pos(a)`` from the belief base (None when unknown)."""
+    if is_point(a):
+        return a
+    return belief.lookup("Pos", (a,))
+
+
 def _position_distance(belief: BeliefBase, a: object, b: object) -> float | None:
-    p1 = belief.lookup("Pos", (a,))
-    p2 = belief.lookup("Pos", (b,))
+    p1 = position(belief, a)
+    p2 = position(belief, b)
     if p1 is None or p2 is None:
         return None
     return dist(p1, p2)
+
+
+def place_dist(belief: BeliefBase, a: object, b: object) -> float:
+    """``dist`` of the formula language: points, or objects placed by ``Pos``."""
+    distance = _position_distance(belief, a, b)
+    if distance is None:
+        unknown = a if position(belief, a) is None else b
+        raise ValueError(f"{unknown!r} is neither a point nor an object with a known Pos")
+    return distance
 
 
 def maximal_dist(belief: BeliefBase, a: object, b: object, d: float) -> bool:
@@ -117,7 +147,9 @@ def default_registry() -> Registry:
     registry.register("abs", builtins.abs, 1, kind=fn, doc="absolute value")
     registry.register("min", _min, (1, None), kind=fn, doc=_min.__doc__ or "")
     registry.register("max", _max, (1, None), kind=fn, doc=_max.__doc__ or "")
-    registry.register("dist", dist, 2, kind=fn, doc="Euclidean distance of two points")
+    registry.register(
+        "dist", place_dist, 2, kind=fn, needs_belief=True, doc="Euclidean distance of two points (or objects' Pos)"
+    )
     registry.register("floor", math.floor, 1, kind=fn, doc="largest integer <= x")
     registry.register("ceil", math.ceil, 1, kind=fn, doc="smallest integer >= x")
     registry.register("round", _round, (1, 2), kind=fn, doc=_round.__doc__ or "")
