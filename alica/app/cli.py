@@ -272,10 +272,12 @@ def build_parser() -> argparse.ArgumentParser:
     from alica.app.cli_plan import add_parser as add_plan_parser
     from alica.app.cli_run import add_parser as add_run_parser
     from alica.app.cli_skill import add_parser as add_skill_parser
+    from alica.app.cli_solve import add_parser as add_solve_parser
 
     add_run_parser(sub)
     add_skill_parser(sub)
     add_plan_parser(sub)
+    add_solve_parser(sub)
     add_demo_parser(sub)
     return parser
 

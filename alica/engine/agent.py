@@ -23,6 +23,7 @@ from alica.engine.generated import GeneratedPlans
 from alica.engine.hosting import Children
 from alica.engine.node import PlanNode
 from alica.engine.slot import Repairs, Slot
+from alica.engine.solving import Solving, binding_names
 from alica.engine.status import ChildStatus
 from alica.engine.sync import SyncProcess, SyncTalk
 from alica.engine.team import SYNC_TOPIC, TEAM_TOPIC, WORLD_TOPIC, AuthorityClaim, PlanKey, TeamMessage, TeamView
@@ -116,6 +117,8 @@ class AgentEngine:
         self.carried: dict[PlanKey, tuple[str, dict[str, set[str]]]] = {}
         """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
         self.allocator = Allocator(self)
+        self.solving = Solving(self)
+        """Plan variables solved at run time (:mod:`alica.engine.solving`)."""
         self.syncs: dict[tuple[PlanKey, str], SyncProcess] = {}
         self._transitions: dict[tuple[str, str], tuple[Transition, ...]] = {}
         self._tree_changed = True
@@ -220,6 +223,7 @@ class AgentEngine:
             root.visit(now)
             if root.failed:
                 self._root_failed(root, now)
+        self.solving.refresh(now)
         if self.root is not None:
             self._tick_behaviours(self.root, now)
         self._broadcast(now)
@@ -336,16 +340,27 @@ class AgentEngine:
     def bind(self, node: PlanNode, ref: ChildRef) -> dict[str, object]:
         """The variables of a child: its bindings evaluated in the parent's context.
 
-        A binding whose value is not known yet (``pos(a)`` before ``a`` is seen)
-        is handed on as its text, for the skill to resolve later, with the
-        parent's variables replaced by their values (``pos(x)`` with ``x = a``
-        becomes ``pos(a)``).
+        A binding to a variable of the parent plan that has a type (``real[..]``,
+        an object type, ...) takes the value the constraint solver gives this
+        agent (:mod:`alica.engine.solving`). A binding whose value is not known
+        yet (``pos(a)`` before ``a`` is seen) is handed on as its text, for the
+        skill to resolve later, with the parent's variables replaced by their
+        values (``pos(x)`` with ``x = a`` becomes ``pos(a)``).
+
+        Raises:
+            NoSolution: a binding reads a solved variable and the constraints have no solution now.
         """
         env: dict[str, object] = {"self": self.name}
         if not ref.bindings:
             return env
+        solved = self.solving.bound_names(node, binding_names(ref))
+        if solved:
+            values = self.solving.values(node, tuple(sorted(set(solved.values()))))
+            env.update({child: values[parent] for child, parent in solved.items()})
         belief = self.belief_for(node)
         for binding in ref.bindings:
+            if binding.variable in solved:
+                continue
             try:
                 env[binding.variable] = self.formulas.value(binding.value, belief, node.env)
             except AlicaError:
@@ -364,6 +379,7 @@ class AgentEngine:
         context = SkillContext(
             self.name, self.now, self.world_model, self.belief, self.rng, self.world, behaviour, path
         )
+        context.solver = self.solving.asker(slot)
         try:
             factory = self.skills.factory(behaviour)
         except AlicaError as exc:

@@ -49,6 +49,8 @@ class SkillContext:
         world: the simulated or real robot interface, when there is one.
         behaviour: the model behaviour being run.
         path: where it runs, ``Plan/State/Behaviour`` from the root.
+        extra: run options for skills (e.g. ``optimize_time``).
+        solver: the engine's constraint query for this behaviour (see :meth:`solve`).
     """
 
     agent: str
@@ -60,6 +62,23 @@ class SkillContext:
     behaviour: Behaviour | None = None
     path: str = ""
     extra: dict[str, object] = field(default_factory=dict)
+    solver: Callable[[tuple[str, ...]], Any] | None = None
+
+    def solve(self, *names: str) -> Any:
+        """The values the constraint solver gives the behaviour's variables ``names`` now.
+
+        Returns:
+            A :class:`alica.engine.solving.SolveResult`: ``status`` (``solved``,
+            ``infeasible``, ``timeout``), ``values`` (this agent's, by variable
+            name), ``team`` (every agent's), ``utility`` and ``reason``. No
+            solution is a status, never an exception.
+
+        Raises:
+            AlicaError: the skill runs outside an engine (no plan to take constraints from).
+        """
+        if self.solver is None:
+            raise AlicaError(f"'{self.path or self.agent}' runs outside an engine: there are no constraints to solve")
+        return self.solver(tuple(names))
 
 
 SkillFactory = Callable[[str, Mapping[str, object], SkillContext], py_trees.behaviour.Behaviour]

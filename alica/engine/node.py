@@ -28,6 +28,7 @@ from collections import deque
 from typing import TYPE_CHECKING
 
 from alica.engine.slot import Slot
+from alica.engine.solving import NoSolution
 from alica.engine.status import ChildStatus
 from alica.engine.team import Claim, PlanKey, key_text
 from alica.model import Plan, StateKind, Transition
@@ -204,11 +205,18 @@ class PlanNode:
             self.dirty = True  # free now: maybe needed for another task
         engine.tree_changed()
         for ref in model.children:
-            slot = Slot(self, ref, engine.bind(self, ref))
+            try:
+                env, unsolved = engine.bind(self, ref), ""
+            except NoSolution as exc:
+                env, unsolved = {"self": engine.name}, str(exc)
+            slot = Slot(self, ref, env)
             self.slots.append(slot)
-            if slot.is_behaviour:
+            if unsolved:
+                slot.fail_unsolved(unsolved)  # a status the plan reacts to ('failed'), not an exception
+            elif slot.is_behaviour:
                 slot.runner = engine.make_runner(slot)
                 slot.status = slot.runner.status
+                engine.solving.track(slot)
             else:
                 slot.start(now)
 

@@ -281,8 +281,33 @@ class Slot:
             self.status = ChildStatus.FAILURE
             self.reason = f"plan '{node.plan.name}' failed: {node.reason}"
 
+    def fail_unsolved(self, reason: str) -> None:
+        """The constraints that give the child its variables have no solution: the child fails with ``reason``."""
+        engine = self.parent.engine
+        engine.solving.unwatch(self)
+        if self.runner is not None:
+            self.runner.stop()
+            self.runner = None
+        if self.node is not None:
+            self.node.stop()
+            self.node = None
+        self.status = ChildStatus.FAILURE
+        self.reason = reason
+        engine.emit("failure", key=self.parent.key_text, child=self.name, reason=reason)
+
+    def restart_with(self, values: dict[str, object], now: float) -> None:
+        """Solved variables of the child changed: a behaviour starts again with them (a plan reads them itself)."""
+        self.env.update(values)
+        if self.runner is not None:
+            engine = self.parent.engine
+            self.runner.stop()
+            self.runner = engine.make_runner(self)
+            self.status = self.runner.status
+            engine.emit("restart", key=self.parent.key_text, child=self.name, values=dict(sorted(values.items())))
+
     def stop(self) -> None:
         """Stop the child and everything below it (the agent leaves the state)."""
+        self.parent.engine.solving.unwatch(self)
         if self.runner is not None:
             self.runner.stop()
         if self.node is not None:

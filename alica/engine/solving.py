@@ -1,0 +1,336 @@
+"""Constraint queries of one agent's engine: plan variables solved at run time, the same on every agent.
+
+A behaviour whose parameter is bound to a plan variable (``frontier:
+frontier`` in the child reference, ``$frontier`` in the behaviour) receives
+the value the constraint solver gives this agent; a skill may also ask
+through its context (:meth:`SkillContext.solve`).
+
+* **The problem** of a query is collected from the running plan tree, from the
+  root down to the plan that asks (:func:`alica.solver.query.collect`): every
+  plan's constraints, the bindings unifying a child's variables with its
+  parent's, and ``agents(E)`` from who is believed to be where.
+* **Every agent solves the whole team's problem** with a seed taken from the
+  plan instances and who is where, so agents with the same view compute the
+  same values. The solution is also written to the shared world model
+  (``solution(plan key)``, with a time to live); an agent whose view gives the
+  same problem takes the team's solution when it still satisfies every hard
+  constraint, and otherwise starts its search from it.
+* **Solved again** when the problem changes (a teammate joins, leaves or
+  crashes; candidates appear or vanish) or the solution no longer satisfies
+  the constraints (a robot moved), checked every ``RECHECK`` seconds; a
+  behaviour whose values changed is restarted with the new ones.
+* **No solution** (infeasible, or none within the time budget) is a status,
+  not an exception: the behaviour that needs the values fails with the
+  reason, so the state's ``failed`` transitions fire.
+
+Each solve is traced (event ``solve``: status, this plan's values of every
+agent, utility, time).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from alica.errors import AlicaError
+from alica.model import ChildRef
+from alica.solver import Solution, Var, solve
+from alica.solver.problem import Problem
+from alica.solver.query import Level, Query, QueryError, collect
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from alica.engine.agent import AgentEngine
+    from alica.engine.node import PlanNode
+    from alica.engine.slot import Slot
+
+#: Seconds between two checks of a solution in use (problem changed? constraints still hold?).
+RECHECK = 0.5
+#: Seconds a solution shared through the world model stays there without being written again.
+SHARE_TTL = 10.0
+#: The time budget of one solve, in seconds (the best solution so far is used when it runs out).
+TIME_BUDGET = 0.05
+
+_IDENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*$")
+
+
+class NoSolution(AlicaError):
+    """The constraints of a query have no solution (or none was found in the time budget)."""
+
+
+@dataclass(frozen=True)
+class SolveResult:
+    """What a query returns.
+
+    Attributes:
+        status: ``solved``, ``infeasible`` or ``timeout``.
+        values: this agent's values, by the asking plan's variable names.
+        team: every agent's per-agent values and the static ones (under ``""``), by the same names.
+        utility: the utility of the solution (``nan`` when not solved).
+        reason: why there is no solution (empty when solved).
+    """
+
+    status: str
+    values: Mapping[str, object]
+    team: Mapping[str, Mapping[str, object]]
+    utility: float
+    reason: str = ""
+
+    @property
+    def ok(self) -> bool:
+        """Whether there are values."""
+        return self.status == "solved"
+
+
+@dataclass
+class _Cached:
+    query: Query
+    solution: Solution
+    checked_at: float
+
+
+def _encode(values: Mapping[Var, object]) -> tuple[tuple[str, str, object], ...]:
+    return tuple(sorted(((v.name, v.agent or "", _plain(value)) for v, value in values.items()), key=str))
+
+
+def _plain(value: object) -> object:
+    if isinstance(value, (list, tuple)):
+        return tuple(_plain(item) for item in value)
+    if isinstance(value, float) or hasattr(value, "dtype"):
+        return float(value)  # type: ignore[arg-type]
+    return value
+
+
+class Solving:
+    """The constraint queries of one engine (see the module docstring).
+
+    Args:
+        engine: the agent's engine.
+    """
+
+    def __init__(self, engine: AgentEngine) -> None:
+        self.engine = engine
+        self.cache: dict[str, _Cached] = {}
+        self.watched: dict[int, tuple[Slot, dict[str, object]]] = {}
+        self.next_check = 0.0
+
+    # -- the problem ------------------------------------------------------
+
+    def levels(self, node: PlanNode) -> list[Level]:
+        """The running plans from the root down to ``node``, as the query sees them."""
+        engine = self.engine
+        chain: list[PlanNode] = []
+        current: PlanNode | None = node
+        while current is not None:
+            chain.append(current)
+            current = current.slot.parent if current.slot is not None else None
+        chain.reverse()
+        alive = set(engine.team.alive())
+        levels = []
+        for plan_node in chain:
+            places = {a: e for a, e in plan_node.believed.items() if a in alive and a != engine.name}
+            places[engine.name] = (plan_node.ep, plan_node.state)
+            bindings = binding_names(plan_node.slot.ref) if plan_node.slot is not None else {}
+            levels.append(Level(plan_node.key_text, plan_node.plan, places, bindings))
+        return levels
+
+    def solvable(self, node: PlanNode, name: str) -> bool:
+        """Whether ``name`` is a variable of ``node``'s plan that the solver gives values to (it has a type)."""
+        return any(v.name == name and v.type != "any" for v in node.plan.variables)
+
+    # -- queries ----------------------------------------------------------
+
+    def query(self, node: PlanNode, names: tuple[str, ...] = ()) -> SolveResult:
+        """The solution of the constraints of the plan tree down to ``node``, by ``node``'s variable names."""
+        engine = self.engine
+        now = engine.now()
+        try:
+            query = collect(self.levels(node), engine.belief_for(node), registry=engine.formulas.registry, names=names)
+        except QueryError as exc:
+            return SolveResult("infeasible", {}, {}, math.nan, str(exc))
+        cached = self.cache.get(node.key_text)
+        if cached is not None and self._still_good(cached, query, now):
+            solution = cached.solution
+        else:
+            solution = self._solve(node, query, cached)
+            self.cache[node.key_text] = _Cached(query, solution, now)
+        return self._result(node, query, solution)
+
+    def values(self, node: PlanNode, names: tuple[str, ...]) -> dict[str, object]:
+        """This agent's values of ``names`` (variables of ``node``'s plan).
+
+        Raises:
+            NoSolution: the constraints have no solution now.
+        """
+        result = self.query(node, names)
+        if not result.ok:
+            raise NoSolution(f"no values for {', '.join(names)} in plan '{node.plan.name}': {result.reason}")
+        missing = [n for n in names if n not in result.values]
+        if missing:
+            raise NoSolution(f"the solver gave no value to {', '.join(missing)} in plan '{node.plan.name}'")
+        return {n: result.values[n] for n in names}
+
+    def _still_good(self, cached: _Cached, query: Query, now: float) -> bool:
+        if cached.query.digest != query.digest or cached.query.problem.variables != query.problem.variables:
+            return False
+        if cached.solution.status != "solved":
+            return now - cached.checked_at < RECHECK  # try again after a while: the world may have changed
+        if now - cached.checked_at < RECHECK:
+            return True
+        cached.checked_at = now
+        return all(satisfied(query.problem, cached.solution.values).values())
+
+    def _solve(self, node: PlanNode, query: Query, cached: _Cached | None) -> Solution:
+        engine = self.engine
+        problem = query.problem
+        shared = self._shared(node, query)
+        if shared is not None and all(satisfied(problem, shared).values()):
+            solution = Solution(
+                "solved", shared, _utility(problem, shared), satisfied(problem, shared), False, 0.0, "shared"
+            )
+            self._trace(node, query, solution, "shared")
+            return solution
+        start = shared
+        if start is None and cached is not None and cached.solution.status == "solved":
+            start = {v: x for v, x in cached.solution.values.items() if v in set(problem.variables)}
+        solution = solve(problem, time_limit=TIME_BUDGET, start=start or None)
+        engine.stats["solves"] = engine.stats.get("solves", 0) + 1
+        if solution.status == "solved":
+            engine.world_model.set(
+                "solution", node.key_text, value=(query.digest, _encode(solution.values)), ttl=SHARE_TTL
+            )
+        self._trace(node, query, solution, "solved")
+        return solution
+
+    def _shared(self, node: PlanNode, query: Query) -> dict[Var, object] | None:
+        """The team's solution of this plan instance from the world model, when it covers this problem's variables."""
+        stored = self.engine.world_model.get("solution", node.key_text)
+        if not isinstance(stored, tuple) or len(stored) != 2:
+            return None
+        _digest, entries = stored
+        by_key = {(name, agent or None): value for name, agent, value in entries}
+        values: dict[Var, object] = {}
+        for var in query.problem.variables:
+            key = (var.name, var.agent)
+            if key not in by_key:
+                return None
+            values[var] = by_key[key]
+        return values
+
+    def _result(self, node: PlanNode, query: Query, solution: Solution) -> SolveResult:
+        me = self.engine.name
+        local = query.local(_depth(node))
+        team: dict[str, dict[str, object]] = {}
+        for var, value in solution.values.items():
+            name = local.get(var.name)
+            if name is None:
+                continue
+            team.setdefault(var.agent or "", {})[name] = value
+        own = dict(team.get("", {}))
+        own.update(team.get(me, {}))
+        return SolveResult(solution.status, own, team, solution.utility, solution.reason)
+
+    def _trace(self, node: PlanNode, query: Query, solution: Solution, how: str) -> None:
+        values: dict[str, dict[str, object]] = {}
+        for var, value in sorted(solution.values.items(), key=lambda item: (item[0].agent or "", item[0].name)):
+            values.setdefault(var.agent or "", {})[var.name] = _plain(value)
+        self.engine.emit(
+            "solve",
+            key=node.key_text,
+            status=solution.status,
+            how=how,
+            values=values,
+            utility=None if math.isnan(solution.utility) else round(solution.utility, 9),
+            time_ms=round(solution.time_s * 1000, 3) if how == "solved" else 0.0,
+            reason=solution.reason if solution.status != "solved" else "",
+        )
+
+    # -- behaviours bound to solved variables -------------------------------
+
+    def bound_names(self, node: PlanNode, slot_bindings: Mapping[str, str]) -> dict[str, str]:
+        """Child variable -> ``node``'s solved variable, for the bindings that read one."""
+        return {child: parent for child, parent in slot_bindings.items() if self.solvable(node, parent)}
+
+    def track(self, slot: Slot) -> None:
+        """Restart ``slot``'s behaviour when the solved values it was started with change."""
+        names = self.bound_names(slot.parent, binding_names(slot.ref))
+        if names:
+            self.watched[id(slot)] = (slot, {child: slot.env.get(child) for child in names})
+
+    def asker(self, slot: Slot) -> Callable[[tuple[str, ...]], SolveResult]:
+        """The query function of the skill of ``slot`` (``context.solve``): by the behaviour's variable names."""
+        to_parent = binding_names(slot.ref)
+
+        def ask(names: tuple[str, ...]) -> SolveResult:
+            wanted = {name: to_parent.get(name, name) for name in names}
+            result = self.query(slot.parent, tuple(sorted(set(wanted.values()))))
+            back = {parent: child for child, parent in wanted.items()}
+
+            def rename(values: Mapping[str, object]) -> dict[str, object]:
+                return {back.get(k, k): v for k, v in values.items()}
+
+            team = {agent: rename(values) for agent, values in result.team.items()}
+            return SolveResult(result.status, rename(result.values), team, result.utility, result.reason)
+
+        return ask
+
+    def unwatch(self, slot: Slot) -> None:
+        """The slot stopped."""
+        self.watched.pop(id(slot), None)
+
+    def refresh(self, now: float) -> None:
+        """Every ``RECHECK`` seconds: solve again where needed; restart behaviours whose values changed."""
+        if now < self.next_check or not self.watched:
+            return
+        self.next_check = now + RECHECK
+        for slot, values in list(self.watched.values()):
+            node = slot.parent
+            if node.status.done or node.state is None:
+                self.unwatch(slot)
+                continue
+            names = self.bound_names(node, binding_names(slot.ref))
+            try:
+                fresh = self.values(node, tuple(sorted(set(names.values()))))
+            except NoSolution as exc:
+                self.unwatch(slot)
+                slot.fail_unsolved(str(exc))
+                continue
+            new = {child: fresh[parent] for child, parent in names.items()}
+            if new != values:
+                self.watched[id(slot)] = (slot, new)
+                slot.restart_with(new, now)
+
+
+def binding_names(ref: ChildRef) -> dict[str, str]:
+    """Child variable -> parent variable, for the bindings of ``ref`` whose value is a bare variable name."""
+    out: dict[str, str] = {}
+    for binding in ref.bindings:
+        match = _IDENT.match(binding.value)
+        if match:
+            out[binding.variable] = match.group(1)
+    return out
+
+
+def _depth(node: PlanNode) -> int:
+    depth = 0
+    while node.slot is not None:
+        node = node.slot.parent
+        depth += 1
+    return depth
+
+
+def satisfied(problem: Problem, values: Mapping[Var, object]) -> dict[str, bool]:
+    """Whether each hard constraint holds at ``values``."""
+    from alica.solver import check
+
+    return dict(check(problem, values))
+
+
+def _utility(problem: Problem, values: Mapping[Var, object]) -> float:
+    from alica.solver import utility_of
+
+    return float(utility_of(problem, values))
