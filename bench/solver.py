@@ -18,6 +18,14 @@ Run with ``.venv/bin/python bench/solver.py``. Two tables:
   same 100 starts: median time to a feasible point and the share of starts that
   end feasible (checked by the evaluator).
 
+* **Inside the engine**, at 30 Hz: a team of 5 agents runs a plan whose behaviour
+  is bound to a per-agent point variable (pairs at least 1.5 m apart, all within
+  4 m of a centre, as tight as possible), for 20 simulated seconds; one agent
+  crashes at 5 s and comes back at 12 s, so the team solves again twice. The same
+  run without variables and constraints is the baseline. Wall time of every
+  agent's tick (median, p99, max), the solves and their median time, and whether
+  the agents ended with the same values.
+
 Each time is one run on a shared machine; they vary by some 20 %.
 """
 
@@ -217,6 +225,124 @@ def formation_table(runs: int, starts: int, n: int = 10) -> None:
     print()
 
 
+ENGINE_PLAN = """
+alica: 1
+tasks: [Default, Hold]
+rolesets:
+  - name: Bench
+    roles:
+      - name: Robot
+        priorities: {Default: 0.5, Hold: 0.5}
+behaviours:
+  - name: Stay
+    skill: Stay
+    variables: [spot]
+    params: {spot: SPOT}
+plans:
+  - name: Team
+    VARIABLES
+    entry_points:
+      - {name: Hold, task: Hold, state: Standing, min: 1, max: "*"}
+    states:
+      - name: Standing
+        children: [BINDING]
+"""
+ENGINE_VARIABLES = """variables: ["spot - point[-5, 5]", "centre - point[-5, 5]"]
+    constraints:
+      - name: Apart
+        formula: "forall a, b in agents(Hold): a == b or dist(spot(a), spot(b)) >= 1.5"
+      - name: Near
+        formula: "forall a in agents(Hold): dist(spot(a), centre) <= 4.0"
+      - name: Tight
+        utility: "0 - (sum a in agents(Hold): dist(spot(a), centre))"
+"""
+
+
+def engine_run(solved: bool, agents: int = 5, seconds: float = 20.0) -> dict[str, object]:
+    """One team run at 30 Hz; the wall time of every agent step (rules, allocation, solving, behaviours), and the solves."""
+    import tempfile
+    from pathlib import Path
+
+    from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
+    from alica.engine.agent import AgentEngine
+    from alica.io import load_library
+    from alica.lang.skill_plugins import default_registry
+    from alica.lang.skills import ParamSpec
+    from alica.testing import TimedSkill
+
+    text = ENGINE_PLAN.replace("VARIABLES", ENGINE_VARIABLES if solved else "")
+    text = text.replace("SPOT", "$spot" if solved else "[0, 0]")
+    text = text.replace("BINDING", "{ref: Stay, bind: {spot: spot}}" if solved else "Stay")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "team.yaml"
+        path.write_text(text, encoding="utf-8")
+        skills = default_registry()
+        skills.declare("Stay", ParamSpec("spot", "any", required=False), doc="stand still")
+        library = load_library(path, skills=skills)
+    recorder = TraceRecorder()
+    names = {f"r{i}": "Robot" for i in range(1, agents + 1)}
+    team = SimulatedTeam(
+        library,
+        "Team",
+        names,
+        skills={"Stay": lambda name, params, context: TimedSkill(name, None)},
+        observers=[recorder],
+        config=EngineConfig(frequency=30.0),
+    )
+    ticks: list[float] = []
+    original = AgentEngine.step
+
+    def timed(engine: AgentEngine) -> None:
+        began = time.perf_counter()
+        original(engine)
+        ticks.append(time.perf_counter() - began)
+
+    AgentEngine.step = timed  # type: ignore[method-assign]
+    try:
+        team.crash("r5", at=5.0)
+        team.recover("r5", at=12.0)
+        team.run(ticks=int(seconds * 30))
+    finally:
+        AgentEngine.step = original  # type: ignore[method-assign]
+    solves = [e for e in recorder.events if e["event"] == "solve"]
+    last = {}
+    for e in solves:
+        last[e["agent"]] = e["values"]
+    alive = [n for n in names if n not in team.crashed]
+    agree = len({json_key(last.get(n)) for n in alive}) == 1 if solved else True
+    return {
+        "ticks": ticks,
+        "solves": [e["time_ms"] for e in solves if e["how"] == "solved"],
+        "adopted": sum(e["how"] == "shared" for e in solves),
+        "agree": agree,
+    }
+
+
+def json_key(value: object) -> str:
+    import json
+
+    return json.dumps(value, sort_keys=True)
+
+
+def engine_table(agents: int = 5) -> None:
+    """The cost of solving inside the engine tick (see the module docstring)."""
+    print(f"\n### Inside the engine: {agents} agents at 30 Hz, 20 s, one crash and one recovery\n")
+    print(
+        "| run | agent ticks | tick median ms | tick p99 ms | tick max ms | solves | solve median ms | adopted | agree |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|")
+    for solved in (False, True):
+        out = engine_run(solved, agents)
+        ticks = [t * 1000 for t in out["ticks"]]  # type: ignore[attr-defined]
+        solves = out["solves"]
+        median_solve = f"{statistics.median(solves):.1f}" if solves else "-"  # type: ignore[arg-type]
+        print(
+            f"| {'with constraints' if solved else 'baseline'} | {len(ticks)} | {statistics.median(ticks):.3f} | "
+            f"{percentile(ticks, 99):.2f} | {max(ticks):.1f} | {len(solves)} | {median_solve} | "  # type: ignore[arg-type]
+            f"{out['adopted']} | {'yes' if out['agree'] else 'no'} |"
+        )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--instances", type=int, default=20, help="random instances per frontier size")
@@ -226,6 +352,7 @@ def main() -> None:
     args = parser.parse_args()
     frontier_table(args.instances, args.size)
     formation_table(args.runs, args.starts)
+    engine_table()
 
 
 if __name__ == "__main__":

@@ -47,13 +47,27 @@ def add_parser(sub: Any) -> None:
         "Exit 0 solved, 1 bad input, 3 infeasible, 4 no solution within the time limit.",
     )
     p.add_argument("plan", metavar="PLANFILE", help="a plan file")
-    p.add_argument("--plan", dest="name", metavar="NAME", help="the plan (default: the file's first plan with constraints)")
+    p.add_argument(
+        "--plan", dest="name", metavar="NAME", help="the plan (default: the file's first plan with constraints)"
+    )
     p.add_argument("--agents", required=True, metavar="NAME[:ROLE],...", help="the team, e.g. r1:Robot,r2:Robot")
     p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
     p.add_argument(
-        "--fact", action="append", default=[], metavar="LITERALS", help="facts of the world, e.g. 'found(a)' (repeatable)"
+        "--fact",
+        action="append",
+        default=[],
+        metavar="LITERALS",
+        help="facts of the world, e.g. 'found(a)' (repeatable)",
     )
     p.add_argument("--world", metavar="FILE", help="a YAML file with objects, function values and facts")
+    p.add_argument(
+        "--at",
+        action="append",
+        default=[],
+        metavar="AGENT=STATE,...",
+        help="put agents in states of the plan instead of their entry point's initial state (and under the entry "
+        "point the state belongs to), for constraints over agents(STATE) (repeatable)",
+    )
     p.add_argument("--time-limit", type=_positive, default=1.0, metavar="S", help="seconds of search (default 1)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     add_skills_option(p)
@@ -73,6 +87,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     plan = _pick_plan(library, entry, args.name, args.plan)
     roles = _roles(library, _agents(args.agents), args.roleset)
     places = _allocate(library, plan, roles, args.roleset)
+    _place(plan, places, args.at)
     belief = _world(args.world, args.fact)
     query = collect([Level(plan.name, plan, places)], belief)
     if not query.problem.variables:
@@ -90,6 +105,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
         "optimal": solution.optimal,
         "satisfied": dict(solution.satisfied),
         "assignment": {agent: place[0] for agent, place in sorted(places.items())},
+        "states": {agent: place[1] for agent, place in sorted(places.items())},
         "reason": solution.reason,
     }
     if args.json:
@@ -125,6 +141,28 @@ def _allocate(library: Any, plan: Any, roles: dict[str, Any], roleset_name: str 
     for agent, ep in result.assignment.entries:
         places[agent] = (ep, plan.entry_point(ep).state if ep is not None else None)
     return places
+
+
+def _place(plan: Any, places: dict[str, Any], texts: list[str]) -> None:
+    """Move agents to the states ``--at`` names (and to the entry point a state lies under, if it is another)."""
+    for text in texts:
+        for part in (p.strip() for p in text.split(",") if p.strip()):
+            agent, _, state = part.partition("=")
+            agent, state = agent.strip(), state.strip()
+            if not state:
+                raise AlicaError(f"--at: '{part}' is not AGENT=STATE")
+            if agent not in places:
+                raise AlicaError(f"--at: '{agent}' is not one of the agents ({', '.join(sorted(places))})")
+            entry = places[agent][0]
+            under = [ep.name for ep in plan.entry_points if state in plan.reachable_states(ep.name)]
+            if not under:
+                raise AlicaError(
+                    f"--at: plan '{plan.name}' has no state '{state}' (states: "
+                    f"{', '.join(sorted(s.name for s in plan.states))})"
+                )
+            if entry not in under:
+                entry = under[0]  # the state lies under another entry point: the agent takes that one
+            places[agent] = (entry, state)
 
 
 def _world(path: str | None, facts: list[str]) -> Any:
@@ -194,7 +232,7 @@ def _plain(value: object) -> object:
     if isinstance(value, (list, tuple)):
         return [_plain(v) for v in value]
     if hasattr(value, "item"):
-        return value.item()  # type: ignore[union-attr]
+        return value.item()
     return value
 
 
@@ -202,11 +240,15 @@ def _print(result: dict[str, Any]) -> None:
     status = result["status"]
     print(f"plan {result['plan']}: {status}" + (f" ({result['reason']})" if result["reason"] else ""))
     if result["utility"] is not None:
-        print(f"utility {result['utility']:.6g}, {result['time_s'] * 1000:.1f} ms" + (", optimal" if result["optimal"] else ""))
+        print(
+            f"utility {result['utility']:.6g}, {result['time_s'] * 1000:.1f} ms"
+            + (", optimal" if result["optimal"] else "")
+        )
     for agent, values in sorted(result["values"].items()):
         shown = ", ".join(f"{k} = {_show(v)}" for k, v in sorted(values.items()))
         entry = result["assignment"].get(agent)
-        print(f"  {agent or '(team)'}" + (f" [{entry}]" if entry else "") + f": {shown}")
+        where = f" [{entry}/{result['states'][agent]}]" if entry else ""
+        print(f"  {agent or '(team)'}{where}: {shown}")
     for name, holds in sorted(result["satisfied"].items()):
         print(f"  {'holds' if holds else 'VIOLATED'}: {name}")
 

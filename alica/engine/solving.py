@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 from alica.errors import AlicaError
 from alica.model import ChildRef
-from alica.solver import Solution, Var, solve
+from alica.solver import Solution, Var, check, solve
 from alica.solver.problem import Problem
 from alica.solver.query import Level, Query, QueryError, collect
 
@@ -53,7 +53,7 @@ RECHECK = 0.5
 #: Seconds a solution shared through the world model stays there without being written again.
 SHARE_TTL = 10.0
 #: The time budget of one solve, in seconds (the best solution so far is used when it runs out).
-TIME_BUDGET = 0.05
+TIME_BUDGET = 1.0
 
 _IDENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*$")
 
@@ -91,6 +91,7 @@ class _Cached:
     query: Query
     solution: Solution
     checked_at: float
+    shared_at: float = 0.0
 
 
 def _encode(values: Mapping[Var, object]) -> tuple[tuple[str, str, object], ...]:
@@ -155,6 +156,12 @@ class Solving:
         cached = self.cache.get(node.key_text)
         if cached is not None and self._still_good(cached, query, now):
             solution = cached.solution
+            if solution.status == "solved" and now >= cached.shared_at:
+                # agents whose searches differed (a time budget ran out) converge on the team's solution
+                cached.shared_at = now + RECHECK
+                adopted = self._adopt(node, query, solution)
+                if adopted is not None:
+                    cached.solution = solution = adopted
         else:
             solution = self._solve(node, query, cached)
             self.cache[node.key_text] = _Cached(query, solution, now)
@@ -182,28 +189,46 @@ class Solving:
         if now - cached.checked_at < RECHECK:
             return True
         cached.checked_at = now
-        return all(satisfied(query.problem, cached.solution.values).values())
+        checked = _checked(query.problem, cached.solution.values)
+        return checked is not None and all(checked[0].values())
 
     def _solve(self, node: PlanNode, query: Query, cached: _Cached | None) -> Solution:
         engine = self.engine
         problem = query.problem
         shared = self._shared(node, query)
-        if shared is not None and all(satisfied(problem, shared).values()):
-            solution = Solution(
-                "solved", shared, _utility(problem, shared), satisfied(problem, shared), False, 0.0, "shared"
-            )
+        checked = _checked(problem, shared) if shared is not None else None
+        if shared is not None and checked is not None and all(checked[0].values()):
+            solution = Solution("solved", shared, checked[1], checked[0], False, 0.0, "the team's solution")
             self._trace(node, query, solution, "shared")
             return solution
         start = shared
         if start is None and cached is not None and cached.solution.status == "solved":
             start = {v: x for v, x in cached.solution.values.items() if v in set(problem.variables)}
-        solution = solve(problem, time_limit=TIME_BUDGET, start=start or None)
+        try:
+            solution = solve(problem, time_limit=TIME_BUDGET, start=start or None)
+        except AlicaError as exc:  # a formula that cannot be read here: no values, with the reason
+            solution = Solution("infeasible", {}, math.nan, {}, False, 0.0, str(exc))
         engine.stats["solves"] = engine.stats.get("solves", 0) + 1
         if solution.status == "solved":
             engine.world_model.set(
                 "solution", node.key_text, value=(query.digest, _encode(solution.values)), ttl=SHARE_TTL
             )
         self._trace(node, query, solution, "solved")
+        return solution
+
+    def _adopt(self, node: PlanNode, query: Query, own: Solution) -> Solution | None:
+        """The team's solution for the same view when it differs from ``own`` and satisfies the constraints."""
+        stored = self.engine.world_model.get("solution", node.key_text)
+        if not isinstance(stored, tuple) or len(stored) != 2 or stored[0] != query.digest:
+            return None
+        shared = self._shared(node, query)
+        if shared is None or shared == dict(own.values):
+            return None
+        checked = _checked(query.problem, shared)
+        if checked is None or not all(checked[0].values()):
+            return None
+        solution = Solution("solved", shared, checked[1], checked[0], False, 0.0, "the team's solution")
+        self._trace(node, query, solution, "shared")
         return solution
 
     def _shared(self, node: PlanNode, query: Query) -> dict[Var, object] | None:
@@ -252,8 +277,21 @@ class Solving:
     # -- behaviours bound to solved variables -------------------------------
 
     def bound_names(self, node: PlanNode, slot_bindings: Mapping[str, str]) -> dict[str, str]:
-        """Child variable -> ``node``'s solved variable, for the bindings that read one."""
-        return {child: parent for child, parent in slot_bindings.items() if self.solvable(node, parent)}
+        """Child variable -> ``node``'s solved variable, for the bindings that read one.
+
+        A variable of ``node``'s plan is solved when it has a type, its own parent
+        did not bind it, and a constraint of the running plan tree reads it.
+        """
+        typed = {c: p for c, p in slot_bindings.items() if p not in node.env and self.solvable(node, p)}
+        if not typed:
+            return {}
+        try:
+            query = collect(self.levels(node), self.engine.belief_for(node), registry=self.engine.formulas.registry)
+        except QueryError:
+            return typed  # it is solved, and the query says why it has no values
+        depth = _depth(node)
+        solved = {name for (level, name) in query.names if level == depth}
+        return {c: p for c, p in typed.items() if p in solved}
 
     def track(self, slot: Slot) -> None:
         """Restart ``slot``'s behaviour when the solved values it was started with change."""
@@ -323,14 +361,9 @@ def _depth(node: PlanNode) -> int:
     return depth
 
 
-def satisfied(problem: Problem, values: Mapping[Var, object]) -> dict[str, bool]:
-    """Whether each hard constraint holds at ``values``."""
-    from alica.solver import check
-
-    return dict(check(problem, values))
-
-
-def _utility(problem: Problem, values: Mapping[Var, object]) -> float:
-    from alica.solver import utility_of
-
-    return float(utility_of(problem, values))
+def _checked(problem: Problem, values: Mapping[Var, object]) -> tuple[dict[str, bool], float] | None:
+    """Which hard constraints hold at ``values`` and the utility there; ``None`` when they cannot be read."""
+    try:
+        return check(problem, values)
+    except AlicaError:
+        return None

@@ -17,7 +17,7 @@ of each formula is read from; :func:`solve` returns a :class:`Solution`.
 from __future__ import annotations
 
 from alica.solver.problem import Domain, Finite, Integer, Point, Problem, ProblemError, Real, Solution, Term, Var
-from alica.solver.solve import solve
+from alica.solver.solve import check, solve
 
 __all__ = [
     "Domain",
@@ -30,5 +30,6 @@ __all__ = [
     "Solution",
     "Term",
     "Var",
+    "check",
     "solve",
 ]

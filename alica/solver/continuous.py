@@ -68,6 +68,10 @@ MARGIN = 1e-6
 PATIENCE = 10
 #: Ascent steps per restart.
 MAX_STEPS = 300
+#: Steps without the best feasible utility growing by more than ``STALL_TOLERANCE`` (relative) that end the ascent.
+STALL_STEPS = 30
+#: See ``STALL_STEPS``.
+STALL_TOLERANCE = 1e-4
 
 _FLIP = {"<": ">=", "<=": ">", ">": "<=", ">=": "<", "==": "!=", "!=": "=="}
 
@@ -583,6 +587,7 @@ class Continuous:
         weight = np.full(r, 2.0)  # smooth says feasible, the evaluator does not (at a boundary)
         steps = 0
         complete = True
+        record, since = -np.inf, 0  # the best utility found, and the steps since it last grew
         while steps < max_steps:
             steps += 1
             vals = self.graph.forward(x) if self.graph.ops else []
@@ -600,6 +605,14 @@ class Continuous:
                 best_u[better], best_x[better], found[better] = u[better], x[better], True
             if self.u_node is None and found.any():
                 break
+            if found.any():
+                top = float(best_u[found].max())
+                if top > record + STALL_TOLERANCE * (1.0 + abs(record) if math.isfinite(record) else 1.0):
+                    record, since = top, 0
+                else:
+                    since += 1
+                    if since >= STALL_STEPS:
+                        break  # the best restart stopped improving: more steps would not pay
             if clock() > deadline:
                 complete = False
                 break

@@ -34,7 +34,22 @@ from dataclasses import dataclass, field, replace
 
 from alica.errors import AlicaError
 from alica.lang import BeliefBase, Registry, parse
-from alica.lang.ast import Call, Name, Node, Quantified, agents_of, children
+from alica.lang.ast import (
+    And,
+    Attr,
+    Binary,
+    Call,
+    Compare,
+    Iff,
+    Implies,
+    Name,
+    Node,
+    Not,
+    Or,
+    Quantified,
+    Unary,
+    agents_of,
+)
 from alica.lang.evaluator import evaluate
 from alica.lang.walk import walk
 from alica.model import Plan, Variable
@@ -119,17 +134,17 @@ def _rename(node: Node, names: Mapping[str, str], bound: frozenset[str] = frozen
         args = tuple(_rename(arg, names, bound) for arg in node.args)
         name = names[node.name] if node.name in names and node.name not in bound and len(args) == 1 else node.name
         return replace(node, name=name, args=args)
-    kids = children(node)
-    if not kids:
-        return node
-    renamed = [_rename(kid, names, bound) for kid in kids]
-    if hasattr(node, "items"):
-        return replace(node, items=tuple(renamed))  # type: ignore[call-arg]
-    if hasattr(node, "operand"):
-        return replace(node, operand=renamed[0])  # type: ignore[call-arg]
-    if hasattr(node, "obj"):
-        return replace(node, obj=renamed[0])  # type: ignore[call-arg]
-    return replace(node, left=renamed[0], right=renamed[1])  # type: ignore[call-arg]
+    if isinstance(node, (And, Or)):
+        return replace(node, items=tuple(_rename(item, names, bound) for item in node.items))
+    if isinstance(node, Not):
+        return replace(node, operand=_rename(node.operand, names, bound))
+    if isinstance(node, Unary):
+        return replace(node, operand=_rename(node.operand, names, bound))
+    if isinstance(node, Attr):
+        return replace(node, obj=_rename(node.obj, names, bound))
+    if isinstance(node, (Binary, Compare, Implies, Iff)):
+        return replace(node, left=_rename(node.left, names, bound), right=_rename(node.right, names, bound))
+    return node
 
 
 def _identifiers(node: Node) -> set[str]:
@@ -166,8 +181,14 @@ def _domain(variable: Variable, belief: BeliefBase, registry: Registry | None) -
             raise QueryError(
                 f"candidates of variable '{variable.name}' ({variable.candidates}) gave {found!r}, not a list"
             )
-        return Finite(tuple(found))
-    return Finite(tuple(belief.objects(kind)))
+        values = tuple(found)
+        where = f"its candidates {variable.candidates} are none"
+    else:
+        values = tuple(belief.objects(kind))
+        where = f"no object of type {kind} is known"
+    if not values:
+        raise QueryError(f"variable '{variable.name}' has no value to choose from: {where}")
+    return Finite(values)
 
 
 class LevelBelief:
@@ -244,7 +265,7 @@ def collect(
     for i, level in enumerate(levels):
         renames = {name: name_of[(i, name)] for (j, name) in declared if j == i}
         for constraint in level.plan.constraints:
-            for text, into in ((constraint.text, constraints), (getattr(constraint, "utility", ""), utilities)):
+            for text, into in ((constraint.text, constraints), (constraint.utility, utilities)):
                 if not text:
                     continue
                 node = _rename(parse(text), renames)
@@ -263,7 +284,11 @@ def collect(
         if classes.find(item) != item:
             continue  # the class is declared once, at its outermost level
         domain_source = next(
-            (declared[other] for other in sorted(declared) if name_of[other] == solved and declared[other].type != "any"),
+            (
+                declared[other]
+                for other in sorted(declared)
+                if name_of[other] == solved and declared[other].type != "any"
+            ),
             variable,
         )
         domain = _domain(domain_source, scoped, registry)

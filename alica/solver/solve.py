@@ -30,8 +30,15 @@ from alica.solver.problem import Finite, Integer, Problem, ProblemError, Solutio
 RESTARTS = 64
 
 
-def _check(problem: Problem, values: Mapping[Var, object]) -> tuple[dict[str, bool], float]:
-    """Which constraints hold at ``values``, and the utility there (exact evaluator)."""
+def check(problem: Problem, values: Mapping[Var, object]) -> tuple[dict[str, bool], float]:
+    """Which constraints hold at ``values``, and the utility there, read with the exact evaluator.
+
+    A solution in use is checked with it when the world may have changed (a robot
+    moved, a frontier vanished): one that no longer satisfies is solved again.
+
+    Raises:
+        EvaluationError: a utility cannot be evaluated at ``values``.
+    """
     from alica.lang.evaluator import evaluate, holds
 
     reading = Reading(problem.belief, values)
@@ -120,7 +127,7 @@ def solve(
             reason = f"no solution found within {time_limit:g} s"
         satisfied = dict.fromkeys((t.name for t in problem.constraints), False)
         return Solution(status, {}, math.nan, satisfied, False, elapsed, reason, nodes)
-    satisfied, utility = _check(problem, values)
+    satisfied, utility = check(problem, values)
     if not all(satisfied.values()):  # the solvers check their answers; this would be a bug of ours
         failed = ", ".join(name for name, ok in satisfied.items() if not ok)
         raise ProblemError(f"internal: the solver's answer breaks {failed}")
