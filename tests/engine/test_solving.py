@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping
 from typing import Any
@@ -164,3 +165,51 @@ def test_a_skill_asks_through_its_context(tmp_path):
     assert set(result.team) == {"a", "b"}
     assert result.values["spot"] == result.team["a"]["spot"]
     assert math.dist(result.team["a"]["spot"], result.team["b"]["spot"]) >= 2.0 - 1e-9
+
+
+def test_the_explore_plan_gives_each_explorer_its_frontier_eq_7_8():
+    """IMPERA Eq. 7-8 in the shipped Explore plan, frontier candidates and gains from a test map."""
+    from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
+    from alica.io import load_library
+    from alica.io.loader import plans_dir
+    from alica.testing import default_fallback
+
+    lib = load_library(plans_dir() / "skills" / "explore.yaml")
+    # frontier cells of a test map: a ring 8 m around the origin, one cell every 30 degrees;
+    # the cells towards +x border more unknown space (a higher gain)
+    cells = {f"f{k}": (8 * math.cos(math.radians(30 * k)), 8 * math.sin(math.radians(30 * k))) for k in range(12)}
+    gains = {name: round(10 + 5 * math.cos(math.radians(30 * k)), 3) for k, name in enumerate(cells)}
+    robots = {"scout": (0.0, 0.0), "stummel": (1.0, 1.0), "s2": (-1.0, 0.5)}
+    work = Recorder()
+    recorder = TraceRecorder()
+    sim = SimulatedTeam(
+        lib,
+        "Explore",
+        {"scout": "Scout", "stummel": "Stummel", "s2": "Stummel"},
+        skills={"ExploreFrontier": work},
+        fallback=default_fallback(),
+        observers=[recorder],
+        config=EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3),
+    )
+    for engine in sim.engines.values():
+        engine.own.add("mapped")
+        for name, xy in {**cells, **robots}.items():
+            engine.own.set("Pos", name, value=xy)
+        for name in cells:
+            engine.own.add_object(name, "Frontier")
+            engine.own.set("gain", name, value=gains[name])
+    sim.run(ticks=60)
+    latest = {agent: params["frontier"] for agent, params in work.params}
+    assert set(latest) == {"scout", "stummel", "s2"}, work.params
+    chosen = list(latest.values())
+    for i, f in enumerate(chosen):
+        for g in chosen[i + 1 :]:
+            assert math.dist(cells[f], cells[g]) > 4.0  # Eq. 7: spread, so distinct
+    for agent, f in latest.items():
+        assert math.dist(cells[f], robots[agent]) < 15.0  # Eq. 8
+    # the best three cells more than 4 m apart: the ones facing +x (gain) at 60 degree steps
+    assert sum(gains[f] for f in chosen) == max(
+        sum(gains[f] for f in combo)
+        for combo in itertools.combinations(cells, 3)
+        if all(math.dist(cells[p], cells[q]) > 4.0 for p, q in itertools.combinations(combo, 2))
+    )
