@@ -48,8 +48,8 @@ plans:
 def levels(lib, agents=("a", "b")):
     outer, inner = lib.plans["Outer"], lib.plans["Inner"]
     return [
-        Level("Outer", outer, {x: ("Work", "Busy") for x in agents}),
-        Level("Outer/Busy/Inner", inner, {x: ("Go", "Going") for x in agents}, {"where": "spot"}),
+        Level("Outer", outer, dict.fromkeys(agents, ("Work", "Busy"))),
+        Level("Outer/Busy/Inner", inner, dict.fromkeys(agents, ("Go", "Going")), {"where": "spot"}),
     ]
 
 
