@@ -16,6 +16,7 @@ from pathlib import Path
 from alica import __version__
 from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError, PlanFormatError
+from alica.model.library import Document
 from alica.source import Diagnostic
 
 EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
@@ -148,6 +149,24 @@ def _relocated(imports: Sequence[str], source: Path, target: Path) -> list[str]:
     return out
 
 
+def _states_named_twice(document: Document) -> list[Diagnostic]:
+    """A diagnostic for every state whose plan has another state of its name (also with --no-validate)."""
+    problems = []
+    for plan in document.plans:
+        seen: set[str] = set()
+        for state in plan.states:
+            if state.name in seen and state.span is not None:
+                problems.append(
+                    Diagnostic(
+                        state.span,
+                        f"plan '{plan.name}' has two states named '{state.name}'",
+                        "give each state its own name",
+                    )
+                )
+            seen.add(state.name)
+    return problems
+
+
 def _cmd_convert(args: argparse.Namespace) -> int:
     from alica.io import Loader, format_of, read_text
     from alica.io.dump import document_data
@@ -163,6 +182,9 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     if not args.no_validate:
         loader.load(source)
     document = loader.document(source)
+    twice = _states_named_twice(document)
+    if twice:  # each state's transitions are written under it by name: two of one name cannot be written back
+        raise PlanFormatError(twice)
     tree, _ = parse_text(source.read_bytes().decode("utf-8-sig"), str(source), in_fmt)
     if fmt == "xml" and tree is not None:
         unwritable = unwritable_text(tree)

@@ -12,6 +12,7 @@ their place.
 from __future__ import annotations
 
 import datetime
+import math
 from typing import Any
 
 import yaml
@@ -37,6 +38,15 @@ _TAG_NAMES = {
 }
 
 _Loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+
+
+#: Integers of more bits than this (about 3900 decimal digits) are refused: Python writes at most 4300 digits.
+_MAX_INT_BITS = 13_000
+
+
+def _shown(text: str) -> str:
+    """``text``, cut to 30 characters for a message."""
+    return text if len(text) <= 30 else text[:27] + "..."
 
 
 class _TooLarge(Exception):
@@ -86,6 +96,18 @@ class _Reader:
         except (ValueError, OverflowError, TypeError, yaml.YAMLError) as exc:
             self.diagnostics.append(self._unreadable(node, span, exc))
             return Node(None, span)
+        if type(value) is int and value.bit_length() > _MAX_INT_BITS:
+            # a hexadecimal, octal or sexagesimal integer of few characters but more decimal digits
+            # than Python writes as text (str() refuses over 4300): refuse it here, where it was written
+            digits = int(value.bit_length() * math.log10(2)) + 1
+            self.diagnostics.append(
+                Diagnostic(
+                    span,
+                    f"cannot read '{_shown(str(node.value))}' as an integer: it has about {digits} digits",
+                    "write a smaller number",
+                )
+            )
+            return Node(None, span)
         if isinstance(value, (datetime.date, datetime.datetime)):
             value = str(node.value)
         elif isinstance(value, bytes):
@@ -97,7 +119,7 @@ class _Reader:
     def _unreadable(self, node: yaml.ScalarNode, span: SourceSpan, exc: Exception) -> Diagnostic:
         """The problem of a scalar PyYAML cannot construct (``!!int x``, 5000 digits, month 13)."""
         text = str(node.value)
-        shown = text if len(text) <= 30 else text[:27] + "..."
+        shown = _shown(text)
         kind = _TAG_NAMES.get(node.tag, f"'{node.tag}'")
         digits = sum(c.isdigit() for c in text)
         if node.tag == "tag:yaml.org,2002:int" and digits > 4000:

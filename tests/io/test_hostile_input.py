@@ -39,6 +39,8 @@ def plan(freq: str = "10", low: str = "1", desc: str = "ok") -> str:
 # name -> (file text, expected 'LINE:COL: error: ' fragment)
 CASES: dict[str, tuple[str | bytes, str]] = {
     "int_4301_digits.yaml": (plan(low="9" * 4301), "6:40: error: cannot read '9"),
+    # a hexadecimal integer of 4000 characters has 4817 decimal digits, more than Python writes as text
+    "hex_int_4000_digits.yaml": (plan(low="0x" + "f" * 4000), "6:40: error: cannot read '0xfff"),
     "tagged_int.yaml": (plan(low="!!int x"), "6:40: error: cannot read 'x' as a whole number"),
     "tagged_float.yaml": (plan(low="!!float x"), "6:40: error: cannot read 'x' as a number"),
     "month_13.yaml": (plan(desc="2020-13-45"), "7:37: error: cannot read '2020-13-45' as a date"),
@@ -85,6 +87,21 @@ def test_hostile_file_is_one_located_error(
     argv = ["validate", name] if command == "validate" else ["convert", name, out]
     err = run(tmp_path, monkeypatch, capsys, *argv)
     assert f"{name}:{expected}" in err, err
+
+
+def test_states_of_one_name_are_refused_by_convert_even_without_validation(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # a fuzzed file with 1000 states of one name: each state's transitions are written under it by name,
+    # so convert wrote every transition 1000 times (70 s) and then refused its own output
+    states = "".join(f"      - {{name: A, transitions: [{{to: A, condition: c{i}}}]}}\n" for i in range(200))
+    text = (
+        "tasks: [Default]\nplans:\n  - name: P\n    entry_points: [{task: Default, state: A}]\n    states:\n" + states
+    )
+    (tmp_path / "p.yaml").write_text(text, encoding="utf-8")
+    err = run(tmp_path, monkeypatch, capsys, "convert", "p.yaml", "p.xml", "--no-validate")
+    assert "p.yaml:7:9: error: plan 'P' has two states named 'A'" in err
+    assert "199 problem(s) found" in err
 
 
 def test_control_character_cannot_go_to_xml(
