@@ -37,12 +37,18 @@ class SensorNoise:
             it grows linearly to twice that at the perception range; 3-D perception has a quarter of it.
         camera_misclassification: probability that a camera reports a wrong sample kind.
         stereo_misclassification: the same for 3-D (stereo and 3-D lidar) perception.
+        pixel_sigma: standard deviation of the Gaussian noise on each colour channel of a robot
+            camera's pixels, in intensity levels (0-255).
+        depth_sigma: standard deviation (m) of a robot camera's depth at 1 m; it grows with the
+            square of the distance, as a stereo pair's does.
     """
 
     lidar_sigma: float = 0.0
     position_sigma: float = 0.03
     camera_misclassification: float = 0.1
     stereo_misclassification: float = 0.01
+    pixel_sigma: float = 2.0
+    depth_sigma: float = 0.005
 
 
 def _probability(value: float, what: str) -> float:

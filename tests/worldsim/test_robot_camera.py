@@ -1,0 +1,55 @@
+"""The robots' own cameras: colour and depth from pybullet, with consistent geometry."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from alica.worldsim.errors import WorldError
+from alica.worldsim.robot_camera import camera_pose, robot_camera
+
+
+def test_a_sample_in_view_projects_onto_its_pixels_at_its_depth(lunar_world):
+    scout = lunar_world.robots["scout"]
+    sample = lunar_world.objects["a"]
+    sx, sy, sz = sample.position()
+    toward = -np.array([sx, sy]) / math.hypot(sx, sy)  # from the sample towards the field's centre
+    scout.set_pose(
+        sx + 2.0 * toward[0], sy + 2.0 * toward[1], math.atan2(-toward[1], -toward[0])
+    )  # 2 m away, facing it
+    lunar_world.step(0.01)
+    image = robot_camera(scout, width=160, height=120)
+    assert image.rgb.shape == (120, 160, 3) and image.rgb.dtype == np.uint8
+    u, v, d = image.project((sx, sy, sz))
+    assert 0 <= u < 160 and 0 <= v < 120
+    seen = image.depth[int(round(v)), int(round(u))]
+    assert abs(seen - d) < 0.1  # the surface of the container, a few cm before its axis
+    # the pixel goes back to a world point on the container
+    points = image.points(max_depth=5.0)
+    near = points[np.linalg.norm(points[:, :2] - np.array([sx, sy]), axis=1) < 0.15]
+    assert len(near) > 10
+
+
+def test_empty_sky_has_no_depth_and_the_ground_is_below_the_camera(lunar_world):
+    scout = lunar_world.robots["scout"]
+    image = robot_camera(scout, width=80, height=60)
+    assert np.isinf(image.depth[0]).any()  # the top row looks above the horizon (tilt 15 deg, fov 60 deg: not all)
+    ground = image.points(max_depth=3.0)
+    assert len(ground) and np.all(ground[:, 2] < camera_pose(scout)[0][2])
+
+
+def test_same_seed_same_picture(lunar_world):
+    scout = lunar_world.robots["scout"]
+    a = robot_camera(scout, width=40, height=30)
+    b = robot_camera(scout, width=40, height=30)
+    assert np.array_equal(np.isinf(a.depth), np.isinf(b.depth))
+    assert not np.array_equal(a.rgb, b.rgb) or lunar_world.noise.pixel_sigma == 0  # fresh noise per picture
+
+
+def test_a_robot_without_a_camera_and_bad_sizes_are_clear_errors(blocks_world, lunar_world):
+    with pytest.raises(WorldError, match="width and height"):
+        robot_camera(lunar_world.robots["scout"], width=2)
+    with pytest.raises(WorldError, match="fov"):
+        robot_camera(lunar_world.robots["scout"], fov=4.0)

@@ -1,0 +1,164 @@
+"""The robots' own cameras: colour and depth images rendered by pybullet from where the robot stands.
+
+A robot with the ``camera`` or ``stereo_camera`` capability carries a camera
+on top of its base, :data:`MOUNT_FORWARD` of its radius ahead of its centre
+and :data:`MOUNT_UP` above the base, looking along the robot's heading and
+:data:`TILT` down. :func:`robot_camera` renders what it sees:
+
+* ``rgb``: ``(height, width, 3)`` ``uint8``, with seeded Gaussian pixel noise
+  (``world.noise.pixel_sigma``, in intensity levels);
+* ``depth``: ``(height, width)`` metres along the optical axis, ``inf`` where
+  nothing is within the far plane, with seeded Gaussian noise growing with the
+  square of the distance (``world.noise.depth_sigma`` at 1 m, as a stereo
+  pair's depth error does);
+* the pinhole intrinsics ``(fx, fy, cx, cy)`` in pixels and the camera pose:
+  ``position`` and ``rotation`` (world from camera, OpenCV axes: x right, y
+  down, z forward), so a pixel ``(u, v)`` with depth ``d`` is the world point
+  ``position + rotation @ [(u - cx) d / fx, (v - cy) d / fy, d]``
+  (:meth:`CameraImage.points` does this for every pixel).
+
+Nothing here reads object names or the simulator's ground truth beyond what a
+camera sees: perception skills get pixels and depths only.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from alica.worldsim.errors import WorldError
+
+if TYPE_CHECKING:
+    from alica.worldsim.robots import Robot
+
+#: The camera sits this fraction of the robot's radius ahead of its centre.
+MOUNT_FORWARD = 0.8
+#: ... and this many metres above the top of its base.
+MOUNT_UP = 0.15
+#: It looks this many radians below the horizon.
+TILT = math.radians(15.0)
+#: Nearest distance rendered, metres.
+NEAR = 0.05
+
+
+@dataclass(frozen=True)
+class CameraImage:
+    """One picture of a robot's camera (see the module docstring).
+
+    Attributes:
+        rgb: colour image, ``(height, width, 3)`` ``uint8``.
+        depth: metres along the optical axis, ``(height, width)``; ``inf`` where nothing was hit.
+        intrinsics: ``(fx, fy, cx, cy)`` in pixels.
+        position: the camera centre in the world, metres.
+        rotation: 3x3 rotation, world from camera (OpenCV axes: x right, y down, z forward).
+        time: the simulated time of the picture.
+    """
+
+    rgb: np.ndarray
+    depth: np.ndarray
+    intrinsics: tuple[float, float, float, float]
+    position: np.ndarray
+    rotation: np.ndarray
+    time: float
+
+    def points(self, max_depth: float = math.inf) -> np.ndarray:
+        """World points of every pixel with a depth below ``max_depth``: ``(n, 3)``, row-major pixel order."""
+        fx, fy, cx, cy = self.intrinsics
+        h, w = self.depth.shape
+        v, u = np.mgrid[0:h, 0:w]
+        d = self.depth
+        keep = np.isfinite(d) & (d < max_depth)
+        z = d[keep]
+        cam = np.column_stack([(u[keep] - cx) * z / fx, (v[keep] - cy) * z / fy, z])
+        return cam @ self.rotation.T + self.position
+
+    def project(self, point: np.ndarray | tuple[float, float, float]) -> tuple[float, float, float]:
+        """Pixel ``(u, v)`` and depth of a world point (depth <= 0: behind the camera)."""
+        p = self.rotation.T @ (np.asarray(point, dtype=float) - self.position)
+        fx, fy, cx, cy = self.intrinsics
+        if p[2] <= 1e-9:
+            return math.nan, math.nan, float(p[2])
+        return float(fx * p[0] / p[2] + cx), float(fy * p[1] / p[2] + cy), float(p[2])
+
+
+def camera_pose(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
+    """Where the robot's camera is and how it is turned: ``(position, rotation world-from-camera)``."""
+    x, y, yaw = robot.pose
+    spec = robot.spec
+    position = np.array(
+        [
+            x + MOUNT_FORWARD * spec.radius * math.cos(yaw),
+            y + MOUNT_FORWARD * spec.radius * math.sin(yaw),
+            spec.height + MOUNT_UP,
+        ]
+    )
+    forward = np.array([math.cos(yaw) * math.cos(TILT), math.sin(yaw) * math.cos(TILT), -math.sin(TILT)])
+    right = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+    down = np.cross(forward, right)
+    return position, np.column_stack([right, down, forward])
+
+
+def robot_camera(
+    robot: Robot,
+    *,
+    width: int = 320,
+    height: int = 240,
+    fov: float | None = None,
+    far: float | None = None,
+) -> CameraImage:
+    """Render the robot's camera (see the module docstring).
+
+    Args:
+        robot: a robot with the ``camera`` or ``stereo_camera`` capability.
+        width: image width in pixels.
+        height: image height in pixels.
+        fov: horizontal field of view in radians (default: the robot's ``camera_fov``).
+        far: farthest distance rendered, metres (default: twice the robot's ``perception_range``).
+
+    Raises:
+        WorldError: a robot without a camera, a closed world, a bad size, field of view or range.
+    """
+    from alica.worldsim.world import pybullet
+
+    spec = robot.spec
+    if not ({"camera", "stereo_camera"} & spec.capabilities):
+        raise WorldError(f"robot '{robot.name}' ({spec.kind}) has no camera")
+    world = robot.world
+    if getattr(world, "closed", False):
+        raise WorldError("robot_camera: the world is closed")
+    if not (isinstance(width, int) and isinstance(height, int) and 8 <= width <= 4096 and 8 <= height <= 4096):
+        raise WorldError(
+            f"robot_camera: width and height are whole numbers of pixels in [8, 4096], got {width}x{height}"
+        )
+    hfov = spec.camera_fov if fov is None else float(fov)
+    if not (math.isfinite(hfov) and 0.0 < hfov < math.pi):
+        raise WorldError(f"robot_camera: fov must be in (0, pi) radians, got {fov}")
+    far_plane = 2.0 * spec.perception_range if far is None else float(far)
+    if not (math.isfinite(far_plane) and far_plane > NEAR):
+        raise WorldError(f"robot_camera: far must be a number of metres above {NEAR}, got {far}")
+    position, rotation = camera_pose(robot)
+    forward, down = rotation[:, 2], rotation[:, 1]
+    fx = (width / 2.0) / math.tan(hfov / 2.0)
+    fy = fx
+    vfov = 2.0 * math.atan((height / 2.0) / fy)
+    client = world.client
+    view = client.computeViewMatrix(list(position), list(position + forward), list(-down))
+    projection = client.computeProjectionMatrixFOV(math.degrees(vfov), width / height, NEAR, far_plane)
+    _, _, rgba, zbuffer, _ = client.getCameraImage(
+        width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER, shadow=0
+    )
+    rgb = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].astype(float)
+    z = np.asarray(zbuffer, dtype=float).reshape(height, width)
+    depth = far_plane * NEAR / (far_plane - (far_plane - NEAR) * z)
+    depth[z >= 1.0 - 1e-7] = math.inf
+    noise = world.noise
+    if noise.pixel_sigma > 0.0:
+        rgb += world.rng.normal(0.0, noise.pixel_sigma, rgb.shape)
+    finite = np.isfinite(depth)
+    if noise.depth_sigma > 0.0 and finite.any():
+        depth[finite] += world.rng.normal(0.0, 1.0, int(finite.sum())) * noise.depth_sigma * depth[finite] ** 2
+    image = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
+    return CameraImage(image, depth, (fx, fy, width / 2.0 - 0.5, height / 2.0 - 0.5), position, rotation, world.now())
