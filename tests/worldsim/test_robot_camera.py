@@ -24,7 +24,7 @@ def test_a_sample_in_view_projects_onto_its_pixels_at_its_depth(lunar_world):
     assert image.rgb.shape == (120, 160, 3) and image.rgb.dtype == np.uint8
     u, v, d = image.project((sx, sy, sz))
     assert 0 <= u < 160 and 0 <= v < 120
-    seen = image.depth[int(round(v)), int(round(u))]
+    seen = image.depth[round(v), round(u)]
     assert abs(seen - d) < 0.1  # the surface of the container, a few cm before its axis
     # the pixel goes back to a world point on the container
     points = image.points(max_depth=5.0)
