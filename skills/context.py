@@ -51,6 +51,17 @@ class SkillContextLike(Protocol):
         """Run options (``jobs``, ``optimize_time``)."""
         ...
 
+    @property
+    def scratch(self) -> dict[str, object]:
+        """The agent's own scratch space, shared by its behaviours and never sent to the team.
+
+        A pipeline of skills in consecutive states hands its data on here (a
+        point cloud, the clusters found in it, a cropped image): too large or
+        too private for the shared world model. Keys are the producing skill's
+        documented outputs, e.g. ``"cloud"``.
+        """
+        ...
+
 
 @dataclass(frozen=True, slots=True)
 class SkillEnv:
@@ -63,6 +74,7 @@ class SkillEnv:
         world: the robot world, or None.
         world_model: the world model, or None (what the skill writes goes nowhere).
         extra: run options.
+        scratch: the agent's scratch space (see :attr:`SkillContextLike.scratch`).
     """
 
     agent: str
@@ -71,8 +83,9 @@ class SkillEnv:
     world: object | None = None
     world_model: WorldModelLike | None = None
     extra: Mapping[str, object] = field(default_factory=dict)
+    scratch: dict[str, object] = field(default_factory=dict)
 
     @classmethod
     def without_world_model(cls, context: SkillContextLike) -> SkillEnv:
-        """``context`` with the same agent, clock, generator, world and options, but no world model."""
-        return cls(context.agent, context.now, context.rng, context.world, None, dict(context.extra))
+        """``context`` with the same agent, clock, generator, world, options and scratch space, but no world model."""
+        return cls(context.agent, context.now, context.rng, context.world, None, dict(context.extra), context.scratch)

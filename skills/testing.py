@@ -110,6 +110,7 @@ def run_skill(
     skills: Iterable[str] | str = (),
     world_model: WorldModelLike | None = None,
     on_tick: Callable[[World, Behaviour], None] | None = None,
+    scratch: dict[str, object] | None = None,
 ) -> SkillRun:
     """Run skill ``name`` on ``robot`` of ``world`` until it ends or ``timeout`` simulated seconds pass.
 
@@ -119,7 +120,9 @@ def run_skill(
     faults at the right moment, say). The skill is looked up in ``registry``,
     or else in the installed plug-ins and the plug-in modules named in
     ``skills`` (as ``--skills`` does on the command line, e.g.
-    ``skills=["my_skills"]``).
+    ``skills=["my_skills"]``). Pass one ``scratch`` dict to several calls to
+    run a pipeline of skills step by step: each finds what the one before
+    left in the agent's scratch space (``context.scratch``).
 
     Raises:
         SkillError: bad parameters, no such robot, or no implementation.
@@ -143,6 +146,8 @@ def run_skill(
     wm = world_model if world_model is not None else WorldModel(robot, clock=world.clock)
     belief: Any = wm  # alone, the world model is the skill's whole belief base
     context = SkillContext(robot, world.now, wm, belief, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
+    if scratch is not None:
+        context.scratch = scratch  # shared with the skills run before and after: a pipeline, step by step
     behaviour = factory(name, values, context)
     behaviour.setup(context=context)
     start = world.now()

@@ -118,6 +118,8 @@ class AgentEngine:
         """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
         self.allocator = Allocator(self)
         self.solving = Solving(self)
+        self.scratch: dict[str, object] = {}
+        """The agent's scratch space, shared by its behaviours (``SkillContext.scratch``); lost in a crash."""
         """Plan variables solved at run time (:mod:`alica.engine.solving`)."""
         self.syncs: dict[tuple[PlanKey, str], SyncProcess] = {}
         self._transitions: dict[tuple[str, str], tuple[Transition, ...]] = {}
@@ -380,6 +382,7 @@ class AgentEngine:
             self.name, self.now, self.world_model, self.belief, self.rng, self.world, behaviour, path
         )
         context.solver = self.solving.asker(slot)
+        context.scratch = self.scratch
         try:
             factory = self.skills.factory(behaviour)
         except AlicaError as exc:

@@ -51,6 +51,8 @@ class SkillContext:
         path: where it runs, ``Plan/State/Behaviour`` from the root.
         extra: run options for skills (e.g. ``optimize_time``).
         solver: the engine's constraint query for this behaviour (see :meth:`solve`).
+        scratch: the agent's scratch space, shared by all its behaviours, never sent to the
+            team: a pipeline of skills in consecutive states hands its data on here.
     """
 
     agent: str
@@ -63,6 +65,7 @@ class SkillContext:
     path: str = ""
     extra: dict[str, object] = field(default_factory=dict)
     solver: Callable[[tuple[str, ...]], Any] | None = None
+    scratch: dict[str, object] = field(default_factory=dict)
 
     def solve(self, *names: str) -> Any:
         """The values the constraint solver gives the behaviour's variables ``names`` now.
