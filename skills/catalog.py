@@ -269,28 +269,45 @@ def _directed_vision(registry: SkillRegistry) -> None:
 
 
 def _semantic_perception(registry: SkillRegistry) -> None:
+    module = "alica.skills.semantic_perception"
     registry.declare(
         "StereoPointCloud",
         _p("max_depth", "float", "points farther than this many metres are dropped", default=3.0),
-        doc="compute a 3D point cloud from the stereo camera pair",
+        _p("width", "int", "width in pixels of the depth image", default=640),
+        _p("height", "int", "height in pixels of the depth image", default=480),
+        _p("median", "int", "side in pixels of the median filter on the depth image (1: none)", default=3),
+        doc="compute a 3D point cloud from the stereo camera's depth image into scratch['cloud']",
         capabilities=("stereo_camera",),
+        implementation=f"{module}:StereoPointCloud",
     )
     registry.declare(
         "RansacGroundPlane",
         _p("distance_threshold", "float", "largest point-to-plane distance in metres of an inlier", default=0.02),
         _p("iterations", "int", "RANSAC iterations", default=500),
+        _p("max_tilt", "float", "largest angle in degrees between the plane's normal and up", default=30.0),
+        _p("min_inliers", "float", "smallest fraction of the cloud the plane must hold", default=0.1),
         doc="fit the ground plane with RANSAC and remove its points from the cloud",
+        implementation=f"{module}:RansacGroundPlane",
     )
     registry.declare(
         "EuclideanCluster",
         _p("tolerance", "float", "largest distance in metres between neighbouring points of a cluster", default=0.03),
         _p("min_points", "int", "smallest cluster kept", default=50),
+        _p("max_points", "int", "largest cluster kept (0: no limit)", default=0),
         doc="split the remaining points into clusters of nearby points",
+        implementation=f"{module}:EuclideanCluster",
     )
     registry.declare(
         "FitModel",
         _p("model", "str", "geometric model of the object", default="cylinder"),
+        _p(
+            "axis",
+            "str",
+            "cylinder axis: 'plane' (the ground's normal) or 'pca' (the cluster's main axis)",
+            default="plane",
+        ),
         doc="fit the sample's geometric model to every cluster and extract its features",
+        implementation=f"{module}:FitModel",
     )
     registry.declare(
         "FuzzyDLClassify",
@@ -301,8 +318,18 @@ def _semantic_perception(registry: SkillRegistry) -> None:
             default="drill_sample",
         ),
         _p("threshold", "float", "smallest degree of membership that counts as a match", default=0.6),
-        doc="rate the fitted clusters against the fuzzy object description with FuzzyDL",
+        _p("tnorm", "str", "fuzzy conjunction of the memberships: min, product or lukasiewicz", default="min"),
+        _p("match_radius", "float", "metres within which a detection is a sample the world model knows", default=0.3),
+        _p(
+            "retract_range",
+            "float",
+            "metres within which a found sample in clear view that is not seen again is retracted (0: never)",
+            default=2.0,
+        ),
+        doc="rate the fitted clusters against the fuzzy object description and report found(s), pos(s), confidence(s)",
+        implementation=f"{module}:FuzzyDLClassify",
     )
+    registry.declare_function("confidence", 1, "confidence(s): degree in [0, 1] to which sample s was recognised")
 
 
 def _facts(registry: SkillRegistry) -> None:
