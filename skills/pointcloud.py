@@ -225,7 +225,8 @@ class CylinderFit:
         axis: unit axis direction (upwards).
         radius: radius of the circle fit of the points projected along the axis, metres.
         height: top of the cluster above the ground plane, metres (98th percentile).
-        tilt: angle in degrees between the axis and the plane normal (0 = upright).
+        tilt: angle in degrees between the silhouette's main axis and the plane normal: 0 for an
+            upright slender object, 90 for one lying, or wider than tall (a rock).
         base_gap: bottom of the cluster above the plane, metres (2nd percentile): about
             the RANSAC threshold for an object standing on the ground.
         width: the silhouette width across the line of sight, metres (4th to 96th percentile).
@@ -275,10 +276,12 @@ def fit_cylinder(
 ) -> CylinderFit | None:
     """Fit a cylinder to a cluster standing on ``plane``, seen from ``viewpoint``.
 
-    The tilt is measured on the silhouette: the principal axis of the points
+    The tilt is measured on the silhouette: the angle from the plane normal of
+    the principal axis of the points
     in the plane across the line of sight (spanned by the plane normal and the
     horizontal perpendicular to the view), where a stereo camera's depth error
-    (along the line of sight) does not reach. ``axis_from="plane"`` takes the
+    (along the line of sight) does not reach; an object wider than tall has
+    its main axis across, a tilt near 90 degrees. ``axis_from="plane"`` takes the
     cylinder axis along the plane normal (drill samples stand upright);
     ``"pca"`` takes the cluster's principal axis in 3-D. The radius is a
     circle fit of the points projected along the axis; the height and the

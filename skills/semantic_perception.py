@@ -298,9 +298,10 @@ class StereoPointCloud(WorldSkill):
             SkillError: no world or robot, a robot without a camera, or a bad parameter.
         """
         super().setup(**kwargs)
-        caps = self.robot.spec.capabilities
-        if not ({"stereo_camera", "camera"} & caps):
-            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no stereo camera")
+        if "stereo_camera" not in self.robot.spec.capabilities:  # a single camera gives no depth
+            raise SkillError(
+                f"skill '{self.name}': robot '{self.robot.name}' ({self.robot.spec.kind}) has no stereo camera"
+            )
         self.max_depth = _number(self, "max_depth", 3.0, low=0.1, high=100.0)
         self.width = _number(self, "width", 640, low=8, high=4096, integer=True)
         self.height = _number(self, "height", 480, low=8, high=4096, integer=True)
