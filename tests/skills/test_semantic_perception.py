@@ -428,3 +428,44 @@ def test_stereo_point_cloud_runs_from_the_command_line(capfd):
     out = json.loads(capfd.readouterr().out)
     assert code == 0, out
     assert out["robot"] == "amparo" and out["status"] == "success"
+
+
+@pytest.mark.parametrize("with_sample", [True, False])
+def test_the_semantic_perception_plan_runs_with_the_skills(tmp_path, with_sample):
+    from pathlib import Path
+
+    from alica.engine import SimulatedTeam
+    from alica.io import load_library
+    from alica.lang.skill_plugins import default_registry
+    from alica.worldsim.scenarios import lunar
+
+    plans = Path(__file__).resolve().parents[2] / "plans"
+    team_file = tmp_path / "team.yaml"
+    team_file.write_text(
+        f"alica: 1\nimports: [{plans / 'roles.yaml'}, {plans / 'skills' / 'semantic_perception.yaml'}]\n",
+        encoding="utf-8",
+    )
+    registry = default_registry()
+    library = load_library(team_file, skills=registry)
+    with lunar(seed=0, rocks=0, samples=0, size=20.0) as world:
+        x, y, yaw = world.robots["amparo"].pose
+        if with_sample:
+            world.add_sample("probe", "red-black-red", (x + 2 * math.cos(yaw), y + 2 * math.sin(yaw)))
+        world.add_rock("stone", (x + 2.5 * math.cos(yaw + 0.4), y + 2.5 * math.sin(yaw + 0.4)), 0.3, seed=1)
+        world.step(0.2)
+        team = SimulatedTeam(
+            library, "SemanticPerception", {"amparo": "Amparo"}, skill_registry=registry, world=world, roleset="Impera"
+        )
+        team.run(until_done=True, max_time=30)
+        summary = team.summary()["agents"]["amparo"]
+        wm = team.engines["amparo"].world_model
+        found = [f.args[0] for f in wm.facts() if f.predicate == "found"]
+        if with_sample:
+            assert summary["path"] == "SemanticPerception:SampleRecognised"
+            (name,) = found
+            assert name in wm.objects("Sample")
+            pos = wm.get("pos", name)
+            truth = world.objects["probe"].position()
+            assert math.hypot(pos[0] - truth[0], pos[1] - truth[1]) < 0.05
+        else:
+            assert summary["path"] == "SemanticPerception:NoSample" and not found
