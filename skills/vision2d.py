@@ -506,7 +506,7 @@ class DetectCircles(_Pipeline):
             max_range=self.max_range,
             scan_range=robot.spec.lidar_range,
             sigma=max(sigma, 0.005),
-            seed=int(self.world.seed) * 1_000_003 + int(round(self.now() * 1000)),
+            seed=int(self.world.seed) * 1_000_003 + round(self.now() * 1000),
         )
 
     def update(self) -> Status:
