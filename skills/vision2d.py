@@ -57,6 +57,8 @@ __all__ = [
 ASSOCIATION_RADIUS = 0.25
 #: Height of the sample containers in metres (the projection of a candidate into the image).
 SAMPLE_HEIGHT = 0.1
+#: BlobDetect looks for blobs in the candidate's silhouette grown by this fraction of a section's height.
+WINDOW_PAD = 0.3
 #: HSV ranges (OpenCV: hue 0-180, saturation and value 0-255) of the colours BlobDetect knows.
 HSV_RANGES: dict[str, tuple[tuple[tuple[int, int, int], tuple[int, int, int]], ...]] = {
     "red": (((0, 110, 60), (8, 255, 255)), ((172, 110, 60), (180, 255, 255))),
@@ -92,7 +94,7 @@ class Circle:
     fit_radius: float
 
 
-def segment_scan(ranges: np.ndarray, max_range: float, jump: float = 0.1) -> list[np.ndarray]:
+def segment_scan(ranges: np.ndarray, max_range: float, jump: float = 0.05) -> list[np.ndarray]:
     """Clusters of consecutive hits: index arrays, split where the range jumps by more than ``jump`` metres.
 
     Readings at ``max_range`` or beyond (no hit) end a cluster; a cluster that
@@ -234,7 +236,7 @@ def detect_circles(
     scan_range: float,
     sigma: float = 0.01,
     min_points: int = 2,
-    jump: float = 0.1,
+    jump: float = 0.05,
     seed: int = 0,
 ) -> list[Circle]:
     """Circles of ``radius`` (within ``tolerance``) in a 2D scan, nearest first.
@@ -309,8 +311,17 @@ def detect_circles(
 # -- the camera: blobs and sections ------------------------------------------------------------------
 
 
-def find_blobs(rgb: np.ndarray, colours: tuple[str, ...], min_area: int) -> list[dict[str, Any]]:
+def find_blobs(
+    rgb: np.ndarray,
+    colours: tuple[str, ...],
+    min_area: int,
+    window: tuple[float, float, float, float] | None = None,
+) -> list[dict[str, Any]]:
     """Connected components of each colour's HSV range with at least ``min_area`` pixels.
+
+    With a ``window`` ``(u0, v0, u1, v1)`` only pixels inside it count (the
+    candidate's silhouette, slightly grown: a red robot or rock right behind
+    the sample then does not merge with its sections).
 
     Returns:
         Blobs as dicts ``{"colour", "area", "centroid": (u, v), "box": (u0, v0, u1, v1)}`` in crop
@@ -319,11 +330,17 @@ def find_blobs(rgb: np.ndarray, colours: tuple[str, ...], min_area: int) -> list
     import cv2
 
     hsv = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2HSV)
+    keep = np.ones(hsv.shape[:2], dtype=np.uint8) * 255
+    if window is not None:
+        keep[:] = 0
+        u0, v0, u1, v1 = (int(round(c)) for c in window)
+        keep[max(v0, 0) : max(v1, 0), max(u0, 0) : max(u1, 0)] = 255
     blobs: list[dict[str, Any]] = []
     for colour in colours:
         mask = np.zeros(hsv.shape[:2], dtype=np.uint8)
         for lo, hi in HSV_RANGES[colour]:
             mask |= cv2.inRange(hsv, np.array(lo, dtype=np.uint8), np.array(hi, dtype=np.uint8))
+        mask &= keep
         count, _, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
         for k in range(1, count):
             u, v, w, h, area = (int(s) for s in stats[k])
@@ -686,7 +703,9 @@ class BlobDetect(_Pipeline):
         candidate = cast("dict[str, Any] | None", self.scratch.get("candidate"))
         if crop is None or candidate is None:
             return self.fail("no cropped candidate: run CropCandidate first")
-        blobs = find_blobs(crop["rgb"], self.colours, self.min_area)
+        u0, v0, u1, v1 = crop["expected"]
+        pad = max(2.0, WINDOW_PAD * (v1 - v0) / 3.0)
+        blobs = find_blobs(crop["rgb"], self.colours, self.min_area, (u0 - pad, v0 - pad, u1 + pad, v1 + pad))
         self.scratch["blobs"] = blobs
         if not blobs:
             reason = f"no {' or '.join(self.colours)} blob of {self.min_area} px or more at {candidate['id']}"

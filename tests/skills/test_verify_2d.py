@@ -158,7 +158,7 @@ def test_an_unknown_sample_is_named_after_its_kind(skill_run):
 
 
 def _false_candidate(world, scratch, xy, cid="scout_c9"):
-    x, y, yaw = world.robots["scout"].pose
+    x, y, _ = world.robots["scout"].pose
     scratch["circles"] = [
         {
             "id": cid,
