@@ -225,6 +225,18 @@ def _fixed_radius_centre(points: np.ndarray, origin: np.ndarray, radius: float) 
     return centre
 
 
+def _radius_error(points: np.ndarray, cx: float, cy: float, sigma: float) -> float:
+    """Standard error of a geometric circle fit's radius: ``sigma`` times the root of (J^T J)^-1 at the fit.
+
+    A short arc of a few points leaves the radius nearly free (a large error),
+    so the fit then hardly constrains the acceptance and the estimate.
+    """
+    d = np.maximum(np.hypot(points[:, 0] - cx, points[:, 1] - cy), 1e-9)
+    jac = np.column_stack([-(points[:, 0] - cx) / d, -(points[:, 1] - cy) / d, -np.ones(len(points))])
+    cov = np.linalg.pinv(jac.T @ jac)
+    return float(sigma * math.sqrt(max(float(cov[2, 2]), 0.0)))
+
+
 def detect_circles(
     ranges: np.ndarray,
     angles: np.ndarray,
@@ -290,12 +302,10 @@ def detect_circles(
             fit = fit_circle(points, threshold=max(2.5 * sigma, 0.005), rng=rng, radius=None)
             if fit is not None:
                 fit_r = fit[2]
-                inl = int(fit[3].sum())
-                # standard error of the fitted radius: grows with the noise, shrinks with points and arc
-                err = max(sigma, 1e-3) / math.sqrt(inl) * max(1.0, radius / max(near * abs(span), 1e-3)) * 2.0
+                err = _radius_error(points[fit[3]], fit[0], fit[1], sigma)
                 if abs(fit_r - radius) > tolerance + 3.0 * err:
                     continue
-                w_fit, w_sil = 1.0 / err**2, 12.0 / max(spacing, 1e-4) ** 2
+                w_fit, w_sil = 1.0 / max(err, 1e-4) ** 2, 12.0 / max(spacing, 1e-4) ** 2
                 estimate = (w_fit * fit_r + w_sil * silhouette) / (w_fit + w_sil)
         centre = _fixed_radius_centre(points, origin, radius)
         d = float(np.hypot(*(centre - origin)))
@@ -333,7 +343,7 @@ def find_blobs(
     keep = np.ones(hsv.shape[:2], dtype=np.uint8) * 255
     if window is not None:
         keep[:] = 0
-        u0, v0, u1, v1 = (int(round(c)) for c in window)
+        u0, v0, u1, v1 = (round(c) for c in window)
         keep[max(v0, 0) : max(v1, 0), max(u0, 0) : max(u1, 0)] = 255
     blobs: list[dict[str, Any]] = []
     for colour in colours:
@@ -555,6 +565,7 @@ class DetectCircles(_Pipeline):
                 wm.assert_fact("candidate", cid)
                 wm.set("candidate_pos", cid, value=(round(c.x, 3), round(c.y, 3)))
         self.scratch["circles"] = out
+        self.scratch["circle_radius"] = self.radius
         if not out:
             return self.fail("no circle of the sample radius in the scan")
         near = out[0]
@@ -606,8 +617,7 @@ class CropCandidate(_Pipeline):
         if not circles:
             return self.fail("no candidate to look at: run DetectCircles first")
         verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
-        radius = float(cast("dict[str, Any]", circles[0]).get("radius", 0.03))
-        radius = 0.03 if not 0.005 < radius < 0.2 else radius
+        radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
         views = []
         reasons = []
         for c in circles:

@@ -39,12 +39,17 @@ def _ahead(world, distance: float, bearing_deg: float) -> tuple[float, float]:
     return x + distance * math.cos(a), y + distance * math.sin(a)
 
 
-def _pipeline(skill_run, world, scratch, wm, params=None):
+def _pipeline(skill_run, world, scratch, wm, rounds=4):
+    """The plan's loop: look at the nearest unverified candidate in view until a sample is found."""
     runs = []
-    for name in PIPELINE:
-        run = skill_run(name, world, "scout", (params or {}).get(name, {}), scratch=scratch, world_model=wm)
-        runs.append(run)
-        if not run.ok:
+    for _ in range(rounds):
+        runs = []
+        for name in PIPELINE:
+            run = skill_run(name, world, "scout", {}, scratch=scratch, world_model=wm)
+            runs.append(run)
+            if not run.ok:
+                break
+        if runs[-1].ok or len(runs) < 3:  # a sample, or nothing (more) to look at
             break
     return runs
 
@@ -286,3 +291,39 @@ def test_cli_runs_detect_circles_in_the_lunar_world():
     text = out.stdout + out.stderr
     assert "DetectCircles on scout" in text and "Traceback" not in text
     assert out.returncode in (0, 1)
+
+
+# -- the plan --------------------------------------------------------------------------------------
+
+
+def test_the_verify_plan_finds_a_sample_in_the_engine(tmp_path):
+    from pathlib import Path
+
+    from alica.engine import SimulatedTeam
+    from alica.io import Loader
+    from alica.lang.skill_plugins import default_registry
+
+    root = Path(__file__).resolve().parents[2] / "plans"
+    entry = tmp_path / "verify.yaml"
+    entry.write_text(
+        f"alica: 1\nimports: [{root / 'roles.yaml'}, {root / 'skills' / 'verify_2d_object.yaml'}]\n", encoding="utf-8"
+    )
+    registry = default_registry()
+    library = Loader(skills=registry).load(entry)
+    world = _field()
+    try:
+        xy = _ahead(world, 2.5, 8.0)
+        world.add_sample("a", "green-white-red", xy)
+        world.add_rock("rock1", _ahead(world, 3.5, -15.0), 0.4, seed=2)
+        world.step(0.2)
+        team = SimulatedTeam(
+            library, "Verify2DObject", {"scout": "Scout"}, seed=0, skill_registry=registry, world=world
+        )
+        team.run(until_done=True, max_time=20.0)
+        summary = team.summary()
+        assert summary["success"], summary
+        wm = team.engines["scout"].world_model
+        assert wm.holds("found", "green_white_red")
+        assert math.dist(wm.get("sample_pos", "green_white_red"), xy) < 0.05
+    finally:
+        world.close()
