@@ -242,29 +242,48 @@ def _manipulation(registry: SkillRegistry) -> None:
 def _directed_vision(registry: SkillRegistry) -> None:
     registry.declare(
         "DetectCircles",
-        _p("radius", "float", "radius in metres of the drill samples to look for", default=0.05),
-        _p("tolerance", "float", "allowed radius error in metres", default=0.01),
+        _p("radius", "float", "radius in metres of the drill samples to look for", default=0.03),
+        _p("tolerance", "float", "allowed radius error in metres (plus half a ray spacing at the range)", default=0.01),
         _p("max_range", "float", "farthest distance in metres to consider", default=8.0),
+        _p(
+            "n_rays",
+            "int",
+            "rays of the scan over the full circle (1440: 0.25 degrees, a Hokuyo UTM-30LX)",
+            default=1440,
+        ),
         doc="find circular shapes of the sample radius in the 2D laser scan and report them as candidates",
         capabilities=("lidar2d",),
+        implementation="alica.skills.vision2d:DetectCircles",
     )
     registry.declare(
         "CropCandidate",
         _p("margin", "float", "extra border around the candidate in metres", default=0.1),
+        _p(
+            "max_range",
+            "float",
+            "farthest candidate in metres to look at (blob detection works at short range)",
+            default=5.0,
+        ),
+        _p("width", "int", "camera image width in pixels (752: Scout's Guppy camera)", default=752),
+        _p("height", "int", "camera image height in pixels", default=480),
         doc="project the candidate into the camera image and crop it",
         capabilities=("camera",),
+        implementation="alica.skills.vision2d:CropCandidate",
     )
     registry.declare(
         "BlobDetect",
-        _p("colours", "list", "colours to search for", default=("green", "red")),
-        _p("min_area", "int", "smallest blob in pixels", default=40),
+        _p("colours", "list", "colours to search for (green, red, blue, yellow)", default=("green", "red")),
+        _p("min_area", "int", "smallest blob in pixels", default=12),
         doc="find coloured blobs in the cropped candidate image (short range only)",
         capabilities=("camera",),
+        implementation="alica.skills.vision2d:BlobDetect",
     )
     registry.declare(
         "ClassifySample",
+        _p("min_confidence", "float", "lowest confidence in [0, 1] that counts as a sample", default=0.3),
         doc="decode the sample from its upper, middle and lower sections (green/red, black/white, green/red)",
         capabilities=("camera",),
+        implementation="alica.skills.vision2d:ClassifySample",
     )
 
 
@@ -340,8 +359,27 @@ def _facts(registry: SkillRegistry) -> None:
     registry.declare_predicate("on", 2, "on(x, y): block x stands on block y (Stack, Unstack; blocks-world perception)")
     registry.declare_predicate("ontable", 1, "ontable(x): block x stands on the table (Putdown)")
     registry.declare_predicate("clear", 1, "clear(x): nothing stands on block x")
-    registry.declare_function("pos", 1, "pos(r): the position [x, y] a robot reached (MoveToPosition)")
+    registry.declare_function(
+        "pos",
+        1,
+        "pos(x): the position [x, y] a robot reached (MoveToPosition), or where sample x was found "
+        "(ClassifySample, FuzzyDLClassify)",
+    )
     registry.declare_function("attempts", 1, "attempts(r): grasp attempts of robot r so far (Pickup)")
+    registry.declare_predicate(
+        "candidate",
+        1,
+        "candidate(c): a circle of the sample radius seen by the laser, not yet verified (DetectCircles)",
+    )
+    registry.declare_predicate(
+        "invalid", 1, "invalid(c): a closer look found candidate c is no sample (BlobDetect, ClassifySample)"
+    )
+    registry.declare_function(
+        "candidate_pos", 1, "candidate_pos(c): the position [x, y] of candidate c (DetectCircles)"
+    )
+    registry.declare_function(
+        "sample_kind", 1, "sample_kind(s): the kind of sample s, e.g. green-black-red (ClassifySample)"
+    )
 
 
 def declare_all(registry: SkillRegistry) -> None:

@@ -1,0 +1,814 @@
+"""Verify2DObject (IMPERA Section 6.4.3, Figs. 12-13): sample detection with a 2D laser and a directed colour camera.
+
+Four skills in consecutive states of ``plans/skills/verify_2d_object.yaml``
+hand their data on through the agent's scratch space (``context.scratch``):
+
+1. :class:`DetectCircles` segments a 2D lidar scan into clusters and keeps
+   those whose circle has the sample radius (silhouette width and a robust
+   RANSAC + least-squares circle fit): ``scratch["circles"]``, and
+   ``candidate(c)`` / ``candidate_pos(c)`` in the world model.
+2. :class:`CropCandidate` renders the robot's camera, projects the nearest
+   candidate in view (its footprint and height) into the image and crops it:
+   ``scratch["candidate"]``, ``scratch["crop"]``.
+3. :class:`BlobDetect` finds green and red blobs in the crop (HSV thresholds,
+   connected components; OpenCV): ``scratch["blobs"]``.
+4. :class:`ClassifySample` decodes the kind from the upper and lower blobs and
+   the middle section's brightness, and writes ``found(s)``, ``sample_kind(s)``,
+   ``pos(s)`` and ``confidence(s)``; a candidate the closer look
+   disagrees with is retracted and recorded as ``invalid(c)``.
+
+The skills read lidar ranges and rendered pixels only (never the simulator's
+object names or poses); the pure functions below (:func:`detect_circles`,
+:func:`find_blobs`, :func:`decode_sections`) do the work and are tested alone.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, cast
+
+import numpy as np
+from py_trees.common import Status
+
+from alica.errors import SkillError
+from alica.skills.jobs import Job
+from alica.skills.world_skill import WorldSkill
+from alica.worldsim.objects import SAMPLE_KINDS
+
+if TYPE_CHECKING:
+    from alica.worldsim.robot_camera import CameraImage
+    from alica.worldsim.robots import Robot
+
+__all__ = [
+    "BlobDetect",
+    "Circle",
+    "ClassifySample",
+    "CropCandidate",
+    "DetectCircles",
+    "decode_sections",
+    "detect_circles",
+    "find_blobs",
+    "fit_circle",
+    "segment_scan",
+]
+
+#: A new detection within this many metres of a known candidate is the same candidate.
+ASSOCIATION_RADIUS = 0.25
+#: Height of the sample containers in metres (the projection of a candidate into the image).
+SAMPLE_HEIGHT = 0.1
+#: BlobDetect looks for blobs in the candidate's silhouette grown by this fraction of a section's height.
+WINDOW_PAD = 0.3
+#: HSV ranges (OpenCV: hue 0-180, saturation and value 0-255) of the colours BlobDetect knows.
+HSV_RANGES: dict[str, tuple[tuple[tuple[int, int, int], tuple[int, int, int]], ...]] = {
+    "red": (((0, 110, 60), (8, 255, 255)), ((172, 110, 60), (180, 255, 255))),
+    "green": (((40, 110, 50), (85, 255, 255)),),
+    "blue": (((100, 110, 50), (130, 255, 255)),),
+    "yellow": (((22, 110, 80), (35, 255, 255)),),
+}
+
+
+# -- the lidar: clusters and circles -----------------------------------------------------------------
+
+
+@dataclass(frozen=True, slots=True)
+class Circle:
+    """A circle of the sample radius found in a scan.
+
+    Attributes:
+        x: centre in the world, metres.
+        y: centre in the world, metres.
+        radius: the estimated radius (silhouette width and circle fit combined), metres.
+        range: distance of the centre from the scanner, metres.
+        bearing: direction of the centre relative to the robot's heading, radians.
+        points: scan points in the cluster.
+        fit_radius: the radius of the free least-squares circle fit (NaN with fewer than 4 points).
+    """
+
+    x: float
+    y: float
+    radius: float
+    range: float
+    bearing: float
+    points: int
+    fit_radius: float
+
+
+def segment_scan(ranges: np.ndarray, max_range: float, jump: float = 0.05) -> list[np.ndarray]:
+    """Clusters of consecutive hits: index arrays, split where the range jumps by more than ``jump`` metres.
+
+    Readings at ``max_range`` or beyond (no hit) end a cluster; a cluster that
+    wraps around the end of the scan is joined with the one at its start.
+    """
+    ranges = np.asarray(ranges, dtype=float)
+    n = len(ranges)
+    hit = ranges < max_range - 1e-6
+    clusters: list[list[int]] = []
+    current: list[int] = []
+    for i in range(n):
+        if not hit[i]:
+            if current:
+                clusters.append(current)
+            current = []
+            continue
+        if current and abs(ranges[i] - ranges[current[-1]]) > jump:
+            clusters.append(current)
+            current = []
+        current.append(i)
+    if current:
+        clusters.append(current)
+    if (
+        len(clusters) > 1
+        and clusters[0][0] == 0
+        and clusters[-1][-1] == n - 1
+        and abs(ranges[0] - ranges[n - 1]) <= jump
+    ):
+        clusters[0] = clusters.pop() + clusters[0]
+    return [np.asarray(c, dtype=int) for c in clusters]
+
+
+def _circle_through(p: np.ndarray) -> tuple[float, float, float] | None:
+    """The circle through three points, or None when they are (nearly) collinear."""
+    (x1, y1), (x2, y2), (x3, y3) = p
+    d = 2.0 * (x1 * (y2 - y3) + x2 * (y3 - y1) + x3 * (y1 - y2))
+    if abs(d) < 1e-12:
+        return None
+    s1, s2, s3 = x1 * x1 + y1 * y1, x2 * x2 + y2 * y2, x3 * x3 + y3 * y3
+    cx = (s1 * (y2 - y3) + s2 * (y3 - y1) + s3 * (y1 - y2)) / d
+    cy = (s1 * (x3 - x2) + s2 * (x1 - x3) + s3 * (x2 - x1)) / d
+    return cx, cy, math.hypot(x1 - cx, y1 - cy)
+
+
+def _kasa(points: np.ndarray) -> tuple[float, float, float] | None:
+    """Algebraic (Kasa) least-squares circle: solve ``x^2 + y^2 + D x + E y + F = 0``."""
+    a = np.column_stack([points, np.ones(len(points))])
+    b = -(points**2).sum(axis=1)
+    sol, *_ = np.linalg.lstsq(a, b, rcond=None)
+    d, e, f = sol
+    r2 = 0.25 * (d * d + e * e) - f
+    if not (np.isfinite(r2) and r2 > 0.0):
+        return None
+    return float(-0.5 * d), float(-0.5 * e), float(math.sqrt(r2))
+
+
+def fit_circle(
+    points: np.ndarray,
+    *,
+    threshold: float,
+    rng: np.random.Generator,
+    iterations: int = 60,
+    radius: float | None = None,
+) -> tuple[float, float, float, np.ndarray] | None:
+    """A robust circle fit: RANSAC over circles through three points, then a geometric least-squares refinement.
+
+    Args:
+        points: ``(n, 2)`` points, ``n >= 3``.
+        threshold: largest distance in metres of an inlier from the circle.
+        rng: the generator of the RANSAC samples (seeded: the fit is repeatable).
+        iterations: RANSAC samples.
+        radius: when given, only circles within ``3 * threshold`` of it are hypotheses.
+
+    Returns:
+        ``(cx, cy, r, inliers)`` or None when no circle has three inliers.
+    """
+    from scipy.optimize import least_squares
+
+    n = len(points)
+    if n < 3:
+        return None
+    best: np.ndarray | None = None
+    for _ in range(iterations if n > 3 else 1):
+        pick = rng.choice(n, 3, replace=False) if n > 3 else np.arange(3)
+        circle = _circle_through(points[pick])
+        if circle is None:
+            continue
+        if radius is not None and abs(circle[2] - radius) > 3.0 * threshold:
+            continue
+        d = np.abs(np.hypot(points[:, 0] - circle[0], points[:, 1] - circle[1]) - circle[2])
+        inliers = d <= threshold
+        if best is None or inliers.sum() > best.sum():
+            best = inliers
+    if best is None or best.sum() < 3:
+        return None
+    inl = points[best]
+    start = _kasa(inl)
+    if start is None:
+        return None
+
+    def residual(c: np.ndarray) -> np.ndarray:
+        return np.hypot(inl[:, 0] - c[0], inl[:, 1] - c[1]) - c[2]
+
+    sol = least_squares(residual, np.asarray(start), method="lm" if len(inl) >= 3 else "trf")
+    cx, cy, r = (float(v) for v in sol.x)
+    return cx, cy, abs(r), best
+
+
+def _fixed_radius_centre(points: np.ndarray, origin: np.ndarray, radius: float) -> np.ndarray:
+    """The centre of a circle of known ``radius`` through ``points`` seen from ``origin`` (least squares)."""
+    from scipy.optimize import least_squares
+
+    mean = points.mean(axis=0)
+    away = mean - origin
+    away /= max(float(np.linalg.norm(away)), 1e-9)
+    start = mean + radius * away
+
+    def residual(c: np.ndarray) -> np.ndarray:
+        return np.hypot(points[:, 0] - c[0], points[:, 1] - c[1]) - radius
+
+    if len(points) < 2:
+        return start
+    sol = least_squares(residual, start, method="trf")
+    centre = np.asarray(sol.x, dtype=float)
+    # the centre lies behind the points as seen from the scanner
+    if float(np.dot(centre - mean, away)) < 0.0:
+        centre = start
+    return centre
+
+
+def _radius_error(points: np.ndarray, cx: float, cy: float, sigma: float) -> float:
+    """Standard error of a geometric circle fit's radius: ``sigma`` times the root of (J^T J)^-1 at the fit.
+
+    A short arc of a few points leaves the radius nearly free (a large error),
+    so the fit then hardly constrains the acceptance and the estimate.
+    """
+    d = np.maximum(np.hypot(points[:, 0] - cx, points[:, 1] - cy), 1e-9)
+    jac = np.column_stack([-(points[:, 0] - cx) / d, -(points[:, 1] - cy) / d, -np.ones(len(points))])
+    cov = np.linalg.pinv(jac.T @ jac)
+    return float(sigma * math.sqrt(max(float(cov[2, 2]), 0.0)))
+
+
+def detect_circles(
+    ranges: np.ndarray,
+    angles: np.ndarray,
+    pose: tuple[float, float, float],
+    *,
+    radius: float,
+    tolerance: float,
+    max_range: float,
+    scan_range: float,
+    sigma: float = 0.01,
+    min_points: int = 2,
+    jump: float = 0.05,
+    seed: int = 0,
+) -> list[Circle]:
+    """Circles of ``radius`` (within ``tolerance``) in a 2D scan, nearest first.
+
+    Each cluster of :func:`segment_scan` is measured twice: its silhouette
+    width across the bearing gives a radius whose error is at most half the
+    spacing of two rays at that range (so the tolerance grows by that much),
+    and, with four points or more, a robust circle fit (:func:`fit_circle`)
+    gives another, accepted within ``tolerance`` plus three times its
+    standard error. Clusters much wider than a sample (rocks, robots, walls)
+    fail the first test. The centre is the least-squares centre of a circle
+    of the nominal radius through the cluster.
+
+    Args:
+        ranges: the scan's ranges, metres.
+        angles: the rays' angles relative to the heading (:func:`alica.worldsim.sensors.lidar_angles`).
+        pose: the scanner's ``(x, y, yaw)``.
+        radius: the sample radius, metres.
+        tolerance: allowed radius error, metres.
+        max_range: farthest centre to report, metres.
+        scan_range: the scanner's maximum range (a reading at it is no hit).
+        sigma: the scanner's range noise, metres (the inlier threshold of the fit).
+        min_points: fewest points in a cluster.
+        jump: a range jump that splits two clusters, metres.
+        seed: seeds the RANSAC samples.
+    """
+    ranges = np.asarray(ranges, dtype=float)
+    angles = np.asarray(angles, dtype=float)
+    x0, y0, yaw = pose
+    origin = np.array([x0, y0])
+    step = float(2.0 * math.pi / len(ranges)) if len(ranges) else 0.0
+    rng = np.random.default_rng(seed)
+    out: list[Circle] = []
+    for idx in segment_scan(ranges, scan_range, jump):
+        if len(idx) < min_points:
+            continue
+        r_i, a_i = ranges[idx], yaw + angles[idx]
+        near = float(r_i.min())
+        if near > max_range + radius:
+            continue
+        spacing = near * step
+        # the silhouette: angular extent of the cluster, widened by one ray spacing (the rays hit inside it)
+        span = float(np.unwrap(a_i)[-1] - np.unwrap(a_i)[0])
+        silhouette = 0.5 * (near * abs(span) + spacing)
+        if abs(silhouette - radius) > tolerance + 0.5 * spacing:
+            continue
+        points = np.column_stack([x0 + r_i * np.cos(a_i), y0 + r_i * np.sin(a_i)])
+        fit_r = math.nan
+        estimate = silhouette
+        if len(points) >= 4:
+            fit = fit_circle(points, threshold=max(2.5 * sigma, 0.005), rng=rng, radius=None)
+            if fit is not None:
+                fit_r = fit[2]
+                err = _radius_error(points[fit[3]], fit[0], fit[1], sigma)
+                if abs(fit_r - radius) > tolerance + 3.0 * err:
+                    continue
+                w_fit, w_sil = 1.0 / max(err, 1e-4) ** 2, 12.0 / max(spacing, 1e-4) ** 2
+                estimate = (w_fit * fit_r + w_sil * silhouette) / (w_fit + w_sil)
+        centre = _fixed_radius_centre(points, origin, radius)
+        d = float(np.hypot(*(centre - origin)))
+        if d > max_range:
+            continue
+        bearing = math.atan2(centre[1] - y0, centre[0] - x0) - yaw
+        bearing = (bearing + math.pi) % (2.0 * math.pi) - math.pi
+        out.append(Circle(float(centre[0]), float(centre[1]), float(estimate), d, bearing, len(idx), fit_r))
+    out.sort(key=lambda c: c.range)
+    return out
+
+
+# -- the camera: blobs and sections ------------------------------------------------------------------
+
+
+def find_blobs(
+    rgb: np.ndarray,
+    colours: tuple[str, ...],
+    min_area: int,
+    window: tuple[float, float, float, float] | None = None,
+) -> list[dict[str, Any]]:
+    """Connected components of each colour's HSV range with at least ``min_area`` pixels.
+
+    With a ``window`` ``(u0, v0, u1, v1)`` only pixels inside it count (the
+    candidate's silhouette, slightly grown: a red robot or rock right behind
+    the sample then does not merge with its sections).
+
+    Returns:
+        Blobs as dicts ``{"colour", "area", "centroid": (u, v), "box": (u0, v0, u1, v1)}`` in crop
+        pixels (``u1``, ``v1`` exclusive), largest first.
+    """
+    import cv2
+
+    hsv = cv2.cvtColor(np.ascontiguousarray(rgb), cv2.COLOR_RGB2HSV)
+    keep = np.ones(hsv.shape[:2], dtype=np.uint8) * 255
+    if window is not None:
+        keep[:] = 0
+        u0, v0, u1, v1 = (round(c) for c in window)
+        keep[max(v0, 0) : max(v1, 0), max(u0, 0) : max(u1, 0)] = 255
+    blobs: list[dict[str, Any]] = []
+    for colour in colours:
+        mask = np.zeros(hsv.shape[:2], dtype=np.uint8)
+        for lo, hi in HSV_RANGES[colour]:
+            mask |= cv2.inRange(hsv, np.array(lo, dtype=np.uint8), np.array(hi, dtype=np.uint8))
+        mask &= keep
+        count, _, stats, centroids = cv2.connectedComponentsWithStats(mask, connectivity=8)
+        for k in range(1, count):
+            u, v, w, h, area = (int(s) for s in stats[k])
+            if area >= min_area:
+                blobs.append(
+                    {
+                        "colour": colour,
+                        "area": area,
+                        "centroid": (float(centroids[k][0]), float(centroids[k][1])),
+                        "box": (u, v, u + w, v + h),
+                    }
+                )
+    blobs.sort(key=lambda b: -int(b["area"]))
+    return blobs
+
+
+def decode_sections(
+    rgb: np.ndarray, blobs: list[dict[str, Any]], expected: tuple[float, float, float, float]
+) -> tuple[str, float] | str:
+    """The sample kind and a confidence from the blobs of a crop, or why it is not a sample.
+
+    The blobs inside the sample's expected box (``(u0, v0, u1, v1)`` in crop
+    pixels) are read top to bottom: the uppermost is the upper section, the
+    lowest the lower one; both must be about a third of the box high and the
+    two must be apart by about a section. The middle section is the strip
+    between them: white when bright and unsaturated, black when dark. The
+    confidence combines how much of the expected sections the blobs cover and
+    how clear the middle is.
+
+    Returns:
+        ``(kind, confidence)`` or a reason string.
+    """
+    import cv2
+
+    u0, v0, u1, v1 = expected
+    width, height = max(u1 - u0, 1.0), max(v1 - v0, 1.0)
+    section = height / 3.0
+    inside = [
+        b
+        for b in blobs
+        if u0 - 0.5 * width <= b["centroid"][0] <= u1 + 0.5 * width
+        and v0 - 0.5 * section <= b["centroid"][1] <= v1 + 0.5 * section
+    ]
+    if len(inside) < 2:
+        return f"{len(inside)} coloured blob(s) where the sample should be; a sample has two"
+    too_big = [
+        b
+        for b in inside
+        if (b["box"][3] - b["box"][1]) > 1.6 * section + 2 or (b["box"][2] - b["box"][0]) > 2.0 * width + 2
+    ]
+    if too_big:
+        b = too_big[0]
+        return f"a {b['colour']} blob of {b['box'][2] - b['box'][0]}x{b['box'][3] - b['box'][1]} px is larger than a section of the sample ({width:.0f}x{section:.0f} px)"
+    inside.sort(key=lambda b: b["centroid"][1])
+    upper, lower = inside[0], inside[-1]
+    gap = lower["centroid"][1] - upper["centroid"][1]
+    if not (1.2 * section <= gap + 1.0 and gap - 1.0 <= 2.8 * section):
+        return f"the coloured blobs are {gap:.1f} px apart, the sample's sections {2 * section:.1f} px"
+    top, bottom = upper["box"][3], lower["box"][1]
+    left = int(max(min(upper["box"][0], lower["box"][0]), 0))
+    right = int(max(upper["box"][2], lower["box"][2]))
+    strip = rgb[int(top) : int(max(bottom, top + 1)), left : max(right, left + 1)]
+    if strip.size == 0:
+        return "no middle section between the coloured blobs"
+    hsv = cv2.cvtColor(np.ascontiguousarray(strip), cv2.COLOR_RGB2HSV).reshape(-1, 3).astype(float)
+    value, saturation = float(np.median(hsv[:, 2])), float(np.median(hsv[:, 1]))
+    if value >= 150 and saturation <= 80:
+        middle, clarity = "white", min(1.0, (value - 150) / 60 + 0.5)
+    elif value <= 70:
+        middle, clarity = "black", min(1.0, (70 - value) / 40 + 0.5)
+    else:
+        return f"the middle section is neither black nor white (value {value:.0f}, saturation {saturation:.0f})"
+    ends = sorted((upper["colour"], lower["colour"]))  # green before red: the kinds list green first
+    kind = f"{ends[0]}-{middle}-{ends[1]}"
+    if kind not in SAMPLE_KINDS:
+        return f"the code {upper['colour']}-{middle}-{lower['colour']} is no sample kind"
+    area = width * section
+    cover = min(1.0, min(upper["area"], lower["area"]) / max(0.6 * area, 1.0))
+    return kind, round(float(0.5 * cover + 0.5 * clarity), 3)
+
+
+# -- the skills --------------------------------------------------------------------------------------
+
+
+def _number(skill: WorldSkill, name: str, default: float, *, low: float = 0.0, strict: bool = True) -> float:
+    """A numeric parameter checked against a lower bound, or a clear SkillError."""
+    raw = skill.param(name, default)
+    try:
+        value = float(raw)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SkillError(f"skill '{skill.name}': parameter '{name}' must be a number, got {raw!r}") from None
+    if not math.isfinite(value) or (value <= low if strict else value < low):
+        raise SkillError(
+            f"skill '{skill.name}': parameter '{name}' must be {'>' if strict else '>='} {low}, got {raw!r}"
+        )
+    return value
+
+
+def _sim_robot(skill: WorldSkill) -> Robot:
+    """The skill's robot as the simulator's robot, for the simulated sensors."""
+    return cast("Robot", skill.robot)
+
+
+class _Pipeline(WorldSkill):
+    """A Verify2DObject step: the scratch space and the world model's candidate facts."""
+
+    @property
+    def scratch(self) -> dict[str, object]:
+        """The agent's scratch space (an own dict when the context has none)."""
+        scratch = getattr(self.context, "scratch", None)
+        if scratch is None:
+            scratch = self.__dict__.setdefault("_own_scratch", {})
+        return cast("dict[str, object]", scratch)
+
+    def reject_candidate(self, candidate: dict[str, Any], reason: str) -> None:
+        """A closer look disagrees: retract the candidate (and a sample found there), record it as invalid."""
+        cid = str(candidate["id"])
+        wm = self.world_model
+        if wm is not None:
+            wm.retract_fact("candidate", cid)
+            wm.assert_fact("invalid", cid)
+            for name, at in _found_samples(wm):
+                if math.hypot(at[0] - candidate["x"], at[1] - candidate["y"]) <= ASSOCIATION_RADIUS:
+                    wm.retract_fact("found", name)
+        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
+        verdicts[cid] = "invalid"
+        self.scratch["last_verdict"] = {"candidate": cid, "valid": False, "reason": reason}
+
+
+def _found_samples(wm: Any) -> list[tuple[str, tuple[float, float]]]:
+    """``(name, pos)`` of the samples found so far."""
+    out = []
+    for name, args, value in wm.values():
+        if name == "pos" and len(args) == 1 and isinstance(value, (tuple, list)) and len(value) >= 2:
+            if wm.holds("found", args[0]):
+                out.append((str(args[0]), (float(value[0]), float(value[1]))))
+    return out
+
+
+class DetectCircles(_Pipeline):
+    """Find circles of the sample radius in the 2D laser scan (see :func:`detect_circles`).
+
+    Succeeds with ``scratch["circles"]`` (a list of candidate dicts ``{"id", "x", "y", "radius",
+    "range", "bearing", "points"}``, nearest first) and ``candidate(c)``, ``candidate_pos(c)``
+    in the world model; fails when there is none.
+    """
+
+    def initialise(self) -> None:
+        """Check the parameters and start the scan."""
+        self.radius = _number(self, "radius", 0.03)
+        self.tolerance = _number(self, "tolerance", 0.01, strict=False)
+        self.max_range = _number(self, "max_range", 8.0)
+        raw = self.param("n_rays", 1440)
+        if not isinstance(raw, int) or isinstance(raw, bool) or not 16 <= raw <= 100_000:
+            raise SkillError(
+                f"skill '{self.name}': parameter 'n_rays' must be a whole number in [16, 100000], got {raw!r}"
+            )
+        self.n_rays = raw
+        if self.tolerance >= self.radius:
+            raise SkillError(
+                f"skill '{self.name}': parameter 'tolerance' ({self.tolerance}) must be smaller than 'radius' ({self.radius})"
+            )
+        if "lidar2d" not in self.robot.spec.capabilities:
+            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no 2D lidar")
+        self.job: Job = self.jobs.submit(self._scan)
+
+    def _scan(self) -> list[Circle]:
+        from alica.worldsim.sensors import lidar_angles, lidar_scan
+
+        robot = _sim_robot(self)
+        pose = robot.pose
+        ranges = lidar_scan(robot, self.n_rays)
+        sigma = float(getattr(getattr(robot.world, "noise", None), "lidar_sigma", 0.01))
+        return detect_circles(
+            ranges,
+            lidar_angles(self.n_rays),
+            pose,
+            radius=self.radius,
+            tolerance=self.tolerance,
+            max_range=self.max_range,
+            scan_range=robot.spec.lidar_range,
+            sigma=max(sigma, 0.005),
+            seed=int(self.world.seed) * 1_000_003 + round(self.now() * 1000),
+        )
+
+    def update(self) -> Status:
+        """Poll the scan; hand the circles on."""
+        if not self.job.done():
+            return self.running("scanning")
+        circles: list[Circle] = self.job.result()
+        known = cast("dict[str, tuple[float, float]]", self.scratch.setdefault("candidate_ids", {}))
+        out = []
+        wm = self.world_model
+        for c in circles:
+            cid = next((k for k, p in known.items() if math.hypot(p[0] - c.x, p[1] - c.y) <= ASSOCIATION_RADIUS), None)
+            if cid is None:
+                cid = f"{self.robot.name}_c{len(known) + 1}"
+            known[cid] = (c.x, c.y)
+            out.append(
+                {
+                    "id": cid,
+                    "x": c.x,
+                    "y": c.y,
+                    "radius": c.radius,
+                    "range": c.range,
+                    "bearing": c.bearing,
+                    "points": c.points,
+                }
+            )
+            verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+            if wm is not None and cid not in verdicts:  # verified ones stay found (or invalid) until a new look
+                wm.assert_fact("candidate", cid)
+                wm.set("candidate_pos", cid, value=(round(c.x, 3), round(c.y, 3)))
+        self.scratch["circles"] = out
+        self.scratch["circle_radius"] = self.radius
+        if not out:
+            return self.fail("no circle of the sample radius in the scan")
+        near = out[0]
+        return self.succeed(
+            f"{len(out)} candidate(s); nearest {near['id']} at ({near['x']:.2f}, {near['y']:.2f}), {near['range']:.2f} m"
+        )
+
+
+class CropCandidate(_Pipeline):
+    """Render the camera, project the nearest unverified candidate in view into it and crop it.
+
+    Candidates come from ``scratch["circles"]`` (DetectCircles). The crop is the
+    candidate's cylinder (footprint of the sample radius, :data:`SAMPLE_HEIGHT`
+    high) grown by ``margin`` metres; ``scratch["candidate"]`` and
+    ``scratch["crop"]`` (``{"rgb", "depth", "box", "expected", "range"}``) go on to
+    BlobDetect and ClassifySample. Fails when no candidate is within
+    ``max_range`` and in the camera's view, or the view of it is blocked.
+    """
+
+    def initialise(self) -> None:
+        """Check the parameters, choose the candidate and render the camera."""
+        self.margin = _number(self, "margin", 0.1, strict=False)
+        self.max_range = _number(self, "max_range", 5.0)
+        self.width = self._pixels("width", 752)
+        self.height = self._pixels("height", 480)
+        if not ({"camera", "stereo_camera"} & self.robot.spec.capabilities):
+            raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no camera")
+        self.job: Job = self.jobs.submit(self._render)
+
+    def _pixels(self, name: str, default: int) -> int:
+        raw = self.param(name, default)
+        if not isinstance(raw, int) or isinstance(raw, bool) or not 16 <= raw <= 4096:
+            raise SkillError(
+                f"skill '{self.name}': parameter '{name}' must be a whole number of pixels in [16, 4096], got {raw!r}"
+            )
+        return raw
+
+    def _render(self) -> CameraImage:
+        from alica.worldsim.robot_camera import robot_camera
+
+        return robot_camera(_sim_robot(self), width=self.width, height=self.height)
+
+    def update(self) -> Status:
+        """Poll the rendering; crop the candidate."""
+        if not self.job.done():
+            return self.running("taking a picture")
+        image: CameraImage = self.job.result()
+        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
+        if not circles:
+            return self.fail("no candidate to look at: run DetectCircles first")
+        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
+        views = []
+        reasons = []
+        for c in circles:
+            view = self._view(image, c, radius)
+            if isinstance(view, str):
+                reasons.append(f"{c['id']}: {view}")
+            else:
+                views.append((c["id"] in verdicts, c["range"], c, view))
+        if not views:
+            return self.fail("no candidate in view: " + "; ".join(reasons[:3]))
+        views.sort(key=lambda t: (t[0], t[1]))
+        _, _, candidate, (box, expected) = views[0]
+        u0, v0, u1, v1 = box
+        self.scratch["candidate"] = dict(candidate)
+        self.scratch["crop"] = {
+            "rgb": image.rgb[v0:v1, u0:u1].copy(),
+            "depth": image.depth[v0:v1, u0:u1].copy(),
+            "box": box,
+            "expected": (expected[0] - u0, expected[1] - v0, expected[2] - u0, expected[3] - v0),
+            "range": candidate["range"],
+            "time": image.time,
+        }
+        return self.succeed(f"cropped {candidate['id']} ({u1 - u0}x{v1 - v0} px at {candidate['range']:.2f} m)")
+
+    def _view(
+        self, image: CameraImage, c: dict[str, Any], radius: float
+    ) -> tuple[tuple[int, int, int, int], tuple[float, float, float, float]] | str:
+        """The crop box and the sample's expected box in image pixels, or why the candidate cannot be seen."""
+        if c["range"] > self.max_range:
+            return f"{c['range']:.1f} m away, beyond the {self.max_range:.1f} m of a closer look"
+        h, w = image.depth.shape
+        x, y = float(c["x"]), float(c["y"])
+        # the sample's cylinder: its silhouette's left/right edges at the bottom and the top
+        to = np.array([x, y, 0.0]) - image.position
+        side = np.array([-to[1], to[0], 0.0]) / max(math.hypot(to[0], to[1]), 1e-9)
+        corners = []
+        for z in (0.0, SAMPLE_HEIGHT):
+            for s in (-1.0, 1.0):
+                corners.append(image.project(np.array([x, y, z]) + s * radius * side))
+        if any(not math.isfinite(u) or d <= 0.0 for u, _, d in corners):
+            return "behind the camera"
+        us, vs = [u for u, _, _ in corners], [v for _, v, _ in corners]
+        expected = (min(us), min(vs), max(us) + 1.0, max(vs) + 1.0)
+        if expected[2] < 0 or expected[0] >= w or expected[3] < 0 or expected[1] >= h:
+            return "outside the camera's field of view"
+        if expected[0] < 0 or expected[2] > w or expected[1] < 0 or expected[3] > h:
+            return "only partly in the camera's field of view"
+        depth = corners[0][2]
+        fx = image.intrinsics[0]
+        pad = self.margin * fx / depth
+        box = (
+            int(max(0, math.floor(expected[0] - pad))),
+            int(max(0, math.floor(expected[1] - pad))),
+            int(min(w, math.ceil(expected[2] + pad))),
+            int(min(h, math.ceil(expected[3] + pad))),
+        )
+        # something nearer than the candidate covers it: the middle of its silhouette is closer in depth
+        cu, cv = 0.5 * (expected[0] + expected[2]), 0.5 * (expected[1] + expected[3])
+        patch = image.depth[int(cv) - 1 : int(cv) + 2, int(cu) - 1 : int(cu) + 2]
+        seen = float(np.median(patch)) if patch.size else math.inf
+        if seen < depth - 4.0 * radius - 0.05:
+            return f"hidden behind something {seen:.2f} m from the camera"
+        return box, expected
+
+
+class BlobDetect(_Pipeline):
+    """Find coloured blobs in the crop (HSV thresholds, connected components of at least ``min_area`` pixels).
+
+    Reads ``scratch["crop"]`` (CropCandidate), writes ``scratch["blobs"]`` (see
+    :func:`find_blobs`). Fails, retracting the candidate, when no blob of the
+    colours is near the candidate: a closer look disagrees.
+    """
+
+    def initialise(self) -> None:
+        """Check the parameters."""
+        raw = self.param("colours", ("green", "red"))
+        colours = (raw,) if isinstance(raw, str) else tuple(raw) if isinstance(raw, (list, tuple)) else None
+        if not colours or any(c not in HSV_RANGES for c in colours):
+            raise SkillError(
+                f"skill '{self.name}': parameter 'colours' must list colours of {', '.join(sorted(HSV_RANGES))}, got {raw!r}"
+            )
+        self.colours = cast("tuple[str, ...]", colours)
+        area = self.param("min_area", 12)
+        if not isinstance(area, int) or isinstance(area, bool) or area < 1:
+            raise SkillError(
+                f"skill '{self.name}': parameter 'min_area' must be a whole number of pixels >= 1, got {area!r}"
+            )
+        self.min_area = area
+
+    def update(self) -> Status:
+        """Detect the blobs (cheap: the crop is small)."""
+        crop = cast("dict[str, Any] | None", self.scratch.get("crop"))
+        candidate = cast("dict[str, Any] | None", self.scratch.get("candidate"))
+        if crop is None or candidate is None:
+            return self.fail("no cropped candidate: run CropCandidate first")
+        u0, v0, u1, v1 = crop["expected"]
+        pad = max(2.0, WINDOW_PAD * (v1 - v0) / 3.0)
+        blobs = find_blobs(crop["rgb"], self.colours, self.min_area, (u0 - pad, v0 - pad, u1 + pad, v1 + pad))
+        self.scratch["blobs"] = blobs
+        if not blobs:
+            reason = f"no {' or '.join(self.colours)} blob of {self.min_area} px or more at {candidate['id']}"
+            self.reject_candidate(candidate, reason)
+            return self.fail(reason)
+        summary = ", ".join(f"{b['colour']} {b['area']} px" for b in blobs[:4])
+        return self.succeed(f"{len(blobs)} blob(s) at {candidate['id']}: {summary}")
+
+
+class ClassifySample(_Pipeline):
+    """Decode the sample's kind from the blobs' vertical order and the middle section (see :func:`decode_sections`).
+
+    On success: ``found(s)``, ``sample_kind(s)``, ``pos(s)`` and
+    ``confidence(s)`` in the world model; ``s`` is the sample the mission
+    already knows with that kind (a value ``sample_kind(s)`` set beforehand,
+    e.g. ``a``), else one named after the kind. The candidate fact is
+    retracted (it is a sample now). On failure the candidate is retracted and
+    recorded as ``invalid(c)``, and a sample found at its place is retracted.
+    """
+
+    def initialise(self) -> None:
+        """Check the parameters."""
+        self.min_confidence = _number(self, "min_confidence", 0.3, strict=False)
+        if self.min_confidence > 1.0:
+            raise SkillError(
+                f"skill '{self.name}': parameter 'min_confidence' must be in [0, 1], got {self.min_confidence}"
+            )
+
+    def update(self) -> Status:
+        """Classify and write the result."""
+        crop = cast("dict[str, Any] | None", self.scratch.get("crop"))
+        candidate = cast("dict[str, Any] | None", self.scratch.get("candidate"))
+        blobs = cast("list[dict[str, Any]] | None", self.scratch.get("blobs"))
+        if crop is None or candidate is None or blobs is None:
+            return self.fail("nothing to classify: run CropCandidate and BlobDetect first")
+        result = decode_sections(crop["rgb"], blobs, crop["expected"])
+        if isinstance(result, str):
+            self.reject_candidate(candidate, result)
+            return self.fail(f"{candidate['id']} is no sample: {result}")
+        kind, confidence = result
+        if confidence < self.min_confidence:
+            reason = f"{kind} with confidence {confidence:.2f} below {self.min_confidence:.2f}"
+            self.reject_candidate(candidate, reason)
+            return self.fail(f"{candidate['id']} is no sample: {reason}")
+        name = self._name(kind, candidate)
+        position = (round(float(candidate["x"]), 3), round(float(candidate["y"]), 3))
+        wm = self.world_model
+        if wm is not None:
+            wm.set("sample_kind", name, value=kind)
+            wm.set("pos", name, value=position)
+            wm.set("confidence", name, value=confidence)
+            wm.assert_fact("found", name)
+            wm.retract_fact("candidate", str(candidate["id"]))
+            add_object = getattr(wm, "add_object", None)
+            if callable(add_object):
+                add_object(name, "Sample")
+        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
+        verdicts[str(candidate["id"])] = name
+        self.scratch["last_verdict"] = {
+            "candidate": candidate["id"],
+            "valid": True,
+            "sample": name,
+            "kind": kind,
+            "position": position,
+            "confidence": confidence,
+        }
+        return self.succeed(
+            f"found {name}: {kind} at ({position[0]:.2f}, {position[1]:.2f}), confidence {confidence:.2f}"
+        )
+
+    def _name(self, kind: str, candidate: dict[str, Any]) -> str:
+        """The sample's name: the known sample of this kind nearby or without a position, else a new one."""
+        wm = self.world_model
+        here = (float(candidate["x"]), float(candidate["y"]))
+        base = kind.replace("-", "_")
+        if wm is None:
+            return base
+        taken: dict[str, tuple[float, float] | None] = {}
+        for name, args, value in wm.values():
+            if name == "sample_kind" and len(args) == 1 and value == kind:
+                at = wm.get("pos", args[0])
+                taken[str(args[0])] = (
+                    (float(at[0]), float(at[1])) if isinstance(at, (tuple, list)) and len(at) >= 2 else None
+                )
+        for name, at in sorted(taken.items(), key=lambda t: t[1] is None):
+            if at is not None and math.hypot(at[0] - here[0], at[1] - here[1]) <= 2 * ASSOCIATION_RADIUS:
+                return name
+        for name, at in sorted(taken.items()):
+            if at is None:
+                return name
+        k = 1
+        name = base
+        while name in taken:
+            k += 1
+            name = f"{base}_{k}"
+        return name
