@@ -241,7 +241,9 @@ def coordinated_choice(
     return min(apart, key=lambda c: math.dist(c.position, needy.xy)), True
 
 
-def run(fld: Field, n: int, method: str, args: argparse.Namespace) -> tuple[float, list[tuple[float, float]], dict[str, int]]:
+def run(
+    fld: Field, n: int, method: str, args: argparse.Namespace
+) -> tuple[float, list[tuple[float, float]], dict[str, int]]:
     occ = np.full(fld.truth.shape, UNKNOWN, dtype=np.int8)
     bots = [Bot(name, fld.starts[name]) for name in ROBOTS[:n]]
     planner = Planner(fld)
@@ -264,9 +266,7 @@ def run(fld: Field, n: int, method: str, args: argparse.Namespace) -> tuple[floa
                 break
         if t >= next_frontiers:
             next_frontiers = t + args.period
-            cands = extract_frontiers(
-                occ, fld.resolution, fld.origin, reach=3.0, min_gain=1.0, clearance=RADIUS + 0.1
-            )
+            cands = extract_frontiers(occ, fld.resolution, fld.origin, reach=3.0, min_gain=1.0, clearance=RADIUS + 0.1)
             names = {c.name for c in cands}
             planner.update(occ)
             for b in bots:
@@ -299,7 +299,9 @@ def run(fld: Field, n: int, method: str, args: argparse.Namespace) -> tuple[floa
     return reached, curve, stats
 
 
-def _plan(planner: Planner, b: Bot, goal: tuple[float, float], stats: dict[str, int]) -> list[tuple[float, float]] | None:
+def _plan(
+    planner: Planner, b: Bot, goal: tuple[float, float], stats: dict[str, int]
+) -> list[tuple[float, float]] | None:
     stats["plans"] += 1
     dist, pred = planner.tree(b.xy)
     k = planner.nearest_open(goal, dist)
@@ -371,7 +373,10 @@ def main() -> None:
                 acc = extra.setdefault(key, {})
                 for k, v in stats.items():
                     acc[k] = acc.get(k, 0) + v
-                print(f"seed {seed} {method:11s} {n} robots: 90 % at {reached:.0f} s ({wall[key][-1]:.1f} s wall)", flush=True)
+                print(
+                    f"seed {seed} {method:11s} {n} robots: 90 % at {reached:.0f} s ({wall[key][-1]:.1f} s wall)",
+                    flush=True,
+                )
     print()
     print(f"Time to 90 % coverage, {args.seeds} seeds, 40 x 40 m, 60 rocks, lidar {args.range:g} m, {args.speed:g} m/s")
     print()
@@ -396,7 +401,11 @@ def main() -> None:
 
 
 STYLES = {"coordinated": "-", "nearest": "--", "gain-dist": ":"}
-LABELS = {"coordinated": "Eq. 7-8 (explore.yaml)", "nearest": "nearest frontier", "gain-dist": "Eq. 7-8 + distance cost"}
+LABELS = {
+    "coordinated": "Eq. 7-8 (explore.yaml)",
+    "nearest": "nearest frontier",
+    "gain-dist": "Eq. 7-8 + distance cost",
+}
 
 
 def plot(curves, counts, args) -> None:
@@ -416,8 +425,13 @@ def plot(curves, counts, args) -> None:
             ys.append(np.interp(grid, ts, cs, right=cs[-1]))
         mean = np.mean(ys, axis=0)
         last = grid <= max(c[-1][0] for c in runs) + 5
-        ax.plot(grid[last], mean[last], color=colours.get(n, "k"), ls=STYLES[method],
-                label=f"{n} robot{'s' if n > 1 else ''}, {LABELS[method]}")
+        ax.plot(
+            grid[last],
+            mean[last],
+            color=colours.get(n, "k"),
+            ls=STYLES[method],
+            label=f"{n} robot{'s' if n > 1 else ''}, {LABELS[method]}",
+        )
     ax.axhline(0.9, color="grey", lw=0.8)
     ax.set_xlabel("simulated time (s)")
     ax.set_ylabel("coverage of the free field")

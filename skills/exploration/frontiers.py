@@ -238,7 +238,7 @@ def extract_frontiers(
             name,
             (float(xs[pick]), float(ys[pick])),
             (int(rows[pick]), int(cols[pick])),
-            int(len(members)),
+            len(members),
             round(gain, 4),
             bool(result.boundary[rows[best], cols[best]]),
         )

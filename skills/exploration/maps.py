@@ -88,7 +88,9 @@ class LidarMap:
         scan_to_grid(self.grid, robot, ranges, reach)  # type: ignore[arg-type]
 
 
-def current_map(context: SkillContextLike, robot: MobileRobot, world_bounds: tuple[float, float, float, float]) -> MapView:
+def current_map(
+    context: SkillContextLike, robot: MobileRobot, world_bounds: tuple[float, float, float, float]
+) -> MapView:
     """The map the exploration works on now.
 
     THE SWAP POINT: once ``alica.skills.mapping`` is merged this becomes

@@ -228,7 +228,9 @@ class ExploreFrontier(WorldSkill):
         assert self.context is not None
         context = SkillEnv.without_world_model(self.context)
         inner = MoveToPosition(
-            f"{self.name}/drive", {"goal": [goal[0], goal[1]], "tolerance": self.tolerance, "timeout": DRIVE_TIMEOUT}, context
+            f"{self.name}/drive",
+            {"goal": [goal[0], goal[1]], "tolerance": self.tolerance, "timeout": DRIVE_TIMEOUT},
+            context,
         )
         inner.setup(context=context)
         return inner

@@ -20,12 +20,12 @@ from alica.skills.exploration import (
     information_gain,
 )
 
-F, O, U = FREE, OCCUPIED, UNKNOWN
+F, W, U = FREE, OCCUPIED, UNKNOWN  # free, wall, unknown
 
 
 def grid(rows: list[str]) -> np.ndarray:
     """'.' free, '#' occupied, '?' unknown; the first string is the top row (highest y)."""
-    table = {".": F, "#": O, "?": U}
+    table = {".": F, "#": W, "?": U}
     return np.array([[table[ch] for ch in row] for row in reversed(rows)], dtype=np.int8)
 
 
@@ -110,7 +110,7 @@ def test_bad_reach_is_refused():
 
 @settings(max_examples=60, deadline=None)
 @given(
-    arrays(np.int8, st.tuples(st.integers(1, 12), st.integers(1, 12)), elements=st.sampled_from([F, O, U])),
+    arrays(np.int8, st.tuples(st.integers(1, 12), st.integers(1, 12)), elements=st.sampled_from([F, W, U])),
     st.integers(1, 6),
 )
 def test_gain_properties_on_random_grids(occ, reach):
