@@ -33,7 +33,7 @@ from alica.skills.exploration.frontiers import FrontierCandidate, extract_fronti
 from alica.skills.exploration.maps import current_map
 from alica.skills.world_skill import WorldSkill, distance
 
-__all__ = ["ExploreFrontier"]
+__all__ = ["ExploreFrontier", "publish_frontiers"]
 
 #: Seconds a published frontier (and the robot's Pos) lives in the world model without being written again.
 PUBLISH_TTL = 10.0
@@ -45,6 +45,45 @@ CLEARANCE_MARGIN = 0.1
 DRIVE_TIMEOUT = 30.0
 #: Scratch key: the names of the frontiers this agent published last.
 PUBLISHED_KEY = "exploration_published"
+
+
+def publish_frontiers(
+    wm: Any,
+    scratch: dict[str, object],
+    candidates: list[FrontierCandidate],
+    robot: str,
+    position: tuple[float, float],
+) -> None:
+    """Write frontier candidates to the team's world model and retract the ones published before that are gone.
+
+    ``Frontier`` objects with ``Pos(f)`` and ``gain(f)`` (time to live
+    :data:`PUBLISH_TTL`), and ``Pos(robot)`` for Eq. 8. What this agent
+    published is remembered in its ``scratch`` (key :data:`PUBLISHED_KEY`).
+    BuildMap may call it too, so that the first frontiers are known before
+    ExploreFrontier starts (its variable needs a candidate).
+    """
+
+    def put(name: str, arg: str, value: object) -> None:
+        try:
+            wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
+        except ValueError:  # a world model without a clock takes no time to live
+            wm.set(name, arg, value=value)
+
+    put("Pos", robot, (round(position[0], 3), round(position[1], 3)))
+    add_object = getattr(wm, "add_object", None)
+    fresh = set()
+    for cand in candidates:
+        if add_object is not None:
+            add_object(cand.name, "Frontier")
+        put("Pos", cand.name, (round(cand.position[0], 3), round(cand.position[1], 3)))
+        put("gain", cand.name, cand.gain)
+        fresh.add(cand.name)
+    before = scratch.get(PUBLISHED_KEY)
+    for name in sorted(before if isinstance(before, set) else set()):
+        if name not in fresh:  # stale: retract it
+            wm.set("Pos", name, value=None)
+            wm.set("gain", name, value=None)
+    scratch[PUBLISHED_KEY] = fresh
 
 
 class ExploreFrontier(WorldSkill):
@@ -166,29 +205,7 @@ class ExploreFrontier(WorldSkill):
         if wm is None or self.context is None:
             return
         x, y, _ = self.robot.pose
-        self._set(wm, "Pos", self.robot.name, (round(float(x), 3), round(float(y), 3)))
-        add_object = getattr(wm, "add_object", None)
-        fresh = set()
-        for cand in self.candidates:
-            if add_object is not None:
-                add_object(cand.name, "Frontier")
-            self._set(wm, "Pos", cand.name, (round(cand.position[0], 3), round(cand.position[1], 3)))
-            self._set(wm, "gain", cand.name, cand.gain)
-            fresh.add(cand.name)
-        scratch = self.context.scratch
-        before = scratch.get(PUBLISHED_KEY)
-        for name in sorted(before if isinstance(before, set) else set()):
-            if name not in fresh:  # stale: retract it
-                wm.set("Pos", name, value=None)
-                wm.set("gain", name, value=None)
-        scratch[PUBLISHED_KEY] = fresh
-
-    @staticmethod
-    def _set(wm: Any, name: str, arg: str, value: object) -> None:
-        try:
-            wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
-        except ValueError:  # a world model without a clock takes no time to live
-            wm.set(name, arg, value=value)
+        publish_frontiers(wm, self.context.scratch, self.candidates, self.robot.name, (float(x), float(y)))
 
     # -- choosing ---------------------------------------------------------------
 
