@@ -148,8 +148,18 @@ def _navigation(registry: SkillRegistry) -> None:
             "minimal distance in metres to the frontiers of other robots (eps of Eq. 7)",
             default=4.0,
         ),
+        _p("reach", "float", "range in metres of the wave fronts of Algorithm 1 (information gain)", default=3.0),
+        _p(
+            "min_gain",
+            "float",
+            "frontiers with at most this information gain in square metres count as explored",
+            default=1.0,
+        ),
+        _p("period", "float", "seconds between two readings of the map (frontiers published to the team)", default=1.0),
+        _p("tolerance", "float", "distance in metres at which a frontier counts as reached", default=0.5),
         doc="drive to frontier cells in order of information gain and boundary relation, updating the map",
         capabilities=("base",),
+        implementation="alica.skills.exploration.skill:ExploreFrontier",
     )
     registry.declare(
         "Idle",

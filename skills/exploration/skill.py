@@ -1,0 +1,258 @@
+"""ExploreFrontier: drive to frontiers until no frontier with gain is left (IMPERA Fig. 7, Eq. 7-8).
+
+Every ``period`` simulated seconds the skill reads the map
+(:func:`alica.skills.exploration.maps.current_map`), extracts the frontier
+candidates with their information gain (Algorithm 1,
+:func:`alica.skills.exploration.frontiers.extract_frontiers`) and publishes
+them to the team's world model: objects of type ``Frontier`` with ``Pos(f) =
+(x, y)`` and ``gain(f)`` (with a time to live), plus ``Pos(robot)``, so the
+constraints of ``plans/skills/explore.yaml`` (Eq. 7-8) can assign one
+frontier to each robot. Frontiers it published earlier that are gone are
+retracted (``Pos`` and ``gain`` removed; the world model's object sets only
+grow, so a retracted frontier stays listed but no constraint can pick it).
+
+The robot drives with an inner :class:`~alica.skills.navigation.MoveToPosition`
+to the frontier its ``frontier`` parameter names (bound by the plan). When
+that one is explored, unreachable or gone, it asks the team's solution again
+(``context.solve("frontier")``) and otherwise takes the best remaining one
+itself (gain over distance, away from the frontiers the other robots were
+given). With no frontier of gain left it writes ``explored`` and succeeds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from py_trees.common import Status
+
+from alica.errors import SkillError
+from alica.skills.context import SkillContextLike
+from alica.skills.exploration.frontiers import FrontierCandidate, extract_frontiers
+from alica.skills.exploration.maps import current_map
+from alica.skills.world_skill import WorldSkill, distance
+
+__all__ = ["ExploreFrontier", "publish_frontiers"]
+
+#: Seconds a published frontier (and the robot's Pos) lives in the world model without being written again.
+PUBLISH_TTL = 10.0
+#: Seconds a frontier the robot could not reach is left out of its own choice.
+UNREACHABLE_FOR = 30.0
+#: Metres beyond the robot's radius a frontier cell keeps from occupied cells to be a candidate.
+CLEARANCE_MARGIN = 0.1
+#: Seconds MoveToPosition may take to one frontier.
+DRIVE_TIMEOUT = 30.0
+#: Scratch key: the names of the frontiers this agent published last.
+PUBLISHED_KEY = "exploration_published"
+
+
+def publish_frontiers(
+    wm: Any,
+    scratch: dict[str, object],
+    candidates: list[FrontierCandidate],
+    robot: str,
+    position: tuple[float, float],
+) -> None:
+    """Write frontier candidates to the team's world model and retract the ones published before that are gone.
+
+    ``Frontier`` objects with ``Pos(f)`` and ``gain(f)`` (time to live
+    :data:`PUBLISH_TTL`), and ``Pos(robot)`` for Eq. 8. What this agent
+    published is remembered in its ``scratch`` (key :data:`PUBLISHED_KEY`).
+    BuildMap may call it too, so that the first frontiers are known before
+    ExploreFrontier starts (its variable needs a candidate).
+    """
+
+    def put(name: str, arg: str, value: object) -> None:
+        try:
+            wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
+        except ValueError:  # a world model without a clock takes no time to live
+            wm.set(name, arg, value=value)
+
+    put("Pos", robot, (round(position[0], 3), round(position[1], 3)))
+    add_object = getattr(wm, "add_object", None)
+    fresh = set()
+    for cand in candidates:
+        if add_object is not None:
+            add_object(cand.name, "Frontier")
+        put("Pos", cand.name, (round(cand.position[0], 3), round(cand.position[1], 3)))
+        put("gain", cand.name, cand.gain)
+        fresh.add(cand.name)
+    before = scratch.get(PUBLISHED_KEY)
+    for name in sorted(before if isinstance(before, set) else set()):
+        if name not in fresh:  # stale: retract it
+            wm.set("Pos", name, value=None)
+            wm.set("gain", name, value=None)
+    scratch[PUBLISHED_KEY] = fresh
+
+
+class ExploreFrontier(WorldSkill):
+    """Explore frontier by frontier; see the module docstring.
+
+    Parameters (see :mod:`alica.skills.catalog`): ``frontier`` (a ``Frontier``
+    object name, optional), ``spacing`` (m, Eq. 7), ``reach`` (m, wave-front
+    range of Algorithm 1), ``min_gain`` (m²), ``period`` (s), ``tolerance`` (m).
+
+    Attributes:
+        candidates: the frontier candidates of the last update, best first.
+        visited: the frontiers the robot drove to, in order.
+    """
+
+    def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
+        super().__init__(name, params, context)
+        self.candidates: list[FrontierCandidate] = []
+        self.visited: list[str] = []
+        self._check_params()
+
+    # -- parameters -------------------------------------------------------------
+
+    def _number(self, name: str, default: float, *, positive: bool = True) -> float:
+        value = self.param(name, default)
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise SkillError(f"skill '{self.name}': parameter '{name}' must be a number, got {value!r}")
+        if positive and not value > 0.0:
+            raise SkillError(f"skill '{self.name}': parameter '{name}' must be > 0, got {value!r}")
+        if not positive and value < 0.0:
+            raise SkillError(f"skill '{self.name}': parameter '{name}' must be >= 0, got {value!r}")
+        return float(value)
+
+    def _check_params(self) -> None:
+        frontier = self.params.get("frontier")
+        if frontier is not None and (not isinstance(frontier, str) or not frontier.strip()):
+            raise SkillError(
+                f"skill '{self.name}': parameter 'frontier' must name a Frontier object (e.g. f_3_4), got {frontier!r}"
+            )
+        self.bound = frontier.strip() if isinstance(frontier, str) else None
+        self.spacing = self._number("spacing", 4.0, positive=False)
+        self.reach = self._number("reach", 3.0)
+        self.min_gain = self._number("min_gain", 1.0, positive=False)
+        self.period = self._number("period", 1.0)
+        self.tolerance = self._number("tolerance", 0.5)
+
+    # -- life cycle -------------------------------------------------------------
+
+    def initialise(self) -> None:
+        """Start: the first update reads the map at once."""
+        self.inner: Any = None
+        self.target: FrontierCandidate | None = None
+        self.next_update = -math.inf
+        self.unreachable: dict[str, float] = {}
+        self.first = True
+
+    def update(self) -> Status:
+        """Read the map and publish frontiers when due, pick a frontier, drive to it."""
+        now = self.now()
+        if now >= self.next_update:
+            self.next_update = now + self.period
+            self._refresh()
+            if not self.candidates:
+                self._stop_inner()
+                self.robot.stop()
+                self.write(True, "explored")
+                return self.succeed("explored: no frontier with gain is left")
+            if self.target is not None and self.target.name not in self._by_name():
+                self._stop_inner()  # seen while driving there (or no longer a frontier)
+                self.target = None
+        if self.target is None:
+            self.target = self._choose(now)
+            if self.target is None:
+                self.robot.stop()
+                return self.running(f"waiting: every one of {len(self.candidates)} frontiers is taken or unreachable")
+            self.visited.append(self.target.name)
+            self.inner = self._drive(self.target.position)
+        self.inner.tick_once()
+        status = self.inner.status
+        if status == Status.RUNNING:
+            return self.running(
+                f"to frontier {self.target.name} at ({self.target.position[0]:.1f}, {self.target.position[1]:.1f}), "
+                f"gain {self.target.gain:.1f} m²; {len(self.candidates)} frontiers"
+            )
+        if status == Status.FAILURE:
+            self.unreachable[self.target.name] = now + UNREACHABLE_FOR
+        else:  # reached: should it still be a frontier at the next reading, it is not one to drive to again
+            self.unreachable[self.target.name] = math.inf
+        self.inner = None
+        self.target = None
+        self.next_update = now  # read the map from where the robot stands now
+        return self.running("frontier reached" if status == Status.SUCCESS else "frontier unreachable")
+
+    def terminate(self, new_status: Status) -> None:
+        """Stop the drive and the base."""
+        self._stop_inner()
+        if self.has_robot:
+            self.robot.stop()
+
+    # -- map and world model ----------------------------------------------------
+
+    def _by_name(self) -> dict[str, FrontierCandidate]:
+        return {c.name: c for c in self.candidates}
+
+    def _refresh(self) -> None:
+        assert self.context is not None
+        view = current_map(self.context, self.robot, self.world.bounds)
+        self.candidates = extract_frontiers(
+            view.occupancy(),
+            view.resolution,
+            view.origin,
+            reach=self.reach,
+            min_gain=self.min_gain,
+            clearance=self.robot.spec.radius + CLEARANCE_MARGIN,
+        )
+        self._publish()
+
+    def _publish(self) -> None:
+        wm = self.world_model
+        if wm is None or self.context is None:
+            return
+        x, y, _ = self.robot.pose
+        publish_frontiers(wm, self.context.scratch, self.candidates, self.robot.name, (float(x), float(y)))
+
+    # -- choosing ---------------------------------------------------------------
+
+    def _choose(self, now: float) -> FrontierCandidate | None:
+        by_name = self._by_name()
+        usable = {n: c for n, c in by_name.items() if self.unreachable.get(n, -math.inf) <= now}
+        if not usable:
+            return None
+        # 1. the frontier the plan bound (once: after it, the team's current solution)
+        if self.first:
+            self.first = False
+            if self.bound is not None and self.bound in usable:
+                return usable[self.bound]
+        # 2. the team's current assignment
+        others: list[tuple[float, float]] = []
+        ask = getattr(self.context, "solve", None)
+        if callable(ask) and getattr(self.context, "solver", True) is not None:  # alone, no engine: no constraints
+            result = ask("frontier")
+            if getattr(result, "ok", False):
+                mine = result.values.get("frontier")
+                if isinstance(mine, str) and mine in usable:
+                    return usable[mine]
+                for agent, values in result.team.items():
+                    other = values.get("frontier")
+                    if agent != self.robot.name and isinstance(other, str) and other in by_name:
+                        others.append(by_name[other].position)
+        # 3. its own choice: gain over distance, away from the others' frontiers (Eq. 7)
+        here = (self.robot.pose[0], self.robot.pose[1])
+        apart = [c for c in usable.values() if all(distance(c.position, o) > self.spacing for o in others)]
+        pool = apart or list(usable.values())
+        return max(pool, key=lambda c: (c.gain / (1.0 + distance(here, c.position)), c.name))
+
+    def _drive(self, goal: tuple[float, float]) -> Any:
+        from alica.skills.context import SkillEnv
+        from alica.skills.navigation import MoveToPosition
+
+        assert self.context is not None
+        context = SkillEnv.without_world_model(self.context)
+        inner = MoveToPosition(
+            f"{self.name}/drive",
+            {"goal": [goal[0], goal[1]], "tolerance": self.tolerance, "timeout": DRIVE_TIMEOUT},
+            context,
+        )
+        inner.setup(context=context)
+        return inner
+
+    def _stop_inner(self) -> None:
+        if self.inner is not None and self.inner.status == Status.RUNNING:
+            self.inner.stop(Status.INVALID)
+        self.inner = None

@@ -1,0 +1,210 @@
+"""Frontier extraction, IMPERA Algorithm 1 and the ExploreFrontier skill (issue 16)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from alica.errors import SkillError
+from alica.lang.fact import Fact
+from alica.skills.exploration import (
+    FREE,
+    OCCUPIED,
+    UNKNOWN,
+    coverage,
+    extract_frontiers,
+    frontier_mask,
+    information_gain,
+)
+
+F, W, U = FREE, OCCUPIED, UNKNOWN  # free, wall, unknown
+
+
+def grid(rows: list[str]) -> np.ndarray:
+    """'.' free, '#' occupied, '?' unknown; the first string is the top row (highest y)."""
+    table = {".": F, "#": W, "?": U}
+    return np.array([[table[ch] for ch in row] for row in reversed(rows)], dtype=np.int8)
+
+
+# -- frontier cells -------------------------------------------------------------
+
+
+def test_frontier_cells_are_free_cells_next_to_unknown_ones():
+    occ = grid(
+        [
+            "..??",
+            ".#??",
+            "....",
+        ]
+    )
+    mask = frontier_mask(occ)
+    # rows reversed: row 0 is the bottom line "...."
+    expected = np.array(
+        [
+            [False, True, True, True],  # bottom: touching the unknown above, diagonally too
+            [False, False, False, False],  # '#' is not free
+            [False, True, False, False],  # top: (2,1) touches (2,2) and (1,2)
+        ]
+    )
+    assert (mask == expected).all()
+
+
+def test_a_fully_known_map_has_no_frontier():
+    occ = grid(["...", ".#.", "..."])
+    assert not frontier_mask(occ).any()
+    assert extract_frontiers(occ, 0.1, (0.0, 0.0)) == []
+
+
+# -- Algorithm 1 ----------------------------------------------------------------
+
+
+def test_one_open_region_is_propagated_once_and_shared_by_all_its_frontier_cells():
+    occ = grid(["..???"] * 5)  # 15 unknown cells on the right, touching the map's edge
+    result = information_gain(occ, reach=50)
+    mask = frontier_mask(occ)
+    assert mask[:, 1].all() and mask.sum() == 5
+    assert result.propagations == 1  # the other four frontier cells were observed (line 16)
+    assert (result.gain[mask] == 15).all()
+    assert (result.gain[~mask] == 0).all()
+    assert result.boundary[mask].all()
+
+
+def test_an_enclosed_pocket_has_no_boundary_relation_and_its_own_gain():
+    occ = grid(
+        [
+            ".........",
+            ".........",
+            "..???....",
+            "..???..??",
+            "..???..??",
+            ".........",
+        ]
+    )
+    result = information_gain(occ, reach=50)
+    pocket = (slice(1, 5), 1)  # column 1 borders the 3x3 pocket
+    assert result.gain[2, 1] == 9 and not result.boundary[2, 1]
+    # the 2x2 region at the right edge: gain 4, next to the boundary
+    assert result.gain[1, 6] == 4 and result.boundary[1, 6]
+    assert result.propagations == 2
+    assert pocket  # (documentation of the place)
+
+
+def test_the_wave_front_stops_after_reach_cells():
+    occ = grid([".?????????"])  # a corridor of 9 unknown cells
+    for reach in (1, 3, 9, 20):
+        assert information_gain(occ, reach=reach).gain[0, 0] == min(reach, 9)
+
+
+def test_occupied_cells_stop_the_wave_front():
+    occ = grid([".?#???"])
+    assert information_gain(occ, reach=10).gain[0, 0] == 1
+
+
+def test_bad_reach_is_refused():
+    with pytest.raises(ValueError, match="reach"):
+        information_gain(grid([".?"]), reach=0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    arrays(np.int8, st.tuples(st.integers(1, 12), st.integers(1, 12)), elements=st.sampled_from([F, W, U])),
+    st.integers(1, 6),
+)
+def test_gain_properties_on_random_grids(occ, reach):
+    result = information_gain(occ, reach=reach)
+    mask = frontier_mask(occ)
+    # every frontier cell has an unknown neighbour, so a gain of at least 1; other cells none
+    assert (result.gain[mask] >= 1).all()
+    assert (result.gain[~mask] == 0).all()
+    # a wave front travels at most reach steps from its frontier cell, over unknown cells only
+    assert (result.gain <= min((2 * reach + 1) ** 2, int((occ == U).sum()))).all()
+    assert result.propagations <= int(mask.sum())
+
+
+# -- candidates -----------------------------------------------------------------
+
+
+def test_candidates_lie_on_frontier_cells_with_names_from_their_place_best_first():
+    occ = np.full((40, 60), U, dtype=np.int8)
+    occ[:, :20] = F  # known on the left: a straight frontier at column 19, 4 m long (0.1 m cells)
+    occ[10:14, 30:34] = F  # a small known island in the unknown
+    cands = extract_frontiers(occ, 0.1, (-3.0, -2.0), reach=1.0, chunk=2.0)
+    names = [c.name for c in cands]
+    assert len(names) == len(set(names))
+    mask = frontier_mask(occ)
+    for c in cands:
+        row, col = c.cell
+        assert mask[row, col]
+        assert c.position == pytest.approx((-3.0 + (col + 0.5) * 0.1, -2.0 + (row + 0.5) * 0.1))
+        assert c.name == f"f_{col // 20}_{row // 20}"
+    gains = [c.gain for c in cands]
+    assert gains == sorted(gains, reverse=True)
+    assert {c.name for c in cands if c.cell[1] == 19} == {"f_0_0", "f_0_1"}  # the long frontier in two chunks
+
+
+def test_clearance_drops_frontier_cells_next_to_obstacles():
+    occ = grid(["....#???"] * 6)
+    assert extract_frontiers(occ, 0.1, (0.0, 0.0), clearance=0.0) == []  # '#' hides the unknown
+    occ = grid(["...#?"] + ["...??"] * 6)
+    near = extract_frontiers(occ, 0.1, (0.0, 0.0), clearance=0.0, min_size=1)
+    far = extract_frontiers(occ, 0.1, (0.0, 0.0), clearance=0.25, min_size=1)
+    assert near and all(c.cell[0] < 5 for c in far)
+
+
+def test_coverage_counts_known_free_cells():
+    occ = grid(["..??", "#.??"])
+    truth_free = np.ones(occ.shape, dtype=bool)
+    truth_free[0, 0] = False
+    assert coverage(occ) == pytest.approx(0.5)
+    assert coverage(occ, truth_free) == pytest.approx(3 / 7)
+
+
+# -- the skill ----------------------------------------------------------------
+
+
+@pytest.fixture
+def small_field():
+    from alica.worldsim.scenarios import lunar
+
+    world = lunar(seed=0, rocks=8, samples=0, size=14.0)
+    try:
+        yield world
+    finally:
+        world.close()
+
+
+def test_explore_frontier_alone_covers_a_small_field_and_ends_with_explored(small_field, skill_run):
+    from alica.worldsim.grid import OccupancyGrid
+
+    scratch: dict[str, object] = {}
+    run = skill_run("ExploreFrontier", small_field, "scout", {}, timeout=400.0, scratch=scratch)
+    assert run.ok, (run.reason, run.trace[-5:])
+    assert Fact("explored", ()) in run.facts
+    # stale frontiers were retracted: no frontier keeps a gain in the world model
+    assert not [k for k in run.values if k.predicate == "gain"]
+    # coverage scored against the ground truth (the test may read it; the skill does not)
+    view = scratch["exploration_map"]
+    truth = OccupancyGrid.from_obstacles(small_field.ground_truth_obstacles(), small_field.bounds, view.resolution)
+    occ = view.occupancy()
+    free = truth.cells == 0
+    assert truth.cells.shape == occ.shape
+    assert coverage(occ, free) >= 0.9
+
+
+@pytest.mark.parametrize(
+    ("params", "name"),
+    [
+        ({"spacing": -1.0}, "spacing"),
+        ({"reach": 0}, "reach"),
+        ({"min_gain": "lots"}, "min_gain"),
+        ({"period": float("nan")}, "period"),
+        ({"frontier": 3}, "frontier"),
+        ({"tolerance": True}, "tolerance"),
+    ],
+)
+def test_bad_parameters_give_a_clear_error(small_field, skill_run, params, name):
+    with pytest.raises(SkillError, match=f"'{name}'"):
+        skill_run("ExploreFrontier", small_field, "scout", params, timeout=1.0)
