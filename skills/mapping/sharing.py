@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from alica.skills.mapping.grid import L_MAX, L_MIN, TILE, LogOddsGrid
+from alica.skills.mapping.grid import L_MAX, L_MIN, THRESHOLD, TILE, LogOddsGrid
 from alica.worldmodel.encoding import encode
 from alica.worldmodel.protocol import WorldModelLike
 
@@ -66,15 +66,39 @@ INDEX = "map_index"
 #: The grow-only set of the robots with a layer.
 ROBOTS = "map_robots"
 #: Log-odds step of the int8 tiles that are sent.
-QUANTUM = 0.05
+QUANTUM = 0.1
+#: A tile is sent again when a cell's log-odds moved this much since it was last sent (or a cell changed class).
+RESEND = 1.0
+#: Seconds between two publishes of a robot's changed tiles (see :meth:`RobotMapper.publish`).
+PUBLISH_PERIOD = 1.0
 #: Bytes of a write's stamp and framing on the wire, besides its name, arguments and value (an estimate).
 WRITE_OVERHEAD = 24
 
 
+def quantize(logodds: np.ndarray) -> np.ndarray:
+    """Log-odds as int8 steps of :data:`QUANTUM`."""
+    return np.clip(np.rint(logodds / QUANTUM), -127, 127).astype(np.int8)
+
+
 def encode_tile(logodds: np.ndarray) -> str:
     """A tile's log-odds as text: int8 steps of :data:`QUANTUM`, zlib-compressed, Ascii85."""
-    q = np.clip(np.rint(logodds / QUANTUM), -127, 127).astype(np.int8)
-    return base64.b85encode(zlib.compress(q.tobytes(), 6)).decode("ascii")
+    return _encode_steps(quantize(logodds))
+
+
+def _encode_steps(steps: np.ndarray) -> str:
+    return base64.b85encode(zlib.compress(steps.tobytes(), 9)).decode("ascii")
+
+
+def significant(old: np.ndarray, new: np.ndarray) -> bool:
+    """Whether a tile changed enough to send again: a cell changed its class, or its log-odds by :data:`RESEND`."""
+    t = THRESHOLD / QUANTUM
+
+    def classes(q: np.ndarray) -> np.ndarray:
+        return (q > t).astype(np.int8) - (q < -t).astype(np.int8)
+
+    if np.abs(new.astype(np.int16) - old).max(initial=0) * QUANTUM >= RESEND - 1e-9:
+        return True
+    return bool((classes(old) != classes(new)).any())
 
 
 def decode_tile(payload: str, shape: tuple[int, int]) -> np.ndarray:
@@ -146,17 +170,23 @@ class RobotMapper:
 
     Attributes:
         robot: the robot's name (its tiles' first argument).
+        period: seconds between two publishes (see :meth:`publish`).
         layer: the robot's own log-odds (only its scans).
         bytes_sent: bytes of the tile writes so far (see :func:`write_bytes`).
         tiles_sent: tile writes so far.
     """
 
-    def __init__(self, world_model: WorldModelLike | None, robot: str, layer: LogOddsGrid) -> None:
+    def __init__(
+        self, world_model: WorldModelLike | None, robot: str, layer: LogOddsGrid, *, period: float = PUBLISH_PERIOD
+    ) -> None:
         self.world_model = world_model
+        self.period = float(period)
+        self.last_publish = -math.inf
         self.robot = robot
         self.layer = layer
         self.versions: dict[tuple[int, int], int] = {}
-        self.sent: dict[tuple[int, int], str] = {}
+        self.sent: dict[tuple[int, int], np.ndarray] = {}
+        self.pending: set[tuple[int, int]] = set()
         self.index = np.zeros(layer.tile_shape, dtype=bool)
         self.bytes_sent = 0
         self.tiles_sent = 0
@@ -194,7 +224,7 @@ class RobotMapper:
                 except ValueError:
                     continue
                 mapper.versions[(tj, ti)] = int(value[0])  # type: ignore[call-overload]
-                mapper.sent[(tj, ti)] = str(value[2])
+                mapper.sent[(tj, ti)] = quantize(view)
                 mapper.index[tj, ti] = True
         return mapper
 
@@ -204,19 +234,39 @@ class RobotMapper:
         """Ray trace one scan into the robot's layer (see :meth:`LogOddsGrid.update`); the cells updated."""
         return self.layer.update(pose, ranges, angles, max_range)
 
-    def publish(self) -> int:
-        """Write the tiles changed since the last publish to the world model; the bytes written."""
+    def publish(self, *, now: float | None = None, force: bool = False) -> int:
+        """Write the tiles that changed significantly (see :func:`significant`) to the world model.
+
+        Args:
+            now: the time; a publish within :attr:`period` seconds of the last one sends nothing
+                (the changes wait for the next), so a robot scanning often sends each tile at most
+                once a period. ``None`` publishes now.
+            force: send now every tile that changed at all since it was last sent.
+
+        Returns:
+            The bytes written.
+        """
+        if not force and now is not None and now - self.last_publish < self.period:
+            return 0
+        if now is not None:
+            self.last_publish = now
         tiles = self.layer.take_dirty_tiles()
+        if force:
+            tiles = sorted(set(tiles) | self.pending)
         wm = self.world_model
         if wm is None or not tiles:
             return 0
         sent = 0
         grown = False
         for tj, ti in tiles:
-            payload = encode_tile(self.layer.tile(tj, ti))
-            if self.sent.get((tj, ti)) == payload:
-                continue  # changed less than a quantum: nothing new to send
-            self.sent[(tj, ti)] = payload
+            steps = quantize(self.layer.tile(tj, ti))
+            old = self.sent.get((tj, ti))
+            if old is not None and not (force and not np.array_equal(old, steps)) and not significant(old, steps):
+                self.pending.add((tj, ti))
+                continue  # no cell changed its class nor moved by RESEND since the last send: later
+            self.pending.discard((tj, ti))
+            self.sent[(tj, ti)] = steps
+            payload = _encode_steps(steps)
             version = self.versions.get((tj, ti), 0) + 1
             self.versions[(tj, ti)] = version
             value = (version, self.layer.resolution, payload)

@@ -91,15 +91,32 @@ def robot_mapper(
     return mapper
 
 
-def map_scan(robot: MobileRobot, mapper: RobotMapper, *, max_range: float, n_rays: int) -> int:
+def map_scan(
+    robot: MobileRobot,
+    mapper: RobotMapper,
+    *,
+    max_range: float,
+    n_rays: int | None = None,
+    now: float | None = None,
+    force: bool = False,
+) -> int:
     """Scan, ray trace the scan at the robot's pose estimate into its layer, publish the changed tiles.
+
+    Args:
+        robot: the scanning robot.
+        mapper: its layer (:func:`robot_mapper`).
+        max_range: the range traced, in metres (capped at the lidar's).
+        n_rays: rays of the scan; by default enough for neighbouring rays to lie a cell apart at ``max_range``.
+        now: the time, to publish at most once per ``mapper.period`` (``None``: publish now).
+        force: publish every changed tile now.
 
     Returns:
         The bytes written to the world model.
     """
-    ranges, angles = lidar(robot, n_rays, max_range)
+    rays = n_rays if n_rays is not None else rays_for(max_range, mapper.layer.resolution)
+    ranges, angles = lidar(robot, rays, max_range)
     mapper.add_scan(robot.estimate, ranges, angles, min(max_range, robot.spec.lidar_range))
-    return mapper.publish()
+    return mapper.publish(now=now, force=force)
 
 
 def _number(skill: WorldSkill, name: str, default: float, *, low: float = 0.0, high: float = math.inf) -> float:
@@ -135,7 +152,7 @@ class BuildMap(WorldSkill):
             raise SkillError(
                 f"skill '{self.name}': parameter 'max_range' ({self.max_range} m) must be at least 'radius' ({self.radius} m)"
             )
-        self.n_rays = rays_for(self.radius, self.resolution)
+        self.n_rays = rays_for(self.max_range, self.resolution)
 
     def initialise(self) -> None:
         """Stand still; find this robot's layer of the team map."""
@@ -149,7 +166,7 @@ class BuildMap(WorldSkill):
         """One scan into the map; done when the surroundings are known."""
         robot = self.robot
         robot.stop()
-        map_scan(robot, self.mapper, max_range=self.max_range, n_rays=self.n_rays)
+        map_scan(robot, self.mapper, max_range=self.max_range, n_rays=self.n_rays, force=True)
         self.scans += 1
         grid = team_map(self.world_model) or self.mapper.layer
         x, y, _ = robot.estimate
@@ -221,7 +238,7 @@ class Localize(WorldSkill):
         # alone: start the map here, at the estimate
         res = grid.resolution if grid is not None else DEFAULT_RESOLUTION
         mapper = robot_mapper(self.context, self.robot.name, self.world.bounds, res)
-        map_scan(self.robot, mapper, max_range=self.max_range, n_rays=rays_for(self.max_range / 2, res))
+        map_scan(self.robot, mapper, max_range=self.max_range, force=True)
         if self.world_model is None:
             return mapper.layer
         return team_map(self.world_model)
