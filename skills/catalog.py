@@ -124,15 +124,22 @@ def _navigation(registry: SkillRegistry) -> None:
     registry.declare(
         "Localize",
         _p("timeout", "float", "seconds before the skill fails", default=30.0),
-        doc="localize the robot in the shared map",
+        _p("continuous", "bool", "keep correcting every period until the state is left", default=False),
+        _p("period", "float", "seconds between two scan matches", default=0.5),
+        _p("max_range", "float", "lidar range in metres used for matching", default=15.0),
+        doc="localize the robot in the shared map: match lidar scans against it and correct the pose estimate",
         capabilities=("base",),
+        implementation="alica.skills.mapping:Localize",
     )
     registry.declare(
         "BuildMap",
         _p("resolution", "float", "cell size of the occupancy grid in metres", default=0.05),
         _p("radius", "float", "radius in metres around the start to map before the map counts as ready", default=5.0),
-        doc="build the team's first occupancy map around the robot and share it",
+        _p("max_range", "float", "lidar range in metres traced into the map", default=10.0),
+        _p("timeout", "float", "seconds before the skill fails", default=30.0),
+        doc="build the team's first occupancy map around the robot and share it; asserts mapped",
         capabilities=("base", "lidar2d"),
+        implementation="alica.skills.mapping:BuildMap",
     )
     registry.declare(
         "ExploreFrontier",

@@ -5,7 +5,9 @@ by the robot's radius (:func:`alica.skills.motion.plan_path`), checks the path
 exactly with FCL against the rocks' meshes and the other robots, follows it,
 replans when another robot or a new obstacle blocks it, and when the robot is
 stuck (bumped, or no progress) drives into free space first. Planning runs as
-a job; ``update`` only polls.
+a job; ``update`` only polls. The robot drives by its pose *estimate*
+(``robot.estimate``: odometry, corrected by Localize), which is its true pose
+while the world's odometry drift is 0.
 """
 
 from __future__ import annotations
@@ -145,7 +147,7 @@ class MoveToPosition(WorldSkill):
         optimize = float(extra.get("optimize_time", 0.0))  # type: ignore[arg-type]
         self.job = self.jobs.submit(
             plan_path,
-            self.robot.pose,
+            self.robot.estimate,
             goal,
             checker,
             self.robot.spec.radius,
@@ -161,7 +163,7 @@ class MoveToPosition(WorldSkill):
         robot = self.robot
         now = self.now()
         dt, self.last = now - self.last, now
-        here = (robot.pose[0], robot.pose[1])
+        here = (robot.estimate[0], robot.estimate[1])
         if not self.escaping and distance(here, self.goal) <= self.tolerance:
             robot.stop()
             self._arrived(here)
@@ -171,8 +173,8 @@ class MoveToPosition(WorldSkill):
             return self.fail(f"did not reach {self.goal} within {self.timeout:.0f} s ({self.reason or 'no progress'})")
         if self.follower is None:
             return self._poll_plan(now)
-        v, w, done = self.follower.command(robot.pose, dt)
-        if robot.bumped or self.follower.stuck(robot.pose, now):
+        v, w, done = self.follower.command(robot.estimate, dt)
+        if robot.bumped or self.follower.stuck(robot.estimate, now):
             return self._stuck(now)
         if self._blocked():
             self.replans += 1
@@ -247,15 +249,15 @@ class MoveToPosition(WorldSkill):
         # free space away from the other robots too: the robot it bumped into is often one of them
         spot = escape_goal(
             planning_grid(self.world),
-            robot.pose,
+            robot.estimate,
             clearance=robot.spec.radius + 0.3,
             max_distance=3.0,
             other_robots=self._others(),
             body_radius=robot.spec.radius,
         )
         if spot is None:
-            return self.fail(f"stuck at {robot.pose[:2]} and no free space within 3 m to drive to")
-        x, y, yaw = robot.pose
+            return self.fail(f"stuck at {robot.estimate[:2]} and no free space within 3 m to drive to")
+        x, y, yaw = robot.estimate
         heading = math.atan2(spot[1] - y, spot[0] - x)
         path = np.array([[x, y, yaw], [spot[0], spot[1], heading]])
         spec = robot.spec
@@ -280,7 +282,7 @@ class MoveToPosition(WorldSkill):
             return False
         self.next_block_check = now + 0.3
         checker = planning_checker(self.world, self.robot.spec.radius)  # rebuilt when the layout changed
-        return bool(follower.blocked(checker, self.robot.pose, other_robots=self._others(), horizon=4.0))
+        return bool(follower.blocked(checker, self.robot.estimate, other_robots=self._others(), horizon=4.0))
 
     def _arrived(self, here: tuple[float, float]) -> None:
         wm = self.world_model
@@ -312,7 +314,7 @@ class DriveToFreeSpace(MoveToPosition):
     def initialise(self) -> None:
         """Find the free place, then drive there like MoveToPosition."""
         self.spot = self._free_place()
-        self.params["goal"] = self.spot if self.spot is not None else self.robot.pose[:2]
+        self.params["goal"] = self.spot if self.spot is not None else self.robot.estimate[:2]
         self.params.setdefault("tolerance", 0.2)
         self.moved_goal = 0
         super().initialise()
@@ -328,7 +330,7 @@ class DriveToFreeSpace(MoveToPosition):
         sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
         return escape_goal(
             grid,
-            self.robot.pose,
+            self.robot.estimate,
             clearance=self.robot.spec.radius + clearance,
             max_distance=reach,
             other_robots=self._others(),

@@ -41,6 +41,9 @@ class SensorNoise:
             camera's pixels, in intensity levels (0-255).
         depth_sigma: standard deviation (m) of a robot camera's depth at 1 m; it grows with the
             square of the distance, as a stereo pair's does.
+        odometry_drift: relative error of the robots' odometry (0.02 = 2 %): each step's distance and
+            turn are scaled by ``1 + drift * (bias + noise)`` (see :mod:`alica.worldsim.odometry`);
+            0 keeps every robot's pose estimate equal to its true pose.
     """
 
     lidar_sigma: float = 0.0
@@ -49,6 +52,7 @@ class SensorNoise:
     stereo_misclassification: float = 0.01
     pixel_sigma: float = 2.0
     depth_sigma: float = 0.005
+    odometry_drift: float = 0.0
 
 
 def _probability(value: float, what: str) -> float:
@@ -87,10 +91,21 @@ class Faults:
         """Each later successful attach slips with this probability: the object drops within a short time."""
         self.grasp_slip = _probability(probability, "the grasp slip")
 
-    def set_sensor_noise(self, lidar_sigma: float | None = None, position_sigma: float | None = None) -> SensorNoise:
-        """Change the lidar range noise and the perception position noise (``None`` keeps a value)."""
+    def set_sensor_noise(
+        self,
+        lidar_sigma: float | None = None,
+        position_sigma: float | None = None,
+        *,
+        odometry_drift: float | None = None,
+    ) -> SensorNoise:
+        """Change the lidar range noise, the perception position noise and the odometry drift (``None`` keeps a value)."""
         noise = self._world.noise
         changes = {}
+        if odometry_drift is not None:
+            drift = float(odometry_drift)
+            if not (0.0 <= drift < 1.0):
+                raise WorldError(f"odometry_drift is a relative error in [0, 1), got {odometry_drift}")
+            changes["odometry_drift"] = drift
         if lidar_sigma is not None:
             changes["lidar_sigma"] = _sigma(lidar_sigma, "lidar_sigma")
         if position_sigma is not None:
@@ -133,7 +148,11 @@ def set_grasp_slip(world: World, probability: float) -> None:
 
 
 def set_sensor_noise(
-    world: World, lidar_sigma: float | None = None, position_sigma: float | None = None
+    world: World,
+    lidar_sigma: float | None = None,
+    position_sigma: float | None = None,
+    *,
+    odometry_drift: float | None = None,
 ) -> SensorNoise:
     """Set the sensor noise of ``world`` (see :meth:`Faults.set_sensor_noise`)."""
-    return world.faults.set_sensor_noise(lidar_sigma, position_sigma)
+    return world.faults.set_sensor_noise(lidar_sigma, position_sigma, odometry_drift=odometry_drift)

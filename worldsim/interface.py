@@ -109,6 +109,15 @@ class MobileRobot(Protocol):
         ...
 
     @property
+    def estimate(self) -> Position:
+        """``(x, y, yaw)`` the robot believes it has (odometry corrected by localization); skills drive by it."""
+        ...
+
+    def set_estimate(self, pose: tuple[float, float, float]) -> None:
+        """Correct the pose estimate (a localization's result)."""
+        ...
+
+    @property
     def crashed(self) -> bool:
         """Whether the robot is out (it no longer moves)."""
         ...

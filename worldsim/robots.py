@@ -19,6 +19,7 @@ from alica.worldsim.arm import Arm
 from alica.worldsim.errors import WorldError
 from alica.worldsim.geometry import Footprints, wrap_angle, yaw_to_quat
 from alica.worldsim.grid import Obstacle2D
+from alica.worldsim.odometry import Odometry
 
 if TYPE_CHECKING:
     from alica.worldsim.world import World
@@ -157,6 +158,7 @@ class Robot:
         "_near_at",
         "_near_free",
         "_near_version",
+        "_odometry",
         "_quat",
         "_sin",
         "_v",
@@ -201,6 +203,7 @@ class Robot:
             useMaximalCoordinates=True,
         )
         self.arm: Arm | None = Arm(self, mount_offset=(spec.radius - 0.12, 0.0, spec.height)) if spec.has_arm else None
+        self._odometry = Odometry(self, world.seed)
 
     # ------------------------------------------------------------------ state
     @property
@@ -212,6 +215,34 @@ class Robot:
     def pose(self) -> tuple[float, float, float]:
         """``(x, y, yaw)`` of the base."""
         return (self._x, self._y, self._yaw)
+
+    @property
+    def estimate(self) -> tuple[float, float, float]:
+        """``(x, y, yaw)`` the robot believes it has: its odometry, corrected by localization.
+
+        The true :attr:`pose` while ``world.noise.odometry_drift`` is 0 and nothing corrected it
+        (see :mod:`alica.worldsim.odometry`).
+        """
+        return self._odometry.pose
+
+    def set_estimate(self, pose: Sequence[float]) -> None:
+        """Overwrite the pose estimate ``(x, y, yaw)`` (a localization's correction); odometry continues from it.
+
+        Raises:
+            WorldError: not three finite numbers.
+        """
+        try:
+            x, y, yaw = (float(v) for v in pose)
+        except (TypeError, ValueError):
+            raise WorldError(f"set_estimate of robot '{self.name}' takes (x, y, yaw), got {pose!r}") from None
+        if not all(math.isfinite(v) for v in (x, y, yaw)):
+            raise WorldError(f"set_estimate of robot '{self.name}' needs finite numbers, got {pose!r}")
+        self._odometry.set((x, y, yaw))
+
+    @property
+    def odometry(self) -> Odometry:
+        """The robot's :class:`~alica.worldsim.odometry.Odometry` (distance driven, drift bias)."""
+        return self._odometry
 
     @property
     def velocity(self) -> tuple[float, float]:
@@ -257,6 +288,7 @@ class Robot:
         self._x, self._y, self._yaw = x, y, wrap_angle(yaw)
         self._near_at = (math.inf, math.inf)
         self._apply_pose()
+        self._odometry.reset()
 
     # --------------------------------------------------------------- commands
     def drive(self, v: float, w: float) -> None:
@@ -358,6 +390,7 @@ class Robot:
         if v == 0.0 and w == 0.0:
             return False
         yaw = self._yaw
+        ds = 0.0
         if v != 0.0:
             mid = yaw + 0.5 * w * dt
             nx = self._x + v * math.cos(mid) * dt
@@ -378,12 +411,21 @@ class Robot:
                 logger.debug("robot %s bumped at (%.3f, %.3f)", self.name, self._x, self._y)
                 return False
             self._x, self._y = nx, ny
+            ds = v * dt
         self._yaw = wrap_angle(yaw + w * dt)
         self._apply_pose()
+        self._odometry.advance(ds, w * dt)
         return True
 
     def _state(self) -> dict[str, Any]:
-        return {"pose": self.pose, "v": self._v, "w": self._w, "bumped": self.bumped, "crashed": self._crashed}
+        return {
+            "pose": self.pose,
+            "v": self._v,
+            "w": self._w,
+            "bumped": self.bumped,
+            "crashed": self._crashed,
+            "odometry": self._odometry._state(),
+        }
 
     def _restore(self, state: dict[str, Any]) -> None:
         self._x, self._y, self._yaw = state["pose"]
@@ -392,6 +434,8 @@ class Robot:
         self._crashed = state["crashed"]
         self._near_at = (math.inf, math.inf)
         self._apply_pose()
+        if "odometry" in state:
+            self._odometry._restore(state["odometry"])
 
     def __repr__(self) -> str:
         return f"Robot({self.name!r}, {self.spec.kind!r}, pose=({self._x:.3f}, {self._y:.3f}, {self._yaw:.3f}))"
