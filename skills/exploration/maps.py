@@ -23,6 +23,8 @@ __all__ = ["LidarMap", "MapView", "current_map"]
 
 #: Cell size of the stand-in map in metres.
 STANDIN_RESOLUTION = 0.1
+#: Range in metres of the scans the robot adds to the team map while it explores.
+MAPPING_RANGE = 10.0
 #: Range in metres the stand-in reads of each lidar scan (beyond it nothing counts as seen).
 STANDIN_RANGE = 6.0
 #: Rays per stand-in scan.
@@ -91,13 +93,26 @@ class LidarMap:
 def current_map(
     context: SkillContextLike, robot: MobileRobot, world_bounds: tuple[float, float, float, float]
 ) -> MapView:
-    """The map the exploration works on now.
+    """The map the exploration works on now: the team map, with this robot's scan of this moment in it.
 
-    THE SWAP POINT: once ``alica.skills.mapping`` is merged this becomes
-    ``team_map(context.world_model)`` (falling back to the stand-in while it is
-    ``None``). Until then: the agent's :class:`LidarMap` in its scratch space,
-    with the robot's scan of this moment added.
+    The robot maps as it explores: its scan goes into its own layer of the team
+    map (:func:`alica.skills.mapping.map_scan`, at its pose estimate), and the
+    frontiers come from :func:`alica.skills.mapping.team_map`, every robot's
+    layer summed, so what a teammate saw is explored by nobody again. A skill
+    run without a world model (alone, with nowhere to share) keeps a
+    :class:`LidarMap` of its own in its scratch space instead.
     """
+    from alica.skills.mapping import map_scan, robot_mapper, team_map
+
+    world_model = context.world_model
+    if world_model is not None:
+        existing = team_map(world_model)
+        resolution = existing.resolution if existing is not None else STANDIN_RESOLUTION
+        mapper = robot_mapper(context, robot.name, world_bounds, resolution)
+        map_scan(robot, mapper, max_range=MAPPING_RANGE, now=context.now())
+        grid = team_map(world_model)
+        if grid is not None:
+            return grid
     found = context.scratch.get(SCRATCH_KEY)
     if not isinstance(found, LidarMap):
         found = LidarMap(world_bounds)

@@ -179,14 +179,18 @@ def small_field():
 def test_explore_frontier_alone_covers_a_small_field_and_ends_with_explored(small_field, skill_run):
     from alica.worldsim.grid import OccupancyGrid
 
-    scratch: dict[str, object] = {}
-    run = skill_run("ExploreFrontier", small_field, "scout", {}, timeout=400.0, scratch=scratch)
+    from alica.skills.mapping import team_map
+    from alica.worldmodel import WorldModel
+
+    wm = WorldModel("scout", clock=small_field.clock)
+    run = skill_run("ExploreFrontier", small_field, "scout", {}, timeout=400.0, world_model=wm)
     assert run.ok, (run.reason, run.trace[-5:])
     assert Fact("explored", ()) in run.facts
     # stale frontiers were retracted: no frontier keeps a gain in the world model
     assert not [k for k in run.values if k.predicate == "gain"]
     # coverage scored against the ground truth (the test may read it; the skill does not)
-    view = scratch["exploration_map"]
+    view = team_map(wm)  # the robot mapped as it explored, into the team map
+    assert view is not None
     truth = OccupancyGrid.from_obstacles(small_field.ground_truth_obstacles(), small_field.bounds, view.resolution)
     occ = view.occupancy()
     free = truth.cells == 0
