@@ -323,6 +323,7 @@ def _semantic_perception(registry: SkillRegistry) -> None:
         _p("max_tilt", "float", "largest angle in degrees between the plane's normal and up", default=30.0),
         _p("min_inliers", "float", "smallest fraction of the cloud the plane must hold", default=0.1),
         doc="fit the ground plane with RANSAC and remove its points from the cloud",
+        capabilities=("stereo_camera",),  # a step of the pipeline on the stereo cloud: it runs where the cloud is
         implementation=f"{module}:RansacGroundPlane",
     )
     registry.declare(
@@ -331,6 +332,7 @@ def _semantic_perception(registry: SkillRegistry) -> None:
         _p("min_points", "int", "smallest cluster kept", default=50),
         _p("max_points", "int", "largest cluster kept (0: no limit)", default=0),
         doc="split the remaining points into clusters of nearby points",
+        capabilities=("stereo_camera",),  # a step of the pipeline on the stereo cloud: it runs where the cloud is
         implementation=f"{module}:EuclideanCluster",
     )
     registry.declare(
@@ -343,6 +345,7 @@ def _semantic_perception(registry: SkillRegistry) -> None:
             default="plane",
         ),
         doc="fit the sample's geometric model to every cluster and extract its features",
+        capabilities=("stereo_camera",),  # a step of the pipeline on the stereo cloud: it runs where the cloud is
         implementation=f"{module}:FitModel",
     )
     registry.declare(
@@ -363,6 +366,7 @@ def _semantic_perception(registry: SkillRegistry) -> None:
             default=2.0,
         ),
         doc="rate the fitted clusters against the fuzzy object description and report found(s), pos(s), confidence(s)",
+        capabilities=("stereo_camera",),  # a step of the pipeline on the stereo cloud: it runs where the cloud is
         implementation=f"{module}:FuzzyDLClassify",
     )
     registry.declare_function("confidence", 1, "confidence(s): degree in [0, 1] to which sample s was recognised")

@@ -177,10 +177,9 @@ def small_field():
 
 
 def test_explore_frontier_alone_covers_a_small_field_and_ends_with_explored(small_field, skill_run):
-    from alica.worldsim.grid import OccupancyGrid
-
     from alica.skills.mapping import team_map
     from alica.worldmodel import WorldModel
+    from alica.worldsim.grid import OccupancyGrid
 
     wm = WorldModel("scout", clock=small_field.clock)
     run = skill_run("ExploreFrontier", small_field, "scout", {}, timeout=400.0, world_model=wm)
