@@ -126,7 +126,12 @@ def _navigation(registry: SkillRegistry) -> None:
         _p("timeout", "float", "seconds before the skill fails", default=30.0),
         _p("continuous", "bool", "keep correcting every period until the state is left", default=False),
         _p("period", "float", "seconds between two scan matches", default=0.5),
-        _p("max_range", "float", "lidar range in metres used for matching", default=15.0),
+        _p(
+            "max_range",
+            "float",
+            "lidar range in metres used for matching (as far as BuildMap maps, by default: hits beyond the map cannot match)",
+            default=10.0,
+        ),
         doc="localize the robot in the shared map: match lidar scans against it and correct the pose estimate",
         capabilities=("base",),
         implementation="alica.skills.mapping:Localize",

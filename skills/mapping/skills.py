@@ -214,7 +214,7 @@ class Localize(WorldSkill):
         super().setup(**kwargs)
         self.timeout = _number(self, "timeout", 30.0)
         self.period = _number(self, "period", 0.5)
-        self.max_range = _number(self, "max_range", 15.0)
+        self.max_range = _number(self, "max_range", 10.0)
         continuous = self.param("continuous", False)
         if not isinstance(continuous, bool):
             raise SkillError(f"skill '{self.name}': parameter 'continuous' must be true or false, got {continuous!r}")
