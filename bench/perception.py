@@ -44,12 +44,13 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.ndimage import binary_dilation, binary_erosion
 
 from alica.lang.skill_plugins import default_registry
 from alica.skills.context import SkillEnv
 from alica.skills.mapping import LogOddsGrid, lidar, map_scan, match_scan, rays_for, robot_mapper, team_map
 from alica.skills.navigation import planning_checker
+from alica.skills.testing import map_agreement as agreement
+from alica.skills.testing import map_truth as truth_grid
 from alica.worldmodel import WorldModel
 from alica.worldsim.scenarios import lunar
 from alica.worldsim.world import World
@@ -60,52 +61,6 @@ SCAN_PERIOD = 0.5
 TICK = 0.1
 DRIVE_DISTANCE = 100.0
 N_RAYS = rays_for(MAP_RANGE, RESOLUTION)
-
-
-def truth_grid(world: World, grid: LogOddsGrid, *, skip: tuple[str, ...] = (), height: float = 0.1) -> np.ndarray:
-    """Ground truth at the lidar's height on ``grid``'s cells (for scoring only): True = occupied."""
-    res = grid.resolution
-    cx = grid.origin[0] + (np.arange(grid.nx) + 0.5) * res
-    cy = grid.origin[1] + (np.arange(grid.ny) + 0.5) * res
-    out = np.zeros((grid.ny, grid.nx), dtype=bool)
-    for obj in world.objects.values():
-        mesh = obj.world_mesh()
-        if mesh is not None:
-            lo, hi = mesh.bounds
-            i0, i1 = np.searchsorted(cx, lo[0]), np.searchsorted(cx, hi[0])
-            j0, j1 = np.searchsorted(cy, lo[1]), np.searchsorted(cy, hi[1])
-            if i1 <= i0 or j1 <= j0:
-                continue
-            xs, ys = np.meshgrid(cx[i0:i1], cy[j0:j1])
-            points = np.stack([xs, ys, np.full_like(xs, height)], -1).reshape(-1, 3)
-            normals, corners = mesh.face_normals, mesh.triangles[:, 0]
-            inside = ((points[:, None, :] - corners[None]) * normals[None]).sum(-1).max(axis=1) <= 0.0
-            out[j0:j1, i0:i1] |= inside.reshape(xs.shape)
-        elif obj.kind in ("table", "block", "sample"):
-            footprint = obj.footprint()
-            if footprint is not None:
-                out |= footprint.distance(cx[None, :], cy[:, None]) <= 0.0
-    for name, robot in world.robots.items():
-        if name not in skip:
-            x, y, _ = robot.pose
-            out |= np.hypot(cx[None, :] - x, cy[:, None] - y) <= robot.spec.radius
-    return out
-
-
-def agreement(occupancy: np.ndarray, truth: np.ndarray, *, strict: bool = False) -> float:
-    """The fraction of known cells that agree with the truth, within one cell (see the module docstring).
-
-    ``strict``: no tolerance, the cell's class must be the truth's.
-    """
-    known = occupancy >= 0
-    if not known.any():
-        return float("nan")
-    if strict:
-        return float(((occupancy == 1) == truth)[known].mean())
-    occupied_ok = binary_dilation(truth, iterations=1)
-    free_ok = ~binary_erosion(truth, iterations=1)
-    good = np.where(occupancy == 1, occupied_ok, free_ok)
-    return float(good[known].mean())
 
 
 @dataclass

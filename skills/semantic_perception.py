@@ -33,6 +33,7 @@ closer look disagrees.
 
 from __future__ import annotations
 
+import abc
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -198,7 +199,7 @@ def _choice(skill: Any, name: str, default: str, choices: Mapping[str, object] |
 # -- the pipeline's base ------------------------------------------------------------
 
 
-class PipelineSkill(py_trees.behaviour.Behaviour):
+class PipelineSkill(py_trees.behaviour.Behaviour, abc.ABC):
     """A step of the perception pipeline: reads and writes the agent's scratch space, computes in a job.
 
     Needs a context with ``scratch``, not a world: the geometry steps run on
@@ -238,9 +239,9 @@ class PipelineSkill(py_trees.behaviour.Behaviour):
     def configure(self) -> None:
         """Check and keep the parameters (raise :class:`SkillError` naming a bad one)."""
 
+    @abc.abstractmethod
     def compute(self) -> tuple[bool, str]:
-        """The step's work: ``(succeeded, message)``."""
-        raise NotImplementedError
+        """The step's work: ``(succeeded, message)``; every step defines it."""
 
     def need(self, key: str, kind: type, producer: str) -> Any:
         """``scratch[key]``, which ``producer`` writes.

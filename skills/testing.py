@@ -20,6 +20,8 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from alica.errors import SkillError
 from alica.lang.fact import Fact
 from alica.lang.skill_plugins import default_registry
@@ -180,3 +182,59 @@ def run_skill(
     facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
     written = {Fact(key, args): value for key, args, value in wm.values()}
     return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts, written)
+
+
+# -- scoring maps against the ground truth (tests and benches) --------------------------
+
+
+def map_truth(world: Any, grid: Any, *, skip: tuple[str, ...] = (), height: float = 0.1) -> np.ndarray:
+    """Ground truth at the lidar's height on the cells of ``grid`` (a ``LogOddsGrid``): True = occupied.
+
+    For scoring maps in tests and benches only (a skill never reads the simulator's bodies): rock
+    meshes sliced at ``height``, tables, blocks and samples by their footprints, and the robots not
+    in ``skip``.
+    """
+    res = grid.resolution
+    cx = grid.origin[0] + (np.arange(grid.nx) + 0.5) * res
+    cy = grid.origin[1] + (np.arange(grid.ny) + 0.5) * res
+    out = np.zeros((grid.ny, grid.nx), dtype=bool)
+    for obj in world.objects.values():
+        mesh = obj.world_mesh()
+        if mesh is not None:
+            lo, hi = mesh.bounds
+            i0, i1 = np.searchsorted(cx, lo[0]), np.searchsorted(cx, hi[0])
+            j0, j1 = np.searchsorted(cy, lo[1]), np.searchsorted(cy, hi[1])
+            if i1 <= i0 or j1 <= j0:
+                continue
+            xs, ys = np.meshgrid(cx[i0:i1], cy[j0:j1])
+            points = np.stack([xs, ys, np.full_like(xs, height)], -1).reshape(-1, 3)
+            normals, corners = mesh.face_normals, mesh.triangles[:, 0]
+            inside = ((points[:, None, :] - corners[None]) * normals[None]).sum(-1).max(axis=1) <= 0.0
+            out[j0:j1, i0:i1] |= inside.reshape(xs.shape)
+        elif obj.kind in ("table", "block", "sample"):
+            footprint = obj.footprint()
+            if footprint is not None:
+                out |= footprint.distance(cx[None, :], cy[:, None]) <= 0.0
+    for name, robot in world.robots.items():
+        if name not in skip:
+            x, y, _ = robot.pose
+            out |= np.hypot(cx[None, :] - x, cy[:, None] - y) <= robot.spec.radius
+    return out
+
+
+def map_agreement(occupancy: np.ndarray, truth: np.ndarray, *, strict: bool = False) -> float:
+    """The fraction of known cells that agree with the truth, within one cell (an occupied cell next to a truly occupied one, a free cell at most one cell deep in an obstacle).
+
+    ``strict``: no tolerance, the cell's class must be the truth's.
+    """
+    from scipy.ndimage import binary_dilation, binary_erosion
+
+    known = occupancy >= 0
+    if not known.any():
+        return float("nan")
+    if strict:
+        return float(((occupancy == 1) == truth)[known].mean())
+    occupied_ok = binary_dilation(truth, iterations=1)
+    free_ok = ~binary_erosion(truth, iterations=1)
+    good = np.where(occupancy == 1, occupied_ok, free_ok)
+    return float(good[known].mean())

@@ -7,12 +7,13 @@ from itertools import permutations
 
 import numpy as np
 import pytest
-from scipy.ndimage import binary_dilation, binary_erosion
 
 from alica.errors import SkillError
 from alica.skills.mapping import FREE, OCCUPIED, TILE, UNKNOWN, LogOddsGrid, RobotMapper, match_scan, team_map
 from alica.skills.mapping.sharing import decode_tile, encode_tile
+from alica.skills.testing import map_agreement, map_truth
 from alica.worldmodel import WorldModel
+from tests.worldmodel.test_worldmodel_partition import gossip
 
 pytest.importorskip("pybullet")
 
@@ -88,36 +89,6 @@ def test_icp_pulls_a_wrong_estimate_onto_the_map() -> None:
 # -- the simulated field -----------------------------------------------------------
 
 
-def truth_grid(world, grid: LogOddsGrid, *, skip: tuple[str, ...] = ()) -> np.ndarray:
-    """Ground truth at the lidar's height (scoring only): rock meshes, other robots."""
-    cx = grid.origin[0] + (np.arange(grid.nx) + 0.5) * grid.resolution
-    cy = grid.origin[1] + (np.arange(grid.ny) + 0.5) * grid.resolution
-    out = np.zeros((grid.ny, grid.nx), dtype=bool)
-    for obj in world.objects.values():
-        mesh = obj.world_mesh()
-        if mesh is None:
-            continue
-        lo, hi = mesh.bounds
-        i0, i1 = np.searchsorted(cx, lo[0]), np.searchsorted(cx, hi[0])
-        j0, j1 = np.searchsorted(cy, lo[1]), np.searchsorted(cy, hi[1])
-        if i1 <= i0 or j1 <= j0:
-            continue
-        xs, ys = np.meshgrid(cx[i0:i1], cy[j0:j1])
-        points = np.stack([xs, ys, np.full_like(xs, 0.1)], -1).reshape(-1, 3)
-        inside = ((points[:, None, :] - mesh.triangles[:, 0][None]) * mesh.face_normals[None]).sum(-1).max(1) <= 0
-        out[j0:j1, i0:i1] |= inside.reshape(xs.shape)
-    for name, robot in world.robots.items():
-        if name not in skip:
-            out |= np.hypot(cx[None, :] - robot.pose[0], cy[:, None] - robot.pose[1]) <= robot.spec.radius
-    return out
-
-
-def agreement(occ: np.ndarray, truth: np.ndarray) -> float:
-    """Known cells agreeing with the truth within one cell."""
-    good = np.where(occ == OCCUPIED, binary_dilation(truth), ~binary_erosion(truth))
-    return float(good[occ >= 0].mean())
-
-
 def _build(world, robot: str, wm: WorldModel, skill_run, **params: object):
     run = skill_run("BuildMap", world, robot, {"resolution": 0.05, "radius": 5.0, **params}, world_model=wm)
     assert run.ok, run.reason
@@ -134,22 +105,7 @@ def test_build_map_matches_the_ground_truth(lunar_world, skill_run) -> None:
     x, y, _ = lunar_world.robots["scout"].pose
     assert grid.known_fraction(x, y, 5.0) >= 0.8
     assert (occ == OCCUPIED).sum() > 50 and (occ == FREE).sum() > 10_000
-    assert agreement(occ, truth_grid(lunar_world, grid, skip=("scout",))) >= 0.95
-
-
-def gossip(group: list[WorldModel]) -> None:
-    """Deliver every pending delta of the group to the rest of the group."""
-    moved = True
-    while moved:
-        moved = False
-        for sender in group:
-            delta = sender.take_delta()
-            if delta is None:
-                continue
-            moved = True
-            for receiver in group:
-                if receiver is not sender:
-                    receiver.merge(delta)
+    assert map_agreement(occ, map_truth(lunar_world, grid, skip=("scout",))) >= 0.95
 
 
 def test_maps_built_apart_in_a_partition_converge_when_it_heals_and_a_late_joiner_gets_them(
