@@ -39,7 +39,7 @@ from alica.errors import AlicaError
 from alica.model import ChildRef
 from alica.solver import Solution, Var, check, solve
 from alica.solver.problem import Problem
-from alica.solver.query import Level, Query, QueryError, collect
+from alica.solver.query import Level, Query, QueryError, collect, digest
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -118,6 +118,7 @@ class Solving:
         self.cache: dict[str, _Cached] = {}
         self.watched: dict[int, tuple[Slot, dict[str, object]]] = {}
         self.next_check = 0.0
+        self._last: tuple[PlanNode, float, Query] | None = None
 
     # -- the problem ------------------------------------------------------
 
@@ -139,6 +140,22 @@ class Solving:
             levels.append(Level(plan_node.key_text, plan_node.plan, places, bindings))
         return levels
 
+    def _collect(self, node: PlanNode, names: tuple[str, ...]) -> Query:
+        """The query of ``node`` now; collected once per plan node, moment and view (binding a child asks twice)."""
+        engine = self.engine
+        now = engine.now()
+        levels = self.levels(node)
+        view = digest(levels)
+        last = self._last
+        if last is not None and last[0] is node and last[1] == now and last[2].digest == view:
+            query = last[2]
+            depth = len(levels) - 1
+            if all((depth, name) in query.names for name in names):
+                return query
+        query = collect(levels, engine.belief_for(node), registry=engine.formulas.registry, names=names)
+        self._last = (node, now, query)
+        return query
+
     def solvable(self, node: PlanNode, name: str) -> bool:
         """Whether ``name`` is a variable of ``node``'s plan that the solver gives values to (it has a type)."""
         return any(v.name == name and v.type != "any" for v in node.plan.variables)
@@ -150,7 +167,7 @@ class Solving:
         engine = self.engine
         now = engine.now()
         try:
-            query = collect(self.levels(node), engine.belief_for(node), registry=engine.formulas.registry, names=names)
+            query = self._collect(node, names)
         except QueryError as exc:
             return SolveResult("infeasible", {}, {}, math.nan, str(exc))
         cached = self.cache.get(node.key_text)
@@ -286,7 +303,7 @@ class Solving:
         if not typed:
             return {}
         try:
-            query = collect(self.levels(node), self.engine.belief_for(node), registry=self.engine.formulas.registry)
+            query = self._collect(node, ())
         except QueryError:
             return typed  # it is solved, and the query says why it has no values
         depth = _depth(node)
