@@ -15,7 +15,7 @@ import re
 import sys
 from typing import Any
 
-from alica.app.skill_options import add_skills_option
+from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options
 from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
@@ -107,7 +107,7 @@ def add_parser(sub: Any) -> None:
         "or lunar (the robots scout, stummel and amparo; name the agents after them)",
     )
     p.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first (default 'a,b;c')")
-    p.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
+    add_lunar_options(p)
     p.add_argument(
         "--stand-ins",
         action="store_true",

@@ -12,7 +12,7 @@ from typing import Any
 
 import yaml
 
-from alica.app.skill_options import add_skills_option, skill_registry
+from alica.app.skill_options import add_lunar_options, add_skills_option, lunar_field, skill_registry
 from alica.errors import AlicaError
 
 
@@ -41,7 +41,7 @@ def add_parser(sub: Any) -> None:
     )
     r.add_argument("--robot", help="the robot (default: the first one that has what the skill needs)")
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
-    r.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
+    add_lunar_options(r)
     r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
     r.add_argument("--timeout", type=float, default=120.0, help="simulated seconds before giving up (default 120)")
     r.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -68,11 +68,7 @@ def _params(items: list[str]) -> dict[str, object]:
 
 def _world(args: argparse.Namespace) -> Any:
     if args.world == "lunar":
-        from alica.worldsim.scenarios import lunar
-
-        if args.rocks < 0:
-            raise AlicaError(f"--rocks must be >= 0, got {args.rocks}")
-        return lunar(seed=args.seed, rocks=args.rocks)
+        return lunar_field(args)
     from alica.worldsim.scenarios import blocksworld
 
     stacks = [[b.strip() for b in stack.split(",") if b.strip()] for stack in args.stacks.split(";") if stack.strip()]

@@ -127,11 +127,9 @@ def _blocks_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
 
 
 def _lunar_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
-    from alica.worldsim.scenarios import lunar
+    from alica.app.skill_options import lunar_field
 
-    if args.rocks < 0:
-        raise AlicaError(f"--rocks must be >= 0, got {args.rocks}")
-    world = lunar(seed=args.seed, rocks=args.rocks)
+    world = lunar_field(args)
     strangers = [a for a in agents if a not in world.robots]
     if strangers:
         robots = ", ".join(sorted(world.robots))

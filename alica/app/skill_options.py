@@ -1,4 +1,4 @@
-"""The ``--skills MODULE`` option of the commands that read skill declarations."""
+"""Options shared by the commands that run skills: ``--skills MODULE`` and the lunar field's size and contents."""
 
 from __future__ import annotations
 
@@ -24,6 +24,36 @@ def add_skills_option(parser: Any) -> None:
         help="load skill declarations from this module's register(registry), importable from the current folder "
         "(repeatable; installed packages' plug-ins of the entry-point group alica.skills are always loaded)",
     )
+
+
+def add_lunar_options(parser: Any) -> None:
+    """Add ``--rocks``, ``--samples`` and ``--size``: the lunar field of ``--world lunar``."""
+    parser.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
+    parser.add_argument("--samples", type=int, default=2, help="drill samples on the lunar field (default 2)")
+    parser.add_argument(
+        "--size", type=float, default=40.0, help="side of the square lunar field in metres (default 40)"
+    )
+
+
+def lunar_field(args: argparse.Namespace) -> Any:
+    """The lunar world of ``args`` (seed, rocks, samples, size).
+
+    Raises:
+        AlicaError: a count below zero or a field too small (the message says which option).
+    """
+    from alica.errors import AlicaError
+    from alica.worldsim.errors import WorldError
+    from alica.worldsim.scenarios import lunar
+
+    for option in ("rocks", "samples"):
+        if getattr(args, option) < 0:
+            raise AlicaError(f"--{option} must be >= 0, got {getattr(args, option)}")
+    try:
+        return lunar(seed=args.seed, rocks=args.rocks, samples=args.samples, size=args.size)
+    except WorldError as exc:
+        raise AlicaError(
+            f"--world lunar with --size {args.size:g}, --rocks {args.rocks}, --samples {args.samples}: {exc}"
+        ) from None
 
 
 def skill_registry(args: argparse.Namespace) -> SkillRegistry:

@@ -128,8 +128,26 @@ def _round(value: float, digits: int | None = None) -> float:
     return builtins.round(value, digits) if digits is not None else builtins.round(value)
 
 
-def count(belief: BeliefBase, type_name: object) -> int:
-    """Number of objects of a type in the belief base."""
+def having(belief: BeliefBase, type_name: object, fluent: object) -> list[object]:
+    """The objects of a type for which the unary function or predicate ``fluent`` has a value, sorted by name.
+
+    A world model's object sets only grow; what was retracted loses its
+    values. ``having(Frontier, gain)`` lists the frontiers that are frontiers
+    now, as a variable's ``candidates`` or in a condition.
+    """
+    name = str(fluent)
+    found = []
+    for obj in belief.objects(str(type_name)):
+        value = belief.lookup(name, (obj,))
+        if value is not None and value is not False:  # a gain of 0.0 is a value
+            found.append(obj)
+    return sorted(found, key=str)
+
+
+def count(belief: BeliefBase, type_name: object, fluent: object | None = None) -> int:
+    """Number of objects of a type in the belief base; with ``fluent``, of those for which it has a value."""
+    if fluent is not None:
+        return len(having(belief, type_name, fluent))
     return sum(1 for _ in belief.objects(str(type_name)))
 
 
@@ -138,7 +156,7 @@ def default_registry() -> Registry:
 
     Returns:
         A registry with ``sqrt``, ``abs``, ``min``, ``max``, ``dist``,
-        ``floor``, ``ceil``, ``round``, ``count``, ``MaximalDist`` and
+        ``floor``, ``ceil``, ``round``, ``count``, ``having``, ``MaximalDist`` and
         ``MinimalDist``; callers may add to it freely.
     """
     registry = Registry()
@@ -153,7 +171,22 @@ def default_registry() -> Registry:
     registry.register("floor", math.floor, 1, kind=fn, doc="largest integer <= x")
     registry.register("ceil", math.ceil, 1, kind=fn, doc="smallest integer >= x")
     registry.register("round", _round, (1, 2), kind=fn, doc=_round.__doc__ or "")
-    registry.register("count", count, 1, kind=fn, needs_belief=True, doc="count(Type): objects of a type")
+    registry.register(
+        "count",
+        count,
+        (1, 2),
+        kind=fn,
+        needs_belief=True,
+        doc="count(Type): objects of a type; count(Type, f): those for which f(o) has a value",
+    )
+    registry.register(
+        "having",
+        having,
+        2,
+        kind=fn,
+        needs_belief=True,
+        doc="having(Type, f): the objects of a type for which f(o) has a value, sorted",
+    )
     registry.register(
         "MaximalDist",
         maximal_dist,

@@ -12,11 +12,19 @@ retracted (``Pos`` and ``gain`` removed; the world model's object sets only
 grow, so a retracted frontier stays listed but no constraint can pick it).
 
 The robot drives with an inner :class:`~alica.skills.navigation.MoveToPosition`
-to the frontier its ``frontier`` parameter names (bound by the plan). When
-that one is explored, unreachable or gone, it asks the team's solution again
-(``context.solve("frontier")``) and otherwise takes the best remaining one
-itself (gain over distance, away from the frontiers the other robots were
-given). With no frontier of gain left it writes ``explored`` and succeeds.
+to its frontier. It asks the team's solution (``context.solve("frontier")``:
+the plan's constraints, Eq. 7-8) when it needs a frontier: at the start, and
+when its frontier is reached, unreachable or gone, so it is not sent
+elsewhere while it drives. A ``frontier`` parameter (bound by a plan) names
+the first one. When the constraints have no solution, or give a frontier
+within ``spacing`` of one another robot heads for, it takes the best
+remaining one itself: gain over distance, more than ``spacing`` from the
+frontiers the other robots head for (``heading(robot) = (x, y)`` in the world
+model, written with a time to live while a robot drives to a frontier). With
+no frontier of gain left it writes ``explored`` and succeeds.
+
+Positions are the robot's pose *estimate* (odometry corrected by Localize),
+never the true pose.
 """
 
 from __future__ import annotations
@@ -45,6 +53,8 @@ CLEARANCE_MARGIN = 0.1
 DRIVE_TIMEOUT = 30.0
 #: Scratch key: the names of the frontiers this agent published last.
 PUBLISHED_KEY = "exploration_published"
+#: World-model function: where a robot is heading (its frontier's position), for the others' own choice.
+HEADING = "heading"
 
 
 def publish_frontiers(
@@ -63,12 +73,7 @@ def publish_frontiers(
     ExploreFrontier starts (its variable needs a candidate).
     """
 
-    def put(name: str, arg: str, value: object) -> None:
-        try:
-            wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
-        except ValueError:  # a world model without a clock takes no time to live
-            wm.set(name, arg, value=value)
-
+    put = _putter(wm)
     put("Pos", robot, (round(position[0], 3), round(position[1], 3)))
     add_object = getattr(wm, "add_object", None)
     fresh = set()
@@ -86,6 +91,27 @@ def publish_frontiers(
     scratch[PUBLISHED_KEY] = fresh
 
 
+def _putter(wm: Any) -> Any:
+    def put(name: str, arg: str, value: object) -> None:
+        try:
+            wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
+        except ValueError:  # a world model without a clock takes no time to live
+            wm.set(name, arg, value=value)
+
+    return put
+
+
+def headings(wm: Any, but: str) -> list[tuple[float, float]]:
+    """Where the robots other than ``but`` are heading now (``heading(robot)`` in the world model)."""
+    if wm is None:
+        return []
+    out = []
+    for name, args, value in wm.values():
+        if name == HEADING and args and args[0] != but and isinstance(value, (tuple, list)) and len(value) == 2:
+            out.append((float(value[0]), float(value[1])))
+    return out
+
+
 class ExploreFrontier(WorldSkill):
     """Explore frontier by frontier; see the module docstring.
 
@@ -96,6 +122,8 @@ class ExploreFrontier(WorldSkill):
     Attributes:
         candidates: the frontier candidates of the last update, best first.
         visited: the frontiers the robot drove to, in order.
+        solved: how many of them the team's constraints gave.
+        fallbacks: how many it chose itself (no solution, or another robot heads there).
     """
 
     def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
@@ -138,6 +166,8 @@ class ExploreFrontier(WorldSkill):
         self.next_update = -math.inf
         self.unreachable: dict[str, float] = {}
         self.first = True
+        self.solved = 0
+        self.fallbacks = 0
 
     def update(self) -> Status:
         """Read the map and publish frontiers when due, pick a frontier, drive to it."""
@@ -156,9 +186,11 @@ class ExploreFrontier(WorldSkill):
         if self.target is None:
             self.target = self._choose(now)
             if self.target is None:
+                self._head(None)
                 self.robot.stop()
                 return self.running(f"waiting: every one of {len(self.candidates)} frontiers is taken or unreachable")
             self.visited.append(self.target.name)
+            self._head(self.target.position)
             self.inner = self._drive(self.target.position)
         self.inner.tick_once()
         status = self.inner.status
@@ -177,10 +209,11 @@ class ExploreFrontier(WorldSkill):
         return self.running("frontier reached" if status == Status.SUCCESS else "frontier unreachable")
 
     def terminate(self, new_status: Status) -> None:
-        """Stop the drive and the base."""
+        """Stop the drive and the base; head nowhere."""
         self._stop_inner()
         if self.has_robot:
             self.robot.stop()
+            self._head(None)
 
     # -- map and world model ----------------------------------------------------
 
@@ -204,8 +237,21 @@ class ExploreFrontier(WorldSkill):
         wm = self.world_model
         if wm is None or self.context is None:
             return
-        x, y, _ = self.robot.pose
+        x, y, _ = self.robot.estimate
         publish_frontiers(wm, self.context.scratch, self.candidates, self.robot.name, (float(x), float(y)))
+        if self.target is not None:
+            self._head(self.target.position)  # keep it alive
+
+    def _head(self, goal: tuple[float, float] | None) -> None:
+        """Tell the team where this robot heads (``None``: nowhere)."""
+        wm = self.world_model
+        if wm is None:
+            return
+        if goal is None:
+            if wm.get(HEADING, self.robot.name) is not None:
+                wm.set(HEADING, self.robot.name, value=None)
+            return
+        _putter(wm)(HEADING, self.robot.name, (round(goal[0], 3), round(goal[1], 3)))
 
     # -- choosing ---------------------------------------------------------------
 
@@ -219,22 +265,22 @@ class ExploreFrontier(WorldSkill):
             self.first = False
             if self.bound is not None and self.bound in usable:
                 return usable[self.bound]
-        # 2. the team's current assignment
-        others: list[tuple[float, float]] = []
+        # 2. the team's assignment (Eq. 7-8), unless another robot already heads there
+        heading = headings(self.world_model, self.robot.name)
         ask = getattr(self.context, "solve", None)
         if callable(ask) and getattr(self.context, "solver", True) is not None:  # alone, no engine: no constraints
             result = ask("frontier")
             if getattr(result, "ok", False):
                 mine = result.values.get("frontier")
                 if isinstance(mine, str) and mine in usable:
-                    return usable[mine]
-                for agent, values in result.team.items():
-                    other = values.get("frontier")
-                    if agent != self.robot.name and isinstance(other, str) and other in by_name:
-                        others.append(by_name[other].position)
-        # 3. its own choice: gain over distance, away from the others' frontiers (Eq. 7)
-        here = (self.robot.pose[0], self.robot.pose[1])
-        apart = [c for c in usable.values() if all(distance(c.position, o) > self.spacing for o in others)]
+                    if all(distance(usable[mine].position, o) > self.spacing for o in heading):
+                        self.solved += 1
+                        return usable[mine]
+        # 3. its own choice: gain over distance, away from where the others head (Eq. 7)
+        self.fallbacks += 1
+        x, y, _ = self.robot.estimate
+        here = (float(x), float(y))
+        apart = [c for c in usable.values() if all(distance(c.position, o) > self.spacing for o in heading)]
         pool = apart or list(usable.values())
         return max(pool, key=lambda c: (c.gain / (1.0 + distance(here, c.position)), c.name))
 

@@ -7,6 +7,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+import pytest
+
 from alica.testing import scripted
 from tests.engine.helpers import library, team
 
@@ -199,17 +201,23 @@ def test_the_explore_plan_gives_each_explorer_its_frontier_eq_7_8():
             engine.own.add_object(name, "Frontier")
             engine.own.set("gain", name, value=gains[name])
     sim.run(ticks=60)
-    latest = {agent: params["frontier"] for agent, params in work.params}
-    assert set(latest) == {"scout", "stummel", "s2"}, work.params
+    # ExploreFrontier asks for its frontier through its context when it needs one
+    contexts = {c.agent: c for c in work.contexts}
+    assert set(contexts) == {"scout", "stummel", "s2"}, work.params
+    latest = {agent: context.solve("frontier").values["frontier"] for agent, context in contexts.items()}
     chosen = list(latest.values())
     for i, f in enumerate(chosen):
         for g in chosen[i + 1 :]:
             assert math.dist(cells[f], cells[g]) > 4.0  # Eq. 7: spread, so distinct
     for agent, f in latest.items():
         assert math.dist(cells[f], robots[agent]) < 15.0  # Eq. 8
-    # the best three cells more than 4 m apart: the ones facing +x (gain) at 60 degree steps
-    assert sum(gains[f] for f in chosen) == max(
-        sum(gains[f] for f in combo)
-        for combo in itertools.combinations(cells, 3)
+    # the utility: the summed gain less each robot's travel, best over every assignment of cells more than 4 m apart
+    def value(assignment: dict[str, str]) -> float:
+        return sum(gains[f] - math.dist(cells[f], robots[a]) for a, f in assignment.items())
+
+    best = max(
+        value(dict(zip(robots, combo, strict=True)))
+        for combo in itertools.permutations(cells, 3)
         if all(math.dist(cells[p], cells[q]) > 4.0 for p, q in itertools.combinations(combo, 2))
     )
+    assert value(latest) == pytest.approx(best)

@@ -402,16 +402,17 @@ def test_shipped_solver_plans_validate() -> None:
 
 def test_explore_states_eq_7_8_per_agent() -> None:
     plan = next(p for p in load_document(PLANS / "skills" / "explore.yaml").plans if p.name == "Explore")
-    assert plan.variables == (Variable("frontier", "Frontier"),)
+    assert plan.variables == (Variable("frontier", "Frontier", candidates="having(Frontier, gain)"),)
     by_name = {c.name: c for c in plan.constraints}
-    assert set(by_name) == {"SpreadFrontiers", "NearbyFrontiers", "InformationGain"}
+    assert set(by_name) == {"SpreadFrontiers", "NearbyFrontiers", "GainOverTravel"}
     spread = parse(by_name["SpreadFrontiers"].text)
     assert {r.name for r in reads(spread) if r.per_agent and r.of_agent} == {"frontier"}
     assert {d.name for d in agent_domains(spread, by_name["SpreadFrontiers"].text)} == {
         "ExploreFrontiers",
         "ExploreAfterMapping",
     }
-    assert by_name["InformationGain"].text == "" and "gain(frontier(a))" in by_name["InformationGain"].utility
+    utility = by_name["GainOverTravel"].utility
+    assert by_name["GainOverTravel"].text == "" and "gain(frontier(a)) - dist(frontier(a), a)" in utility
 
 
 def test_formation_example_has_a_per_agent_point() -> None:

@@ -353,3 +353,15 @@ def test_evaluate_accepts_nodes() -> None:
     node = parse("x + 1")
     assert evaluate(node, FactBase(), {"x": 1}) == 2
     assert evaluate(node, FactBase(), {"x": 2}) == 3
+
+
+def test_having_lists_the_objects_whose_fluent_has_a_value() -> None:
+    # a world model's object sets only grow: a retracted frontier keeps its object but loses its gain
+    fb = FactBase(
+        objects={"Frontier": ["f_2", "f_1", "f_3"]},
+        values={("gain", "f_1"): 4.0, ("gain", "f_3"): 0.0},
+    )
+    assert evaluate("having(Frontier, gain)", fb) == ["f_1", "f_3"]
+    assert evaluate("count(Frontier, gain)", fb) == 2
+    assert evaluate("count(Frontier)", fb) == 3
+    assert holds("count(Sample, gain) = 0", fb)

@@ -89,14 +89,15 @@ def test_eq_7_8_each_explorer_gets_its_best_frontier(capsys, tmp_path):
         assert math.dist(pos[chosen[a]], pos[chosen[b]]) > 4.0  # Eq. 7
     for a, f in chosen.items():
         assert math.dist(pos[f], pos[a]) < 15.0  # Eq. 8
-    # the optimum, by enumeration over the frontiers each robot may take
-    near = {a: [f for f in gain if math.dist(pos[f], pos[a]) < 15.0] for a in chosen}
+    # the optimum (summed gain less each robot's travel), by enumeration over the frontiers each robot may take
+    robots = sorted(chosen)
+    near = {a: [f for f in gain if math.dist(pos[f], pos[a]) < 15.0] for a in robots}
     best = max(
-        sum(gain[f] for f in combo)
-        for combo in itertools.product(*(near[a] for a in sorted(chosen)))
+        sum(gain[f] - math.dist(pos[f], pos[a]) for a, f in zip(robots, combo, strict=True))
+        for combo in itertools.product(*(near[a] for a in robots))
         if all(math.dist(pos[p], pos[q]) > 4.0 for p, q in itertools.combinations(combo, 2))
     )
-    assert result["utility"] == best
+    assert result["utility"] == pytest.approx(best)
 
 
 def test_no_frontier_far_enough_apart_is_infeasible(capsys, tmp_path):
