@@ -211,6 +211,7 @@ def test_the_explore_plan_gives_each_explorer_its_frontier_eq_7_8():
             assert math.dist(cells[f], cells[g]) > 4.0  # Eq. 7: spread, so distinct
     for agent, f in latest.items():
         assert math.dist(cells[f], robots[agent]) < 15.0  # Eq. 8
+
     # the utility: the summed gain less each robot's travel, best over every assignment of cells more than 4 m apart
     def value(assignment: dict[str, str]) -> float:
         return sum(gains[f] - math.dist(cells[f], robots[a]) for a, f in assignment.items())
