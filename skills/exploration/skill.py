@@ -41,7 +41,7 @@ from alica.skills.exploration.frontiers import FrontierCandidate, extract_fronti
 from alica.skills.exploration.maps import current_map
 from alica.skills.world_skill import WorldSkill, distance
 
-__all__ = ["ExploreFrontier", "publish_frontiers"]
+__all__ = ["HEADING", "ExploreFrontier", "headings", "publish_frontiers"]
 
 #: Seconds a published frontier (and the robot's Pos) lives in the world model without being written again.
 PUBLISH_TTL = 10.0

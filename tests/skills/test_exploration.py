@@ -197,6 +197,39 @@ def test_explore_frontier_alone_covers_a_small_field_and_ends_with_explored(smal
     assert coverage(occ, free) >= 0.9
 
 
+def _first_frontier(run) -> tuple[float, float]:
+    import re
+
+    for entry in run.trace:
+        found = re.search(r"to frontier \S+ at \((-?[\d.]+), (-?[\d.]+)\)", str(entry["feedback"]))
+        if found:
+            return float(found.group(1)), float(found.group(2))
+    raise AssertionError(f"the robot never headed for a frontier: {run.trace[:5]}")
+
+
+def test_its_own_choice_keeps_away_from_where_the_others_head(skill_run):
+    """Without a solution (alone, no engine) the robot picks a frontier more than `spacing` from the others' headings."""
+    import math
+
+    from alica.skills.exploration.skill import HEADING
+    from alica.worldmodel import WorldModel
+    from alica.worldsim.scenarios import lunar
+
+    def first(heading: tuple[float, float] | None) -> tuple[float, float]:
+        world = lunar(seed=0, rocks=8, samples=0, size=14.0)
+        try:
+            wm = WorldModel("scout", clock=world.clock)
+            if heading is not None:
+                wm.set(HEADING, "stummel", value=heading)
+            return _first_frontier(skill_run("ExploreFrontier", world, "scout", {}, timeout=1.0, world_model=wm))
+        finally:
+            world.close()
+
+    best = first(None)
+    other = first(best)  # stummel heads for it now
+    assert math.dist(other, best) > 4.0
+
+
 @pytest.mark.parametrize(
     ("params", "name"),
     [
@@ -211,3 +244,58 @@ def test_explore_frontier_alone_covers_a_small_field_and_ends_with_explored(smal
 def test_bad_parameters_give_a_clear_error(small_field, skill_run, params, name):
     with pytest.raises(SkillError, match=f"'{name}'"):
         skill_run("ExploreFrontier", small_field, "scout", params, timeout=1.0)
+
+
+# -- the Explore plan (Fig. 7) ------------------------------------------------
+
+
+def test_the_explore_plan_maps_localizes_and_explores_a_field_as_a_team(tmp_path):
+    """One robot builds the first map (GetMap), the other localizes in it; both explore with Eq. 7-8 until explored."""
+    from alica.engine import SimulatedTeam, TraceRecorder
+    from alica.io import load_library
+    from alica.io.loader import plans_dir
+    from alica.lang.skill_plugins import default_registry
+    from alica.skills.mapping import team_map
+    from alica.worldsim.grid import OccupancyGrid
+    from alica.worldsim.scenarios import lunar
+
+    registry = default_registry()
+    library = load_library(plans_dir() / "skills" / "explore.yaml", skills=registry)
+    world = lunar(seed=3, rocks=8, samples=0, size=16.0)
+    try:
+        start = {name: robot.pose[:2] for name, robot in world.robots.items()}
+        recorder = TraceRecorder()
+        team = SimulatedTeam(
+            library,
+            "Explore",
+            {"scout": "Scout", "stummel": "Stummel"},
+            seed=0,
+            skill_registry=registry,
+            world=world,
+            observers=[recorder],
+        )
+        team.run(until_done=True, max_time=300.0)
+        summary = team.summary()
+        assert summary["success"], summary
+        transitions = {(e["agent"], e["source"], e["target"]) for e in recorder.events if e["event"] == "transition"}
+        # Fig. 7: the GetMap robot maps, the other waits for the map and localizes; both explore
+        mapper = next(a for a, s, t in transitions if s == "Mapping")
+        other = "stummel" if mapper == "scout" else "scout"
+        assert (mapper, "Mapping", "ExploreAfterMapping") in transitions
+        assert (other, "WaitForMap", "Localize") in transitions and (other, "Localize", "ExploreFrontiers") in transitions
+        # the team's constraints chose frontiers (Eq. 7-8), solved and shared through the world model
+        solves = [e for e in recorder.events if e["event"] == "solve" and e["status"] == "solved"]
+        assert solves and all("frontier" in v for s in solves for a, v in s["values"].items() if a)
+        # both robots drove, and the team map covers the field
+        for name, robot in world.robots.items():
+            if name in ("scout", "stummel"):
+                x, y = start[name]
+                assert abs(robot.pose[0] - x) + abs(robot.pose[1] - y) > 1.0, name
+        wm = team.engines[other].world_model
+        assert wm.holds("explored")
+        view = team_map(wm)
+        assert view is not None
+        truth = OccupancyGrid.from_obstacles(world.ground_truth_obstacles(), world.bounds, view.resolution)
+        assert coverage(view.occupancy(), truth.cells == 0) >= 0.9
+    finally:
+        world.close()
