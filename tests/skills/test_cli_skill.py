@@ -47,6 +47,9 @@ def test_move_to_a_goal_inside_a_rock_fails_with_the_reason(capfd):
         (["Pickup", "--world", "blocks", "--param", "object=c", "--param", "grip=hard"], "has no parameter 'grip'"),
         (["Pickup", "--world", "lunar", "--robot", "scout", "--param", "object=a"], "has no arm"),
         (["MoveToPosition", "--world", "lunar", "--param", "goal=[1, 2", "--rocks", "5"], "not a YAML value"),
+        (["BuildMap", "--size", "5"], "--size 5"),
+        (["BuildMap", "--samples", "-1"], "--samples must be >= 0"),
+        (["BuildMap", "--size", "12", "--rocks", "500"], "--rocks 500"),
     ],
 )
 def test_bad_input(argv, message, capfd):
@@ -54,3 +57,11 @@ def test_bad_input(argv, message, capfd):
     err = capfd.readouterr().err
     assert message in err, err
     assert "Traceback" not in err and "internal error" not in err
+
+
+def test_a_small_lunar_field_from_the_command_line(capfd):
+    """--size, --rocks and --samples shape the field: BuildMap on a 12 m field with no rocks maps it at once."""
+    code = main(["skill", "run", "BuildMap", "--size", "12", "--rocks", "0", "--samples", "1", "--param", "radius=3"])
+    out = capfd.readouterr().out
+    assert code == 0, out
+    assert "mapped" in out

@@ -299,3 +299,18 @@ def test_the_explore_plan_maps_localizes_and_explores_a_field_as_a_team(tmp_path
         assert coverage(view.occupancy(), truth.cells == 0) >= 0.9
     finally:
         world.close()
+
+
+def test_the_explore_plan_runs_from_the_command_line(capsys):
+    import json
+
+    from alica.app.cli import main
+    from alica.io.loader import plans_dir
+
+    argv = ["run", str(plans_dir() / "skills" / "explore.yaml"), "--agents", "scout:Scout,stummel:Stummel"]
+    argv += ["--world", "lunar", "--size", "12", "--rocks", "4", "--samples", "0", "--seed", "1", "--json"]
+    code = main([*argv, "--max-time", "120"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["success"], summary
+    assert {"BuildMap", "Localize", "ExploreFrontier"} <= set(summary["skills"]["real"])
+    assert not summary["skills"]["stand_ins"]
