@@ -282,7 +282,8 @@ def test_the_explore_plan_maps_localizes_and_explores_a_field_as_a_team(tmp_path
         mapper = next(a for a, s, t in transitions if s == "Mapping")
         other = "stummel" if mapper == "scout" else "scout"
         assert (mapper, "Mapping", "ExploreAfterMapping") in transitions
-        assert (other, "WaitForMap", "Localize") in transitions and (other, "Localize", "ExploreFrontiers") in transitions
+        assert (other, "WaitForMap", "Localize") in transitions
+        assert (other, "Localize", "ExploreFrontiers") in transitions
         # the team's constraints chose frontiers (Eq. 7-8), solved and shared through the world model
         solves = [e for e in recorder.events if e["event"] == "solve" and e["status"] == "solved"]
         assert solves and all("frontier" in v for s in solves for a, v in s["values"].items() if a)
