@@ -315,3 +315,19 @@ def test_the_explore_plan_runs_from_the_command_line(capsys):
     assert code == 0 and summary["success"], summary
     assert {"BuildMap", "Localize", "ExploreFrontier"} <= set(summary["skills"]["real"])
     assert not summary["skills"]["stand_ins"]
+
+
+def test_when_the_mapper_crashes_the_other_robot_finishes_the_exploration(capsys):
+    import json
+
+    from alica.app.cli import main
+    from alica.io.loader import plans_dir
+
+    argv = ["run", str(plans_dir() / "skills" / "explore.yaml"), "--agents", "scout:Scout,stummel:Stummel"]
+    argv += ["--world", "lunar", "--size", "12", "--rocks", "4", "--samples", "0", "--seed", "1", "--json"]
+    code = main([*argv, "--crash", "scout@3", "--loss", "0.1", "--max-time", "200"])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["success"], summary
+    agents = summary["agents"]
+    assert agents["scout"]["status"] == "crashed" and agents["stummel"]["status"] == "success"
+    assert agents["stummel"]["tasks"][-1] == "GetMap"  # it took over the crashed mapper's task
