@@ -39,7 +39,16 @@ def add_parser(sub: Any) -> None:
         metavar="KEY=VALUE",
         help="a parameter; VALUE is read as YAML, e.g. goal=[5, 5] (repeatable)",
     )
-    r.add_argument("--robot", help="the robot (default: the first one that has what the skill needs)")
+    r.add_argument(
+        "--after",
+        action="append",
+        default=[],
+        metavar="SKILL",
+        help="run this skill first, with its default parameters, on the same robot, world model and scratch space "
+        "(repeatable, in order): a pipeline step by step, e.g. --after DetectCircles --after CropCandidate "
+        "for BlobDetect; the run stops at the first step that does not succeed",
+    )
+    r.add_argument("--robot", help="the robot (default: the first one that has what the skills need)")
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
     add_lunar_options(r)
     r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
@@ -96,17 +105,32 @@ def _c_prints_to_stderr() -> Iterator[None]:
 
 
 def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, object], run_skill: Any) -> Any:
+    from alica.worldmodel import WorldModel
+
+    steps = [registry.get(name) for name in args.after]
+    needs = frozenset().union(spec.capabilities, *(step.capabilities for step in steps))
+    names = ", ".join([*args.after, args.name])
     world = _world(args)
     try:
         robot = args.robot
         if robot is None:
-            fits = [n for n, r in sorted(world.robots.items()) if spec.capabilities <= r.spec.capabilities]
+            fits = [n for n, r in sorted(world.robots.items()) if needs <= r.spec.capabilities]
             if not fits:
                 raise AlicaError(
-                    f"no robot of the {args.world} world can run {args.name} (it needs {', '.join(sorted(spec.capabilities))})"
+                    f"no robot of the {args.world} world can run {names} (needs {', '.join(sorted(needs))})"
                 )
             robot = fits[0]
-        return run_skill(args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry)
+        shared: dict[str, Any] = {"world_model": WorldModel(robot, clock=world.clock), "scratch": {}}
+        for step in steps:
+            run = run_skill(
+                step.name, world, robot, {}, timeout=args.timeout, seed=args.seed, registry=registry, **shared
+            )
+            if not run.ok:
+                run.reason = f"step {step.name} before {args.name} did not succeed: {run.reason}"
+                return run
+        return run_skill(
+            args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry, **shared
+        )
     finally:
         world.close()
 

@@ -65,3 +65,35 @@ def test_a_small_lunar_field_from_the_command_line(capfd):
     out = capfd.readouterr().out
     assert code == 0, out
     assert "mapped" in out
+
+
+@pytest.mark.parametrize(
+    ("argv", "robot", "words"),
+    [
+        (
+            ["ClassifySample", "--after", "DetectCircles", "--after", "CropCandidate", "--after", "BlobDetect"],
+            "scout",
+            "found",
+        ),
+        (
+            ["FuzzyDLClassify", "--after", "StereoPointCloud", "--after", "RansacGroundPlane"]
+            + ["--after", "EuclideanCluster", "--after", "FitModel", "--seed", "4"],
+            "amparo",
+            "found",
+        ),
+    ],
+)
+def test_a_pipeline_runs_step_by_step_from_the_command_line(argv, robot, words, capfd):
+    """--after runs the steps before on the same robot, world model and scratch space (Verify2DObject, SemanticPerception)."""
+    field = ["--size", "12", "--rocks", "3", "--samples", "3"]
+    code = main(["skill", "run", *argv, *field, *([] if "--seed" in argv else ["--seed", "1"])])
+    out = capfd.readouterr().out
+    assert code == 0, out
+    assert out.startswith(f"{argv[0]} on {robot}: success") and words in out
+
+
+def test_a_pipeline_step_that_fails_is_named(capfd):
+    code = main(["skill", "run", "BlobDetect", "--after", "DetectCircles", "--after", "CropCandidate", "--seed", "0"])
+    out = capfd.readouterr().out
+    assert code == 1
+    assert "step DetectCircles before BlobDetect did not succeed: no circle of the sample radius" in out
