@@ -13,7 +13,7 @@ from alica.skills.exploration.frontiers import (
     frontier_mask,
     information_gain,
 )
-from alica.skills.exploration.maps import LidarMap, MapView, current_map
+from alica.skills.exploration.maps import MapView, current_map
 
 __all__ = [
     "FREE",
@@ -21,7 +21,6 @@ __all__ = [
     "UNKNOWN",
     "FrontierCandidate",
     "GainMap",
-    "LidarMap",
     "MapView",
     "coverage",
     "current_map",
