@@ -117,6 +117,10 @@ class MobileRobot(Protocol):
         """Correct the pose estimate (a localization's result)."""
         ...
 
+    def lidar(self, n_rays: int, max_range: float | None = None) -> np.ndarray:
+        """One 2-D lidar scan: ``n_rays`` ranges (m) over the full circle from the heading on; no hit reads ``max_range``."""
+        ...
+
     @property
     def crashed(self) -> bool:
         """Whether the robot is out (it no longer moves)."""

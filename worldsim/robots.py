@@ -15,6 +15,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from alica.worldsim.arm import Arm
 from alica.worldsim.errors import WorldError
 from alica.worldsim.geometry import Footprints, wrap_angle, yaw_to_quat
@@ -224,6 +226,18 @@ class Robot:
         (see :mod:`alica.worldsim.odometry`).
         """
         return self._odometry.pose
+
+    def lidar(self, n_rays: int, max_range: float | None = None) -> np.ndarray:
+        """One scan of the 2-D lidar: ``n_rays`` ranges in metres over the full circle, from the heading on.
+
+        See :func:`alica.worldsim.sensors.lidar_scan` (seeded range noise; a ray without a hit reads ``max_range``).
+
+        Raises:
+            WorldError: fewer than 1 ray or a range inside the robot.
+        """
+        from alica.worldsim.sensors import lidar_scan
+
+        return lidar_scan(self, n_rays, max_range)
 
     def set_estimate(self, pose: Sequence[float]) -> None:
         """Overwrite the pose estimate ``(x, y, yaw)`` (a localization's correction); odometry continues from it.
