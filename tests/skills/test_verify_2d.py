@@ -238,18 +238,58 @@ def test_a_found_sample_that_is_gone_is_retracted(skill_run):
         world.close()
 
 
-def test_crop_fails_clearly_when_the_candidate_is_not_in_view(skill_run):
+def test_the_camera_pans_to_a_candidate_behind_the_robot(skill_run):
     world = _field()
     try:
-        world.add_sample("a", SAMPLE_KINDS[0], _ahead(world, 2.0, 180.0))
+        xy = _ahead(world, 2.0, 175.0)
+        world.add_sample("a", "green-black-red", xy)
+        world.step(0.2)
+        scratch: dict[str, object] = {}
+        wm = WorldModel("scout", clock=world.clock)
+        runs = _pipeline(skill_run, world, scratch, wm, rounds=1)
+        assert [r.status for r in runs] == ["success"] * 4, [r.reason for r in runs]
+        assert abs(scratch["crop"]["pan"]) > math.radians(150)  # turned round (pan limit 160 deg)
+        assert wm.holds("found", "green_black_red")
+        assert math.dist(wm.get("pos", "green_black_red"), xy) < 0.05
+    finally:
+        world.close()
+
+
+def test_crop_fails_clearly_when_no_candidate_is_in_reach(skill_run):
+    world = _field()
+    try:
+        world.add_sample("a", SAMPLE_KINDS[0], _ahead(world, 5.6, 90.0))
         world.step(0.2)
         scratch: dict[str, object] = {}
         assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
         run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
-        assert run.status == "failure" and "no candidate in view" in run.reason
-        assert "behind the camera" in run.reason or "field of view" in run.reason
+        assert run.status == "failure" and "beyond the 5 m" in run.reason
         none = skill_run("CropCandidate", world, "scout", {}, scratch={})
         assert none.status == "failure" and "DetectCircles first" in none.reason
+        # Amparo's stereo camera has no pan unit: a candidate behind it is out of reach
+        x, y, yaw = world.robots["amparo"].pose
+        behind = {"id": "c1", "x": x - 2.0 * math.cos(yaw), "y": y - 2.0 * math.sin(yaw), "range": 2.0}
+        run = skill_run("CropCandidate", world, "amparo", {}, scratch={"circles": [behind]})
+        assert run.status == "failure" and "out of the camera's reach (pan +-0 deg)" in run.reason
+    finally:
+        world.close()
+
+
+def test_a_candidate_the_camera_cannot_see_goes_last(skill_run):
+    """A candidate the lidar sees below a rock's overhang is hidden from the camera: the next crop takes another."""
+    world = _field()
+    try:
+        world.add_sample("a", "green-white-red", _ahead(world, 3.0, -10.0))
+        world.step(0.2)
+        scratch: dict[str, object] = {}
+        assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
+        (seen,) = scratch["circles"]
+        ghost = dict(seen, id="ghost", x=seen["x"] + 0.5, y=seen["y"] + 0.3)  # no sample there: a hole in the view
+        ghost["range"] = math.dist(world.robots["scout"].estimate[:2], (ghost["x"], ghost["y"]))
+        scratch["circles"] = sorted([seen, ghost], key=lambda c: c["range"])
+        scratch["unseen"] = {"ghost": world.now()}
+        run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
+        assert run.ok and scratch["candidate"]["id"] == seen["id"], run.reason
     finally:
         world.close()
 
@@ -264,6 +304,10 @@ def test_crop_fails_clearly_when_the_candidate_is_not_in_view(skill_run):
         ("DetectCircles", {"radius": 0.03, "tolerance": 0.05}, "'tolerance'"),
         ("DetectCircles", {"n_rays": 4}, "'n_rays'"),
         ("DetectCircles", {"max_range": 0.0}, "'max_range'"),
+        ("DetectCircles", {"wait": -1.0}, "'wait'"),
+        ("DetectCircles", {"wait": "soon"}, "'wait'"),
+        ("DetectCircles", {"period": 0.0}, "'period'"),
+        ("CropCandidate", {"retry": -1.0}, "'retry'"),
         ("CropCandidate", {"margin": -1.0}, "'margin'"),
         ("CropCandidate", {"width": 2}, "'width'"),
         ("BlobDetect", {"colours": ["purple"]}, "'colours'"),
