@@ -268,6 +268,14 @@ def _directed_vision(registry: SkillRegistry) -> None:
         _p("tolerance", "float", "allowed radius error in metres (plus half a ray spacing at the range)", default=0.01),
         _p("max_range", "float", "farthest distance in metres to consider", default=8.0),
         _p(
+            "wait",
+            "float",
+            "seconds to keep scanning for an unverified candidate within max_range before failing "
+            "(0: fail at once when the scan has no circle; inf: until one is found)",
+            default=0.0,
+        ),
+        _p("period", "float", "seconds between two scans while waiting", default=0.5),
+        _p(
             "n_rays",
             "int",
             "rays of the scan over the full circle (1440: 0.25 degrees, a Hokuyo UTM-30LX)",
@@ -286,9 +294,15 @@ def _directed_vision(registry: SkillRegistry) -> None:
             "farthest candidate in metres to look at (blob detection works at short range)",
             default=5.0,
         ),
+        _p(
+            "retry",
+            "float",
+            "seconds a candidate the camera could not see comes after the others",
+            default=5.0,
+        ),
         _p("width", "int", "camera image width in pixels (752: Scout's Guppy camera)", default=752),
         _p("height", "int", "camera image height in pixels", default=480),
-        doc="project the candidate into the camera image and crop it",
+        doc="turn the camera (pan unit) to the nearest unverified candidate, project it into the image and crop it",
         capabilities=("camera",),
         implementation="alica.skills.vision2d:CropCandidate",
     )

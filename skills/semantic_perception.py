@@ -16,7 +16,10 @@ skill                  reads                        writes
                                                     and the world model (below)
 =====================  ===========================  ==================================================
 
-Only the depth image is used: no object names, no poses of other bodies.
+Only the depth image is used: no object names, no poses of other bodies. The
+points are put into the world with the camera pose derived from the robot's
+pose *estimate* (``robot.estimate``: odometry corrected by Localize), not its
+true pose: with odometry drift the samples land where the robot believes they are.
 
 **Naming the samples.** Perception cannot know the simulator's names. A
 detection within ``match_radius`` of a ``Sample`` the world model already
@@ -288,8 +291,9 @@ class StereoPointCloud(WorldSkill):
     Parameters: ``max_depth`` (metres; farther points dropped), ``width`` and
     ``height`` (pixels of the depth image), ``median`` (side in pixels of a
     median filter on the depth image, a stereo matcher's post-filter; 1: none).
-    Writes ``scratch["cloud"]`` (a :class:`PointCloud`, with the camera pose and
-    the depth image); fails when no pixel is nearer than ``max_depth``.
+    Writes ``scratch["cloud"]`` (a :class:`PointCloud`, with the camera pose of
+    the robot's pose estimate and the depth image); fails when no pixel is
+    nearer than ``max_depth``.
     """
 
     def setup(self, **kwargs: Any) -> None:
@@ -312,7 +316,14 @@ class StereoPointCloud(WorldSkill):
     def _capture(self) -> tuple[bool, str]:
         from alica.worldsim.robot_camera import robot_camera
 
-        image = robot_camera(self.robot, width=self.width, height=self.height, far=self.max_depth + 0.5)  # type: ignore[arg-type]
+        # taken where the robot is, placed in the world by the camera pose of its pose estimate
+        image = robot_camera(
+            self.robot,  # type: ignore[arg-type]
+            width=self.width,
+            height=self.height,
+            far=self.max_depth + 0.5,
+            believed=True,
+        )
         depth = image.depth
         if self.median > 1:
             from scipy.ndimage import median_filter

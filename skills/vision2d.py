@@ -59,6 +59,9 @@ ASSOCIATION_RADIUS = 0.25
 SAMPLE_HEIGHT = 0.1
 #: BlobDetect looks for blobs in the candidate's silhouette grown by this fraction of a section's height.
 WINDOW_PAD = 0.3
+#: A middle section at least this bright (HSV value, 0-255) and unsaturated is white; a white section
+#: lit from the side renders at about 147, from the front at 200 and more, a black one below 70.
+WHITE_VALUE = 120
 #: HSV ranges (OpenCV: hue 0-180, saturation and value 0-255) of the colours BlobDetect knows.
 HSV_RANGES: dict[str, tuple[tuple[tuple[int, int, int], tuple[int, int, int]], ...]] = {
     "red": (((0, 110, 60), (8, 255, 255)), ((172, 110, 60), (180, 255, 255))),
@@ -417,8 +420,8 @@ def decode_sections(
         return "no middle section between the coloured blobs"
     hsv = cv2.cvtColor(np.ascontiguousarray(strip), cv2.COLOR_RGB2HSV).reshape(-1, 3).astype(float)
     value, saturation = float(np.median(hsv[:, 2])), float(np.median(hsv[:, 1]))
-    if value >= 150 and saturation <= 80:
-        middle, clarity = "white", min(1.0, (value - 150) / 60 + 0.5)
+    if value >= WHITE_VALUE and saturation <= 80:
+        middle, clarity = "white", min(1.0, (value - WHITE_VALUE) / 60 + 0.5)
     elif value <= 70:
         middle, clarity = "black", min(1.0, (70 - value) / 40 + 0.5)
     else:
@@ -493,9 +496,17 @@ def _found_samples(wm: Any) -> list[tuple[str, tuple[float, float]]]:
 class DetectCircles(_Pipeline):
     """Find circles of the sample radius in the 2D laser scan (see :func:`detect_circles`).
 
+    The scan is taken where the robot is (the sensor); the circles are placed
+    in the world by the robot's pose *estimate* (``robot.estimate``: odometry,
+    corrected by Localize), the only pose a skill may know.
+
     Succeeds with ``scratch["circles"]`` (a list of candidate dicts ``{"id", "x", "y", "radius",
     "range", "bearing", "points"}``, nearest first) and ``candidate(c)``, ``candidate_pos(c)``
-    in the world model; fails when there is none.
+    in the world model. With ``wait`` 0 (the default) it fails at once when the
+    scan has no circle. With ``wait`` > 0 it waits for work: it scans every
+    ``period`` seconds while no candidate without a verdict yet (an
+    *unverified* one) is within ``max_range``, running meanwhile, succeeds
+    when one is, and fails after ``wait`` seconds (``inf``: never).
     """
 
     def initialise(self) -> None:
@@ -503,6 +514,16 @@ class DetectCircles(_Pipeline):
         self.radius = _number(self, "radius", 0.03)
         self.tolerance = _number(self, "tolerance", 0.01, strict=False)
         self.max_range = _number(self, "max_range", 8.0)
+        self.period = _number(self, "period", 0.5)
+        raw_wait = self.param("wait", 0.0)
+        try:
+            self.wait = float(raw_wait)  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            self.wait = math.nan
+        if not self.wait >= 0.0:  # NaN too; inf is allowed: wait until a candidate comes
+            raise SkillError(
+                f"skill '{self.name}': parameter 'wait' must be a number of seconds >= 0 (inf: until found), got {raw_wait!r}"
+            )
         raw = self.param("n_rays", 1440)
         if not isinstance(raw, int) or isinstance(raw, bool) or not 16 <= raw <= 100_000:
             raise SkillError(
@@ -515,19 +536,22 @@ class DetectCircles(_Pipeline):
             )
         if "lidar2d" not in self.robot.spec.capabilities:
             raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no 2D lidar")
-        self.job: Job = self.jobs.submit(self._scan)
+        self.started = self.now()
+        self.scans = 0
+        self.next_scan = self.started
+        self._waiting = "waiting for a candidate"
+        self.job: Job | None = self.jobs.submit(self._scan)
 
     def _scan(self) -> list[Circle]:
         from alica.worldsim.sensors import lidar_angles, lidar_scan
 
         robot = _sim_robot(self)
-        pose = robot.pose
-        ranges = lidar_scan(robot, self.n_rays)
+        ranges = lidar_scan(robot, self.n_rays)  # measured where the robot is
         sigma = float(getattr(getattr(robot.world, "noise", None), "lidar_sigma", 0.01))
         return detect_circles(
             ranges,
             lidar_angles(self.n_rays),
-            pose,
+            robot.estimate,  # placed where the robot believes it is
             radius=self.radius,
             tolerance=self.tolerance,
             max_range=self.max_range,
@@ -537,11 +561,44 @@ class DetectCircles(_Pipeline):
         )
 
     def update(self) -> Status:
-        """Poll the scan; hand the circles on."""
+        """Poll the scan; hand the circles on, or scan again while waiting."""
+        if self.job is None:  # waiting for the next scan
+            if self.now() < self.next_scan - 1e-9:
+                return self.running(self._waiting)
+            self.job = self.jobs.submit(self._scan)
         if not self.job.done():
             return self.running("scanning")
         circles: list[Circle] = self.job.result()
+        self.job = None
+        self.scans += 1
+        out = self._candidates(circles)
+        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        fresh = [c for c in out if c["id"] not in verdicts]
+        if self.wait > 0.0 and not fresh:
+            waited = self.now() - self.started
+            seen = f"{len(out)} verified candidate(s)" if out else "no circle of the sample radius"
+            if waited >= self.wait - 1e-9:
+                return self.fail(
+                    f"no unverified candidate within {self.max_range:g} m in {waited:.1f} s "
+                    f"({self.scans} scans; {seen} in the last)"
+                )
+            self.next_scan = self.now() + self.period
+            self._waiting = (
+                f"waiting for a candidate within {self.max_range:g} m ({seen}; {waited:.1f} of {self.wait:g} s)"
+            )
+            return self.running(self._waiting)
+        if not out:
+            return self.fail("no circle of the sample radius in the scan")
+        near = (fresh or out)[0]
+        return self.succeed(
+            f"{len(out)} candidate(s), {len(fresh)} unverified; nearest {near['id']} at "
+            f"({near['x']:.2f}, {near['y']:.2f}), {near['range']:.2f} m"
+        )
+
+    def _candidates(self, circles: list[Circle]) -> list[dict[str, Any]]:
+        """Name the circles (a known candidate nearby keeps its id), write them to the scratch space and world model."""
         known = cast("dict[str, tuple[float, float]]", self.scratch.setdefault("candidate_ids", {}))
+        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
         out = []
         wm = self.world_model
         for c in circles:
@@ -560,40 +617,45 @@ class DetectCircles(_Pipeline):
                     "points": c.points,
                 }
             )
-            verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
             if wm is not None and cid not in verdicts:  # verified ones stay found (or invalid) until a new look
                 wm.assert_fact("candidate", cid)
                 wm.set("candidate_pos", cid, value=(round(c.x, 3), round(c.y, 3)))
         self.scratch["circles"] = out
         self.scratch["circle_radius"] = self.radius
-        if not out:
-            return self.fail("no circle of the sample radius in the scan")
-        near = out[0]
-        return self.succeed(
-            f"{len(out)} candidate(s); nearest {near['id']} at ({near['x']:.2f}, {near['y']:.2f}), {near['range']:.2f} m"
-        )
+        return out
 
 
 class CropCandidate(_Pipeline):
-    """Render the camera, project the nearest unverified candidate in view into it and crop it.
+    """Turn the camera to the nearest unverified candidate, render it, project the candidate into it and crop it.
 
-    Candidates come from ``scratch["circles"]`` (DetectCircles). The crop is the
-    candidate's cylinder (footprint of the sample radius, :data:`SAMPLE_HEIGHT`
-    high) grown by ``margin`` metres; ``scratch["candidate"]`` and
-    ``scratch["crop"]`` (``{"rgb", "depth", "box", "expected", "range"}``) go on to
-    BlobDetect and ClassifySample. Fails when no candidate is within
-    ``max_range`` and in the camera's view, or the view of it is blocked.
+    Candidates come from ``scratch["circles"]`` (DetectCircles). The target
+    is the nearest candidate within ``max_range`` without a verdict, one the
+    camera could not see in the last ``retry`` seconds coming after the others;
+    a camera with a pan unit (``spec.camera_pan_limit``) is turned toward it.
+    The picture is taken where the robot is; the candidate is projected into
+    it with the camera pose of the robot's pose *estimate*. Any candidate in
+    the picture may be cropped, the target first. The crop is the
+    candidate's cylinder (footprint of the sample radius,
+    :data:`SAMPLE_HEIGHT` high) grown by ``margin`` metres;
+    ``scratch["candidate"]`` and ``scratch["crop"]`` (``{"rgb", "depth",
+    "box", "expected", "range", "pan"}``) go on to BlobDetect and
+    ClassifySample. Fails when no candidate is within ``max_range``, within
+    the pan unit's reach and in clear view.
     """
 
     def initialise(self) -> None:
-        """Check the parameters, choose the candidate and render the camera."""
+        """Check the parameters, choose the candidate, turn the camera toward it and render."""
         self.margin = _number(self, "margin", 0.1, strict=False)
         self.max_range = _number(self, "max_range", 5.0)
+        self.retry = _number(self, "retry", 5.0, strict=False)
         self.width = self._pixels("width", 752)
         self.height = self._pixels("height", 480)
         if not ({"camera", "stereo_camera"} & self.robot.spec.capabilities):
             raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no camera")
-        self.job: Job = self.jobs.submit(self._render)
+        self.target: dict[str, Any] | None = None
+        self.reasons: list[str] = []
+        self.pan = self._aim()
+        self.job: Job | None = self.jobs.submit(self._render) if self.target is not None else None
 
     def _pixels(self, name: str, default: int) -> int:
         raw = self.param(name, default)
@@ -603,33 +665,81 @@ class CropCandidate(_Pipeline):
             )
         return raw
 
+    def _aim(self) -> float:
+        """Choose the target (``self.target``) and the pan angle that centres it; reasons for the others."""
+        from alica.worldsim.robot_camera import camera_pose
+
+        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
+        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        unseen = cast("dict[str, float]", self.scratch.get("unseen") or {})
+        robot = _sim_robot(self)
+        spec = robot.spec
+        estimate = robot.estimate
+        camera, _ = camera_pose(robot, estimate)
+        limit = spec.camera_pan_limit
+        # the candidate's middle must be this far inside the picture's edge
+        reach = limit + 0.5 * spec.camera_fov - math.radians(3.0)
+        now = self.now()
+        options = []
+        for c in circles:
+            dx, dy = float(c["x"]) - estimate[0], float(c["y"]) - estimate[1]
+            if math.hypot(dx, dy) > self.max_range:
+                self.reasons.append(
+                    f"{c['id']}: {math.hypot(dx, dy):.1f} m away, beyond the {self.max_range:g} m of a closer look"
+                )
+                continue
+            bearing = math.remainder(
+                math.atan2(float(c["y"]) - camera[1], float(c["x"]) - camera[0]) - estimate[2], math.tau
+            )
+            if abs(bearing) > reach:
+                self.reasons.append(
+                    f"{c['id']}: at {math.degrees(bearing):.0f} deg, out of the camera's reach (pan +-{math.degrees(limit):.0f} deg)"
+                )
+                continue
+            recent = now - unseen.get(str(c["id"]), -math.inf) < self.retry
+            options.append(((c["id"] in verdicts, recent, math.hypot(dx, dy)), bearing, c))
+        if not options:
+            return 0.0
+        options.sort(key=lambda t: t[0])
+        _, bearing, self.target = options[0]
+        return max(-limit, min(limit, bearing))
+
     def _render(self) -> CameraImage:
         from alica.worldsim.robot_camera import robot_camera
 
-        return robot_camera(_sim_robot(self), width=self.width, height=self.height)
+        return robot_camera(_sim_robot(self), width=self.width, height=self.height, pan=self.pan, believed=True)
 
     def update(self) -> Status:
         """Poll the rendering; crop the candidate."""
-        if not self.job.done():
-            return self.running("taking a picture")
-        image: CameraImage = self.job.result()
         circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
         if not circles:
             return self.fail("no candidate to look at: run DetectCircles first")
+        if self.job is None or self.target is None:
+            return self.fail("no candidate in reach: " + "; ".join(self.reasons[:3]))
+        if not self.job.done():
+            return self.running(
+                f"turning the camera to {self.target['id']} ({math.degrees(self.pan):.0f} deg) and taking a picture"
+            )
+        image: CameraImage = self.job.result()
         verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
         radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
         views = []
-        reasons = []
+        reasons: list[str] = []
         for c in circles:
             view = self._view(image, c, radius)
             if isinstance(view, str):
-                reasons.append(f"{c['id']}: {view}")
+                if c["id"] == self.target["id"]:
+                    reasons.insert(0, f"{c['id']}: {view}")
+                    unseen = cast("dict[str, float]", self.scratch.setdefault("unseen", {}))
+                    unseen[str(c["id"])] = self.now()
+                else:
+                    reasons.append(f"{c['id']}: {view}")
             else:
-                views.append((c["id"] in verdicts, c["range"], c, view))
+                views.append((c["id"] in verdicts, c["id"] != self.target["id"], c["range"], c, view))
         if not views:
-            return self.fail("no candidate in view: " + "; ".join(reasons[:3]))
-        views.sort(key=lambda t: (t[0], t[1]))
-        _, _, candidate, (box, expected) = views[0]
+            return self.fail("no candidate in view: " + "; ".join((reasons + self.reasons)[:3]))
+        views.sort(key=lambda t: (t[0], t[1], t[2]))
+        *_, candidate, (box, expected) = views[0]
         u0, v0, u1, v1 = box
         self.scratch["candidate"] = dict(candidate)
         self.scratch["crop"] = {
@@ -639,8 +749,12 @@ class CropCandidate(_Pipeline):
             "expected": (expected[0] - u0, expected[1] - v0, expected[2] - u0, expected[3] - v0),
             "range": candidate["range"],
             "time": image.time,
+            "pan": image.pan,
         }
-        return self.succeed(f"cropped {candidate['id']} ({u1 - u0}x{v1 - v0} px at {candidate['range']:.2f} m)")
+        return self.succeed(
+            f"cropped {candidate['id']} ({u1 - u0}x{v1 - v0} px at {candidate['range']:.2f} m, "
+            f"camera at {math.degrees(image.pan):.0f} deg)"
+        )
 
     def _view(
         self, image: CameraImage, c: dict[str, Any], radius: float

@@ -2,8 +2,11 @@
 
 A robot with the ``camera`` or ``stereo_camera`` capability carries a camera
 on top of its base, :data:`MOUNT_FORWARD` of its radius ahead of its centre
-and :data:`MOUNT_UP` above the base, looking along the robot's heading and
-:data:`TILT` down. :func:`robot_camera` renders what it sees:
+and :data:`MOUNT_UP` above the base, looking :data:`TILT` down and along the
+robot's heading turned by the ``pan`` angle (left positive) of its pan unit:
+up to ``spec.camera_pan_limit`` either way (Scout and Stummel: a directed
+colour camera on a pan-tilt unit; Amparo's stereo pair is fixed, 0).
+:func:`robot_camera` renders what it sees:
 
 * ``rgb``: ``(height, width, 3)`` ``uint8``, with seeded Gaussian pixel noise
   (``world.noise.pixel_sigma``, in intensity levels);
@@ -16,6 +19,12 @@ and :data:`MOUNT_UP` above the base, looking along the robot's heading and
   down, z forward), so a pixel ``(u, v)`` with depth ``d`` is the world point
   ``position + rotation @ [(u - cx) d / fx, (v - cy) d / fy, d]``
   (:meth:`CameraImage.points` does this for every pixel).
+
+The picture is always taken where the robot truly is (it is the sensor). Its
+pose is the true camera pose by default; with ``believed=True`` it is the pose
+derived from the robot's pose *estimate* (``robot.estimate``: odometry,
+corrected by localization), which is all a perception skill may know: points
+and projections then live in the robot's believed world frame.
 
 Nothing here reads object names or the simulator's ground truth beyond what a
 camera sees: perception skills get pixels and depths only.
@@ -55,6 +64,7 @@ class CameraImage:
         position: the camera centre in the world, metres.
         rotation: 3x3 rotation, world from camera (OpenCV axes: x right, y down, z forward).
         time: the simulated time of the picture.
+        pan: the pan angle the picture was taken at, radians left of the heading.
     """
 
     rgb: np.ndarray
@@ -63,6 +73,7 @@ class CameraImage:
     position: np.ndarray
     rotation: np.ndarray
     time: float
+    pan: float = 0.0
 
     def points(self, max_depth: float = math.inf) -> np.ndarray:
         """World points of every pixel with a depth below ``max_depth``: ``(n, 3)``, row-major pixel order."""
@@ -84,9 +95,17 @@ class CameraImage:
         return float(fx * p[0] / p[2] + cx), float(fy * p[1] / p[2] + cy), float(p[2])
 
 
-def camera_pose(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
-    """Where the robot's camera is and how it is turned: ``(position, rotation world-from-camera)``."""
-    x, y, yaw = robot.pose
+def camera_pose(
+    robot: Robot, pose: tuple[float, float, float] | None = None, pan: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where the robot's camera is and how it is turned: ``(position, rotation world-from-camera)``.
+
+    Args:
+        robot: the robot (its spec gives the mount).
+        pose: the base pose ``(x, y, yaw)``; default the true pose (``robot.estimate`` for what the robot believes).
+        pan: the pan angle, radians left of the heading (not checked against the limit here).
+    """
+    x, y, yaw = robot.pose if pose is None else pose
     spec = robot.spec
     position = np.array(
         [
@@ -95,8 +114,9 @@ def camera_pose(robot: Robot) -> tuple[np.ndarray, np.ndarray]:
             spec.height + MOUNT_UP,
         ]
     )
-    forward = np.array([math.cos(yaw) * math.cos(TILT), math.sin(yaw) * math.cos(TILT), -math.sin(TILT)])
-    right = np.array([math.sin(yaw), -math.cos(yaw), 0.0])
+    look = yaw + pan
+    forward = np.array([math.cos(look) * math.cos(TILT), math.sin(look) * math.cos(TILT), -math.sin(TILT)])
+    right = np.array([math.sin(look), -math.cos(look), 0.0])
     down = np.cross(forward, right)
     return position, np.column_stack([right, down, forward])
 
@@ -108,6 +128,8 @@ def robot_camera(
     height: int = 240,
     fov: float | None = None,
     far: float | None = None,
+    pan: float = 0.0,
+    believed: bool = False,
 ) -> CameraImage:
     """Render the robot's camera (see the module docstring).
 
@@ -117,9 +139,11 @@ def robot_camera(
         height: image height in pixels.
         fov: horizontal field of view in radians (default: the robot's ``camera_fov``).
         far: farthest distance rendered, metres (default: twice the robot's ``perception_range``).
+        pan: the pan angle, radians left of the heading, within ``spec.camera_pan_limit`` either way.
+        believed: give the picture the camera pose of the robot's pose estimate instead of the true one.
 
     Raises:
-        WorldError: a robot without a camera, a closed world, a bad size, field of view or range.
+        WorldError: a robot without a camera, a closed world, a bad size, field of view, range or pan angle.
     """
     from alica.worldsim.world import pybullet
 
@@ -139,7 +163,15 @@ def robot_camera(
     far_plane = 2.0 * spec.perception_range if far is None else float(far)
     if not (math.isfinite(far_plane) and far_plane > NEAR):
         raise WorldError(f"robot_camera: far must be a number of metres above {NEAR}, got {far}")
-    position, rotation = camera_pose(robot)
+    try:
+        pan = float(pan)
+    except (TypeError, ValueError):
+        raise WorldError(f"robot_camera: pan must be a number of radians, got {pan!r}") from None
+    limit = spec.camera_pan_limit
+    if not (math.isfinite(pan) and abs(pan) <= limit + 1e-9):
+        turn = f"turns its camera at most {limit:.3f} rad either way" if limit > 0.0 else "has a fixed camera (pan 0)"
+        raise WorldError(f"robot_camera: robot '{robot.name}' ({spec.kind}) {turn}, got pan {pan!r}")
+    position, rotation = camera_pose(robot, pan=pan)
     forward, down = rotation[:, 2], rotation[:, 1]
     fx = (width / 2.0) / math.tan(hfov / 2.0)
     fy = fx
@@ -161,4 +193,7 @@ def robot_camera(
     if noise.depth_sigma > 0.0 and finite.any():
         depth[finite] += world.rng.normal(0.0, 1.0, int(finite.sum())) * noise.depth_sigma * depth[finite] ** 2
     image = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
-    return CameraImage(image, depth, (fx, fy, width / 2.0 - 0.5, height / 2.0 - 0.5), position, rotation, world.now())
+    if believed:
+        position, rotation = camera_pose(robot, robot.estimate, pan)
+    intrinsics = (fx, fy, width / 2.0 - 0.5, height / 2.0 - 0.5)
+    return CameraImage(image, depth, intrinsics, position, rotation, world.now(), pan)

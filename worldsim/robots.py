@@ -52,6 +52,8 @@ class RobotSpec:
         height: height of the base body (the arm is mounted on top).
         lidar_height: height of the scan plane above the ground.
         camera_fov: horizontal field of view of the object perception in radians.
+        camera_pan_limit: how far the camera's pan unit turns it left or right of the heading, radians
+            (0: a fixed camera looking ahead).
         perception_range: default range of the object perception in metres.
         mass: nominal mass in kg (descriptive; the base is kinematic).
         colour: RGBA of the base body.
@@ -68,6 +70,7 @@ class RobotSpec:
     height: float = 0.25
     lidar_height: float = 0.1
     camera_fov: float = math.radians(70.0)
+    camera_pan_limit: float = 0.0
     perception_range: float = 4.0
     mass: float = 30.0
     colour: tuple[float, float, float, float] = (0.5, 0.5, 0.5, 1.0)
@@ -87,6 +90,7 @@ ROBOT_KINDS: dict[str, RobotSpec] = {
         perception="camera",
         height=0.2,
         camera_fov=math.radians(60.0),
+        camera_pan_limit=math.radians(160.0),  # a pan-tilt unit's +-159 degrees
         perception_range=5.0,
         mass=25.0,
         colour=(0.15, 0.45, 0.85, 1.0),
@@ -103,6 +107,7 @@ ROBOT_KINDS: dict[str, RobotSpec] = {
         perception="camera",
         height=0.25,
         camera_fov=math.radians(60.0),
+        camera_pan_limit=math.radians(160.0),  # a pan-tilt unit's +-159 degrees
         perception_range=4.0,
         mass=35.0,
         colour=(0.9, 0.55, 0.1, 1.0),

@@ -306,6 +306,23 @@ def test_semantic_perception_tells_the_sample_from_the_rock(scene, skill_run):
     assert 0.6 <= last.values[Fact("confidence", (name,))] <= 1.0
 
 
+def test_the_cloud_and_the_samples_are_placed_by_the_pose_estimate(scene, skill_run):
+    """Amparo believes it stands 0.4 m further along x and turned by 2 degrees: so do the samples it reports."""
+    amparo = scene.robots["amparo"]
+    x, y, yaw = amparo.pose
+    turn = math.radians(2.0)
+    amparo.set_estimate((x + 0.4, y, yaw + turn))
+    scratch: dict = {}
+    runs = run_pipeline(skill_run, scene, scratch)
+    assert [r.status for r in runs] == ["success"] * 5, runs[-1].reason
+    (detection,) = scratch["detections"]
+    sx, sy = scene.objects["probe"].position()[:2]
+    dx, dy = sx - x, sy - y
+    believed = (x + 0.4 + dx * math.cos(turn) - dy * math.sin(turn), y + dx * math.sin(turn) + dy * math.cos(turn))
+    assert math.dist(detection.position, believed) < 0.05
+    assert math.dist(detection.position, (sx, sy)) > 0.3
+
+
 def test_a_detection_near_a_known_sample_is_that_sample_and_a_clear_view_retracts_a_false_one(scene, skill_run):
     from alica.worldmodel import WorldModel
 
@@ -469,3 +486,41 @@ def test_the_semantic_perception_plan_runs_with_the_skills(tmp_path, with_sample
             assert math.hypot(pos[0] - truth[0], pos[1] - truth[1]) < 0.05
         else:
             assert summary["path"] == "SemanticPerception:NoSample" and not found
+
+
+@pytest.fixture
+def teams(monkeypatch):
+    """The teams ``alica run`` makes, to read their world models afterwards."""
+    import alica.engine
+
+    made = []
+
+    class Recording(alica.engine.SimulatedTeam):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            made.append(self)
+
+    monkeypatch.setattr(alica.engine, "SimulatedTeam", Recording)
+    return made
+
+
+@pytest.mark.parametrize("seed", [3, 10])
+def test_the_semantic_perception_plan_runs_from_the_command_line(capfd, teams, seed):
+    from pathlib import Path
+
+    from alica.app.cli import main
+    from alica.worldsim.scenarios import lunar
+
+    with lunar(seed=seed, rocks=2, samples=1, size=10.0) as world:  # the field alica run builds
+        xy = world.objects["a"].position()[:2]
+        assert math.dist(world.robots["amparo"].pose[:2], xy) < 2.8  # within the 3 m of the cloud
+    plan = Path(__file__).resolve().parents[2] / "plans" / "skills" / "semantic_perception.yaml"
+    args = ["run", str(plan), "--agents", "amparo:Amparo", "--world", "lunar", "--size", "10", "--rocks", "2"]
+    code = main([*args, "--samples", "1", "--seed", str(seed), "--max-time", "30", "--json"])
+    summary = json.loads(capfd.readouterr().out)
+    assert code == 0, summary
+    agent = summary["agents"]["amparo"]
+    assert agent["path"] == "SemanticPerception:SampleRecognised" and agent["repairs"] == 0
+    wm = teams[0].engines["amparo"].world_model
+    (name,) = [f.args[0] for f in wm.facts() if f.predicate == "found"]
+    assert math.dist(wm.get("pos", name), xy) < 0.05

@@ -7,10 +7,12 @@ scores the results here; the skills see lidar ranges and pixels.
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -106,6 +108,60 @@ def test_detect_circles_reports_samples_not_rocks_or_robots(skill_run):
             assert run.holds("candidate", c["id"])
             assert wm.get("candidate_pos", c["id"]) is not None
         assert [c["range"] for c in circles] == sorted(c["range"] for c in circles)
+    finally:
+        world.close()
+
+
+def test_detect_circles_waits_for_an_unverified_candidate(skill_run):
+    world = _field()
+    try:
+        world.robots["stummel"].set_pose(-6.0, -6.0, 0.0)  # the edge of a robot may look like a circle for a scan
+        world.robots["amparo"].set_pose(-6.0, 6.0, 0.0)
+        xy = _ahead(world, 3.0, 60.0)
+        started = world.now()
+
+        def drop_a_sample(w, _behaviour):
+            if w.now() - started >= 1.0 and "a" not in w.objects:
+                w.add_sample("a", SAMPLE_KINDS[1], xy)
+
+        scratch: dict[str, object] = {}
+        run = skill_run("DetectCircles", world, "scout", {"wait": 5.0}, scratch=scratch, on_tick=drop_a_sample)
+        assert run.ok, run.reason
+        assert world.now() - started >= 1.0  # it kept scanning until the sample was there
+        (c,) = scratch["circles"]
+        assert math.dist((c["x"], c["y"]), xy) < 0.03
+        # verified: the next look waits for another one and gives up after the wait
+        scratch["verdicts"] = {c["id"]: "green_black_red"}
+        run = skill_run("DetectCircles", world, "scout", {"wait": 2.0, "period": 0.5}, scratch=scratch)
+        assert run.status == "failure", run.reason
+        assert "no unverified candidate within 8 m in 2." in run.reason and "1 verified" in run.reason
+    finally:
+        world.close()
+
+
+def test_detections_are_placed_by_the_pose_estimate(skill_run):
+    """The skills know only the estimate: a shifted and turned estimate shifts and turns what they report."""
+    world = _field()
+    try:
+        scout = world.robots["scout"]
+        xy = _ahead(world, 2.5, 10.0)
+        world.add_sample("a", "red-white-red", xy)
+        world.step(0.2)
+        x, y, yaw = scout.pose
+        turn = math.radians(3.0)
+        scout.set_estimate((x + 0.3, y - 0.2, yaw + turn))
+        scratch: dict[str, object] = {}
+        wm = WorldModel("scout", clock=world.clock)
+        runs = _pipeline(skill_run, world, scratch, wm, rounds=1)
+        assert [r.status for r in runs] == ["success"] * 4, [r.reason for r in runs]
+        # where the robot believes the sample is: the true offset from the robot, turned and moved with the estimate
+        dx, dy = xy[0] - x, xy[1] - y
+        believed = (
+            x + 0.3 + dx * math.cos(turn) - dy * math.sin(turn),
+            y - 0.2 + dx * math.sin(turn) + dy * math.cos(turn),
+        )
+        assert math.dist(wm.get("pos", "red_white_red"), believed) < 0.03
+        assert math.dist(wm.get("pos", "red_white_red"), xy) > 0.25
     finally:
         world.close()
 
@@ -238,18 +294,58 @@ def test_a_found_sample_that_is_gone_is_retracted(skill_run):
         world.close()
 
 
-def test_crop_fails_clearly_when_the_candidate_is_not_in_view(skill_run):
+def test_the_camera_pans_to_a_candidate_behind_the_robot(skill_run):
     world = _field()
     try:
-        world.add_sample("a", SAMPLE_KINDS[0], _ahead(world, 2.0, 180.0))
+        xy = _ahead(world, 2.0, 175.0)
+        world.add_sample("a", "green-black-red", xy)
+        world.step(0.2)
+        scratch: dict[str, object] = {}
+        wm = WorldModel("scout", clock=world.clock)
+        runs = _pipeline(skill_run, world, scratch, wm, rounds=1)
+        assert [r.status for r in runs] == ["success"] * 4, [r.reason for r in runs]
+        assert abs(scratch["crop"]["pan"]) > math.radians(150)  # turned round (pan limit 160 deg)
+        assert wm.holds("found", "green_black_red")
+        assert math.dist(wm.get("pos", "green_black_red"), xy) < 0.05
+    finally:
+        world.close()
+
+
+def test_crop_fails_clearly_when_no_candidate_is_in_reach(skill_run):
+    world = _field()
+    try:
+        world.add_sample("a", SAMPLE_KINDS[0], _ahead(world, 5.6, 90.0))
         world.step(0.2)
         scratch: dict[str, object] = {}
         assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
         run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
-        assert run.status == "failure" and "no candidate in view" in run.reason
-        assert "behind the camera" in run.reason or "field of view" in run.reason
+        assert run.status == "failure" and "beyond the 5 m" in run.reason
         none = skill_run("CropCandidate", world, "scout", {}, scratch={})
         assert none.status == "failure" and "DetectCircles first" in none.reason
+        # Amparo's stereo camera has no pan unit: a candidate behind it is out of reach
+        x, y, yaw = world.robots["amparo"].pose
+        behind = {"id": "c1", "x": x - 2.0 * math.cos(yaw), "y": y - 2.0 * math.sin(yaw), "range": 2.0}
+        run = skill_run("CropCandidate", world, "amparo", {}, scratch={"circles": [behind]})
+        assert run.status == "failure" and "out of the camera's reach (pan +-0 deg)" in run.reason
+    finally:
+        world.close()
+
+
+def test_a_candidate_the_camera_cannot_see_goes_last(skill_run):
+    """A candidate the lidar sees below a rock's overhang is hidden from the camera: the next crop takes another."""
+    world = _field()
+    try:
+        world.add_sample("a", "green-white-red", _ahead(world, 3.0, -10.0))
+        world.step(0.2)
+        scratch: dict[str, object] = {}
+        assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
+        (seen,) = scratch["circles"]
+        ghost = dict(seen, id="ghost", x=seen["x"] + 0.5, y=seen["y"] + 0.3)  # no sample there: a hole in the view
+        ghost["range"] = math.dist(world.robots["scout"].estimate[:2], (ghost["x"], ghost["y"]))
+        scratch["circles"] = sorted([seen, ghost], key=lambda c: c["range"])
+        scratch["unseen"] = {"ghost": world.now()}
+        run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
+        assert run.ok and scratch["candidate"]["id"] == seen["id"], run.reason
     finally:
         world.close()
 
@@ -264,6 +360,10 @@ def test_crop_fails_clearly_when_the_candidate_is_not_in_view(skill_run):
         ("DetectCircles", {"radius": 0.03, "tolerance": 0.05}, "'tolerance'"),
         ("DetectCircles", {"n_rays": 4}, "'n_rays'"),
         ("DetectCircles", {"max_range": 0.0}, "'max_range'"),
+        ("DetectCircles", {"wait": -1.0}, "'wait'"),
+        ("DetectCircles", {"wait": "soon"}, "'wait'"),
+        ("DetectCircles", {"period": 0.0}, "'period'"),
+        ("CropCandidate", {"retry": -1.0}, "'retry'"),
         ("CropCandidate", {"margin": -1.0}, "'margin'"),
         ("CropCandidate", {"width": 2}, "'width'"),
         ("BlobDetect", {"colours": ["purple"]}, "'colours'"),
@@ -327,3 +427,67 @@ def test_the_verify_plan_finds_a_sample_in_the_engine(tmp_path):
         assert math.dist(wm.get("pos", "green_white_red"), xy) < 0.05
     finally:
         world.close()
+
+
+# -- the plan from the command line --------------------------------------------------------------------
+
+PLAN = str(Path(__file__).resolve().parents[2] / "plans" / "skills" / "verify_2d_object.yaml")
+
+
+@pytest.fixture
+def teams(monkeypatch):
+    """The teams ``alica run`` makes, to read their world models afterwards."""
+    import alica.engine
+
+    made = []
+
+    class Recording(alica.engine.SimulatedTeam):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            made.append(self)
+
+    monkeypatch.setattr(alica.engine, "SimulatedTeam", Recording)
+    return made
+
+
+def _sample_near(seed: int, robot: str) -> tuple[str, tuple[float, float]]:
+    """The kind and place of the sample ``alica run --world lunar --size 10 --rocks 2 --samples 1`` puts near ``robot``."""
+    from alica.worldsim.scenarios import lunar
+
+    with lunar(seed=seed, rocks=2, samples=1, size=10.0) as world:
+        sample = world.objects["a"]
+        xy = (float(sample.position()[0]), float(sample.position()[1]))
+        assert math.dist(world.robots[robot].pose[:2], xy) < 4.0  # within the 5 m of a closer look
+        return str(sample.sample_kind), xy
+
+
+@pytest.mark.parametrize(("agents", "seed"), [("scout:Scout", 27), ("stummel:Stummel", 2)])
+def test_the_verify_plan_runs_from_the_command_line(capfd, teams, agents, seed):
+    from alica.app.cli import main
+
+    robot = agents.split(":")[0]
+    kind, xy = _sample_near(seed, robot)
+    args = ["run", PLAN, "--agents", agents, "--world", "lunar", "--size", "10", "--rocks", "2", "--samples", "1"]
+    code = main([*args, "--seed", str(seed), "--max-time", "30", "--json"])
+    summary = json.loads(capfd.readouterr().out)
+    assert code == 0, summary
+    assert summary["agents"][robot]["path"] == "Verify2DObject:ValidCandidate"
+    assert summary["agents"][robot]["repairs"] == 0
+    wm = teams[0].engines[robot].world_model
+    name = kind.replace("-", "_")
+    assert wm.holds("found", name) and wm.get("sample_kind", name) == kind
+    assert math.dist(wm.get("pos", name), xy) < 0.05
+
+
+def test_the_verify_plan_waits_without_churn_when_nothing_is_in_reach(tmp_path, capfd):
+    from alica.app.cli import main
+
+    trace = tmp_path / "trace.jsonl"
+    args = ["run", PLAN, "--agents", "scout:Scout", "--world", "lunar", "--size", "16", "--rocks", "8"]
+    code = main([*args, "--samples", "2", "--ticks", "240", "--trace", str(trace)])  # 8 s: less than the wait
+    capfd.readouterr()
+    assert code == 1  # not finished: still waiting for a candidate
+    events = [json.loads(line) for line in trace.read_text(encoding="utf-8").splitlines()]
+    assert not [e for e in events if e["event"] in ("transition", "repair")], events
+    (running,) = [e for e in events if e["event"] == "behaviour"]
+    assert running["behaviour"] == "DetectSampleCircles" and running["status"] == "running"

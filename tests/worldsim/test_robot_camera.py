@@ -53,3 +53,36 @@ def test_a_robot_without_a_camera_and_bad_sizes_are_clear_errors(blocks_world, l
         robot_camera(lunar_world.robots["scout"], width=2)
     with pytest.raises(WorldError, match="fov"):
         robot_camera(lunar_world.robots["scout"], fov=4.0)
+
+
+def test_the_pan_unit_turns_the_camera_and_a_fixed_camera_refuses_to_turn(lunar_world):
+    scout = lunar_world.robots["scout"]
+    sample = lunar_world.objects["a"]
+    sx, sy, sz = sample.position()
+    # the sample 2 m to the robot's left: out of the forward view, in view with the camera turned left
+    scout.set_pose(sx, sy - 2.0, 0.0)
+    lunar_world.step(0.01)
+    ahead = robot_camera(scout, width=160, height=120)
+    u, _, d = ahead.project((sx, sy, sz))
+    assert not (d > 0 and 0 <= u < 160)
+    left = robot_camera(scout, width=160, height=120, pan=math.pi / 2)
+    u, v, d = left.project((sx, sy, sz))
+    assert 0 <= u < 160 and 0 <= v < 120 and left.pan == math.pi / 2
+    assert abs(left.depth[round(v), round(u)] - d) < 0.1
+    assert np.allclose(left.position, ahead.position)  # the pan unit turns the camera where it is mounted
+    with pytest.raises(WorldError, match="at most 2.793 rad"):
+        robot_camera(scout, pan=math.radians(170.0))
+    with pytest.raises(WorldError, match="fixed camera"):
+        robot_camera(lunar_world.robots["amparo"], pan=0.1)
+
+
+def test_a_believed_picture_carries_the_camera_pose_of_the_estimate(lunar_world):
+    scout = lunar_world.robots["scout"]
+    x, y, yaw = scout.pose
+    scout.set_estimate((x + 0.5, y, yaw + 0.1))
+    true = robot_camera(scout, width=40, height=30, pan=0.3)
+    believed = robot_camera(scout, width=40, height=30, pan=0.3, believed=True)
+    assert np.array_equal(np.isinf(true.depth), np.isinf(believed.depth))  # the same view, taken where it is
+    position, rotation = camera_pose(scout, (x + 0.5, y, yaw + 0.1), 0.3)
+    assert np.allclose(believed.position, position) and np.allclose(believed.rotation, rotation)
+    assert np.allclose(true.position, camera_pose(scout, pan=0.3)[0])
