@@ -47,6 +47,8 @@ __all__ = ["HEADING", "ExploreFrontier", "headings", "publish_frontiers"]
 PUBLISH_TTL = 10.0
 #: Seconds a frontier the robot could not reach is left out of its own choice.
 UNREACHABLE_FOR = 30.0
+#: Failed drives after which a frontier is given up for good (it lies among rocks, say).
+GIVE_UP_AFTER = 2
 #: Metres beyond the robot's radius a frontier cell keeps from occupied cells to be a candidate.
 CLEARANCE_MARGIN = 0.1
 #: Seconds MoveToPosition may take to one frontier.
@@ -165,6 +167,7 @@ class ExploreFrontier(WorldSkill):
         self.target: FrontierCandidate | None = None
         self.next_update = -math.inf
         self.unreachable: dict[str, float] = {}
+        self.failed_drives: dict[str, int] = {}
         self.first = True
         self.solved = 0
         self.fallbacks = 0
@@ -175,10 +178,16 @@ class ExploreFrontier(WorldSkill):
         if now >= self.next_update:
             self.next_update = now + self.period
             self._refresh()
-            if not self.candidates:
+            if not self.candidates or all(self.unreachable.get(c.name) == math.inf for c in self.candidates):
+                given_up = len(self.candidates)
                 self._stop_inner()
                 self.robot.stop()
                 self.write(True, "explored")
+                if given_up:
+                    return self.succeed(
+                        f"explored: {given_up} frontier(s) left that the robot reached without seeing beyond, "
+                        f"or failed to reach {GIVE_UP_AFTER} times"
+                    )
                 return self.succeed("explored: no frontier with gain is left")
             if self.target is not None and self.target.name not in self._by_name():
                 self._stop_inner()  # seen while driving there (or no longer a frontier)
@@ -200,7 +209,8 @@ class ExploreFrontier(WorldSkill):
                 f"gain {self.target.gain:.1f} m²; {len(self.candidates)} frontiers"
             )
         if status == Status.FAILURE:
-            self.unreachable[self.target.name] = now + UNREACHABLE_FOR
+            failures = self.failed_drives[self.target.name] = self.failed_drives.get(self.target.name, 0) + 1
+            self.unreachable[self.target.name] = now + UNREACHABLE_FOR if failures < GIVE_UP_AFTER else math.inf
         else:  # reached: should it still be a frontier at the next reading, it is not one to drive to again
             self.unreachable[self.target.name] = math.inf
         self.inner = None
