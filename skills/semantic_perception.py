@@ -314,11 +314,9 @@ class StereoPointCloud(WorldSkill):
         self.job: Job | None = None
 
     def _capture(self) -> tuple[bool, str]:
-        from alica.worldsim.robot_camera import robot_camera
 
         # taken where the robot is, placed in the world by the camera pose of its pose estimate
-        image = robot_camera(
-            self.robot,  # type: ignore[arg-type]
+        image = self.robot.camera(
             width=self.width,
             height=self.height,
             far=self.max_depth + 0.5,

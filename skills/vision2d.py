@@ -38,7 +38,6 @@ from alica.worldsim.objects import SAMPLE_KINDS
 
 if TYPE_CHECKING:
     from alica.worldsim.robot_camera import CameraImage
-    from alica.worldsim.robots import Robot
 
 __all__ = [
     "BlobDetect",
@@ -452,11 +451,6 @@ def _number(skill: WorldSkill, name: str, default: float, *, low: float = 0.0, s
     return value
 
 
-def _sim_robot(skill: WorldSkill) -> Robot:
-    """The skill's robot as the simulator's robot, for the simulated sensors."""
-    return cast("Robot", skill.robot)
-
-
 class _Pipeline(WorldSkill):
     """A Verify2DObject step: the scratch space and the world model's candidate facts."""
 
@@ -543,11 +537,11 @@ class DetectCircles(_Pipeline):
         self.job: Job | None = self.jobs.submit(self._scan)
 
     def _scan(self) -> list[Circle]:
-        from alica.worldsim.sensors import lidar_angles, lidar_scan
+        from alica.worldsim.sensors import lidar_angles
 
-        robot = _sim_robot(self)
-        ranges = lidar_scan(robot, self.n_rays)  # measured where the robot is
-        sigma = float(getattr(getattr(robot.world, "noise", None), "lidar_sigma", 0.01))
+        robot = self.robot
+        ranges = robot.lidar(self.n_rays)  # measured where the robot is
+        sigma = robot.lidar_noise
         return detect_circles(
             ranges,
             lidar_angles(self.n_rays),
@@ -672,7 +666,7 @@ class CropCandidate(_Pipeline):
         circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
         verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
         unseen = cast("dict[str, float]", self.scratch.get("unseen") or {})
-        robot = _sim_robot(self)
+        robot = self.robot
         spec = robot.spec
         estimate = robot.estimate
         camera, _ = camera_pose(robot, estimate)
@@ -705,9 +699,8 @@ class CropCandidate(_Pipeline):
         return max(-limit, min(limit, bearing))
 
     def _render(self) -> CameraImage:
-        from alica.worldsim.robot_camera import robot_camera
 
-        return robot_camera(_sim_robot(self), width=self.width, height=self.height, pan=self.pan, believed=True)
+        return self.robot.camera(width=self.width, height=self.height, pan=self.pan, believed=True)
 
     def update(self) -> Status:
         """Poll the rendering; crop the candidate."""

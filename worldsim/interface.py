@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
     from alica.worldsim.arm import Arm
     from alica.worldsim.grid import Obstacle2D
+    from alica.worldsim.robot_camera import CameraImage
     from alica.worldsim.robots import RobotSpec
 
 __all__ = ["MobileRobot", "RobotWorld", "WorldThing"]
@@ -119,6 +120,24 @@ class MobileRobot(Protocol):
 
     def lidar(self, n_rays: int, max_range: float | None = None) -> np.ndarray:
         """One 2-D lidar scan: ``n_rays`` ranges (m) over the full circle from the heading on; no hit reads ``max_range``."""
+        ...
+
+    @property
+    def lidar_noise(self) -> float:
+        """Standard deviation in metres of the lidar's range noise."""
+        ...
+
+    def camera(
+        self,
+        *,
+        width: int = 320,
+        height: int = 240,
+        fov: float | None = None,
+        far: float | None = None,
+        pan: float = 0.0,
+        believed: bool = False,
+    ) -> CameraImage:
+        """One picture of the camera (``pan`` radians left of the heading; ``believed``: its pose from the estimate)."""
         ...
 
     @property

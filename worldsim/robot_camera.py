@@ -41,6 +41,7 @@ import numpy as np
 from alica.worldsim.errors import WorldError
 
 if TYPE_CHECKING:
+    from alica.worldsim.interface import MobileRobot
     from alica.worldsim.robots import Robot
 
 #: The camera sits this fraction of the robot's radius ahead of its centre.
@@ -96,7 +97,7 @@ class CameraImage:
 
 
 def camera_pose(
-    robot: Robot, pose: tuple[float, float, float] | None = None, pan: float = 0.0
+    robot: MobileRobot, pose: tuple[float, float, float] | None = None, pan: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Where the robot's camera is and how it is turned: ``(position, rotation world-from-camera)``.
 

@@ -24,6 +24,7 @@ from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.odometry import Odometry
 
 if TYPE_CHECKING:
+    from alica.worldsim.robot_camera import CameraImage
     from alica.worldsim.world import World
 
 __all__ = ["ROBOT_KINDS", "Arm", "Robot", "RobotSpec"]
@@ -243,6 +244,30 @@ class Robot:
         from alica.worldsim.sensors import lidar_scan
 
         return lidar_scan(self, n_rays, max_range)
+
+    @property
+    def lidar_noise(self) -> float:
+        """Standard deviation in metres of the lidar's range noise (the world's seeded sensor noise)."""
+        return float(self.world.noise.lidar_sigma)
+
+    def camera(
+        self,
+        *,
+        width: int = 320,
+        height: int = 240,
+        fov: float | None = None,
+        far: float | None = None,
+        pan: float = 0.0,
+        believed: bool = False,
+    ) -> CameraImage:
+        """One picture of the robot's camera (colour, depth, intrinsics, pose): see :func:`alica.worldsim.robot_camera.robot_camera`.
+
+        Raises:
+            WorldError: no camera, a bad size, field of view, range or a pan beyond the limit.
+        """
+        from alica.worldsim.robot_camera import robot_camera
+
+        return robot_camera(self, width=width, height=height, fov=fov, far=far, pan=pan, believed=believed)
 
     def set_estimate(self, pose: Sequence[float]) -> None:
         """Overwrite the pose estimate ``(x, y, yaw)`` (a localization's correction); odometry continues from it.

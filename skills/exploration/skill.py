@@ -182,6 +182,9 @@ class ExploreFrontier(WorldSkill):
                 given_up = len(self.candidates)
                 self._stop_inner()
                 self.robot.stop()
+                if given_up:  # nobody is to drive to them any more
+                    self.candidates = []
+                    self._publish()
                 self.write(True, "explored")
                 if given_up:
                     return self.succeed(
