@@ -1,39 +1,53 @@
 """Benchmark of coordinated exploration (issue 16's Exploration figure).
 
-Run with ``.venv/bin/python bench/exploration.py`` (``--seeds 10`` by default).
+Run with ``.venv/bin/python bench/exploration.py`` (``--seeds 10`` by default;
+``--seeds 2 --robots 1,3`` for a quick look).
 
-The field: ``alica.worldsim.scenarios.lunar(seed, rocks=60, size=40)``; its rocks
-(ground truth, used only to simulate the sensor and score) are rasterised at the
-map's resolution. The robots start where the scenario puts scout, stummel and
-amparo, and move in a fast 2-D kinematic simulation (no pybullet stepping):
+The field: ``alica.worldsim.scenarios.lunar(seed, rocks=60, size=40)`` in the
+2-D simulation of ``bench/exploration_sim.py`` (no pybullet stepping): every
+robot has the same speed (``--speed``, 0.8 m/s) and a 2-D lidar of
+``--range`` metres (180 rays, ray-marched on the true grid every time step of
+``--dt`` seconds) that updates one team map (the map the team shares). A robot
+drives along a shortest path on a coarse grid (0.2 m) of the known map,
+unknown cells counted passable, its centre kept :data:`RADIUS` from known
+occupied cells; it plans again as soon as its path runs into a cell newly seen
+too close to a rock. Every ``--period`` seconds, and whenever a robot reached
+its frontier, the frontier candidates and their information gain are computed
+from the team map with the library's own
+:func:`alica.skills.exploration.extract_frontiers` (Algorithm 1).
 
-* every robot has the same speed (``--speed``, 0.8 m/s) and a 2-D lidar of
-  ``--range`` metres (180 rays, ray-marched on the true grid every time step
-  of ``--dt`` seconds) that updates one team map (the map the team shares);
-* a robot drives along a shortest path on a coarse grid (0.25 m) of the known
-  map, unknown cells counted passable, obstacles inflated by its radius, and
-  plans again when its path runs into a cell newly seen occupied;
-* every ``--period`` seconds the frontier candidates and their information gain
-  are computed from the team map with the library's own
-  :func:`alica.skills.exploration.extract_frontiers` (Algorithm 1).
+Ways to choose a robot's next frontier, in the same run and on the same seeds
+(a robot asks when it has none: at the start, when it reached its frontier,
+when that one is no longer a frontier or is unreachable):
 
-Two ways to choose a robot's frontier, in the same run and on the same seeds:
+* **coordinated** (ours): the Explore plan of ``plans/skills/explore.yaml`` as
+  shipped: its constraints SpreadFrontiers (Eq. 7), NearbyFrontiers (Eq. 8)
+  and its utility GainOverTravel are read from the plan file and solved with
+  ``alica.solver.solve`` directly, as the engine would, but without running
+  the engine. Every bench robot is in ``agents(ExploreFrontiers)``
+  (``agents(ExploreAfterMapping)`` is empty: its terms are empty sums and
+  empty ``forall``). The other robots' frontiers are kept (their domains are
+  their current frontier), so robots are not re-routed while they drive. When
+  the constraints have no solution, or the solution lies within 4 m of a
+  frontier another robot heads for, the robot takes what ExploreFrontier
+  (``skills/exploration/skill.py``, ``_choose``) takes: the best usable
+  frontier by gain / (1 + distance) that is more than 4 m from the others'
+  frontiers (any usable one if none is) -- counted as ``fallbacks``.
+* **nearest frontier** (Yamauchi 1997): every robot drives to the usable
+  frontier nearest to it by path length, uncoordinated.
+* **gain only** (ablation, ``--ablation``): Eq. 7-8 from the plan with the
+  utility the plan had before it counted travel (the summed gain alone).
 
-* **coordinated** (ours): the constraints of ``plans/skills/explore.yaml`` (Eq. 7:
-  chosen frontiers more than 4 m apart; Eq. 8: each within 15 m of its robot;
-  utility: the summed gain) solved with ``alica.solver.solve`` directly, as the
-  engine would, but without running the engine. A robot that needs a frontier
-  (it reached its own, or its own vanished) triggers a solve in which the other
-  robots' frontiers are kept (their domains are their current frontier), so
-  robots are not re-routed while they drive; when the constraints cannot be
-  satisfied (no frontier within 15 m, say) the robot takes its nearest
-  frontier at least 4 m from the others' (counted as ``fallbacks``).
-* **nearest frontier** (Yamauchi 1997): every robot drives to the frontier
-  nearest to it by path length, uncoordinated.
+As in ExploreFrontier, a frontier the robot reached is not chosen by it
+again, one it could not plan a path to is left out for 30 s.
 
 For 1, 2 and 3 robots the simulated time to 90 % coverage of the truly free
-cells is measured (runs end at ``--max-time`` seconds). Prints a markdown table
-and writes ``build/exploration_coverage.png`` (mean coverage over time).
+cells is measured; a run ends at ``--stop`` coverage (95 %), when no frontier
+is left, or at ``--max-time`` (a run that never reached 90 % is a *stall*).
+``contacts`` counts robot-steps in which a robot overlapped a rock (should
+be 0: the simulation has no collisions, so it checks the planner). Prints a
+markdown table and the goals, writes ``build/exploration_coverage.png`` (mean
+coverage over time; time to 90 % per run).
 """
 
 from __future__ import annotations
@@ -46,145 +60,47 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from scipy import ndimage
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
+from exploration_sim import RADIUS, Field, Planner, make_field, sense
 
 from alica.lang import FactBase, parse
-from alica.skills.exploration import FREE, OCCUPIED, UNKNOWN, FrontierCandidate, extract_frontiers
+from alica.skills.exploration import UNKNOWN, FrontierCandidate, extract_frontiers
 from alica.solver import Finite, Problem, Term, Var, solve
 
 ROBOTS = ("scout", "stummel", "amparo")
-SPREAD = "forall a, b in agents(ExploreFrontiers): a == b or MaximalDist(frontier(a), frontier(b), 4.0)"
-NEAR = "forall a in agents(ExploreFrontiers): MinimalDist(frontier(a), a, 15.0)"
-GAIN = "sum a in agents(ExploreFrontiers): gain(frontier(a))"
-#: A variant utility (not in explore.yaml): the paper's "minimal distance to travel" as a cost, 1 m² of gain per metre
-GAIN_DIST = "sum a in agents(ExploreFrontiers): gain(frontier(a)) - dist(frontier(a), a)"
-RADIUS = 0.3
-METHODS = ("coordinated", "nearest", "gain-dist")
-PLAN_RES = 0.25
+#: The plan's names: its constraints (Eq. 7, Eq. 8) and its utility.
+PLAN_CONSTRAINTS = ("SpreadFrontiers", "NearbyFrontiers")
+PLAN_UTILITY = "GainOverTravel"
+#: The ablation's utility: the summed gain alone (the plan's utility before it counted the travel).
+GAIN_ONLY = "sum a in agents(ExploreFrontiers): gain(frontier(a))"
+#: Metres from the frontiers the others head for (ExploreFrontier's ``spacing``, eps1 of Eq. 7).
+SPACING = 4.0
+#: Seconds a frontier the robot could not reach is left out (ExploreFrontier's UNREACHABLE_FOR).
+UNREACHABLE_FOR = 30.0
+LABELS = {
+    "coordinated": "Eq. 7-8 + GainOverTravel (explore.yaml)",
+    "nearest": "nearest frontier",
+    "gain-only": "ablation: Eq. 7-8, gain only",
+}
+STYLES = {"coordinated": "-", "nearest": "--", "gain-only": ":"}
 
 
-@dataclass
-class Field:
-    truth: np.ndarray  # occupied [row, col] at the map resolution
-    free: np.ndarray
-    origin: tuple[float, float]
-    resolution: float
-    starts: dict[str, tuple[float, float]]
+def plan_terms() -> tuple[tuple[Term, ...], Term]:
+    """The Explore plan's constraints and utility, read from the shipped ``skills/explore.yaml``."""
+    from alica.io import load_document, plans_dir
 
-
-def make_field(seed: int, resolution: float) -> Field:
-    from alica.worldsim.grid import OccupancyGrid
-    from alica.worldsim.scenarios import lunar
-
-    world = lunar(seed, rocks=60, samples=0, size=40.0)
-    try:
-        grid = OccupancyGrid.from_obstacles(world.ground_truth_obstacles(), world.bounds, resolution)
-        starts = {n: (float(r.pose[0]), float(r.pose[1])) for n, r in world.robots.items()}
-    finally:
-        world.close()
-    truth = grid.cells == OCCUPIED
-    return Field(truth, ~truth, (float(grid.origin[0]), float(grid.origin[1])), resolution, starts)
-
-
-def sense(fld: Field, occ: np.ndarray, xy: tuple[float, float], reach: float) -> None:
-    """One 180-ray scan at ``xy``: cells up to the first hit free, the hit occupied."""
-    res = fld.resolution
-    angles = np.linspace(-math.pi, math.pi, 180, endpoint=False)
-    steps = np.arange(0.0, reach, 0.5 * res)
-    px = xy[0] + np.cos(angles)[:, None] * steps[None, :]
-    py = xy[1] + np.sin(angles)[:, None] * steps[None, :]
-    cols = np.floor((px - fld.origin[0]) / res).astype(int)
-    rows = np.floor((py - fld.origin[1]) / res).astype(int)
-    h, w = occ.shape
-    inside = (rows >= 0) & (rows < h) & (cols >= 0) & (cols < w)
-    rc, cc = np.clip(rows, 0, h - 1), np.clip(cols, 0, w - 1)
-    blocked = fld.truth[rc, cc] | ~inside
-    first = np.where(blocked.any(axis=1), blocked.argmax(axis=1), len(steps))
-    before = np.arange(len(steps))[None, :] < first[:, None]
-    occ[rc[before], cc[before]] = FREE
-    hit = first < len(steps)
-    hr, hc = rc[hit, first[hit]], cc[hit, first[hit]]
-    ok = inside[hit, first[hit]]
-    occ[hr[ok], hc[ok]] = OCCUPIED
-
-
-class Planner:
-    """Shortest paths on a coarse grid of the known map (unknown passable, obstacles inflated)."""
-
-    def __init__(self, fld: Field) -> None:
-        self.fld = fld
-        self.factor = max(1, round(PLAN_RES / fld.resolution))
-        h, w = fld.truth.shape
-        self.shape = (h // self.factor, w // self.factor)
-        hh, ww = self.shape
-        idx = np.arange(hh * ww).reshape(hh, ww)
-        src, dst, cost = [], [], []
-        for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-            # pairs (r, c) -> (r + dr, c + dc) inside the grid
-            a = idx[: hh - dr, max(0, -dc) : ww - max(0, dc)]
-            b = idx[dr:, max(0, dc) : ww + min(0, dc)]
-            src.append(a.ravel())
-            dst.append(b.ravel())
-            cost.append(np.full(a.size, math.hypot(dr, dc) * PLAN_RES))
-        self.src, self.dst, self.cost = np.concatenate(src), np.concatenate(dst), np.concatenate(cost)
-        self.blocked = np.zeros(self.shape, dtype=bool)
-
-    def update(self, occ: np.ndarray) -> None:
-        f = self.factor
-        hh, ww = self.shape
-        occ_coarse = (occ[: hh * f, : ww * f] == OCCUPIED).reshape(hh, f, ww, f).any(axis=(1, 3))
-        grow = max(1, math.ceil(RADIUS / PLAN_RES))
-        self.blocked = ndimage.binary_dilation(occ_coarse, iterations=grow)
-        ok = ~self.blocked.ravel()
-        keep = ok[self.src] & ok[self.dst]
-        n = self.shape[0] * self.shape[1]
-        self.graph = csr_matrix((self.cost[keep], (self.src[keep], self.dst[keep])), shape=(n, n))
-
-    def cell(self, xy: tuple[float, float]) -> int:
-        c = int((xy[0] - self.fld.origin[0]) / PLAN_RES)
-        r = int((xy[1] - self.fld.origin[1]) / PLAN_RES)
-        r = min(max(r, 0), self.shape[0] - 1)
-        c = min(max(c, 0), self.shape[1] - 1)
-        return r * self.shape[1] + c
-
-    def centre(self, k: int) -> tuple[float, float]:
-        r, c = divmod(k, self.shape[1])
-        return (self.fld.origin[0] + (c + 0.5) * PLAN_RES, self.fld.origin[1] + (r + 0.5) * PLAN_RES)
-
-    def tree(self, xy: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-        """Path lengths and predecessors from ``xy`` (from the nearest open cell when the robot is inside an inflation)."""
-        start = self.cell(xy)
-        r0, c0 = divmod(start, self.shape[1])
-        if self.blocked[r0, c0]:
-            rows, cols = np.nonzero(~self.blocked[max(0, r0 - 4) : r0 + 5, max(0, c0 - 4) : c0 + 5])
-            if len(rows):
-                k = int(np.argmin((rows + max(0, r0 - 4) - r0) ** 2 + (cols + max(0, c0 - 4) - c0) ** 2))
-                start = (rows[k] + max(0, r0 - 4)) * self.shape[1] + cols[k] + max(0, c0 - 4)
-        dist, pred = dijkstra(self.graph, directed=False, indices=int(start), return_predecessors=True)
-        return dist, pred
-
-    def nearest_open(self, xy: tuple[float, float], dist: np.ndarray) -> int | None:
-        """The reachable coarse cell nearest to ``xy`` within 0.75 m (a frontier cell may sit in the inflation)."""
-        r0, c0 = divmod(self.cell(xy), self.shape[1])
-        best: tuple[float, int] | None = None
-        for dr in range(-3, 4):
-            for dc in range(-3, 4):
-                r, c = r0 + dr, c0 + dc
-                if 0 <= r < self.shape[0] and 0 <= c < self.shape[1]:
-                    k = r * self.shape[1] + c
-                    if math.isfinite(dist[k]) and (best is None or math.hypot(dr, dc) < best[0]):
-                        best = (math.hypot(dr, dc), k)
-        return None if best is None else best[1]
-
-    def path(self, pred: np.ndarray, goal: int) -> list[tuple[float, float]]:
-        out = []
-        k = goal
-        while k >= 0:
-            out.append(self.centre(k))
-            k = int(pred[k])
-        return out[::-1]
+    path = plans_dir() / "skills" / "explore.yaml"
+    plan = next((p for p in load_document(path).plans if p.name == "Explore"), None)
+    if plan is None:
+        raise SystemExit(f"{path}: no plan 'Explore'; the bench solves that plan's constraints")
+    by_name = {c.name: c for c in plan.constraints}
+    missing = [n for n in (*PLAN_CONSTRAINTS, PLAN_UTILITY) if n not in by_name]
+    if missing:
+        raise SystemExit(f"{path}: the Explore plan has no constraint {', '.join(missing)} (has {sorted(by_name)})")
+    constraints = tuple(Term(n, parse(by_name[n].text), by_name[n].text) for n in PLAN_CONSTRAINTS)
+    text = by_name[PLAN_UTILITY].utility
+    if not text:
+        raise SystemExit(f"{path}: the Explore plan's {PLAN_UTILITY} has no utility")
+    return constraints, Term(PLAN_UTILITY, parse(text), text)
 
 
 @dataclass
@@ -193,16 +109,27 @@ class Bot:
     xy: tuple[float, float]
     target: FrontierCandidate | None = None
     path: list[tuple[float, float]] = field(default_factory=list)
-    done: set[str] = field(default_factory=set)
+    reached: set[str] = field(default_factory=set)
+    unreachable: dict[str, float] = field(default_factory=dict)
+
+    def usable(self, cands: list[FrontierCandidate], now: float) -> list[FrontierCandidate]:
+        """The candidates this robot may choose (ExploreFrontier's ``usable``)."""
+        return [c for c in cands if c.name not in self.reached and self.unreachable.get(c.name, -math.inf) <= now]
 
 
 def coordinated_choice(
-    bots: list[Bot], needy: Bot, cands: list[FrontierCandidate], time_limit: float, utility: str = GAIN
-) -> tuple[FrontierCandidate | None, bool]:
-    """The solver's frontier for ``needy`` (Eq. 7-8, summed gain), the others' frontiers kept."""
-    usable = [c for c in cands if c.name not in needy.done]
-    if not usable:
-        return None, False
+    bots: list[Bot],
+    needy: Bot,
+    usable: list[FrontierCandidate],
+    cands: list[FrontierCandidate],
+    constraints: tuple[Term, ...],
+    utility: Term,
+    time_limit: float,
+) -> tuple[FrontierCandidate, bool]:
+    """The solver's frontier for ``needy`` (the others' frontiers kept), else ExploreFrontier's own choice.
+
+    Returns the frontier and whether it was the fallback.
+    """
     world = FactBase()
     by_name = {c.name: c for c in cands}
     for c in cands:
@@ -211,134 +138,167 @@ def coordinated_choice(
     variables = []
     for b in bots:
         world.set("Pos", b.name, value=b.xy)
-        world.add_object(b.name, "agents(ExploreFrontiers)")
         if b is needy:
             domain: tuple[str, ...] = tuple(c.name for c in usable)
         elif b.target is not None and b.target.name in by_name:
             domain = (b.target.name,)
         else:
-            continue
+            continue  # a robot with no frontier yet is not among the explorers of this solve
+        world.add_object(b.name, "agents(ExploreFrontiers)")
         variables.append(Var("frontier", b.name, Finite(domain)))
-    active = {v.agent for v in variables}
-    for b in bots:
-        if b.name not in active:  # a robot with no frontier yet is not among the explorers of this solve
-            world.remove_object(b.name, "agents(ExploreFrontiers)")
-    problem = Problem(
-        variables=tuple(variables),
-        constraints=(Term("SpreadFrontiers", parse(SPREAD), SPREAD), Term("NearbyFrontiers", parse(NEAR), NEAR)),
-        utilities=(Term("InformationGain", parse(utility), utility),),
-        belief=world,
-    )
+    problem = Problem(variables=tuple(variables), constraints=constraints, utilities=(utility,), belief=world)
     sol = solve(problem, time_limit=time_limit)
+    heading = [b.target.position for b in bots if b is not needy and b.target is not None]
+    mine = {c.name: c for c in usable}
     if sol.status == "solved":
         value = sol.of(needy.name)
         name = value.get("frontier") if isinstance(value, dict) else value
-        if isinstance(name, str) and name in by_name:
-            return by_name[name], False
-    # infeasible: the nearest frontier at least 4 m from the others' (greedy fallback)
-    others = [b.target.position for b in bots if b is not needy and b.target is not None]
-    apart = [c for c in usable if all(math.dist(c.position, o) > 4.0 for o in others)] or usable
-    return min(apart, key=lambda c: math.dist(c.position, needy.xy)), True
+        if isinstance(name, str) and name in mine:
+            if all(math.dist(mine[name].position, o) > SPACING for o in heading):
+                return mine[name], False
+    apart = [c for c in usable if all(math.dist(c.position, o) > SPACING for o in heading)]
+    pool = apart or usable
+    return max(pool, key=lambda c: (c.gain / (1.0 + math.dist(needy.xy, c.position)), c.name)), True
 
 
-def run(
-    fld: Field, n: int, method: str, args: argparse.Namespace
-) -> tuple[float, list[tuple[float, float]], dict[str, int]]:
-    occ = np.full(fld.truth.shape, UNKNOWN, dtype=np.int8)
-    bots = [Bot(name, fld.starts[name]) for name in ROBOTS[:n]]
-    planner = Planner(fld)
-    total_free = int(fld.free.sum())
-    t = 0.0
-    curve: list[tuple[float, float]] = []
-    stats = {"solves": 0, "fallbacks": 0, "plans": 0}
-    cands: list[FrontierCandidate] = []
-    next_frontiers = 0.0
-    reached = math.nan
-    step = args.speed * args.dt
-    while t <= args.max_time:
-        for b in bots:
-            sense(fld, occ, b.xy, args.range)
-        cov = float(((occ != UNKNOWN) & fld.free).sum() / total_free)
-        curve.append((t, cov))
-        if cov >= 0.9 and math.isnan(reached):
-            reached = t
-            if not args.full_curves:
+class Run:
+    """One exploration run of ``n`` robots with one method on one field."""
+
+    def __init__(self, fld: Field, n: int, method: str, args: argparse.Namespace, terms) -> None:
+        self.fld, self.method, self.args = fld, method, args
+        self.constraints, self.utility = terms
+        self.occ = np.full(fld.truth.shape, UNKNOWN, dtype=np.int8)
+        self.bots = [Bot(name, fld.starts[name]) for name in ROBOTS[:n]]
+        self.planner = Planner(fld)
+        self.stats = {"solves": 0, "fallbacks": 0, "plans": 0, "contacts": 0, "idle": 0}
+        self.cands: list[FrontierCandidate] = []
+
+    def go(self) -> tuple[float, list[tuple[float, float]]]:
+        """Simulate; the time to 90 % (nan: never) and the coverage curve."""
+        fld, args = self.fld, self.args
+        total_free = int(fld.free.sum())
+        t, next_frontiers, reached = 0.0, 0.0, math.nan
+        curve: list[tuple[float, float]] = []
+        step = args.speed * args.dt
+        while t <= args.max_time:
+            for b in self.bots:
+                sense(fld, self.occ, b.xy, args.range)
+            cov = float(((self.occ != UNKNOWN) & fld.free).sum() / total_free)
+            curve.append((t, cov))
+            if cov >= 0.9 and math.isnan(reached):
+                reached = t
+            if cov >= args.stop:
                 break
-        if t >= next_frontiers:
-            next_frontiers = t + args.period
-            cands = extract_frontiers(occ, fld.resolution, fld.origin, reach=3.0, min_gain=1.0, clearance=RADIUS + 0.1)
-            names = {c.name for c in cands}
-            planner.update(occ)
-            for b in bots:
-                if b.target is not None and b.target.name not in names:
-                    b.target, b.path = None, []
-            if not cands:
-                break
-        for b in bots:
-            if b.path and any(planner.blocked[divmod(planner.cell(p), planner.shape[1])] for p in b.path[1:-1]):
-                b.path = []  # runs into something newly seen: plan again
-                if b.target is not None:
-                    b.path = _plan(planner, b, b.target.position, stats) or []
-            if b.target is None or not b.path:
-                if b.target is not None:  # unreachable or reached
-                    b.done.add(b.target.name)
-                b.target, b.path = _assign(bots, b, cands, planner, method, stats, args)
-        for b in bots:
-            left = step
-            while left > 0 and b.path:
-                nxt = b.path[0]
-                d = math.dist(b.xy, nxt)
-                if d <= left:
-                    b.xy, left = nxt, left - d
-                    b.path.pop(0)
-                else:
-                    f = left / d
-                    b.xy = (b.xy[0] + f * (nxt[0] - b.xy[0]), b.xy[1] + f * (nxt[1] - b.xy[1]))
-                    left = 0.0
-        t += args.dt
-    return reached, curve, stats
+            self.planner.update(self.occ)
+            if t >= next_frontiers:
+                next_frontiers = t + args.period
+                if not self._frontiers():
+                    break  # explored: no frontier with gain left
+            for b in self.bots:
+                if b.path and self._runs_into(b.path):
+                    b.path = self._plan(b, b.target.position) if b.target is not None else None
+                    if b.path is None:
+                        b.unreachable[b.target.name] = t + UNREACHABLE_FOR  # type: ignore[union-attr]
+                        b.target, b.path = None, []
+                if b.target is None:
+                    self._assign(b, t)
+                if b.target is None:
+                    self.stats["idle"] += 1
+            arrived = False
+            for b in self.bots:
+                arrived |= self._move(b, step)
+                self.stats["contacts"] += int(fld.contact(b.xy))
+            if arrived:  # read the map from where the robot stands now (as ExploreFrontier does)
+                next_frontiers = t + args.dt
+            t += args.dt
+        return reached, curve
+
+    def _frontiers(self) -> bool:
+        self.cands = extract_frontiers(
+            self.occ, self.fld.resolution, self.fld.origin, reach=3.0, min_gain=1.0, clearance=RADIUS + 0.1
+        )
+        names = {c.name for c in self.cands}
+        for b in self.bots:
+            if b.target is not None and b.target.name not in names:
+                b.target, b.path = None, []
+        return bool(self.cands)
+
+    def _runs_into(self, path: list[tuple[float, float]]) -> bool:
+        if len(path) < 2:
+            return False
+        pts = np.asarray(path[:-1])  # the last point is the frontier itself
+        p = self.planner
+        cols = np.clip(((pts[:, 0] - self.fld.origin[0]) / p.step).astype(int), 0, p.shape[1] - 1)
+        rows = np.clip(((pts[:, 1] - self.fld.origin[1]) / p.step).astype(int), 0, p.shape[0] - 1)
+        return bool(p.blocked[rows, cols].any())
+
+    def _move(self, b: Bot, step: float) -> bool:
+        """Drive ``step`` metres along the path; True when the robot reached its frontier."""
+        left = step
+        while left > 0 and b.path:
+            nxt = b.path[0]
+            d = math.dist(b.xy, nxt)
+            if d <= left:
+                b.xy, left = nxt, left - d
+                b.path.pop(0)
+            else:
+                f = left / d
+                b.xy = (b.xy[0] + f * (nxt[0] - b.xy[0]), b.xy[1] + f * (nxt[1] - b.xy[1]))
+                left = 0.0
+        if b.target is not None and not b.path:
+            b.reached.add(b.target.name)
+            b.target = None
+            return True
+        return False
+
+    def _plan(self, b: Bot, goal: tuple[float, float]) -> list[tuple[float, float]] | None:
+        self.stats["plans"] += 1
+        dist, pred = self.planner.tree(b.xy)
+        k = self.planner.nearest_open(goal, dist)
+        if k is None:
+            return None
+        return self.planner.path(pred, k)[1:] + [goal]
+
+    def _assign(self, b: Bot, now: float) -> None:
+        for _ in range(5):
+            usable = b.usable(self.cands, now)
+            if not usable:
+                return
+            if self.method == "nearest":
+                self._assign_nearest(b, usable)
+                return
+            self.stats["solves"] += 1
+            utility = self.utility if self.method == "coordinated" else Term("GainOnly", parse(GAIN_ONLY), GAIN_ONLY)
+            choice, fell_back = coordinated_choice(
+                self.bots, b, usable, self.cands, self.constraints, utility, self.args.time_limit
+            )
+            self.stats["fallbacks"] += int(fell_back)
+            path = self._plan(b, choice.position)
+            if path is not None:
+                b.target, b.path = choice, path
+                return
+            b.unreachable[choice.name] = now + UNREACHABLE_FOR
+
+    def _assign_nearest(self, b: Bot, usable: list[FrontierCandidate]) -> None:
+        self.stats["plans"] += 1
+        dist, pred = self.planner.tree(b.xy)
+        best: tuple[float, FrontierCandidate, int] | None = None
+        for c in usable:
+            k = self.planner.nearest_open(c.position, dist)
+            if k is not None and (best is None or dist[k] < best[0]):
+                best = (float(dist[k]), c, k)
+        if best is not None:
+            b.target, b.path = best[1], self.planner.path(pred, best[2])[1:] + [best[1].position]
 
 
-def _plan(
-    planner: Planner, b: Bot, goal: tuple[float, float], stats: dict[str, int]
-) -> list[tuple[float, float]] | None:
-    stats["plans"] += 1
-    dist, pred = planner.tree(b.xy)
-    k = planner.nearest_open(goal, dist)
-    if k is None:
-        return None
-    return planner.path(pred, k) + [goal]
-
-
-def _assign(
-    bots: list[Bot], b: Bot, cands: list[FrontierCandidate], planner: Planner, method: str, stats: dict[str, int], args
-) -> tuple[FrontierCandidate | None, list[tuple[float, float]]]:
-    for _ in range(5):
-        usable = [c for c in cands if c.name not in b.done]
-        if not usable:
-            return None, []
-        if method == "nearest":
-            stats["plans"] += 1
-            dist, pred = planner.tree(b.xy)
-            best: tuple[float, FrontierCandidate, int] | None = None
-            for c in usable:
-                k = planner.nearest_open(c.position, dist)
-                if k is not None and (best is None or dist[k] < best[0]):
-                    best = (float(dist[k]), c, k)
-            if best is None:
-                return None, []
-            return best[1], planner.path(pred, best[2]) + [best[1].position]
-        stats["solves"] += 1
-        utility = GAIN_DIST if method == "gain-dist" else GAIN
-        choice, fell_back = coordinated_choice(bots, b, cands, args.time_limit, utility)
-        stats["fallbacks"] += int(fell_back)
-        if choice is None:
-            return None, []
-        path = _plan(planner, b, choice.position, stats)
-        if path:
-            return choice, path
-        b.done.add(choice.name)
-    return None, []
+def describe(times: list[float], max_time: float) -> tuple[str, str, float]:
+    """Median and mean (a stalled run counts as ``max_time``, shown as a lower bound) and the median."""
+    stalls = sum(math.isnan(x) for x in times)
+    filled = [max_time if math.isnan(x) else x for x in times]
+    med = statistics.median(filled)
+    mark = ">= " if stalls else ""
+    med_s = f"{mark}{med:.0f}" if stalls * 2 >= len(times) or med >= max_time else f"{med:.0f}"
+    return med_s, f"{mark}{statistics.fmean(filled):.0f}", med
 
 
 def main() -> None:
@@ -351,11 +311,19 @@ def main() -> None:
     parser.add_argument("--period", type=float, default=2.0)
     parser.add_argument("--resolution", type=float, default=0.1)
     parser.add_argument("--max-time", type=float, default=1500.0)
+    parser.add_argument("--stop", type=float, default=0.95, help="coverage at which a run ends (>= 0.9)")
     parser.add_argument("--time-limit", type=float, default=0.2, help="seconds per solve")
-    parser.add_argument("--full-curves", action="store_true", help="run to max-time for the plot")
+    parser.add_argument("--ablation", action="store_true", help="also run the gain-only utility")
     parser.add_argument("--out", default="build/exploration_coverage.png")
     args = parser.parse_args()
-    counts = [int(k) for k in args.robots.split(",")]
+    try:
+        counts = [int(k) for k in args.robots.split(",")]
+    except ValueError:
+        raise SystemExit(f"--robots takes robot counts separated by commas (1,2,3), got {args.robots!r}") from None
+    if not counts or any(not 1 <= k <= len(ROBOTS) for k in counts) or args.seeds < 1 or not 0.9 <= args.stop <= 1.0:
+        raise SystemExit("--robots counts must lie in 1..3, --seeds must be >= 1 and --stop within [0.9, 1]")
+    terms = plan_terms()
+    methods = ("coordinated", "nearest") + (("gain-only",) if args.ablation else ())
     results: dict[tuple[str, int], list[float]] = {}
     curves: dict[tuple[str, int], list[list[tuple[float, float]]]] = {}
     wall: dict[tuple[str, int], list[float]] = {}
@@ -363,71 +331,91 @@ def main() -> None:
     for seed in range(args.seeds):
         fld = make_field(seed, args.resolution)
         for n in counts:
-            for method in METHODS:
+            for method in methods:
                 start = time.perf_counter()
-                reached, curve, stats = run(fld, n, method, args)
+                run = Run(fld, n, method, args, terms)
+                reached, curve = run.go()
                 key = (method, n)
                 wall.setdefault(key, []).append(time.perf_counter() - start)
                 results.setdefault(key, []).append(reached)
                 curves.setdefault(key, []).append(curve)
                 acc = extra.setdefault(key, {})
-                for k, v in stats.items():
+                for k, v in run.stats.items():
                     acc[k] = acc.get(k, 0) + v
                 print(
-                    f"seed {seed} {method:11s} {n} robots: 90 % at {reached:.0f} s ({wall[key][-1]:.1f} s wall)",
+                    f"seed {seed} {method:11s} {n} robots: 90 % at {reached:.0f} s, "
+                    f"{run.stats['solves']} solves ({run.stats['fallbacks']} fallbacks) ({wall[key][-1]:.1f} s wall)",
                     flush=True,
                 )
-    print()
-    print(f"Time to 90 % coverage, {args.seeds} seeds, 40 x 40 m, 60 rocks, lidar {args.range:g} m, {args.speed:g} m/s")
+    table(results, wall, extra, counts, methods, args)
+    plot(curves, results, counts, methods, args)
+
+
+def table(results, wall, extra, counts, methods, args) -> None:
+    """The markdown table and the goals."""
     print()
     print(
-        "| robots | coordinated (Eq. 7-8), median s | mean s | x of 1 robot | nearest frontier, median s | mean s "
-        "| coordinated faster by | solves (fallbacks) | Eq. 7-8 + distance cost, median s | x of 1 robot | faster than nearest by | wall s/run |"
+        f"Time to 90 % coverage (simulated s), {args.seeds} seeds, 40 x 40 m, 60 rocks, lidar {args.range:g} m, "
+        f"{args.speed:g} m/s, runs end at {args.max_time:g} s"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
-    base_gd = statistics.median(results[("gain-dist", counts[0])]) if counts and counts[0] == 1 else math.nan
-    base = statistics.median(results[("coordinated", counts[0])]) if counts and counts[0] == 1 else math.nan
+    print()
+    head = "| robots | coordinated median | mean | x of 1 robot | nearest median | mean | x of 1 robot | coordinated faster by |"
+    rule = "|---|---|---|---|---|---|---|---|"
+    if "gain-only" in methods:
+        head += " gain-only median | x of 1 robot |"
+        rule += "---|---|"
+    print(head + " solves (fallbacks) | stalls (coord. / nearest) | contacts | wall s/run |")
+    print(rule + "---|---|---|---|")
+    med = {k: describe(v, args.max_time)[2] for k, v in results.items()}
+    base = {m: med[(m, 1)] if 1 in counts else math.nan for m in methods}
     for n in counts:
-        co, ne = results[("coordinated", n)], results[("nearest", n)]
-        mco, mne = statistics.median(co), statistics.median(ne)
+        cells = [str(n)]
+        for m in ("coordinated", "nearest"):
+            ms, mean, _ = describe(results[(m, n)], args.max_time)
+            cells += [ms, mean, f"{med[(m, n)] / base[m]:.2f}"]
+        cells.append(f"{100 * (1 - med[('coordinated', n)] / med[('nearest', n)]):.0f} %")
+        if "gain-only" in methods:
+            cells += [
+                describe(results[("gain-only", n)], args.max_time)[0],
+                f"{med[('gain-only', n)] / base['gain-only']:.2f}",
+            ]
+        co = extra[("coordinated", n)]
+        stalls = [sum(math.isnan(x) for x in results[(m, n)]) for m in ("coordinated", "nearest")]
+        cells += [
+            f"{co['solves']} ({co['fallbacks']})",
+            f"{stalls[0]} / {stalls[1]}",
+            str(sum(extra[(m, n)]["contacts"] for m in methods)),
+            f"{statistics.fmean([w for m in methods for w in wall[(m, n)]]):.1f}",
+        ]
+        print("| " + " | ".join(cells) + " |")
+    print()
+    if 1 in counts and 3 in counts:
+        ratio = med[("coordinated", 3)] / med[("coordinated", 1)]
+        faster = 1 - med[("coordinated", 3)] / med[("nearest", 3)]
         print(
-            f"| {n} | {mco:.0f} | {statistics.fmean(co):.0f} | {mco / base:.2f} | {mne:.0f} | {statistics.fmean(ne):.0f} | "
-            f"{100 * (1 - mco / mne):.0f} % | {extra[('coordinated', n)]['solves']} ({extra[('coordinated', n)]['fallbacks']}) | "
-            f"{statistics.median(results[('gain-dist', n)]):.0f} | {statistics.median(results[('gain-dist', n)]) / base_gd:.2f} | "
-            f"{100 * (1 - statistics.median(results[('gain-dist', n)]) / mne):.0f} % | "
-            f"{statistics.fmean([w for m in METHODS for w in wall[(m, n)]]):.1f} |"
+            f"Goal: 3 robots <= 0.45 x the time of 1 (coordinated, medians): {ratio:.2f} -> {'met' if ratio <= 0.45 else 'MISSED'}"
         )
-    plot(curves, counts, args)
+        print(
+            f"Goal: coordinated >= 20 % faster than nearest frontier with 3 robots (medians): {100 * faster:.0f} % -> {'met' if faster >= 0.2 else 'MISSED'}"
+        )
 
 
-STYLES = {"coordinated": "-", "nearest": "--", "gain-dist": ":"}
-LABELS = {
-    "coordinated": "Eq. 7-8 (explore.yaml)",
-    "nearest": "nearest frontier",
-    "gain-dist": "Eq. 7-8 + distance cost",
-}
-
-
-def plot(curves, counts, args) -> None:
+def plot(curves, results, counts, methods, args) -> None:
+    """Mean coverage over time per method and robot count; time to 90 % per run."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    grid = np.arange(0.0, args.max_time + args.dt, 5.0)
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8), gridspec_kw={"width_ratios": [3, 2]})
     colours = {1: "tab:blue", 2: "tab:orange", 3: "tab:green"}
     for (method, n), runs in sorted(curves.items()):
-        ys = []
-        for curve in runs:
-            ts = np.array([c[0] for c in curve])
-            cs = np.array([c[1] for c in curve])
-            ys.append(np.interp(grid, ts, cs, right=cs[-1]))
-        mean = np.mean(ys, axis=0)
-        last = grid <= max(c[-1][0] for c in runs) + 5
+        end = max(c[-1][0] for c in runs)
+        grid = np.arange(0.0, end + args.dt, 5.0)
+        ys = [np.interp(grid, [c[0] for c in curve], [c[1] for c in curve]) for curve in runs]
         ax.plot(
-            grid[last],
-            mean[last],
+            grid,
+            np.mean(ys, axis=0),
             color=colours.get(n, "k"),
             ls=STYLES[method],
             label=f"{n} robot{'s' if n > 1 else ''}, {LABELS[method]}",
@@ -435,9 +423,20 @@ def plot(curves, counts, args) -> None:
     ax.axhline(0.9, color="grey", lw=0.8)
     ax.set_xlabel("simulated time (s)")
     ax.set_ylabel("coverage of the free field")
-    ax.set_title(f"Exploration, 40 x 40 m, 60 rocks, mean of {args.seeds} seeds")
-    ax.legend(fontsize=8)
+    ax.set_title(f"mean coverage, {args.seeds} seeds (a run ends at {100 * args.stop:.0f} %)", fontsize=10)
+    ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
+    keys = [(m, n) for n in counts for m in methods]
+    data = [[args.max_time if math.isnan(x) else x for x in results[k]] for k in keys]
+    box = bx.boxplot(data, patch_artist=True)
+    for patch, (m, n) in zip(box["boxes"], keys):
+        patch.set_facecolor(colours.get(n, "grey"))
+        patch.set_alpha(0.6 if m == "coordinated" else 0.25)
+    bx.set_xticks(range(1, len(keys) + 1), [f"{n}\n{m}" for m, n in keys], fontsize=7)
+    bx.set_ylabel("time to 90 % (s; a stall counts as --max-time)")
+    bx.set_title("time to 90 % coverage per run", fontsize=10)
+    bx.grid(alpha=0.3, axis="y")
+    fig.suptitle("Exploration, 40 x 40 m, 60 rocks")
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
