@@ -488,22 +488,6 @@ def test_the_semantic_perception_plan_runs_with_the_skills(tmp_path, with_sample
             assert summary["path"] == "SemanticPerception:NoSample" and not found
 
 
-@pytest.fixture
-def teams(monkeypatch):
-    """The teams ``alica run`` makes, to read their world models afterwards."""
-    import alica.engine
-
-    made = []
-
-    class Recording(alica.engine.SimulatedTeam):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            made.append(self)
-
-    monkeypatch.setattr(alica.engine, "SimulatedTeam", Recording)
-    return made
-
-
 @pytest.mark.parametrize("seed", [3, 10])
 def test_the_semantic_perception_plan_runs_from_the_command_line(capfd, teams, seed):
     from pathlib import Path

@@ -434,22 +434,6 @@ def test_the_verify_plan_finds_a_sample_in_the_engine(tmp_path):
 PLAN = str(Path(__file__).resolve().parents[2] / "plans" / "skills" / "verify_2d_object.yaml")
 
 
-@pytest.fixture
-def teams(monkeypatch):
-    """The teams ``alica run`` makes, to read their world models afterwards."""
-    import alica.engine
-
-    made = []
-
-    class Recording(alica.engine.SimulatedTeam):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            made.append(self)
-
-    monkeypatch.setattr(alica.engine, "SimulatedTeam", Recording)
-    return made
-
-
 def _sample_near(seed: int, robot: str) -> tuple[str, tuple[float, float]]:
     """The kind and place of the sample ``alica run --world lunar --size 10 --rocks 2 --samples 1`` puts near ``robot``."""
     from alica.worldsim.scenarios import lunar
