@@ -9,7 +9,9 @@ block when the team replans is part of the world, and the plan may use it.
 Facts of other robots (crashed members, opponents) are left out. Objects get
 their types from the predicates they appear in (``clear(a)`` makes ``a`` a
 ``block``), from the problem's ``objects`` and from the world model's typed
-objects.
+objects. At run time the problem's ``objects`` are fixed things the team
+knows without seeing them (the collection point ``g``); every other goal
+object must be mentioned by a fact to be planned for.
 
 While the team executes a generated plan, :func:`remaining_fits` simulates
 what is left of it (each task's remaining steps, run by the agent holding the
@@ -128,17 +130,23 @@ def read_world(
             continue
         kept.add(Fact(name, args))
     types: dict[str, str] = dict(sorted(declared.items()))
+    # objects the problem declares (a fixed place such as the collection point g) are known without being seen
+    fixed = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
+    if not offline:
+        types.update(fixed)
     if not offline and robot_type is not None:
         types.update(dict.fromkeys(members, robot_type))
     for type_name, objects in sorted((typed_objects or {}).items()):
         for obj in objects:
             if offline or type_name != robot_type:
                 types.setdefault(str(obj), type_name)
-    for _, goal_fact in goal_literals(problem):
-        for value, type_name in zip(goal_fact.args, predicates.get(goal_fact.predicate.lower(), ()), strict=False):
-            types.setdefault(str(value), type_name)
+    # what the facts say before what the goal says: a predicate may take different types in different
+    # signatures (at(?r, ?x) of a robot, at(?x, ?l) of a sample), and a fact names the object as it is now
     for fact in sorted(kept):
         for value, type_name in zip(fact.args, predicates[fact.predicate.lower()], strict=True):
+            types.setdefault(str(value), type_name)
+    for _, goal_fact in goal_literals(problem):
+        for value, type_name in zip(goal_fact.args, predicates.get(goal_fact.predicate.lower(), ()), strict=False):
             types.setdefault(str(value), type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
     if not offline:
@@ -148,7 +156,7 @@ def read_world(
             str(a)
             for _, goal_fact in goal_literals(problem)
             for a in goal_fact.args
-            if str(a) not in mentioned and a not in members
+            if str(a) not in mentioned and a not in members and str(a) not in fixed
         )
     return PlanningWorld(
         tuple(sorted(types.items())),
