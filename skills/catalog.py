@@ -384,7 +384,7 @@ def _semantic_perception(registry: SkillRegistry) -> None:
             "metres within which a found sample in clear view that is not seen again is retracted (0: never)",
             default=2.0,
         ),
-        doc="rate the fitted clusters against the fuzzy object description and report found(s), pos(s), confidence(s)",
+        doc="rate the fitted clusters against the fuzzy object description and report found(s), onground(s), pos(s), confidence(s)",
         capabilities=("stereo_camera",),  # a step of the pipeline on the stereo cloud: it runs where the cloud is
         implementation=f"{module}:FuzzyDLClassify",
     )
@@ -395,7 +395,7 @@ def _facts(registry: SkillRegistry) -> None:
     """The facts the implemented skills write to the world model, so any plan may read them undeclared."""
     registry.declare_predicate("holding", 2, "holding(r, x): robot r holds object x (Pickup, Unstack, Putdown, Stack)")
     registry.declare_predicate("handempty", 1, "handempty(r): robot r holds nothing")
-    registry.declare_predicate("onground", 1, "onground(x): object x lies on the ground (Putdown)")
+    registry.declare_predicate("onground", 1, "onground(x): object x lies on the ground (Putdown; a detected sample)")
     registry.declare_predicate("on", 2, "on(x, y): block x stands on block y (Stack, Unstack; blocks-world perception)")
     registry.declare_predicate("ontable", 1, "ontable(x): block x stands on the table (Putdown)")
     registry.declare_predicate("clear", 1, "clear(x): nothing stands on block x")

@@ -551,6 +551,7 @@ class FuzzyDLClassify(PipelineSkill):
             wm.set("pos", d.sample, value=(round(d.position[0], 3), round(d.position[1], 3)))
             wm.set("confidence", d.sample, value=round(d.confidence, 3))
             wm.assert_fact("found", d.sample)
+            wm.assert_fact("onground", d.sample)  # seen standing on the ground (the planning domain's fact)
 
     def _retract(self, known: list[tuple[str, tuple[float, float]]], seen: set[str]) -> list[str]:
         """Retract ``found(s)`` of known samples in clear view within ``retract_range`` that were not seen."""
@@ -574,5 +575,6 @@ class FuzzyDLClassify(PipelineSkill):
             if np.nanmin(window) < depth - 0.15:
                 continue  # something nearer hides it
             wm.retract_fact("found", name)
+            wm.retract_fact("onground", name)
             out.append(name)
         return out

@@ -472,6 +472,7 @@ class _Pipeline(WorldSkill):
             for name, at in _found_samples(wm):
                 if math.hypot(at[0] - candidate["x"], at[1] - candidate["y"]) <= ASSOCIATION_RADIUS:
                     wm.retract_fact("found", name)
+                    wm.retract_fact("onground", name)
         verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
         verdicts[cid] = "invalid"
         self.scratch["last_verdict"] = {"candidate": cid, "valid": False, "reason": reason}
@@ -875,6 +876,7 @@ class ClassifySample(_Pipeline):
             wm.set("pos", name, value=position)
             wm.set("confidence", name, value=confidence)
             wm.assert_fact("found", name)
+            wm.assert_fact("onground", name)  # seen standing on the ground (the planning domain's fact)
             wm.retract_fact("candidate", str(candidate["id"]))
             add_object = getattr(wm, "add_object", None)
             if callable(add_object):

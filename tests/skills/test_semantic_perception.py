@@ -336,9 +336,11 @@ def test_a_detection_near_a_known_sample_is_that_sample_and_a_clear_view_retract
     wm.add_object("ghost", "Sample")
     wm.set("pos", "ghost", value=ghost)
     wm.assert_fact("found", "ghost")
+    wm.assert_fact("onground", "ghost")
     runs = run_pipeline(skill_run, scene, {}, world_model=wm)
     assert runs[-1].ok, runs[-1].reason
     assert wm.holds("found", "a") and not wm.holds("found", "ghost")
+    assert wm.holds("onground", "a") and not wm.holds("onground", "ghost")
     assert "retracted ghost" in runs[-1].reason
     assert wm.get("confidence", "a") >= 0.6
 

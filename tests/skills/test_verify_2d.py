@@ -283,13 +283,13 @@ def test_a_found_sample_that_is_gone_is_retracted(skill_run):
         scratch: dict[str, object] = {}
         wm = WorldModel("scout", clock=world.clock)
         runs = _pipeline(skill_run, world, scratch, wm)
-        assert runs[-1].ok and wm.holds("found", "green_black_red")
+        assert runs[-1].ok and wm.holds("found", "green_black_red") and wm.holds("onground", "green_black_red")
         world.client.resetBasePositionAndOrientation(sample.body_id, (5.5, 5.5, 0.05), (0, 0, 0, 1))
         world.step(0.1)
         skill_run("CropCandidate", world, "scout", {}, scratch=scratch, world_model=wm)
         look = skill_run("BlobDetect", world, "scout", {}, scratch=scratch, world_model=wm)
         assert look.status == "failure"
-        assert not wm.holds("found", "green_black_red")
+        assert not wm.holds("found", "green_black_red") and not wm.holds("onground", "green_black_red")
     finally:
         world.close()
 
