@@ -120,10 +120,11 @@ def test_small_demo_reports_the_steps_each_agent_carried_out(capsys):
 
 
 def test_counter_counts_finished_steps_across_plans_and_not_aborted_ones():
-    from alica.app.demos.blocksworld import PROBLEM, _Counter
+    from alica.app.demos.blocksworld import PROBLEM
+    from alica.app.demos.common import StepCounter
 
     at = f"M/Stacking/{PROBLEM}"
-    counter = _Counter(["Pickup", "Stack"])
+    counter = StepCounter(["Pickup", "Stack"], PROBLEM)
     events = [
         {"event": "allocation", "agent": "r1", "key": at, "plan": "G1", "entries": {"r1": "G1_T0", "r2": "Standby"}},
         {"event": "planner", "agent": "r1", "key": at, "what": "plan", "generation": 1, "steps": 4},
@@ -144,10 +145,11 @@ def test_counter_counts_finished_steps_across_plans_and_not_aborted_ones():
 
 
 def test_counter_keeps_a_step_when_the_agent_reports_a_teammates_allocation():
-    from alica.app.demos.blocksworld import PROBLEM, _Counter
+    from alica.app.demos.blocksworld import PROBLEM
+    from alica.app.demos.common import StepCounter
 
     at = f"M/Stacking/{PROBLEM}"
-    counter = _Counter(["Unstack", "Putdown"])
+    counter = StepCounter(["Unstack", "Putdown"], PROBLEM)
     events = [
         {"event": "allocation", "agent": "r3", "key": at, "plan": "G1", "entries": {"r2": "G1_T1", "r3": "G1_T2"}},
         {"event": "allocation", "agent": "r3", "key": f"{at}/T2_S0/Unstack", "plan": "Unstack", "entries": {}},

@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from alica.app.demos.common import StepCounter, plan_yaml_text, planning_leader
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
 
@@ -187,85 +188,6 @@ def _renamed(stacks: Stacks, names: Sequence[str]) -> Stacks:
     return [[mapping[b] for b in s] for s in stacks]
 
 
-@dataclass(slots=True)
-class _Step:
-    """A step an agent is executing: the key of its step plan's node, and the task it belongs to."""
-
-    key: str
-    task: tuple[str, str]
-
-
-class _Counter:
-    """Counts what the trace says: the steps and tasks each agent carried out, plans made, replans.
-
-    A step starts when an agent allocates itself to one of the problem's
-    elements (``Pickup``, ``Stack``, ...) below the planning problem, and is
-    carried out when that step plan succeeds. A task is an entry point of a
-    generated plan; an agent carried it out when it carried out a step of it.
-    """
-
-    def __init__(self, elements: Iterable[str]) -> None:
-        self.elements = frozenset(elements)
-        self.steps: dict[str, int] = {}
-        self.tasks: dict[str, set[tuple[str, str]]] = {}
-        self.running: dict[str, _Step] = {}
-        self.task_of: dict[str, tuple[str, str]] = {}
-        self.plans: set[tuple[str, int]] = set()
-        self.replans = 0
-        self.plan_length = 0
-
-    def __call__(self, event: dict[str, Any]) -> None:
-        kind = event["event"]
-        agent = str(event.get("agent"))
-        key = str(event.get("key", ""))
-        if kind == "allocation" and "plan" in event:
-            plan = str(event["plan"])
-            if key.rsplit("/", 1)[-1] == PROBLEM:  # the plan that runs under the problem: the task is its entry
-                entries = event.get("entries", {})
-                if (
-                    agent in entries
-                ):  # (an agent also reports teammates' allocations: those leave its own task as it is)
-                    self.task_of[agent] = (plan, str(entries[agent]))
-                    self.running.pop(agent, None)
-            elif plan in self.elements and f"/{PROBLEM}/" in key and agent in self.task_of:
-                self.running[agent] = _Step(key, self.task_of[agent])
-        elif kind == "success" and event.get("plan") in self.elements:
-            step = self.running.get(agent)
-            if step is not None and step.key == key:
-                self._carried_out(agent, self.running.pop(agent))
-        elif kind == "replan":
-            self.replans += 1
-        elif kind == "planner" and event.get("what") == "plan":
-            self.plans.add((key, int(event.get("generation", 0))))
-            self.plan_length = int(event.get("steps", 0))
-
-    def _carried_out(self, agent: str, step: _Step) -> None:
-        self.steps[agent] = self.steps.get(agent, 0) + 1
-        self.tasks.setdefault(agent, set()).add(step.task)
-
-    def finish(self, team: Any, facts: Iterable[tuple[object, ...]]) -> None:
-        """Count the steps still running at the end whose effects hold in the world (the goal came true mid-step)."""
-        from alica.lang import literals
-
-        holds = set(facts)
-        for agent, step in sorted(self.running.items()):
-            engine = team.engines.get(agent)
-            node = next((n for n in engine.index.values() if n.key_text == step.key), None) if engine else None
-            signature = node.plan.signature if node is not None else None
-            if node is None or signature is None or signature.effect is None:
-                continue
-            values: dict[str, object] = {
-                v.name: node.env.get(v.name.lstrip("?"), agent if v.type == "robot" else None)
-                for v in signature.parameters
-            }
-            effect = [
-                (positive, pred, tuple(values.get(str(a), a) for a in args))
-                for positive, pred, args in literals(signature.effect.text)
-            ]
-            if all(((pred, *args) in holds) == positive for positive, pred, args in effect):
-                self._carried_out(agent, self.running.pop(agent))
-
-
 def run_demo(
     config: DemoConfig,
     *,
@@ -307,7 +229,7 @@ def run_demo(
     if gui:
         extra["gui"] = True
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
-    counter = _Counter(library.abstract(PROBLEM).elements)  # type: ignore[union-attr]
+    counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
     trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = engine_config(frequency=config.frequency)
@@ -375,8 +297,8 @@ def run_demo(
         counter.finish(team, perception.facts)
         if on_second is not None:
             on_second(world.now(), satisfied, len(wanted), counter.replans)
-        created = next(iter(latest_plans(e).values()), None) if (e := _leader(team)) is not None else None
-        plan_yaml = _plan_yaml(created, out) if created is not None else ""
+        created = next(iter(latest_plans(e).values()), None) if (e := planning_leader(team)) is not None else None
+        plan_yaml = plan_yaml_text(created, MISSION, out) if created is not None else ""
         if out is not None:
             _picture(world, out / "final.png")
             if plan_yaml:
@@ -402,23 +324,6 @@ def run_demo(
         if trace is not None:
             trace.close()
         world.close()
-
-
-def _leader(team: Any) -> Any:
-    from alica.prophet import latest_plans
-
-    running = [e for e in team.running() if latest_plans(e)]
-    return running[0] if running else None
-
-
-def _plan_yaml(created: Any, out: Path | None) -> str:
-    """The generated plan as YAML, importing the mission from where it is written."""
-    import os
-
-    from alica.prophet.tasks import emit_yaml
-
-    where = out.resolve() if out is not None else Path.cwd()
-    return emit_yaml(created, imports=(Path(os.path.relpath(MISSION, where)).as_posix(),))
 
 
 def _picture(world: Any, path: Path) -> None:
