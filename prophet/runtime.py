@@ -521,6 +521,22 @@ class ProblemRuntime:
         budget = self.budget
         start_expansions = search.expansions
         deadline = time.perf_counter() + budget.seconds if budget.seconds is not None else None
+        try:
+            finished = self._run_search(search, budget, start_expansions, deadline)
+        except (PlannerError, AlicaError) as exc:  # grounding runs inside the search: a domain it cannot read
+            self.search = None
+            self.host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
+            failed = PlanShare(
+                self.key, search.generation, 0, self.host.name, FAILED, entry_task=self._entry_task(), reason=str(exc)
+            )
+            self._publish(failed, now)
+            return
+        self._after_search(now, search, finished)
+
+    def _run_search(
+        self, search: _Search, budget: SearchBudget, start_expansions: int, deadline: float | None
+    ) -> Done | None:
+        """Advance the search within this tick's budget; the Done event when it ended."""
         finished: Done | None = None
         for event in search.events:
             search.expansions = event.expansions
@@ -544,6 +560,10 @@ class ProblemRuntime:
                 break
         else:
             finished = Done(PlanStatus.SOLVED if search.best is not None else PlanStatus.UNSOLVABLE, search.expansions)
+        return finished
+
+    def _after_search(self, now: float, search: _Search, finished: Done | None) -> None:
+        """Share what the search found; end it when it is done."""
         best = search.best
         if best is not None and search.shared_cost is None:
             self._share_plan(now, search, best)

@@ -136,7 +136,11 @@ def read_world(
         types.update(fixed)
     if not offline and robot_type is not None:
         types.update(dict.fromkeys(members, robot_type))
+    # the world model's typed objects, of the types the domain knows (not its frontiers, say)
+    known_types = {t.lower() for arity in predicates.values() for t in arity} | set(fixed.values())
     for type_name, objects in sorted((typed_objects or {}).items()):
+        if type_name.lower() not in known_types:
+            continue
         for obj in objects:
             if offline or type_name != robot_type:
                 types.setdefault(str(obj), type_name)

@@ -257,6 +257,7 @@ def lunar(
     *,
     time_step: float = 1.0 / 240.0,
     start_radius: float = 3.0,
+    gui: bool = False,
 ) -> World:
     """The IMPERA field: rocks, sample containers, the collection point ``g`` and the three robots.
 
@@ -274,7 +275,7 @@ def lunar(
     if not size >= 2.0 * (start_radius + 2.0):
         raise WorldError(f"lunar: size must be at least {2.0 * (start_radius + 2.0)} m for the start area, got {size}")
     half = 0.5 * float(size)
-    world = World(seed, time_step=time_step, bounds=(-half, -half, half, half))
+    world = World(seed, gui=gui, time_step=time_step, bounds=(-half, -half, half, half))
     layout = np.random.default_rng([int(seed), 7])
     placed: list[tuple[float, float, float]] = []
     attempts = 0

@@ -58,3 +58,13 @@ def test_the_team_plans_the_transport_with_the_robots_that_have_a_free_hand(impe
     steps = [str(s) for s in result.plan.steps]
     assert sum(s.startswith("(putdown") for s in steps) == 2
     assert not any("scout" in s for s in steps if s.startswith(("(pickup", "(putdown")))  # no arm, no handempty
+
+
+def test_objects_of_types_the_domain_does_not_know_are_left_out(impera):
+    # the world model also lists the exploration's frontiers: the planning domain has no such type
+    typed = {"Frontier": ["f_0_0", "f_1_0"], "Sample": ["green_white_red"], "location": ["g"]}
+    world = read_world(_problem(impera), impera, _seen("green_white_red", "red_black_red"), TEAM, typed)
+    types = world.object_types()
+    assert "f_0_0" not in types and types["green_white_red"] == "Sample" and types["g"] == "location"
+    result = plan_problem(_problem(impera), impera, world).solve(time_limit=20)
+    assert result.plan is not None

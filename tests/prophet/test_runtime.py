@@ -446,3 +446,24 @@ def test_a_free_task_pinned_to_an_agent_that_waits_for_it_in_an_earlier_task_is_
     # r5 still before step 1 (it comes before T2): it finishes that step and T1 waits for T2 only then
     before = [TaskProgress(None, 1, done=True), TaskProgress("r5", 0), TaskProgress(None, 0), TaskProgress("r3", 0)]
     assert _stalled(before, order, (None, ("r1", "r5"), ("r5",), ("r3",)), members) is None
+
+
+def test_a_planner_that_fails_inside_its_search_fails_the_problem_with_the_reason(monkeypatch):
+    # grounding runs lazily inside the search: an error there is a failed planning, not a crash of the engine
+    import alica.prophet.runtime as runtime
+    from alica.errors import PlannerError
+
+    class Broken:
+        def __init__(self, *args, **kwargs):
+            pass
+
+        def search(self, anytime=True):
+            yield from ()  # a generator: the error comes on the first step, as grounding's does
+            raise PlannerError("object 'f_0_0' has type 'frontier', which domain 'x' does not declare")
+
+    monkeypatch.setattr(runtime, "plan_problem", Broken)
+    skills = BlockSkills()
+    sim, rec = blocks_team(["r1"], skills)
+    sim.run(ticks=40)
+    failed = events(rec, "planner", what="failed")
+    assert failed and "does not declare" in failed[0]["reason"]
