@@ -61,6 +61,157 @@ def add_parser(sub: Any) -> None:
         help="no progress bar (there is none when standard error is not a terminal)",
     )
     b.set_defaults(run=cmd_blocksworld)
+    _add_lunar(demos)
+
+
+def _add_lunar(demos: Any) -> None:
+    lunar = demos.add_parser(
+        "lunar",
+        help="explore, find samples, plan and fetch them as a team (IMPERA Sections 6.4, 7, 8.1)",
+        description="The IMPERA lunar mission in pybullet with the real skills: the robots map and explore an unknown "
+        "field, detect drill samples, the operator chooses which to bring back, pRoPhEt MAS plans the transport at run "
+        "time and the team carries the samples to the collection point g. Exit 0 when every chosen sample lies at g, "
+        "1 when the mission failed or the time limit passed first.",
+    )
+    lunar.add_argument(
+        "--robots",
+        default="scout,stummel,amparo",
+        help="the team, from scout, stummel and amparo (default all three)",
+    )
+    lunar.add_argument(
+        "--samples", type=_count(1), default=6, metavar="N", help="drill samples on the field (default 6)"
+    )
+    lunar.add_argument("--rocks", type=_count(0), default=60, metavar="R", help="rocks on the field (default 60)")
+    lunar.add_argument(
+        "--size", type=float, default=40.0, metavar="M", help="side of the square field in metres (default 40)"
+    )
+    choice = lunar.add_mutually_exclusive_group()
+    choice.add_argument(
+        "--goal", metavar="FORMULA", help="what to bring back, by the samples' names: 'at(green_white_red, g) and ...'"
+    )
+    choice.add_argument(
+        "--collect", metavar="KINDS", help="the kinds to bring back, e.g. green-white-red,red-black-red"
+    )
+    lunar.add_argument(
+        "--pick",
+        type=_count(1),
+        default=2,
+        metavar="K",
+        help="without --goal or --collect: bring back the first K samples found (default 2)",
+    )
+    lunar.add_argument(
+        "--seed", type=int, default=0, metavar="S", help="seeds the world, the network and the team (default 0)"
+    )
+    lunar.add_argument(
+        "--crash",
+        action="append",
+        default=[],
+        metavar="NAME@T",
+        help="crash robot NAME at simulated second T, or NAME@grasp when it first holds a sample (repeatable)",
+    )
+    lunar.add_argument(
+        "--loss", type=float, default=0.0, metavar="P", help="probability that a message is lost (default 0)"
+    )
+    lunar.add_argument(
+        "--delay", type=float, default=0.0, metavar="MS", help="message delay in milliseconds (default 0)"
+    )
+    lunar.add_argument(
+        "--partition",
+        action="append",
+        default=[],
+        metavar="A,B|C@T1-T2",
+        help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)",
+    )
+    lunar.add_argument(
+        "--time-limit", type=float, default=900.0, metavar="S", help="simulated seconds before giving up (default 900)"
+    )
+    lunar.add_argument("--out", metavar="DIR", help="write trace.jsonl, map.png and plan.yaml here")
+    lunar.add_argument("--json", action="store_true", help="print the summary as JSON")
+    lunar.add_argument("--gui", action="store_true", help="show the pybullet window")
+    lunar.add_argument(
+        "--no-progress", action="store_true", help="no progress line (none when standard error is not a terminal)"
+    )
+    lunar.set_defaults(run=cmd_lunar)
+
+
+def lunar_config(args: argparse.Namespace) -> Any:
+    """The lunar demo's configuration from the command line.
+
+    Raises:
+        AlicaError: a value that cannot run (the message names the option).
+    """
+    from alica.app.demos.lunar import LunarConfig, Partition, check_config, parse_crash
+
+    if not 0.0 <= args.loss <= 1.0:
+        raise AlicaError(f"--loss must be a probability in [0, 1], not {args.loss}")
+    if args.delay < 0:
+        raise AlicaError(f"--delay must be >= 0 milliseconds, not {args.delay}")
+    partitions = []
+    for text in args.partition:
+        what, start, end = timed("--partition", text, span=True)
+        partitions.append(Partition(tuple(tuple(g.split(",")) for g in what.split("|")), start, end))
+    config = LunarConfig(
+        robots=tuple(r.strip() for r in args.robots.split(",") if r.strip()),
+        samples=args.samples,
+        rocks=args.rocks,
+        size=args.size,
+        collect=tuple(k.strip() for k in args.collect.split(",") if k.strip()) if args.collect else (),
+        goal=args.goal,
+        pick=args.pick,
+        seed=args.seed,
+        time_limit=args.time_limit,
+        loss=args.loss,
+        delay=args.delay / 1000.0,
+        crashes=tuple(parse_crash(c) for c in args.crash),
+        partitions=tuple(partitions),
+    )
+    check_config(config)
+    for cut in config.partitions:
+        strangers = [r for g in cut.groups for r in g if r not in config.robots]
+        if strangers:
+            raise AlicaError(f"--partition: {', '.join(strangers)} not in the team ({', '.join(config.robots)})")
+    return config
+
+
+class LunarProgress:
+    """A one-line progress bar on a terminal: simulated time, coverage, samples found and delivered, replans."""
+
+    def __init__(self, stream: TextIO, width: int = 24) -> None:
+        self.stream = stream
+        self.width = width
+
+    def __call__(self, p: dict[str, Any]) -> None:
+        done = int(self.width * min(1.0, p["time"] / p["limit"]))
+        bar = "#" * done + "." * (self.width - done)
+        chosen = f"{p['delivered']}/{p['chosen']}" if p["chosen"] else "-"
+        self.stream.write(
+            f"\r[{bar}] sim {p['time']:6.1f} s  coverage {p['coverage']:4.0%}  found {p['found']}  "
+            f"delivered {chosen}  replans {p['replans']}  "
+        )
+        self.stream.flush()
+
+    def close(self) -> None:
+        """End the line."""
+        self.stream.write("\n")
+        self.stream.flush()
+
+
+def cmd_lunar(args: argparse.Namespace) -> int:
+    """Run ``alica demo lunar``; returns the exit code."""
+    from alica.app.demos.lunar import run_lunar, summary_lines
+
+    config = lunar_config(args)
+    progress = LunarProgress(sys.stderr) if sys.stderr.isatty() and not args.no_progress else None
+    try:
+        result = run_lunar(config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui)
+    finally:
+        if progress is not None:
+            progress.close()
+    if args.json:
+        print(json.dumps(result.as_json()))
+    else:
+        print("\n".join(summary_lines(result)))
+    return 0 if result.success else 1
 
 
 def _count(least: int) -> Any:

@@ -354,7 +354,7 @@ def run_lunar(
             robots={
                 name: {
                     "role": ROLES[name],
-                    "tasks": sorted({task for _, task in counter.tasks.get(name, set())}),
+                    "tasks": len(counter.tasks.get(name, set())),
                     "steps": counter.steps.get(name, 0),
                     "distance_m": round(run.distance[name], 2),
                     "crashed": name in team.crashed,
@@ -554,9 +554,11 @@ def summary_lines(result: LunarResult) -> list[str]:
         f"plans made {result.plans}, replans {result.replans}, messages sent {result.messages}",
     ]
     for name, robot in result.robots.items():
-        tasks = ", ".join(robot["tasks"]) or "no task of a generated plan"
         crashed = " (crashed)" if robot["crashed"] else ""
-        lines.append(f"  {name} ({robot['role']}){crashed}: drove {robot['distance_m']:.1f} m; {tasks}")
+        lines.append(
+            f"  {name} ({robot['role']}){crashed}: drove {robot['distance_m']:.1f} m; "
+            f"{robot['steps']} step(s) in {robot['tasks']} task(s) of generated plans"
+        )
     return lines
 
 
