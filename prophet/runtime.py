@@ -70,6 +70,10 @@ from alica.prophet.world import (
 
 SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareStatus.FAILED, ShareStatus.DONE
 
+#: A step that fails this many times for the same reason while the world stays the same fails the problem
+#: (the team runs the AlternativePlan): planning the same plan again would fail the same way for ever.
+GIVE_UP_AFTER = 3
+
 
 @dataclass(frozen=True, slots=True)
 class SearchBudget:
@@ -139,6 +143,7 @@ class ProblemRuntime:
         self.pending: tuple[float, str] | None = None
         self.blocked: set[Fact] | None = None
         self.predicates: dict[str, tuple[str, ...]] | None = None
+        self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
         self.overrides = dict(host.override(self.model.name))
         now = host.now()
         # a share received lately is current (the leader repeats it every UpdateTime); an older one is stale
@@ -398,7 +403,11 @@ class ProblemRuntime:
             self._publish(share if share.leader == me else replace(share, leader=me), now)
 
     def _replan(self, now: float, reason: str, settle: bool = False) -> None:
-        """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step)."""
+        """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step).
+
+        A failed step (``settle``) that failed :data:`GIVE_UP_AFTER` times for the same reason in the
+        same world fails the problem instead: the team runs the AlternativePlan.
+        """
         self.host.counters["replans"] += 1
         self.host.emit("replan", key=key_text(self.key), reason=reason)
         self.search = None
@@ -406,6 +415,14 @@ class ProblemRuntime:
             self._start_search(now, reason)
             return
         generation = self._next_generation()
+        same = (reason.split(": ", 1)[-1], frozenset(self._read_world(self.problem).facts))
+        self.step_failures[same] = count = self.step_failures.get(same, 0) + 1
+        if count >= GIVE_UP_AFTER:
+            self.step_failures.clear()
+            message = f"gave up: the same step failed {count} times while the world stayed the same: {same[0]}"
+            self.host.emit("planner", key=key_text(self.key), what="failed", reason=message)
+            self._publish_failure(now, generation, message)
+            return
         self.pending = (now + self.model.update_time, reason)
         self._publish(
             PlanShare(self.key, generation, 0, self.host.name, SEARCHING, entry_task=self._entry_task(), reason=reason),

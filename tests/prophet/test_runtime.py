@@ -467,3 +467,35 @@ def test_a_planner_that_fails_inside_its_search_fails_the_problem_with_the_reaso
     sim.run(ticks=40)
     failed = events(rec, "planner", what="failed")
     assert failed and "does not declare" in failed[0]["reason"]
+
+
+def test_a_step_that_fails_the_same_way_in_the_same_world_gives_up_with_the_alternative_plan(tmp_path):
+    # an unreachable sample: the same plan would be made and fail again for ever; after GIVE_UP_AFTER tries
+    # in an unchanged world the problem fails and the team runs the AlternativePlan
+    from alica.prophet.runtime import GIVE_UP_AFTER
+
+    text = PROBLEM.replace("PLANNER", "builtin").replace("ALTERNATIVE", "alternative_plan: Home")
+    text = text.replace(
+        "  - {name: GoHome, skill: Work}", "  - {name: GoHome, skill: Work}\n  - {name: Attempt, skill: Check}"
+    )
+    text = text.replace(
+        "      - {name: Stepping, children: [Hold], transitions: [{to: Stepped, condition: succeeded}]}",
+        "      - name: Stepping\n        children: [Attempt]\n"
+        "        transitions: [{to: Stepped, condition: succeeded}, {to: Broken, condition: failed}]\n"
+        "      - {name: Broken, kind: failure}",
+    )
+    lib = library(tmp_path, text)
+    config = engine_config(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    skills = {
+        "Wait": scripted(["running"]),
+        "Work": scripted(["running", "success"]),
+        "Check": scripted(["running", "failure"]),
+    }
+    sim, rec = team(lib, "Top", {"w": "Worker", "h": "Helper"}, skills, config=config)
+    sim.set_facts([(True, "ready", ())])
+    summary = sim.run(until_done=True, max_time=60)
+    replans = events(rec, "replan")
+    assert len({e["reason"].split(": ", 1)[-1] for e in replans}) == 1 and len(replans) >= GIVE_UP_AFTER
+    failed = events(rec, "problem", phase="alternative")
+    assert failed and f"the same step failed {GIVE_UP_AFTER} times" in failed[-1]["reason"]
+    assert summary["success"] and events(rec, "allocation", plan="Home")
