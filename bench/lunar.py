@@ -68,8 +68,13 @@ def _one(scenario: str, seed: int, args: argparse.Namespace, queue: Any) -> None
     try:
         result = run_lunar(config_for(scenario, seed, args))
         row = result.as_json()
-    except Exception as exc:  # noqa: BLE001 - a crash of a run is a figure too
-        row = {"success": False, "reason": f"{type(exc).__name__}: {exc}", "sim_time_s": float("nan"), "wall_time_s": 0.0}
+    except Exception as exc:  # a crash of a run is a figure too
+        row = {
+            "success": False,
+            "reason": f"{type(exc).__name__}: {exc}",
+            "sim_time_s": float("nan"),
+            "wall_time_s": 0.0,
+        }
     row["peak_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
     queue.put(row)
 
@@ -90,7 +95,9 @@ def run_one(scenario: str, seed: int, args: argparse.Namespace) -> dict[str, Any
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10)
-    parser.add_argument("--scenarios", default=",".join(SCENARIOS), help="comma-separated, from " + ", ".join(SCENARIOS))
+    parser.add_argument(
+        "--scenarios", default=",".join(SCENARIOS), help="comma-separated, from " + ", ".join(SCENARIOS)
+    )
     parser.add_argument("--samples", type=int, default=6)
     parser.add_argument("--rocks", type=int, default=60)
     parser.add_argument("--size", type=float, default=40.0)
