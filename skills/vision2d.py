@@ -33,6 +33,7 @@ from py_trees.common import Status
 
 from alica.errors import SkillError
 from alica.skills.jobs import Job
+from alica.skills.sample_facts import seen_on_the_ground
 from alica.skills.world_skill import WorldSkill
 from alica.worldsim.objects import SAMPLE_KINDS
 
@@ -877,6 +878,7 @@ class ClassifySample(_Pipeline):
             wm.set("confidence", name, value=confidence)
             wm.assert_fact("found", name)
             wm.assert_fact("onground", name)  # seen standing on the ground (the planning domain's fact)
+            seen_on_the_ground(wm, name)
             wm.retract_fact("candidate", str(candidate["id"]))
             add_object = getattr(wm, "add_object", None)
             if callable(add_object):

@@ -208,9 +208,11 @@ def test_an_unknown_sample_is_named_after_its_kind(skill_run):
         world.add_sample("a", "red-white-red", _ahead(world, 2.0, 5.0))
         world.step(0.2)
         wm = WorldModel("scout", clock=world.clock)
+        wm.assert_fact("holding", "amparo", "red_white_red")  # amparo crashed holding it; it fell
         runs = _pipeline(skill_run, world, {}, wm)
         assert runs[-1].ok, [r.reason for r in runs]
         assert wm.holds("found", "red_white_red") and wm.get("sample_kind", "red_white_red") == "red-white-red"
+        assert wm.holds("onground", "red_white_red") and not wm.holds("holding", "amparo", "red_white_red")
     finally:
         world.close()
 
