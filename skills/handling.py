@@ -624,13 +624,16 @@ def find_object(skill: WorldSkill, name: object) -> WorldThing:
     """The world object ``name``; a name the world does not know is the sample or block at ``pos(name)``.
 
     Perception names the samples it finds by itself (``green_white_red``, say);
-    the world model's position of such a name picks the object nearest to it,
-    within :data:`ASSOCIATION`.
+    the object Grasp took under such a name (``scratch["names"]``), else the
+    one nearest to the world model's position of it within :data:`ASSOCIATION`, is meant.
 
     Raises:
         SkillError: no such object, and none where the world model puts ``name``.
     """
     objects = skill.world.objects
+    names = getattr(skill.context, "scratch", {}).get("names")  # what Grasp took under this name
+    if isinstance(name, str) and isinstance(names, dict) and names.get(name) in objects:
+        return objects[names[name]]
     if isinstance(name, str) and name not in objects and skill.world_model is not None:
         known = skill.world_model.lookup("pos", (name,))
         if isinstance(known, (tuple, list)) and len(known) >= 2:
