@@ -247,8 +247,8 @@ plans:
 """
 
 
-@pytest.mark.parametrize(("robot", "role"), [("stummel", "Stummel"), ("amparo", "Amparo")])
-def test_the_pickup_and_putdown_plans_fetch_a_sample_in_the_engine(tmp_path, robot, role):
+def _fetch(tmp_path: Path, robot: str, role: str) -> tuple[Any, Any, Any]:
+    """A 12 m field with the sample a in view of ``robot``, and a team that runs FetchA on it: (team, world, spot)."""
     from alica.engine import SimulatedTeam
     from alica.io import Loader
     from alica.lang.skill_plugins import default_registry
@@ -265,14 +265,20 @@ def test_the_pickup_and_putdown_plans_fetch_a_sample_in_the_engine(tmp_path, rob
     registry = default_registry()
     library = Loader(skills=registry).load(entry)
     world = lunar(seed=0, rocks=0, samples=0, size=12.0)
+    x, y, yaw = world.robots[robot].pose
+    spot = (x + 2.5 * math.cos(yaw + 0.1), y + 2.5 * math.sin(yaw + 0.1))  # in view of its lidar and camera
+    world.add_sample("a", "green-white-red", spot)
+    world.step(0.2)
+    team = SimulatedTeam(library, "FetchA", {robot: role}, seed=0, skill_registry=registry, world=world)
+    team.engines[robot].world_model.set("sample_kind", "a", value="green-white-red")  # asked for: found, it is a
+    return team, world, spot
+
+
+@pytest.mark.parametrize(("robot", "role"), [("stummel", "Stummel"), ("amparo", "Amparo")])
+def test_the_pickup_and_putdown_plans_fetch_a_sample_in_the_engine(tmp_path, robot, role):
+    team, world, _ = _fetch(tmp_path, robot, role)
     try:
-        x, y, yaw = world.robots[robot].pose
-        spot = (x + 2.5 * math.cos(yaw + 0.1), y + 2.5 * math.sin(yaw + 0.1))  # in view of its lidar and camera
-        world.add_sample("a", "green-white-red", spot)
-        world.step(0.2)
-        team = SimulatedTeam(library, "FetchA", {robot: role}, seed=0, skill_registry=registry, world=world)
         wm = team.engines[robot].world_model
-        wm.set("sample_kind", "a", value="green-white-red")  # the sample the operator asked for: found, it is named a
         team.run(until_done=True, max_time=90.0)
         summary = team.summary()
         assert summary["success"], summary
@@ -285,5 +291,36 @@ def test_the_pickup_and_putdown_plans_fetch_a_sample_in_the_engine(tmp_path, rob
         assert not wm.holds("holding", robot, "a")
         assert wm.get("attempts", robot) == 1
         assert math.dist(_xy(world.objects["a"]), _xy(world.objects["g"])) < world.objects["g"].radius
+    finally:
+        world.close()
+
+
+@pytest.mark.parametrize(("slips", "attempts"), [(1, 2), (3, 3)])
+def test_the_pickup_plan_retries_after_a_slip_and_gives_up_after_three_attempts(tmp_path, slips, attempts):
+    from alica.worldsim.faults import set_grasp_slip
+
+    team, world, spot = _fetch(tmp_path, "stummel", "Stummel")
+    try:
+        arm, wm = world.robots["stummel"].arm, team.engines["stummel"].world_model
+        engine = team.engines["stummel"]
+        set_grasp_slip(world, 1.0)
+        dropped, holding = 0, False
+        # until the plan succeeds, or the Pickup plan failed (the engine then repairs: it starts the plan again)
+        while not team.done() and engine.stats["repairs"] == 0 and team.now() < 90.0:
+            team.tick()
+            if arm.held is not None:
+                holding = True
+            elif holding and dropped < slips:  # it slipped
+                holding, dropped = False, dropped + 1
+                if dropped == slips:
+                    set_grasp_slip(world, 0.0)
+        summary = team.summary()
+        assert dropped == slips and wm.get("attempts", "stummel") == attempts
+        if slips < 3:
+            assert summary["success"], summary
+            assert wm.holds("at", "a", "g") and engine.stats["repairs"] == 0
+        else:
+            assert engine.stats["repairs"] == 1 and not wm.holds("holding", "stummel", "a"), summary
+            assert arm.held is None and math.dist(_xy(world.objects["a"]), spot) < 0.3  # it lies where it fell
     finally:
         world.close()
