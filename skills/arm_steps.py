@@ -37,19 +37,8 @@ import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from alica.skills.handling import (
-    PLACE_TOLERANCE,
-    REACH,
-    SETTLE,
-    ArmSkill,
-    Pickup,
-    Putdown,
-    find_object,
-    place_area,
-    write_held,
-    write_placed,
-    write_released,
-)
+from alica.skills.arm_world import find_object, place_area, write_held, write_placed, write_released
+from alica.skills.handling import PLACE_TOLERANCE, REACH, SETTLE, ArmSkill, Pickup, Putdown
 from alica.skills.world_skill import WorldSkill, distance
 from alica.worldsim.interface import WorldThing
 
