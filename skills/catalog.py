@@ -182,13 +182,21 @@ def _navigation(registry: SkillRegistry) -> None:
 
 
 def _manipulation(registry: SkillRegistry) -> None:
+    steps = "alica.skills.arm_steps"
     registry.declare(
         "AlignWithObject",
         _p("object", "object", "the object to align with"),
-        _p("standoff", "float", "distance in metres from the object to the robot base after aligning", default=0.4),
+        _p(
+            "standoff",
+            "float",
+            "distance in metres from the object to the centre of the robot base after aligning; "
+            "by default where the arm reaches best (0.55 m ahead of the arm's mount: 0.73 m for Stummel)",
+            required=False,
+        ),
         _p("tolerance", "float", "position tolerance in metres", default=0.02),
-        doc="approach an object precisely so the arm can reach it",
+        doc="drive to a stand-off point facing an object, so that the arm can reach it",
         capabilities=("base",),
+        implementation=f"{steps}:AlignWithObject",
     )
     registry.declare(
         "Grasp",
@@ -196,40 +204,52 @@ def _manipulation(registry: SkillRegistry) -> None:
         _p("force", "float", "finger force in newtons", default=10.0),
         doc="plan and execute a grasp of an object and close the fingers; counts the attempts as attempts(self)",
         capabilities=("arm", "gripper"),
+        implementation=f"{steps}:Grasp",
     )
     registry.declare(
         "MoveArmToTransport",
-        doc="move the arm into its transport (home) pose",
+        doc="move the arm, with what it holds, into its transport (home) pose",
         capabilities=("arm",),
+        implementation=f"{steps}:MoveArmToTransport",
     )
     registry.declare(
         "ValidateGrip",
         _p("min_force", "float", "smallest finger force in newtons that counts as holding", default=2.0),
         doc="check by finger force that the object is still held",
         capabilities=("gripper",),
+        implementation=f"{steps}:ValidateGrip",
     )
     registry.declare(
         "MoveArmToPlace",
         _p(
             "target",
             "position",
-            "where to place: a position or a term such as pos(g); by default in front of the robot",
+            "where to place: a position, an area such as pos(g) (a free spot in it), "
+            "or a block; by default a free spot in front of the robot",
             required=False,
         ),
-        doc="move the held object to its place pose",
-        capabilities=("arm",),
+        doc="move the held object to its place pose (driving there first when it is out of reach)",
+        capabilities=("base", "arm"),
+        implementation=f"{steps}:MoveArmToPlace",
     )
     registry.declare(
         "OpenGripper",
-        doc="open the fingers",
+        doc="open the fingers and let go of what they hold",
         capabilities=("gripper",),
+        implementation=f"{steps}:OpenGripper",
     )
     registry.declare(
         "VerifyPlaced",
         _p("object", "object", "the object that was put down"),
-        _p("target", "position", "where it should lie; by default anywhere on the ground", required=False),
+        _p(
+            "target",
+            "position",
+            "where it should lie (a position, or an area such as pos(g)); by default anywhere on the ground",
+            required=False,
+        ),
         doc="check that the gripper is empty and the object lies at its place",
         capabilities=("gripper",),
+        implementation=f"{steps}:VerifyPlaced",
     )
     registry.declare(
         "RandomBlockSkill",

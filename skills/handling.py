@@ -31,6 +31,7 @@ import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
+from alica.skills.arm_world import area_spots, find_object, place_area, write_held, write_placed, write_released
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
 from alica.skills.navigation import MoveToPosition
@@ -60,6 +61,8 @@ STANDOFF_MARGIN = 0.1
 STANDOFF_WAIT = 30.0
 #: A stand-off point this close (m) to one from which the arm found no plan counts as tried.
 SIDE_TRIED = 0.2
+#: How far (m) a placed object may lie from its place and count as placed there.
+PLACE_TOLERANCE = 0.08
 
 
 def _box(obj: WorldThing) -> Box:
@@ -70,7 +73,7 @@ def _box(obj: WorldThing) -> Box:
     low, high = (np.asarray(v, dtype=float) for v in obj.aabb())
     half = tuple(obj.half_extents)
     if obj.kind == "sample" and obj.radius:
-        # a standing cylinder: its true size, not a bounding box that grows as it turns in the hand
+        # a cylinder: its true size, not a bounding box that grows as it turns in the hand
         r = float(obj.radius)
         half = (r, r, 0.5 * float(obj.size))
     if half and half[0] > 0.0:
@@ -78,6 +81,20 @@ def _box(obj: WorldThing) -> Box:
         yaw, upright = upright_box(quat, half)  # a block that fell onto a side has its faces turned another way
         return Box(obj.name, (float(center[0]), float(center[1]), float(center[2])), upright, yaw)
     return Box(obj.name, tuple((low + high) / 2.0), tuple((high - low) / 2.0))
+
+
+def grasp_shape(obj: WorldThing) -> str:
+    """How to grasp ``obj`` from the top: ``"cylinder"`` for a sample standing upright, else ``"box"``.
+
+    A sample container that fell over lies as a box (its length along the
+    ground, its diameter across and up: :func:`_box`), grasped across.
+    """
+    if obj.kind != "sample" or not obj.radius:
+        return "box"
+    from alica.skills.manipulation.geometry import quat_rotate
+
+    axis = quat_rotate(tuple(obj.pose()[1]), (0.0, 0.0, 1.0))
+    return "cylinder" if abs(axis[2]) > 0.9 else "box"
 
 
 def _crowds(box: Box, target: Box) -> bool:
@@ -105,15 +122,26 @@ def blocks_state(world: RobotWorld) -> set[tuple[str, ...]]:
 
 
 class ArmSkill(WorldSkill):
-    """The phases shared by the manipulation skills; subclasses say what to plan and check."""
+    """The phases shared by the manipulation skills; subclasses say what to plan and check.
+
+    The step skills of the Pickup and Putdown plans (:mod:`alica.skills.arm_steps`)
+    run some of these phases: AlignWithObject only the approach, Grasp the plan
+    and its execution up to the grip, and so on (see the class attributes).
+    """
 
     #: Whether the skill grasps (else it releases what it holds).
     grasps = True
+    #: Whether the robot needs an arm (AlignWithObject only drives).
+    needs_arm = True
+    #: Whether the skill first drives to a stand-off point facing the work site.
+    approaches = True
+    #: Whether failed attempts are written to the world model as ``attempts(self)``.
+    counts_attempts = True
 
     def setup(self, **kwargs: Any) -> None:
-        """Find the robot; it needs an arm."""
+        """Find the robot; it needs an arm (when :attr:`needs_arm`)."""
         super().setup(**kwargs)
-        if self.robot.arm is None:
+        if self.needs_arm and self.robot.arm is None:
             raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no arm")
 
     @property
@@ -131,8 +159,12 @@ class ArmSkill(WorldSkill):
     # -- what subclasses define -----------------------------------------------
 
     def target_object(self) -> WorldThing:
-        """The object grasped (or held, for placing)."""
-        return self.object_named(self.param("object"))
+        """The object grasped (or held, for placing): ``object`` (see :func:`find_object`)."""
+        return find_object(self, self.param("object"))
+
+    def object_label(self) -> str:
+        """The object's name in the outcome facts: the ``object`` parameter as given (the plan's name for it)."""
+        return str(self.param("object"))
 
     def site(self) -> tuple[float, float]:
         """Where the work happens, for the approach."""
@@ -149,12 +181,29 @@ class ArmSkill(WorldSkill):
 
         if self.grasps:
             obj = self.target_object()
-            shape = "cylinder" if obj.kind == "sample" else "box"
-            return plan_pickup(scene, _box(obj), q, rng=rng, kind=shape)
-        from alica.skills.manipulation import held_box
+            return plan_pickup(scene, _box(obj), q, rng=rng, kind=grasp_shape(obj))
+        held = self._held_box(scene, q)  # the object in the tool's frame
+        if held is None:
+            from alica.skills.manipulation import PlacePlan
 
-        held = held_box(_box(self.target_object()), scene.fk(q))  # the object in the tool's frame
+            return PlacePlan(False, None, None, None, None, [], "the object is tilted in the hand")
         return plan_place(scene, held, self.place_top(), q, rng=rng)
+
+    def arm_steps(self, paths: list[np.ndarray]) -> list[Any]:
+        """What the arm does with a plan's paths, in order: a path to follow, or ``"grip"`` / ``"release"``.
+
+        Pick: to the pre-grasp, down, grip, up to the transport pose; place:
+        above the place, down, release, up to the transport pose.
+        """
+        return [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
+
+    def finger_force(self) -> float | None:
+        """The finger force (N) to close with; None: the gripper's default."""
+        return None
+
+    def finished(self) -> Status:
+        """The end of a successful run (after :meth:`check_after`)."""
+        return self.succeed(f"done after {self.attempts + 1} attempt(s)")
 
     def place_top(self) -> tuple[float, float, float]:
         """Where the bottom of a placed object goes: on the ground at the site, or on top of a target block."""
@@ -197,6 +246,9 @@ class ArmSkill(WorldSkill):
         reason = self.check_before()
         if reason is not None:
             return self.fail(reason)
+        if not self.approaches:
+            self.phase = "plan"
+            return self._phase_plan()
         self.phase = "approach"
         return self._phase_approach()
 
@@ -204,16 +256,34 @@ class ArmSkill(WorldSkill):
         position = self.arm.base_pose()[0]
         return float(position[0]), float(position[1])
 
+    # -- the approach (AlignWithObject runs it alone) -------------------------------
+
+    def standoff(self) -> float:
+        """Distance (m) from the work site to the robot's centre after the approach: the arm's reach ahead of its mount."""
+        return REACH + _mount_ahead(self.robot)
+
+    def approach_slack(self) -> float:
+        """How far (m) from :meth:`standoff` the robot may stand and still work without driving."""
+        return 0.12
+
+    def approach_tolerance(self) -> float:
+        """The goal tolerance (m) of the drive to the stand-off point."""
+        return 0.05
+
+    def approached(self) -> Status:
+        """The robot stands at the work site, facing it: go on with planning the arm motion."""
+        self.phase = "plan"
+        return self._phase_plan()
+
     def _phase_approach(self) -> Status:
         robot = self.robot
         site = self.site()
-        x, y, yaw = robot.pose
+        x, y, yaw = robot.estimate  # the robot drives by its estimate (as MoveToPosition does)
         if self.mover is None:
-            gap = distance(self._arm_xy(), site)
+            gap = distance((x, y), site)
             facing = abs(wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw))
-            if abs(gap - REACH) <= 0.12 and facing < 0.15 and not self._side_tried((x, y)):
-                self.phase = "plan"
-                return self._phase_plan()
+            if abs(gap - self.standoff()) <= self.approach_slack() and facing < 0.15 and not self._side_tried((x, y)):
+                return self.approached()
             goal = self._standoff(site)
             if goal is None:
                 if self.blocked_since is None:
@@ -225,7 +295,9 @@ class ArmSkill(WorldSkill):
                 return self.running("waiting: every side of the work site is taken by other robots")
             self.blocked_since = None
             self.mover = MoveToPosition(
-                f"{self.name}/approach", {"goal": goal, "tolerance": 0.05, "timeout": 60.0}, self.context
+                f"{self.name}/approach",
+                {"goal": goal, "tolerance": self.approach_tolerance(), "timeout": 60.0},
+                self.context,
             )
             self.mover.setup(context=self.context)
         if self.mover.status != Status.SUCCESS:
@@ -239,8 +311,7 @@ class ArmSkill(WorldSkill):
             robot.drive(0.0, max(-robot.spec.max_yaw_rate, min(robot.spec.max_yaw_rate, 2.0 * error)))
             return self.running("turning to the work site")
         robot.stop()
-        self.phase = "plan"
-        return self._phase_plan()
+        return self.approached()
 
     def _standoff(self, site: tuple[float, float]) -> tuple[float, float] | None:
         """A free point facing ``site`` at the arm's reach: the nearest side first, then around it.
@@ -251,8 +322,8 @@ class ArmSkill(WorldSkill):
         from alica.skills.navigation import planning_checker
 
         robot = self.robot
-        x, y, _ = robot.pose
-        standoff = REACH + _mount_ahead(robot)
+        x, y, _ = robot.estimate
+        standoff = self.standoff()
         heading = math.atan2(site[1] - y, site[0] - x)
         others = [
             (r.pose[0], r.pose[1], r.spec.radius + STANDOFF_MARGIN)
@@ -284,11 +355,11 @@ class ArmSkill(WorldSkill):
         if scene is None:
             scene = cache[key] = ArmScene(self.arm.urdf_path, self.arm.base_pose(), seed=self.world.seed)
         scene.set_base_pose(self.arm.base_pose())
-        target = self.target_object()
+        left_out = self.scene_exclusions()
         boxes = [
             _box(o)
             for name, o in sorted(self.world.objects.items())
-            if name != target.name and _near(o, self._arm_xy()) and o.kind not in ("terrain", "collection_point")
+            if name not in left_out and _near(o, self._arm_xy()) and o.kind not in ("terrain", "collection_point")
         ]
         scene.set_obstacles(boxes)
         q = np.asarray(self.arm.q(), dtype=float)
@@ -302,23 +373,33 @@ class ArmSkill(WorldSkill):
                 if scene.collides(q, held):
                     touching.append(box)
             scene.set_obstacles([b for b in boxes if b not in touching])
-        elif self.grasps and self.attempts == self.retries - 1:
+        elif self.grasps and self.last_attempt():
             # the last attempt: blocks pressed against the target (one fell right beside it) are left out of
             # the scene, and the closing fingers push them aside; else no grasp of the target ever works
-            near = _box(target)
+            near = _box(self.target_object())
             crowding = [b for b in boxes if _crowds(b, near)]
             if crowding:
                 scene.set_obstacles([b for b in boxes if b not in crowding])
         return scene
 
+    def scene_exclusions(self) -> set[str]:
+        """Objects left out of the arm's planning scene: the target (the planner adds it itself) and what the arm holds."""
+        held = self.arm.held
+        return {self.target_object().name} | ({held.name} if held is not None else set())
+
+    def last_attempt(self) -> bool:
+        """Whether this is the last attempt (objects crowding the target are then pushed aside)."""
+        return self.attempts == self.retries - 1
+
     def _held_box(self, scene: ArmScene, q: np.ndarray) -> Box | None:
-        """What the arm holds, as a box in the tool's frame (None when grasping)."""
-        if self.grasps:
+        """What the arm holds, as a box in the tool's frame (None when it holds nothing)."""
+        held = self.arm.held
+        if held is None:
             return None
         from alica.skills.manipulation import held_box
 
         try:
-            return held_box(_box(self.target_object()), scene.fk(q))
+            return held_box(_box(held), scene.fk(q))
         except ValueError:
             return None  # tilted in the hand: the planner says so itself
 
@@ -334,10 +415,7 @@ class ArmSkill(WorldSkill):
         self.job = None
         if not result.ok:
             return self._retry(f"no arm plan: {result.reason}")
-        paths = [np.asarray(p) for p in result.paths]
-        # pick: to the pre-grasp, down, grip, up to the transport pose;
-        # place: above the place, down, release, up to the transport pose
-        self.steps = [*paths[:2], "grip" if self.grasps else "release", *paths[2:]]
+        self.steps = self.arm_steps([np.asarray(p) for p in result.paths])
         self.step_index = 0
         self.phase = "execute"
         if self.grasps:
@@ -361,7 +439,7 @@ class ArmSkill(WorldSkill):
                 self.followed.append(np.asarray(step, dtype=float))
             return self.running(f"moving the arm (step {self.step_index}/{len(self.steps)})")
         self.phase = "verify"
-        self.settle_until = self.now() + (SETTLE if not self.grasps else 0.0)
+        self.settle_until = self.now() + (SETTLE if self.released else 0.0)
         return self.running("checking the result")
 
     def _grip_or_release(self) -> str | None:
@@ -381,7 +459,7 @@ class ArmSkill(WorldSkill):
                 return f"{obj.name} was taken by robot '{holder}' before the grip"
             if obj.kind == "block" and ("clear", obj.name) not in blocks_state(self.world):
                 return f"something was put on {obj.name} before the grip"  # lifting it would throw that off
-            arm.close()
+            arm.close(self.finger_force())
             arm.attach(obj.name)
         else:
             arm.detach()
@@ -395,12 +473,12 @@ class ArmSkill(WorldSkill):
             return self.running("letting the object settle")
         reason = self.check_after()
         if reason is None:
-            return self.succeed(f"done after {self.attempts + 1} attempt(s)")
+            return self.finished()
         return self._retry(reason)
 
     def _retry(self, reason: str) -> Status:
         self.attempts += 1
-        if self.world_model is not None:
+        if self.world_model is not None and self.counts_attempts:
             self.world_model.set("attempts", self.robot.name, value=self.attempts)
         if self.attempts >= self.retries:
             return self.fail(f"gave up after {self.attempts} attempt(s): {reason}")
@@ -537,15 +615,7 @@ class Pickup(ArmSkill):
         obj = self.target_object()
         if arm.held is not obj or arm.grip_force() <= 0:
             return f"the grip on {obj.name} failed (the object is not held)"
-        me = self.robot.name
-        for positive, fact in (
-            (False, ("ontable", obj.name)),
-            (False, ("clear", obj.name)),
-            (False, ("handempty", me)),
-            (True, ("holding", me, obj.name)),
-            (False, ("onground", obj.name)),
-        ):
-            self.write(positive, *fact)
+        write_held(self, self.object_label())
         return None
 
 
@@ -602,7 +672,7 @@ class Putdown(ArmSkill):
         turned to one side; a retry after a failed placement takes another spot.
         """
         target = self.param("target")
-        if target is not None:
+        if target is not None and place_area(self, target) is None:
             return self.resolve_position(target)
         if self._spot is None:
             self._spot = self._free_spot()
@@ -610,10 +680,18 @@ class Putdown(ArmSkill):
 
     def _free_spot(self) -> tuple[float, float]:
         tried = self._tried
-        for spot in putdown_spots(self.world, self.robot):
+        area = place_area(self, self.param("target"))
+        spots = (
+            putdown_spots(self.world, self.robot)
+            if area is None
+            else area_spots(self.world, self.robot, area, PUTDOWN_ROOM)
+        )
+        for spot in spots:
             if not any(distance(spot, old) < PUTDOWN_ROOM for old in tried):
                 return spot
-        x, y, yaw = self.robot.pose
+        if area is not None:
+            return area[0], area[1]  # nothing free in the area: its centre (the placement check fails)
+        x, y, yaw = self.robot.estimate
         ahead = REACH + _mount_ahead(self.robot)
         return x + ahead * math.cos(yaw), y + ahead * math.sin(
             yaw
@@ -622,7 +700,7 @@ class Putdown(ArmSkill):
     def _retry(self, reason: str) -> Status:
         """Try another spot on the next attempt (when no target was given)."""
         status = super()._retry(reason)
-        if status == Status.RUNNING and self.param("target") is None:
+        if status == Status.RUNNING and (self.param("target") is None or place_area(self, self.param("target"))):
             self._tried = [*self._tried, self.site()]
             self._spot = None
             self.phase = "approach"
@@ -636,30 +714,11 @@ class Putdown(ArmSkill):
             return f"{obj.name} is still in the hand"
         x, y, _ = self.place_top()
         here = obj.position()
-        if math.hypot(here[0] - x, here[1] - y) > 0.08:
+        if math.hypot(here[0] - x, here[1] - y) > PLACE_TOLERANCE:
             return f"{obj.name} lies at ({here[0]:.2f}, {here[1]:.2f}), not at ({x:.2f}, {y:.2f})"
-        me = self.robot.name
-        self.write(False, "holding", me, obj.name)
-        self.write(True, "handempty", me)
-        self.write(True, "clear", obj.name)
-        self.outcome_facts(obj)
+        write_released(self, self.object_label())
+        write_placed(self, self.object_label(), obj, self.param("target"))
         return None
-
-    def outcome_facts(self, obj: WorldThing) -> None:
-        """Putdown: the object is on the target block, on the table (blocks) or on the ground."""
-        target = self.param("target")
-        below = self.world.objects.get(target) if isinstance(target, str) else None
-        if isinstance(target, str) and below is not None and below.kind == "block":
-            self.write(True, "on", obj.name, target)
-            self.write(False, "clear", target)
-        elif obj.kind == "block":
-            self.write(True, "ontable", obj.name)
-        else:
-            self.write(True, "onground", obj.name)
-        target = self.param("target")
-        if isinstance(target, str):
-            name = target.strip().removeprefix("pos(").removesuffix(")").strip()
-            self.write(True, "at", obj.name, name)
 
 
 class Stack(Putdown):
@@ -695,10 +754,8 @@ class Stack(Putdown):
             return f"{obj.name} is still in the hand"
         if ("on", obj.name, below) not in blocks_state(self.world):
             return f"{obj.name} did not come to rest on {below}"
-        me = self.robot.name
-        self.write(False, "holding", me, obj.name)
-        self.write(True, "handempty", me)
-        self.write(True, "clear", obj.name)
-        self.write(True, "on", obj.name, below)
+        write_released(self, self.object_label())
+        self.write(True, "clear", self.object_label())
+        self.write(True, "on", self.object_label(), below)
         self.write(False, "clear", below)
         return None

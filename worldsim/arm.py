@@ -127,6 +127,7 @@ class Arm(GripperMixin):
         self._all_joints = list(_ARM_JOINTS + _FINGER_JOINTS)
         self._q = self.home_q.copy()
         self._fingers = FINGER_OPEN
+        self._force = GRIP_FORCE
         self._path: np.ndarray | None = None
         self._times: np.ndarray | None = None
         self._t = 0.0
@@ -309,6 +310,7 @@ class Arm(GripperMixin):
         return {
             "q": self._q.copy(),
             "fingers": self._fingers,
+            "force": self._force,
             "path": self._path,
             "times": self._times,
             "t": self._t,
@@ -322,6 +324,7 @@ class Arm(GripperMixin):
         """Take a saved kinematic state (the world has released every held object first)."""
         self._q = state["q"].copy()
         self._fingers = state["fingers"]
+        self._force = state.get("force", GRIP_FORCE)
         self._path, self._times, self._t, self._seg = state["path"], state["times"], state["t"], state["seg"]
         self._held, self._grasp, self._slip_at = state["held"], state["grasp"], state["slip_at"]
         if self._held is not None:

@@ -44,10 +44,12 @@ class GripperMixin:
     sets it up and provides the robot, the body and the pose of the end-effector.
     """
 
-    __slots__ = ("_fingers", "_grasp", "_held", "_joints_dirty", "_moved", "_slip_at")
+    __slots__ = ("_fingers", "_force", "_grasp", "_held", "_joints_dirty", "_moved", "_slip_at")
 
     #: The opening of each finger (m).
     _fingers: float
+    #: The finger force (N) commanded by the last :meth:`close`.
+    _force: float
     #: The object in the gripper, or ``None``.
     _held: WorldObject | None
     #: The pose of the held object in the end-effector frame, or ``None``.
@@ -77,10 +79,21 @@ class GripperMixin:
         self._moved = True
         self._joints_dirty = True
 
-    def close(self) -> None:
-        """Close the fingers, on the object between them if there is one (this does not attach it)."""
+    def close(self, force: float | None = None) -> None:
+        """Close the fingers, on the object between them if there is one (this does not attach it).
+
+        Args:
+            force: the finger force in newtons that :meth:`grip_force` senses while holding
+                (default :data:`GRIP_FORCE`).
+
+        Raises:
+            WorldError: a force that is not a finite number > 0.
+        """
+        if force is not None and not (isinstance(force, (int, float)) and math.isfinite(force) and force > 0.0):
+            raise WorldError(f"close of robot '{self.robot.name}' needs a finger force > 0 newtons, got {force!r}")
         if self.robot.crashed:
             return
+        self._force = GRIP_FORCE if force is None else float(force)
         target = self._held or self._between_fingers()
         self._fingers = 0.0 if target is None else min(FINGER_OPEN, _half_width(target))
         self._moved = True
@@ -102,8 +115,8 @@ class GripperMixin:
         return self._held
 
     def grip_force(self) -> float:
-        """The sensed finger force: :data:`GRIP_FORCE` while holding, 0 otherwise."""
-        return GRIP_FORCE if self._held is not None else 0.0
+        """The sensed finger force while holding (the force of the last :meth:`close`, :data:`GRIP_FORCE` by default), 0 otherwise."""
+        return self._force if self._held is not None else 0.0
 
     def attach(self, obj: WorldObject | str) -> bool:
         """Grasp ``obj`` (an object or its name) if the point between the fingers is at it.

@@ -1,4 +1,4 @@
-"""Arm motion planning for the manipulation skills (Pickup, Putdown, Stack, Unstack).
+"""Arm motion planning for the manipulation skills (Pickup, Putdown, Stack, Unstack and their steps).
 
 Works from plain data (a URDF, the base pose, boxes), in its own pybullet
 DIRECT client per :class:`ArmScene`; plans are returned as data (configurations
@@ -14,6 +14,7 @@ from alica.skills.manipulation.grasps import Grasp, held_box, place_poses, place
 from alica.skills.manipulation.ik import IKResult, solve_ik
 from alica.skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
 from alica.skills.manipulation.scene import ArmScene, Box, default_urdf
+from alica.skills.manipulation.transport import TransportPlan, plan_transport
 
 __all__ = [
     "ArmPath",
@@ -25,6 +26,7 @@ __all__ = [
     "PlacePlan",
     "Pose",
     "Quat",
+    "TransportPlan",
     "Vec3",
     "default_urdf",
     "held_box",
@@ -35,6 +37,7 @@ __all__ = [
     "plan_arm",
     "plan_pickup",
     "plan_place",
+    "plan_transport",
     "solve_ik",
     "straight_line",
     "top_down_quat",

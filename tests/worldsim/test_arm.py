@@ -138,6 +138,21 @@ def _grasp(world: World, robot: Robot, block_name: str) -> np.ndarray:
     return q
 
 
+def test_the_grip_force_is_the_force_the_gripper_closed_with(world: World, manipulator: Robot) -> None:
+    from alica.worldsim.arm import GRIP_FORCE
+
+    arm = manipulator.arm
+    world.add_block("b", (arm.mount_offset[0] + 0.5, 0.0))
+    _grasp(world, manipulator, "b")
+    assert arm.grip_force() == GRIP_FORCE  # the default
+    arm.detach()
+    arm.close(5.0)
+    assert arm.grip_force() == 0.0  # nothing held
+    assert arm.attach("b") and arm.grip_force() == 5.0
+    with pytest.raises(WorldError, match="needs a finger force > 0 newtons, got -1"):
+        arm.close(-1.0)
+
+
 def test_attach_carries_and_detach_releases(world: World, manipulator: Robot) -> None:
     arm = manipulator.arm
     block = world.add_block("b", (arm.mount_offset[0] + 0.5, 0.0))

@@ -1,0 +1,125 @@
+"""What the arm skills read and write about the world: objects by name, places, outcome facts.
+
+Shared by the monolithic manipulation skills (:mod:`alica.skills.handling`) and
+the steps of the Pickup and Putdown plans (:mod:`alica.skills.arm_steps`).
+"""
+
+from __future__ import annotations
+
+import math
+
+from alica.errors import SkillError
+from alica.skills.world_skill import WorldSkill, distance
+from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
+
+#: An object name the world does not know stands for the sample or block nearest where the world
+#: model puts it (``pos(name)``, e.g. from perception), within this many metres.
+ASSOCIATION = 0.3
+
+
+def place_area(skill: WorldSkill, target: object) -> tuple[float, float, float] | None:
+    """``(x, y, radius)`` of the area ``target`` names when it is one (a collection point such as ``pos(g)``), else None.
+
+    Several objects are put down in an area, each on a free spot in it (see :func:`area_spots`).
+    """
+    if not isinstance(target, str):
+        return None
+    name = target.strip().removeprefix("pos(").removesuffix(")").strip()
+    obj = skill.world.objects.get(name)
+    if obj is None or obj.kind != "collection_point" or not obj.radius > 0.0:
+        return None
+    x, y = skill.resolve_position(target)
+    return x, y, float(obj.radius)
+
+
+def area_spots(
+    world: RobotWorld, robot: MobileRobot, area: tuple[float, float, float], room: float
+) -> list[tuple[float, float]]:
+    """Free spots (``room`` metres around them) in a round ``area``: its centre first, then further out.
+
+    The spots are the centre and two rings of eight, at a third and two thirds
+    of the radius; on a ring the spots nearest to ``robot`` come first.
+    """
+    from alica.worldsim.queries import blocker
+
+    cx, cy, radius = area
+    x, y, _ = robot.estimate
+    spots = [(cx, cy)]
+    for f in (1.0 / 3.0, 2.0 / 3.0):
+        ring = [
+            (cx + f * radius * math.cos(k * math.pi / 4.0), cy + f * radius * math.sin(k * math.pi / 4.0))
+            for k in range(8)
+        ]
+        spots += sorted(ring, key=lambda spot: distance(spot, (x, y)))
+    return [spot for spot in spots if blocker(world, spot[0], spot[1], room) is None]
+
+
+def find_object(skill: WorldSkill, name: object) -> WorldThing:
+    """The world object ``name``; a name the world does not know is the sample or block at ``pos(name)``.
+
+    Perception names the samples it finds by itself (``green_white_red``, say);
+    the object Grasp took under such a name (``scratch["names"]``), else the
+    one nearest to the world model's position of it within :data:`ASSOCIATION`, is meant.
+
+    Raises:
+        SkillError: no such object, and none where the world model puts ``name``.
+    """
+    objects = skill.world.objects
+    names = getattr(skill.context, "scratch", {}).get("names")  # what Grasp took under this name
+    if isinstance(name, str) and isinstance(names, dict) and names.get(name) in objects:
+        return objects[names[name]]
+    if isinstance(name, str) and name not in objects and skill.world_model is not None:
+        known = skill.world_model.lookup("pos", (name,))
+        if isinstance(known, (tuple, list)) and len(known) >= 2:
+            xy = (float(known[0]), float(known[1]))
+            near = sorted(
+                (distance((float(o.position()[0]), float(o.position()[1])), xy), n)
+                for n, o in objects.items()
+                if o.kind in ("sample", "block")
+            )
+            if near and near[0][0] <= ASSOCIATION:
+                return objects[near[0][1]]
+            raise SkillError(
+                f"skill '{skill.name}': no object lies within {ASSOCIATION:g} m of where the world model puts "
+                f"{name!r} ({xy[0]:.2f}, {xy[1]:.2f})"
+            )
+    return skill.object_named(name)
+
+
+def write_held(skill: WorldSkill, name: str) -> None:
+    """The outcome facts of the robot holding ``name``: ``holding(self, name)``; not ``handempty``, ``onground``, ``ontable``, ``clear``."""
+    me = skill.robot.name
+    for positive, fact in (
+        (False, ("ontable", name)),
+        (False, ("clear", name)),
+        (False, ("handempty", me)),
+        (True, ("holding", me, name)),
+        (False, ("onground", name)),
+    ):
+        skill.write(positive, *fact)
+
+
+def write_released(skill: WorldSkill, name: str) -> None:
+    """The outcome facts of the robot letting ``name`` go: not ``holding(self, name)``, ``handempty(self)``."""
+    me = skill.robot.name
+    skill.write(False, "holding", me, name)
+    skill.write(True, "handempty", me)
+
+
+def write_placed(skill: WorldSkill, name: str, obj: WorldThing, target: object) -> None:
+    """The outcome facts of ``name`` (the world's ``obj``) lying at ``target`` (None: anywhere).
+
+    ``clear(name)``; ``on(name, target)`` on a target block, else ``ontable``
+    (a block) or ``onground``; ``at(name, place)`` when the target names a place (``g`` or ``pos(g)``).
+    """
+    skill.write(True, "clear", name)
+    below = skill.world.objects.get(target) if isinstance(target, str) else None
+    if isinstance(target, str) and below is not None and below.kind == "block":
+        skill.write(True, "on", name, target)
+        skill.write(False, "clear", target)
+    elif obj.kind == "block":
+        skill.write(True, "ontable", name)
+    else:
+        skill.write(True, "onground", name)
+    if isinstance(target, str):
+        skill.write(True, "at", name, target.strip().removeprefix("pos(").removesuffix(")").strip())
