@@ -58,7 +58,17 @@ from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
 from alica.prophet.pipeline import Found, ProblemEvent, Rejected, ValidPlan, plan_problem
 from alica.prophet.planner import Done, PlanStatus
 from alica.prophet.problem import predicate_types
-from alica.prophet.tasks import STEP_DONE, CreatedTasks, Literal, StepKind, conjunction, create_tasks, holds, step_token
+from alica.prophet.tasks import (
+    STEP_DONE,
+    CreatedTasks,
+    Literal,
+    StepKind,
+    conjunction,
+    create_tasks,
+    for_robot,
+    holds,
+    step_token,
+)
 from alica.prophet.world import (
     PlanningWorld,
     TaskProgress,
@@ -261,7 +271,13 @@ class ProblemRuntime:
         self._mark_done()
 
     def _mark_done(self) -> None:
-        """Write ``step_done`` for the steps this agent finished in the generated plan (later steps wait for them)."""
+        """Write ``step_done`` for the steps this agent finished in the generated plan (later steps wait for them).
+
+        The finished step's effect (its skill plan's signature, for this agent) is written too, as a
+        plan executor applies an action's effects when it completes: the skills write what they sense
+        (``holding``, ``onground``), but a fact of the planning domain that no skill writes (the robot's
+        ``at`` a sample it has picked up, deleted by Pickup) would otherwise keep a stale value.
+        """
         node, created = self.slot.node, self.created
         if node is None or created is None or node.plan is not created.plan or node.ep is None:
             return
@@ -269,10 +285,14 @@ class ProblemRuntime:
         if place is None:
             return  # standing by
         world = self.host.world
+        me = self.host.name
         for step in created.tasks[place.task][: place.step]:
             token = step_token(created.plan.name, step.index)
             if token not in self.marked:
                 self.marked.add(token)
+                effect = for_robot(step.effect, step.robot, me)
+                for positive, fact in sorted(effect, key=lambda literal: literal[0]):  # deletes first
+                    (world.assert_fact if positive else world.retract_fact)(fact.predicate, *fact.args)
                 world.assert_fact(STEP_DONE, token)
 
     def stop(self) -> None:

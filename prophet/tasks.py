@@ -3,7 +3,9 @@
 1. **Parallelise** (Algorithms 2-3): the plan's actions are taken in order;
    an action opens a new task if its precondition holds for a *new* robot
    (the team's state before the action, with the robot's own facts those of a
-   robot that has done nothing yet), else it joins the task of the robot's
+   robot that has done nothing yet) and the action's robot is not in the
+   middle of something (its own facts are those it started with: it holds
+   nothing it picked up), else it joins the task of the robot's
    previous action (the last task, in a single-agent plan). The plan may name
    several robots (when the world is planned with every team member, as the
    runtime does, a robot may hold a block already): a task whose first action
@@ -240,7 +242,11 @@ def parallelise(steps: Sequence[Step], init: Iterable[Fact], robots: str | Seque
 
     A step opens a new task when its precondition holds for a robot that has
     done nothing yet (some robot with its initial facts) in the team's state
-    before the step; else it joins the task of the robot's previous step.
+    before the step, and the step's own robot is not in the middle of
+    something (its own facts are those it started with); else it joins the
+    task of the robot's previous step. So a robot that picked a sample up
+    also carries it: driving to the collection point is not a new task for
+    another robot with an empty hand.
     """
     return _parallelise(steps, init, _robots(robots))[0]
 
@@ -264,7 +270,11 @@ def _parallelise(
                 for_robot(step.pre, step.robot, r), shared | _own_facts(r, team, task_of, step.robot, fresh, state)
             )
         )
-        if not tasks or able:
+        # a robot in the middle of something (its own facts are not those it started with: it holds a
+        # sample it picked up) goes on with its own task, even where a new robot could start the step
+        own_now = {f for f in state if step.robot in f[1]}
+        busy = step.robot in task_of and own_now != fresh.get(step.robot, set())
+        if not tasks or (able and not busy):
             tasks.append([step])
             # who may take the task: the robots whose initial facts let them start it, and the planner's own robot
             may = {r for r in team if holds(for_robot(step.pre, step.robot, r), shared | fresh[r])} | (

@@ -15,11 +15,13 @@ object must be mentioned by a fact to be planned for.
 
 While the team executes a generated plan, :func:`remaining_fits` simulates
 what is left of it (each task's remaining steps, run by the agent holding the
-task) from the current facts. A running step whose precondition does not
-hold but whose effect already does counts as done (it has just finished, and
-the teammate's message lags behind the world); any other unmet precondition,
-or a goal not reached at the end, means the world changed under the plan
-(or a task's new holder cannot go on from where its last holder stopped).
+task) from the current facts. A running step counts as under way whatever
+its precondition says now: its skill may have changed part of the world
+already (a grasp takes the sample off the ground before the lift), or have
+just finished while the teammate's message lags behind; it fails by itself
+when it cannot go on. An unmet precondition of a step not started yet, or a
+goal not reached at the end, means the world changed under the plan (or a
+task's new holder cannot go on from where its last holder stopped).
 """
 
 from __future__ import annotations
@@ -275,9 +277,11 @@ def remaining_fits(
     for _, step, who, running in sorted(remaining, key=lambda item: item[0]):
         pre = for_robot(step.pre, step.robot, who)
         effect = for_robot(step.effect, step.robot, who)
-        if holds(pre, state):
+        if holds(pre, state) or running:
+            # a running step is under way: its skill has changed part of the world already (a grasp
+            # took the sample off the ground before the lift) and fails by itself when it cannot go on
             apply_effect(state, effect)
-        elif not (running and holds(effect, state)):
+        else:
             return f"step {step.label} of {who} cannot run: {_unmet(pre, state)} does not hold"
     if not holds(goal, state):
         return f"the plan no longer reaches the goal: {_unmet(goal, state)} would not hold"

@@ -289,7 +289,10 @@ class MoveToPosition(WorldSkill):
         if wm is not None:
             wm.set("pos", self.robot.name, value=(round(here[0], 3), round(here[1], 3)))
         goal = self.param("goal")
-        if isinstance(goal, str):
+        there = self.param("at")
+        if isinstance(there, str) and there.strip():
+            self.write(True, "at", self.robot.name, there.strip())
+        elif isinstance(goal, str):
             self.write(True, "at", self.robot.name, goal.strip().removeprefix("pos(").removesuffix(")").strip())
 
     def terminate(self, new_status: Status) -> None:

@@ -766,6 +766,9 @@ class CropCandidate(_Pipeline):
         for z in (0.0, SAMPLE_HEIGHT):
             for s in (-1.0, 1.0):
                 corners.append(image.project(np.array([x, y, z]) + s * radius * side))
+        # seen from above (close by), the top's far edge shows above the silhouette: the upper section looks taller
+        along = np.array([to[0], to[1], 0.0]) / max(math.hypot(to[0], to[1]), 1e-9)
+        corners.append(image.project(np.array([x, y, SAMPLE_HEIGHT]) + radius * along))
         if any(not math.isfinite(u) or d <= 0.0 for u, _, d in corners):
             return "behind the camera"
         us, vs = [u for u, _, _ in corners], [v for _, v, _ in corners]

@@ -171,6 +171,9 @@ class WorldFacts(Protocol):
     def assert_fact(self, predicate: str, *args: object) -> object:
         """Make a fact hold, for the whole team."""
 
+    def retract_fact(self, predicate: str, *args: object) -> object:
+        """Make a fact not hold, for the whole team."""
+
 
 class ChildHost(Protocol):
     """What an agent's engine offers the child runtimes of one kind (and nothing more)."""

@@ -52,6 +52,9 @@ class _World:
     def assert_fact(self, predicate: str, *args: object) -> object:
         return self._model.assert_fact(predicate, *args)
 
+    def retract_fact(self, predicate: str, *args: object) -> object:
+        return self._model.retract_fact(predicate, *args)
+
 
 class EngineHost:
     """An agent's engine as the host of one kind of child runtime (a :class:`~alica.engine.child.ChildHost`).
