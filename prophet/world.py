@@ -109,6 +109,15 @@ def read_world(
     else:
         source = facts
     members = tuple(sorted(set(team)))
+    fixed = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
+    known_types = {t.lower() for arity in predicates.values() for t in arity} | set(fixed.values())
+    # objects known to be no robots: a predicate may take a robot or a sample in the same place (at/2)
+    not_robots = set(fixed) | {
+        str(o)
+        for type_name, objects in (typed_objects or {}).items()
+        if type_name.lower() in known_types and type_name != robot_type
+        for o in objects
+    }
     kept: set[Fact] = set()
     left_out = 0
     outside: set[str] = set()
@@ -121,10 +130,13 @@ def read_world(
         if arity is None or len(args) != len(arity):
             continue
         if not offline and any(
-            kind == robot_type and arg not in members for arg, kind in zip(args, arity, strict=True)
+            kind == robot_type and arg not in members and arg not in not_robots
+            for arg, kind in zip(args, arity, strict=True)
         ):
             others.update(
-                arg for arg, kind in zip(args, arity, strict=True) if kind == robot_type and arg not in members
+                arg
+                for arg, kind in zip(args, arity, strict=True)
+                if kind == robot_type and arg not in members and arg not in not_robots
             )
             if len(args) > 1:  # a relation of an outside robot with an object (not just its own state)
                 left_out += 1
@@ -133,13 +145,11 @@ def read_world(
         kept.add(Fact(name, args))
     types: dict[str, str] = dict(sorted(declared.items()))
     # objects the problem declares (a fixed place such as the collection point g) are known without being seen
-    fixed = {v.name: (v.type if v.type != "any" else "object") for v in problem.objects}
     if not offline:
         types.update(fixed)
     if not offline and robot_type is not None:
         types.update(dict.fromkeys(members, robot_type))
     # the world model's typed objects, of the types the domain knows (not its frontiers, say)
-    known_types = {t.lower() for arity in predicates.values() for t in arity} | set(fixed.values())
     for type_name, objects in sorted((typed_objects or {}).items()):
         if type_name.lower() not in known_types:
             continue

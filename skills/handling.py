@@ -53,6 +53,8 @@ SETTLE = 0.5
 PUTDOWN_TURNS = (0.0, 0.6, -0.6, 1.2, -1.2, 1.8, -1.8, 3.14)
 #: Free room (m) a put-down spot needs around it.
 PUTDOWN_ROOM = 0.15
+#: Free room (m) a spot in an area (the collection point) needs: the hand descends beside what stands there.
+AREA_ROOM = 0.25
 #: Sides of a work site tried for the stand-off point (the nearest first).
 STANDOFF_TRIES = 12
 #: Room kept around the robot at its stand-off point, metres.
@@ -684,7 +686,7 @@ class Putdown(ArmSkill):
         spots = (
             putdown_spots(self.world, self.robot)
             if area is None
-            else area_spots(self.world, self.robot, area, PUTDOWN_ROOM)
+            else area_spots(self.world, self.robot, area, AREA_ROOM)
         )
         for spot in spots:
             if not any(distance(spot, old) < PUTDOWN_ROOM for old in tried):

@@ -68,3 +68,13 @@ def test_objects_of_types_the_domain_does_not_know_are_left_out(impera):
     assert "f_0_0" not in types and types["green_white_red"] == "Sample" and types["g"] == "location"
     result = plan_problem(_problem(impera), impera, world).solve(time_limit=20)
     assert result.plan is not None
+
+
+def test_a_delivered_sample_is_no_robot_outside_the_team(impera):
+    # at/2 takes a robot (MoveToObject) or a sample (Putdown): at(green_white_red, g) is a sample at g
+    facts = [*_seen("green_white_green"), Fact("at", ("green_white_red", "g")), Fact("onground", ("green_white_red",))]
+    typed = {"Sample": ["green_white_red", "green_white_green"]}
+    problem = _problem(impera, "at(green_white_red, g) and at(green_white_green, g)")
+    world = read_world(problem, impera, facts, TEAM, typed)
+    assert not world.outside and not world.others and world.left_out == 0
+    assert Fact("at", ("green_white_red", "g")) in world.facts
