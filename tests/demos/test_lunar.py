@@ -101,3 +101,32 @@ def test_bad_options_give_a_clear_error(argv, message, capsys):
     err = capsys.readouterr().err
     assert message in err, err
     assert "Traceback" not in err
+
+
+def test_the_mission_brings_the_chosen_samples_to_g_on_a_small_field(tmp_path):
+    """End to end with the real skills: explore, detect, choose, plan at run time, fetch (16 m field, 2 samples).
+
+    In a fresh process, as a user runs it: OMPL has one generator per process, seeded once (the
+    test session seeded it already), and the same seed gives the same run only in a fresh process.
+    """
+    import json
+    import subprocess
+    import sys
+
+    argv = ["demo", "lunar", "--size", "16", "--rocks", "6", "--samples", "2", "--seed", "3", "--time-limit", "300"]
+    done = subprocess.run(
+        [sys.executable, "-m", "alica.app.cli", *argv, "--out", str(tmp_path), "--json", "--no-progress"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    result = json.loads(done.stdout)
+    assert done.returncode == 0 and result["success"], (result, done.stderr[-2000:])
+    assert sorted(result["delivered"]) == sorted(result["chosen"]) and len(result["chosen"]) == 2
+    assert set(result["chosen"]) <= set(result["found"])
+    assert result["coverage"] > 0.9 and result["plans"] >= 1
+    # Amparo and Stummel carried (Scout has no arm), and everything the demo writes is there
+    carried = {name for name, robot in result["robots"].items() if robot["steps"]}
+    assert carried <= {"amparo", "stummel"} and carried
+    assert {p.name for p in tmp_path.iterdir()} >= {"trace.jsonl", "map.png", "plan.yaml"}
