@@ -14,17 +14,16 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $(STAMP)
 
-# The main demo. Until the lunar mission demo with robots exists: validate every
-# plan, render the plan trees, run the lunar mission's team in simulation
-# (--stand-ins: its skills have no implementation yet, so scripted stand-ins run
-# them; Scout crashes and Stummel takes over the exploration), then
-# the blocks-world mission in pybullet (planned at run time, real skills).
+# The main demo: validate every plan, render the plan trees, then the lunar
+# mission in pybullet with the real skills (three robots explore a 40 x 40 m
+# field with 60 rocks, find drill samples, the first two found are planned
+# for at run time and carried to g; Scout crashes at 20 s and 10 % of the
+# messages are lost; map, trace and plan in build/lunar), then the
+# blocks-world mission (planned at run time, real skills).
 demo: $(STAMP)
 	$(BIN)/alica validate plans/
 	$(BIN)/alica render plans/ --out build/plans
-	$(BIN)/alica run plans/lunar/mission.yaml --agents scout,stummel,amparo \
-		--fact "found(a) and found(b)@5" --crash scout@2 --loss 0.1 --delay 20 \
-		--seed 1 --stand-ins --trace build/lunar.jsonl
+	$(BIN)/alica demo lunar --seed 1 --crash scout@20 --loss 0.1 --out build/lunar
 	$(BIN)/alica demo blocksworld --agents 3 --blocks 5 --seed 1 --out build/blocks
 
 test: $(STAMP)
