@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +33,8 @@ __all__ = ["Detection", "lidar_angles", "lidar_scan", "perceive", "scan_to_grid"
 # Rays start just outside the base so that the robot's own cylinder is never hit.
 _RAY_START_GAP = 0.01
 _CAMERA_HEIGHT_ABOVE_BASE = 0.3
+#: Coordinates beyond this are an unbounded box (a ground plane's).
+_UNBOUNDED = 1e20
 
 
 @dataclass(frozen=True, slots=True)
@@ -55,6 +57,12 @@ class Detection:
 def lidar_angles(n_rays: int) -> np.ndarray:
     """Ray angles relative to the robot heading: ``n_rays`` evenly spaced from -pi (inclusive) to pi."""
     return -math.pi + (2.0 * math.pi / n_rays) * np.arange(n_rays)
+
+
+def _level_at_zero(client: Any, body: int) -> bool:
+    """Whether a body sits at z = 0 unrotated (the ground plane as the world makes it)."""
+    position, orientation = client.getBasePositionAndOrientation(body)
+    return abs(position[2]) < 1e-9 and abs(abs(orientation[3]) - 1.0) < 1e-9
 
 
 def _own_bodies(robot: Robot) -> set[int]:
@@ -95,6 +103,56 @@ def _cast(world: World, starts: np.ndarray, ends: np.ndarray, skip: set[int]) ->
     return fractions, bodies
 
 
+#: Metres added around a body's box when deciding which rays can hit it (pybullet's boxes carry margins).
+_BOX_PAD = 0.02
+
+
+def _ray_reach(world: World, origin: np.ndarray, yaw: float, n_rays: int, rng_max: float, own: set[int]) -> np.ndarray:
+    """How far each ray of a horizontal scan from ``origin`` must be cast: beyond the farthest box it meets.
+
+    A ray meets a body's (or link's) axis-aligned box only if its angle lies
+    between the angles of the box's corners seen from the origin; 0 for a ray
+    that meets no box (a miss, not cast at all). The robot's own bodies are
+    passed through anyway and a flat ground plane below the scan is never met.
+    ``rng_max`` for every ray when some body has no bounded box.
+    """
+    c = world.client
+    terrain = {obj.body_id for obj in world.objects.values() if obj.kind == "terrain"}
+    x, y, z = (float(v) for v in origin)
+    step = 2.0 * math.pi / n_rays
+    first = yaw - math.pi  # the angle of ray 0
+    reach = np.zeros(n_rays)
+    for k in range(c.getNumBodies()):
+        body = c.getBodyUniqueId(k)
+        if body in own:
+            continue
+        for link in range(-1, c.getNumJoints(body)):
+            lo, hi = c.getAABB(body, link)
+            if max(abs(v) for v in (*lo, *hi)) >= _UNBOUNDED:
+                if body in terrain and link == -1 and z > 1e-3 and _level_at_zero(c, body):
+                    continue  # the scan runs above the ground plane
+                return np.full(n_rays, rng_max)
+            if not lo[2] - _BOX_PAD <= z <= hi[2] + _BOX_PAD:
+                continue
+            x0, y0, x1, y1 = lo[0] - _BOX_PAD, lo[1] - _BOX_PAD, hi[0] + _BOX_PAD, hi[1] + _BOX_PAD
+            far = math.sqrt(max((x0 - x) ** 2, (x1 - x) ** 2) + max((y0 - y) ** 2, (y1 - y) ** 2))
+            if x0 <= x <= x1 and y0 <= y <= y1:  # the scanner is inside the box: every ray meets it
+                np.maximum(reach, far, out=reach)
+                continue
+            near = math.hypot(x - min(max(x, x0), x1), y - min(max(y, y0), y1))
+            if near > rng_max:
+                continue
+            middle = math.atan2(0.5 * (y0 + y1) - y, 0.5 * (x0 + x1) - x)
+            spread = [
+                math.remainder(math.atan2(cy - y, cx - x) - middle, math.tau) for cx in (x0, x1) for cy in (y0, y1)
+            ]
+            k0 = math.floor((middle + min(spread) - first) / step) - 1
+            k1 = math.ceil((middle + max(spread) - first) / step) + 1
+            idx = np.arange(k0, k1 + 1) % n_rays
+            reach[idx] = np.maximum(reach[idx], far)
+    return reach
+
+
 def lidar_scan(
     robot: Robot, n_rays: int = 360, max_range: float | None = None, *, noise: float | None = None
 ) -> np.ndarray:
@@ -117,15 +175,22 @@ def lidar_scan(
     if not rng_max > start_r:
         raise WorldError(f"lidar_scan: max_range must exceed the robot radius plus {_RAY_START_GAP} m, got {max_range}")
     x, y, yaw = robot.pose
-    angles = yaw + lidar_angles(int(n_rays))
+    n = int(n_rays)
+    angles = yaw + lidar_angles(n)
     dirs = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
     origin = np.array([x, y, robot.spec.lidar_height])
-    starts = origin + start_r * dirs
-    ends = origin + rng_max * dirs
-    fractions, bodies = _cast(world, starts, ends, _own_bodies(robot))
-    ranges = start_r + fractions * (rng_max - start_r)
-    hit = bodies >= 0
-    ranges[~hit] = rng_max
+    own = _own_bodies(robot)
+    # cast only the rays that can hit something, and only as far as that can be
+    reach = _ray_reach(world, origin, yaw, n, rng_max, own)
+    cast = np.flatnonzero(reach > start_r)
+    ranges = np.full(n, rng_max)
+    hit = np.zeros(n, dtype=bool)
+    if len(cast):
+        ends = np.minimum(reach[cast], rng_max)
+        starts = origin + start_r * dirs[cast]
+        fractions, bodies = _cast(world, starts, origin + ends[:, None] * dirs[cast], own)
+        hit[cast] = bodies >= 0
+        ranges[cast] = np.where(bodies >= 0, start_r + fractions * (ends - start_r), rng_max)
     sigma = world.noise.lidar_sigma if noise is None else float(noise)
     if sigma > 0.0 and hit.any():
         ranges[hit] += world.rng.normal(0.0, sigma, int(hit.sum()))
