@@ -56,6 +56,9 @@ __all__ = [
 ASSOCIATION_RADIUS = 0.25
 #: Height of the sample containers in metres (the projection of a candidate into the image).
 SAMPLE_HEIGHT = 0.1
+#: DetectCircles scans this many metres beyond its ``max_range`` (not the lidar's whole range): a
+#: cluster that reaches that far is no sample within ``max_range`` (a sample's is a few centimetres long).
+SCAN_MARGIN = 2.0
 #: Fewest pixels a side of the part of the frame CropCandidate renders.
 _MIN_PICTURE = 16
 #: BlobDetect looks for blobs in the candidate's silhouette grown by this fraction of a section's height.
@@ -494,7 +497,9 @@ class DetectCircles(_Pipeline):
 
     The scan is taken where the robot is (the sensor); the circles are placed
     in the world by the robot's pose *estimate* (``robot.estimate``: odometry,
-    corrected by Localize), the only pose a skill may know.
+    corrected by Localize), the only pose a skill may know. The scan reaches
+    :data:`SCAN_MARGIN` metres beyond ``max_range`` (within the lidar's range):
+    nothing farther can make a candidate, and the rays cost less.
 
     Succeeds with ``scratch["circles"]`` (a list of candidate dicts ``{"id", "x", "y", "radius",
     "range", "bearing", "points"}``, nearest first) and ``candidate(c)``, ``candidate_pos(c)``
@@ -542,7 +547,9 @@ class DetectCircles(_Pipeline):
         from alica.worldsim.sensors import lidar_angles
 
         robot = self.robot
-        ranges = robot.lidar(self.n_rays)  # measured where the robot is
+        # the scan reaches a little beyond max_range only: farther hits make no candidate
+        scan_range = min(robot.spec.lidar_range, self.max_range + SCAN_MARGIN)
+        ranges = robot.lidar(self.n_rays, scan_range)  # measured where the robot is
         sigma = robot.lidar_noise
         return detect_circles(
             ranges,
@@ -551,7 +558,7 @@ class DetectCircles(_Pipeline):
             radius=self.radius,
             tolerance=self.tolerance,
             max_range=self.max_range,
-            scan_range=robot.spec.lidar_range,
+            scan_range=scan_range,
             sigma=max(sigma, 0.005),
             seed=int(self.world.seed) * 1_000_003 + round(self.now() * 1000),
         )

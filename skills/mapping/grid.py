@@ -224,10 +224,12 @@ class LogOddsGrid:
         c, s = np.cos(yaw + a), np.sin(yaw + a)
         step = 0.5 * res
         along = np.arange(0.0, float(reach.max()), step)
-        # free cells: samples strictly before the ray's end
-        keep = along[None, :] < reach[:, None]
-        fi = np.floor((x + c[:, None] * along[None, :] - ox) / res).astype(np.intp)[keep]
-        fj = np.floor((y + s[:, None] * along[None, :] - oy) / res).astype(np.intp)[keep]
+        # free cells: samples strictly before the ray's end (only those are computed: ray by ray, flat)
+        counts = np.searchsorted(along, reach, side="left")
+        ray = np.repeat(np.arange(len(r)), counts)
+        sample = along[np.arange(len(ray)) - np.repeat(np.cumsum(counts) - counts, counts)]
+        fi = np.floor((x + c[ray] * sample - ox) / res).astype(np.intp)
+        fj = np.floor((y + s[ray] * sample - oy) / res).astype(np.intp)
         ok = (fi >= 0) & (fi < nx) & (fj >= 0) & (fj < ny)
         free = np.zeros(nx * ny, dtype=bool)
         free[fj[ok] * nx + fi[ok]] = True
