@@ -218,9 +218,16 @@ def _clear(occupied: np.ndarray, rows: np.ndarray, cols: np.ndarray, resolution:
     n = int(math.ceil(clearance / resolution)) + 1
     dr, dc = np.mgrid[-n : n + 1, -n : n + 1]
     close = np.sqrt((dr * dr + dc * dc).astype(float)) * resolution < clearance
-    padded = np.pad(occupied, n)
-    for a, b in zip(dr[close].tolist(), dc[close].tolist(), strict=True):
-        keep &= ~padded[rows + n + a, cols + n + b]
+    # occupied cells per row up to each column (a leading 0): a run of columns is counted in two look-ups
+    counts = np.zeros((occupied.shape[0] + 2 * n, occupied.shape[1] + 2 * n + 1), dtype=np.int32)
+    np.cumsum(np.pad(occupied, n), axis=1, out=counts[:, 1:])
+    for i in range(2 * n + 1):
+        reach = np.flatnonzero(close[i])
+        if len(reach) == 0:
+            continue
+        lo, hi = int(dc[i, reach[0]]), int(dc[i, reach[-1]])  # the close columns of this row: one run
+        at = rows + n + int(dr[i, 0])
+        keep &= counts[at, cols + n + hi + 1] == counts[at, cols + n + lo]
     return keep
 
 
@@ -278,8 +285,11 @@ def extract_frontiers(
     inverse = inverse.reshape(-1)
     out: dict[str, FrontierCandidate] = {}
     cell_gain = result.gain[rows, cols]
+    # the cells of each key, in cell order (a stable sort by key)
+    by_key = np.argsort(inverse, kind="stable")
+    ends = np.cumsum(np.bincount(inverse, minlength=len(uniq)))
     for k in range(len(uniq)):
-        members = np.nonzero(inverse == k)[0]
+        members = by_key[ends[k - 1] if k else 0 : ends[k]]
         if len(members) < min_size:
             continue
         cx, cy = xs[members].mean(), ys[members].mean()
