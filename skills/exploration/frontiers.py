@@ -177,10 +177,13 @@ def information_gain(
         # line 5: the frontier cells the wave front touched; f itself among them
         touched = near & todo[r0:r1, c0:c1]
         touched[r - r0, c - c0] = True
+        tr, tc = np.nonzero(touched)
+        tr += r0
+        tc += c0
         # lines 13-16: store the result for the observed cells and remove them from the list
-        gain[r0:r1, c0:c1][touched] = size
-        boundary[r0:r1, c0:c1][touched] = at_edge
-        todo[r0:r1, c0:c1][touched] = False
+        gain[tr, tc] = size
+        boundary[tr, tc] = at_edge
+        todo[tr, tc] = False
     return GainMap(gain, boundary, started)
 
 
