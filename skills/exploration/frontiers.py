@@ -173,7 +173,9 @@ def information_gain(
         r0, r1 = max(0, r - reach - 2), min(rows, r + reach + 3)
         c0, c1 = max(0, c - reach - 2), min(cols, c + reach + 3)
         started += 1
-        size, at_edge, near = _propagate(unknown[r0:r1, c0:c1], r - r0, c - c0, reach, (r0 == 0, r1 == rows, c0 == 0, c1 == cols))
+        size, at_edge, near = _propagate(
+            unknown[r0:r1, c0:c1], r - r0, c - c0, reach, (r0 == 0, r1 == rows, c0 == 0, c1 == cols)
+        )
         # line 5: the frontier cells the wave front touched; f itself among them
         touched = near & todo[r0:r1, c0:c1]
         touched[r - r0, c - c0] = True
@@ -218,7 +220,7 @@ def _clear(occupied: np.ndarray, rows: np.ndarray, cols: np.ndarray, resolution:
     keep = np.ones(len(rows), dtype=bool)
     if len(rows) == 0 or not occupied.any():
         return keep
-    n = int(math.ceil(clearance / resolution)) + 1
+    n = math.ceil(clearance / resolution) + 1
     dr, dc = np.mgrid[-n : n + 1, -n : n + 1]
     close = np.sqrt((dr * dr + dc * dc).astype(float)) * resolution < clearance
     # occupied cells per row up to each column (a leading 0): a run of columns is counted in two look-ups

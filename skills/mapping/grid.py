@@ -240,8 +240,10 @@ class LogOddsGrid:
         fi = _cells(np.repeat(c, counts), sample, x, ox, res)
         fj = _cells(np.repeat(s, counts), sample, y, oy, res)
         free = np.zeros(nx * ny, dtype=bool)
-        if (x - ox) - reach.max() > res and (x - ox) + reach.max() < (nx - 1) * res and (
-            (y - oy) - reach.max() > res and (y - oy) + reach.max() < (ny - 1) * res
+        if (
+            (x - ox) - reach.max() > res
+            and (x - ox) + reach.max() < (nx - 1) * res
+            and ((y - oy) - reach.max() > res and (y - oy) + reach.max() < (ny - 1) * res)
         ):  # every sample lies well inside the grid
             fj *= nx
             fj += fi
