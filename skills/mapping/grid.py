@@ -51,16 +51,6 @@ FREE = 0
 OCCUPIED = 1
 
 
-def _cells(direction: np.ndarray, along: np.ndarray, start: float, origin: float, res: float) -> np.ndarray:
-    """``floor((start + direction * along - origin) / res)`` as cell indices, computed in place."""
-    t = direction * along
-    t += start
-    t -= origin
-    t /= res
-    np.floor(t, out=t)
-    return t.astype(np.intp)
-
-
 class LogOddsGrid:
     """A log-odds occupancy grid (see the module docstring).
 
@@ -234,23 +224,13 @@ class LogOddsGrid:
         c, s = np.cos(yaw + a), np.sin(yaw + a)
         step = 0.5 * res
         along = np.arange(0.0, float(reach.max()), step)
-        # free cells: samples strictly before the ray's end (only those are computed: ray by ray, flat)
-        counts = np.searchsorted(along, reach, side="left").tolist()
-        sample = np.concatenate([along[:k] for k in counts]) if counts else along[:0]
-        fi = _cells(np.repeat(c, counts), sample, x, ox, res)
-        fj = _cells(np.repeat(s, counts), sample, y, oy, res)
+        # free cells: samples strictly before the ray's end
+        keep = along[None, :] < reach[:, None]
+        fi = np.floor((x + c[:, None] * along[None, :] - ox) / res).astype(np.intp)[keep]
+        fj = np.floor((y + s[:, None] * along[None, :] - oy) / res).astype(np.intp)[keep]
+        ok = (fi >= 0) & (fi < nx) & (fj >= 0) & (fj < ny)
         free = np.zeros(nx * ny, dtype=bool)
-        if (
-            (x - ox) - reach.max() > res
-            and (x - ox) + reach.max() < (nx - 1) * res
-            and ((y - oy) - reach.max() > res and (y - oy) + reach.max() < (ny - 1) * res)
-        ):  # every sample lies well inside the grid
-            fj *= nx
-            fj += fi
-            free[fj] = True
-        else:
-            ok = (fi >= 0) & (fi < nx) & (fj >= 0) & (fj < ny)
-            free[fj[ok] * nx + fi[ok]] = True
+        free[fj[ok] * nx + fi[ok]] = True
         hi = np.floor((x + c[hit] * reach[hit] - ox) / res).astype(np.intp)
         hj = np.floor((y + s[hit] * reach[hit] - oy) / res).astype(np.intp)
         ok = (hi >= 0) & (hi < nx) & (hj >= 0) & (hj < ny)
