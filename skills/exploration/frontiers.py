@@ -85,8 +85,9 @@ class GainMap:
     propagations: int
 
 
-#: Propagations remembered by :func:`_propagate` (a map changes in a few places between two readings).
-_CACHE_SIZE = 8192
+#: Propagations remembered by :func:`_propagate` (a map changes in a few places between two readings;
+#: a reading of a 40 m field starts about 100; more memory finds no more).
+_CACHE_SIZE = 1024
 _PROPAGATIONS: OrderedDict[tuple[object, ...], tuple[int, bool, np.ndarray]] = OrderedDict()
 
 
