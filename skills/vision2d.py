@@ -57,6 +57,11 @@ __all__ = [
 ASSOCIATION_RADIUS = 0.25
 #: Height of the sample containers in metres (the projection of a candidate into the image).
 SAMPLE_HEIGHT = 0.1
+#: DetectCircles scans this many metres beyond its ``max_range`` (not the lidar's whole range): a
+#: cluster that reaches that far is no sample within ``max_range`` (a sample's is a few centimetres long).
+SCAN_MARGIN = 2.0
+#: Fewest pixels a side of the part of the frame CropCandidate renders.
+_MIN_PICTURE = 16
 #: BlobDetect looks for blobs in the candidate's silhouette grown by this fraction of a section's height.
 WINDOW_PAD = 0.3
 #: A middle section at least this bright (HSV value, 0-255) and unsaturated is white; a white section
@@ -494,7 +499,9 @@ class DetectCircles(_Pipeline):
 
     The scan is taken where the robot is (the sensor); the circles are placed
     in the world by the robot's pose *estimate* (``robot.estimate``: odometry,
-    corrected by Localize), the only pose a skill may know.
+    corrected by Localize), the only pose a skill may know. The scan reaches
+    :data:`SCAN_MARGIN` metres beyond ``max_range`` (within the lidar's range):
+    nothing farther can make a candidate, and the rays cost less.
 
     Succeeds with ``scratch["circles"]`` (a list of candidate dicts ``{"id", "x", "y", "radius",
     "range", "bearing", "points"}``, nearest first) and ``candidate(c)``, ``candidate_pos(c)``
@@ -542,7 +549,9 @@ class DetectCircles(_Pipeline):
         from alica.worldsim.sensors import lidar_angles
 
         robot = self.robot
-        ranges = robot.lidar(self.n_rays)  # measured where the robot is
+        # the scan reaches a little beyond max_range only: farther hits make no candidate
+        scan_range = min(robot.spec.lidar_range, self.max_range + SCAN_MARGIN)
+        ranges = robot.lidar(self.n_rays, scan_range)  # measured where the robot is
         sigma = robot.lidar_noise
         return detect_circles(
             ranges,
@@ -551,7 +560,7 @@ class DetectCircles(_Pipeline):
             radius=self.radius,
             tolerance=self.tolerance,
             max_range=self.max_range,
-            scan_range=robot.spec.lidar_range,
+            scan_range=scan_range,
             sigma=max(sigma, 0.005),
             seed=int(self.world.seed) * 1_000_003 + round(self.now() * 1000),
         )
@@ -701,8 +710,36 @@ class CropCandidate(_Pipeline):
         return max(-limit, min(limit, bearing))
 
     def _render(self) -> CameraImage:
+        """Render the part of the frame the candidates' crops can come from (the same pixels, far cheaper)."""
+        from alica.worldsim.robot_camera import CameraImage, camera_pose
 
-        return self.robot.camera(width=self.width, height=self.height, pan=self.pan, believed=True)
+        robot = self.robot
+        position, rotation = camera_pose(robot, robot.estimate, self.pan)
+        fx = (self.width / 2.0) / math.tan(robot.spec.camera_fov / 2.0)
+        probe = CameraImage(
+            np.zeros((1, 1, 3), dtype=np.uint8),
+            np.zeros((1, 1)),
+            (fx, fx, self.width / 2.0 - 0.5, self.height / 2.0 - 0.5),
+            position,
+            rotation,
+            self.now(),
+            self.pan,
+            frame=(self.width, self.height),
+        )
+        radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
+        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
+        boxes = [g[0] for g in (self._geometry(probe, c, radius) for c in circles) if not isinstance(g, str)]
+        window = None
+        if boxes:
+            u0, v0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
+            u1, v1 = max(b[2] for b in boxes), max(b[3] for b in boxes)
+            # at least the renderer's smallest picture, inside the frame
+            u0, u1 = _span(u0, u1, self.width)
+            v0, v1 = _span(v0, v1, self.height)
+            window = (u0, v0, u1, v1)
+        else:  # nothing can be cropped: a small picture says so as well as a whole one
+            window = (0, 0, _MIN_PICTURE, _MIN_PICTURE)
+        return robot.camera(width=self.width, height=self.height, pan=self.pan, believed=True, window=window)
 
     def update(self) -> Status:
         """Poll the rendering; crop the candidate."""
@@ -736,10 +773,11 @@ class CropCandidate(_Pipeline):
         views.sort(key=lambda t: (t[0], t[1], t[2]))
         *_, candidate, (box, expected) = views[0]
         u0, v0, u1, v1 = box
+        ou, ov = image.offset
         self.scratch["candidate"] = dict(candidate)
         self.scratch["crop"] = {
-            "rgb": image.rgb[v0:v1, u0:u1].copy(),
-            "depth": image.depth[v0:v1, u0:u1].copy(),
+            "rgb": image.rgb[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
+            "depth": image.depth[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
             "box": box,
             "expected": (expected[0] - u0, expected[1] - v0, expected[2] - u0, expected[3] - v0),
             "range": candidate["range"],
@@ -754,10 +792,29 @@ class CropCandidate(_Pipeline):
     def _view(
         self, image: CameraImage, c: dict[str, Any], radius: float
     ) -> tuple[tuple[int, int, int, int], tuple[float, float, float, float]] | str:
-        """The crop box and the sample's expected box in image pixels, or why the candidate cannot be seen."""
+        """The crop box and the sample's expected box in frame pixels, or why the candidate cannot be seen."""
+        geometry = self._geometry(image, c, radius)
+        if isinstance(geometry, str):
+            return geometry
+        box, expected, depth = geometry
+        # something nearer than the candidate covers it: the middle of its silhouette is closer in depth
+        ou, ov = image.offset
+        cu, cv = int(0.5 * (expected[0] + expected[2])), int(0.5 * (expected[1] + expected[3]))
+        patch = image.depth[cv - 1 - ov : cv + 2 - ov, cu - 1 - ou : cu + 2 - ou] if cu >= 1 and cv >= 1 else None
+        seen = float(np.median(patch)) if patch is not None and patch.size else math.inf
+        if seen < depth - 4.0 * radius - 0.05:
+            return f"hidden behind something {seen:.2f} m from the camera"
+        return box, expected
+
+    def _geometry(
+        self, image: CameraImage, c: dict[str, Any], radius: float
+    ) -> tuple[tuple[int, int, int, int], tuple[float, float, float, float], float] | str:
+        """Where the candidate lies in the camera's frame: crop box, expected box, depth (pixels of the whole
+        frame, from the picture's pose and intrinsics); or why it cannot be seen there."""
         if c["range"] > self.max_range:
             return f"{c['range']:.1f} m away, beyond the {self.max_range:.1f} m of a closer look"
-        h, w = image.depth.shape
+        w, h = image.frame_size
+        ou, ov = image.offset
         x, y = float(c["x"]), float(c["y"])
         # the sample's cylinder: its silhouette's left/right edges at the bottom and the top
         to = np.array([x, y, 0.0]) - image.position
@@ -771,7 +828,7 @@ class CropCandidate(_Pipeline):
         corners.append(image.project(np.array([x, y, SAMPLE_HEIGHT]) + radius * along))
         if any(not math.isfinite(u) or d <= 0.0 for u, _, d in corners):
             return "behind the camera"
-        us, vs = [u for u, _, _ in corners], [v for _, v, _ in corners]
+        us, vs = [u + ou for u, _, _ in corners], [v + ov for _, v, _ in corners]
         expected = (min(us), min(vs), max(us) + 1.0, max(vs) + 1.0)
         if expected[2] < 0 or expected[0] >= w or expected[3] < 0 or expected[1] >= h:
             return "outside the camera's field of view"
@@ -786,13 +843,15 @@ class CropCandidate(_Pipeline):
             int(min(w, math.ceil(expected[2] + pad))),
             int(min(h, math.ceil(expected[3] + pad))),
         )
-        # something nearer than the candidate covers it: the middle of its silhouette is closer in depth
-        cu, cv = 0.5 * (expected[0] + expected[2]), 0.5 * (expected[1] + expected[3])
-        patch = image.depth[int(cv) - 1 : int(cv) + 2, int(cu) - 1 : int(cu) + 2]
-        seen = float(np.median(patch)) if patch.size else math.inf
-        if seen < depth - 4.0 * radius - 0.05:
-            return f"hidden behind something {seen:.2f} m from the camera"
-        return box, expected
+        return box, expected, depth
+
+
+def _span(a: int, b: int, size: int) -> tuple[int, int]:
+    """``[a, b)`` grown to at least :data:`_MIN_PICTURE` pixels, kept inside ``[0, size)``."""
+    if b - a < _MIN_PICTURE:
+        a = max(0, min(a, size - _MIN_PICTURE))
+        b = min(size, a + _MIN_PICTURE)
+    return a, b
 
 
 class BlobDetect(_Pipeline):

@@ -136,8 +136,10 @@ class MobileRobot(Protocol):
         far: float | None = None,
         pan: float = 0.0,
         believed: bool = False,
+        window: tuple[int, int, int, int] | None = None,
     ) -> CameraImage:
-        """One picture of the camera (``pan`` radians left of the heading; ``believed``: its pose from the estimate)."""
+        """One picture of the camera (``pan`` radians left of the heading; ``believed``: its pose from the estimate;
+        ``window``: only these pixels ``(u0, v0, u1, v1)`` of the frame)."""
         ...
 
     @property

@@ -66,6 +66,10 @@ class CameraImage:
         rotation: 3x3 rotation, world from camera (OpenCV axes: x right, y down, z forward).
         time: the simulated time of the picture.
         pan: the pan angle the picture was taken at, radians left of the heading.
+        offset: ``(u0, v0)``: where this picture lies in the camera's frame; a picture of a
+            ``window`` of the frame (see :func:`robot_camera`) is its pixels ``[v0:v0+height, u0:u0+width]``.
+            The intrinsics are this picture's (the principal point shifted by the offset).
+        frame: ``(width, height)`` of the whole frame; ``None``: the picture is the whole frame.
     """
 
     rgb: np.ndarray
@@ -75,6 +79,16 @@ class CameraImage:
     rotation: np.ndarray
     time: float
     pan: float = 0.0
+    offset: tuple[int, int] = (0, 0)
+    frame: tuple[int, int] | None = None
+
+    @property
+    def frame_size(self) -> tuple[int, int]:
+        """``(width, height)`` of the camera's whole frame (this picture's size when it is the whole frame)."""
+        if self.frame is not None:
+            return self.frame
+        h, w = self.depth.shape
+        return w, h
 
     def points(self, max_depth: float = math.inf) -> np.ndarray:
         """World points of every pixel with a depth below ``max_depth``: ``(n, 3)``, row-major pixel order."""
@@ -131,6 +145,7 @@ def robot_camera(
     far: float | None = None,
     pan: float = 0.0,
     believed: bool = False,
+    window: tuple[int, int, int, int] | None = None,
 ) -> CameraImage:
     """Render the robot's camera (see the module docstring).
 
@@ -142,9 +157,12 @@ def robot_camera(
         far: farthest distance rendered, metres (default: twice the robot's ``perception_range``).
         pan: the pan angle, radians left of the heading, within ``spec.camera_pan_limit`` either way.
         believed: give the picture the camera pose of the robot's pose estimate instead of the true one.
+        window: ``(u0, v0, u1, v1)``: render only these pixels ``[v0:v1, u0:u1]`` of the ``width`` x ``height``
+            frame (the same pixels as the whole frame's there, at a fraction of the cost); the picture's
+            ``offset`` and ``frame`` say where it lies, its intrinsics are the window's. At least 8 pixels a side.
 
     Raises:
-        WorldError: a robot without a camera, a closed world, a bad size, field of view, range or pan angle.
+        WorldError: a robot without a camera, a closed world, a bad size, field of view, range, pan angle or window.
     """
     from alica.worldsim.world import pybullet
 
@@ -172,19 +190,31 @@ def robot_camera(
     if not (math.isfinite(pan) and abs(pan) <= limit + 1e-9):
         turn = f"turns its camera at most {limit:.3f} rad either way" if limit > 0.0 else "has a fixed camera (pan 0)"
         raise WorldError(f"robot_camera: robot '{robot.name}' ({spec.kind}) {turn}, got pan {pan!r}")
+    u0, v0, u1, v1 = _window(window, width, height)
     position, rotation = camera_pose(robot, pan=pan)
     forward, down = rotation[:, 2], rotation[:, 1]
     fx = (width / 2.0) / math.tan(hfov / 2.0)
     fy = fx
-    vfov = 2.0 * math.atan((height / 2.0) / fy)
     client = world.client
     view = client.computeViewMatrix(list(position), list(position + forward), list(-down))
-    projection = client.computeProjectionMatrixFOV(math.degrees(vfov), width / height, NEAR, far_plane)
-    _, _, rgba, zbuffer, _ = client.getCameraImage(
-        width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER, shadow=0
+    # the frustum through the window's pixel edges (the whole frame's when there is no window)
+    n, f = NEAR, far_plane
+    left, right = n * (u0 - width / 2.0) / fx, n * (u1 - width / 2.0) / fx
+    top, bottom = n * (height / 2.0 - v0) / fy, n * (height / 2.0 - v1) / fy
+    projection = (
+        client.computeProjectionMatrixFOV(math.degrees(2.0 * math.atan((height / 2.0) / fy)), width / height, n, f)
+        if window is None
+        else [
+            *(2.0 * n / (right - left), 0.0, 0.0, 0.0),
+            *(0.0, 2.0 * n / (top - bottom), 0.0, 0.0),
+            *((right + left) / (right - left), (top + bottom) / (top - bottom), -(f + n) / (f - n), -1.0),
+            *(0.0, 0.0, -2.0 * f * n / (f - n), 0.0),
+        ]
     )
-    rgb = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)[:, :, :3].astype(float)
-    z = np.asarray(zbuffer, dtype=float).reshape(height, width)
+    w, h = u1 - u0, v1 - v0
+    _, _, rgba, zbuffer, _ = client.getCameraImage(w, h, view, projection, renderer=pybullet.ER_TINY_RENDERER, shadow=0)
+    rgb = np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3].astype(float)
+    z = np.asarray(zbuffer, dtype=float).reshape(h, w)
     depth = far_plane * NEAR / (far_plane - (far_plane - NEAR) * z)
     depth[z >= 1.0 - 1e-7] = math.inf
     noise = world.noise
@@ -196,5 +226,23 @@ def robot_camera(
     image = np.clip(np.rint(rgb), 0, 255).astype(np.uint8)
     if believed:
         position, rotation = camera_pose(robot, robot.estimate, pan)
-    intrinsics = (fx, fy, width / 2.0 - 0.5, height / 2.0 - 0.5)
-    return CameraImage(image, depth, intrinsics, position, rotation, world.now(), pan)
+    intrinsics = (fx, fy, width / 2.0 - 0.5 - u0, height / 2.0 - 0.5 - v0)
+    frame = None if window is None else (width, height)
+    return CameraImage(image, depth, intrinsics, position, rotation, world.now(), pan, (u0, v0), frame)
+
+
+def _window(window: tuple[int, int, int, int] | None, width: int, height: int) -> tuple[int, int, int, int]:
+    """The pixels ``(u0, v0, u1, v1)`` to render, checked against the frame."""
+    if window is None:
+        return 0, 0, width, height
+    try:
+        u0, v0, u1, v1 = window
+    except (TypeError, ValueError):
+        raise WorldError(f"robot_camera: window is (u0, v0, u1, v1) in pixels, got {window!r}") from None
+    if not all(isinstance(v, (int, np.integer)) and not isinstance(v, bool) for v in (u0, v0, u1, v1)):
+        raise WorldError(f"robot_camera: window is four whole numbers of pixels, got {window!r}")
+    if not (0 <= u0 and u1 <= width and 0 <= v0 and v1 <= height and u1 - u0 >= 8 and v1 - v0 >= 8):
+        raise WorldError(
+            f"robot_camera: window {window!r} must lie in the {width}x{height} frame and be at least 8 pixels a side"
+        )
+    return int(u0), int(v0), int(u1), int(v1)

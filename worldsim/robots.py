@@ -259,6 +259,7 @@ class Robot:
         far: float | None = None,
         pan: float = 0.0,
         believed: bool = False,
+        window: tuple[int, int, int, int] | None = None,
     ) -> CameraImage:
         """One picture of the robot's camera (colour, depth, intrinsics, pose): see :func:`alica.worldsim.robot_camera.robot_camera`.
 
@@ -267,7 +268,9 @@ class Robot:
         """
         from alica.worldsim.robot_camera import robot_camera
 
-        return robot_camera(self, width=width, height=height, fov=fov, far=far, pan=pan, believed=believed)
+        return robot_camera(
+            self, width=width, height=height, fov=fov, far=far, pan=pan, believed=believed, window=window
+        )
 
     def set_estimate(self, pose: Sequence[float]) -> None:
         """Overwrite the pose estimate ``(x, y, yaw)`` (a localization's correction); odometry continues from it.

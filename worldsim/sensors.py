@@ -15,8 +15,9 @@ Noise comes from the world's seeded rng and ``world.noise``.
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -33,6 +34,8 @@ __all__ = ["Detection", "lidar_angles", "lidar_scan", "perceive", "scan_to_grid"
 # Rays start just outside the base so that the robot's own cylinder is never hit.
 _RAY_START_GAP = 0.01
 _CAMERA_HEIGHT_ABOVE_BASE = 0.3
+#: Coordinates beyond this are an unbounded box (a ground plane's).
+_UNBOUNDED = 1e20
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,6 +60,12 @@ def lidar_angles(n_rays: int) -> np.ndarray:
     return -math.pi + (2.0 * math.pi / n_rays) * np.arange(n_rays)
 
 
+def _level_at_zero(client: Any, body: int) -> bool:
+    """Whether a body sits at z = 0 unrotated (the ground plane as the world makes it)."""
+    position, orientation = client.getBasePositionAndOrientation(body)
+    return abs(position[2]) < 1e-9 and abs(abs(orientation[3]) - 1.0) < 1e-9
+
+
 def _own_bodies(robot: Robot) -> set[int]:
     own = {robot.body_id}
     if robot.arm is not None:
@@ -79,20 +88,104 @@ def _cast(world: World, starts: np.ndarray, ends: np.ndarray, skip: set[int]) ->
             break
         s = starts[todo] + seg[todo] * offset[todo, None]
         hits = c.rayTestBatch(s.tolist(), ends[todo].tolist())
-        again = []
-        for k, hit in zip(todo, hits, strict=True):
-            body, frac = hit[0], hit[2]
-            if body < 0:
-                continue
-            total = offset[k] + (1.0 - offset[k]) * frac
-            if body in skip:
-                offset[k] = min(1.0, total + 1e-4)
-                again.append(k)
-                continue
-            fractions[k] = total
-            bodies[k] = body
-        todo = np.array(again, dtype=int)
+        body = np.fromiter((hit[0] for hit in hits), dtype=int, count=len(hits))
+        frac = np.fromiter((hit[2] for hit in hits), dtype=float, count=len(hits))
+        total = offset[todo] + (1.0 - offset[todo]) * frac
+        own = np.isin(body, list(skip))
+        done = (body >= 0) & ~own
+        fractions[todo[done]] = total[done]
+        bodies[todo[done]] = body[done]
+        # a ray that hit the robot itself goes on from just past that hit
+        offset[todo[own]] = np.minimum(1.0, total[own] + 1e-4)
+        todo = todo[own]
     return fractions, bodies
+
+
+#: Metres added around a body's box when deciding which rays can hit it (pybullet's boxes carry margins).
+_BOX_PAD = 0.02
+
+
+def _boxes(world: World, own: set[int], z: float) -> np.ndarray | None:
+    """The axis-aligned boxes ``(xmin, ymin, zmin, xmax, ymax, zmax)`` of every body and link but ``own``,
+    grown by :data:`_BOX_PAD`; ``None`` when one is unbounded (other than a ground plane below ``z``).
+
+    Rocks never move: their boxes are kept until the world's bodies change.
+    """
+    c = world.client
+    cached = _STILL.get(world)
+    if cached is None or cached[0] != world._version:
+        kinds = {obj.body_id: obj.kind for obj in world.objects.values()}
+        still = {obj.body_id: c.getAABB(obj.body_id) for obj in world.objects.values() if obj.kind == "rock"}
+        cached = (world._version, kinds, still)
+        _STILL[world] = cached
+    _, kinds, still = cached
+    rows = []
+    for k in range(c.getNumBodies()):
+        body = c.getBodyUniqueId(k)
+        if body in own:
+            continue
+        box = still.get(body)
+        if box is not None:
+            rows.append((*box[0], *box[1]))
+            continue
+        for link in range(-1, c.getNumJoints(body)):
+            lo, hi = c.getAABB(body, link)
+            if max(abs(v) for v in (*lo, *hi)) >= _UNBOUNDED:
+                if kinds.get(body) == "terrain" and link == -1 and z > 1e-3 and _level_at_zero(c, body):
+                    continue  # the scan runs above the ground plane
+                return None
+            rows.append((*lo, *hi))
+    boxes = np.array(rows, dtype=float).reshape(-1, 6)
+    boxes[:, :3] -= _BOX_PAD
+    boxes[:, 3:] += _BOX_PAD
+    return boxes
+
+
+_STILL: weakref.WeakKeyDictionary[Any, tuple[int, dict[int, str], dict[int, Any]]] = weakref.WeakKeyDictionary()
+
+
+def _ray_reach(world: World, origin: np.ndarray, yaw: float, n_rays: int, rng_max: float, own: set[int]) -> np.ndarray:
+    """How far each ray of a horizontal scan from ``origin`` must be cast: beyond the farthest box it meets.
+
+    A ray meets a body's (or link's) axis-aligned box only if its angle lies
+    between the angles of the box's corners seen from the origin; 0 for a ray
+    that meets no box (a miss, not cast at all). The robot's own bodies are
+    passed through anyway and a flat ground plane below the scan is never met.
+    ``rng_max`` for every ray when some body has no bounded box.
+    """
+    x, y, z = (float(v) for v in origin)
+    boxes = _boxes(world, own, z)
+    if boxes is None:
+        return np.full(n_rays, rng_max)
+    boxes = boxes[(boxes[:, 2] <= z) & (z <= boxes[:, 5])]
+    x0, y0, x1, y1 = boxes[:, 0], boxes[:, 1], boxes[:, 3], boxes[:, 4]
+    far = np.sqrt(np.maximum((x0 - x) ** 2, (x1 - x) ** 2) + np.maximum((y0 - y) ** 2, (y1 - y) ** 2))
+    inside = (x0 <= x) & (x <= x1) & (y0 <= y) & (y <= y1)
+    near = np.hypot(x - np.clip(x, x0, x1), y - np.clip(y, y0, y1))
+    reach = np.zeros(n_rays)
+    if inside.any():  # the scanner is inside a box: every ray meets it
+        reach[:] = far[inside].max()
+    seen = ~inside & (near <= rng_max)
+    x0, y0, x1, y1, far = x0[seen], y0[seen], x1[seen], y1[seen], far[seen]
+    middle = np.arctan2(0.5 * (y0 + y1) - y, 0.5 * (x0 + x1) - x)
+    corners = np.arctan2(np.stack([y0, y1, y0, y1]) - y, np.stack([x0, x0, x1, x1]) - x)
+    spread = (corners - middle + math.pi) % math.tau - math.pi  # corner angles about the middle, (-pi, pi)
+    step = math.tau / n_rays
+    first = yaw - math.pi  # the angle of ray 0
+    k0 = np.floor((middle + spread.min(axis=0) - first) / step).astype(int) - 1
+    k1 = np.ceil((middle + spread.max(axis=0) - first) / step).astype(int) + 1
+    for a, b, d in zip(k0.tolist(), k1.tolist(), far.tolist(), strict=True):
+        count = b - a + 1  # rays a..b, around the end of the scan if need be
+        if count >= n_rays:
+            np.maximum(reach, d, out=reach)
+            continue
+        a %= n_rays
+        part = reach[a : min(a + count, n_rays)]
+        np.maximum(part, d, out=part)
+        if a + count > n_rays:
+            part = reach[: a + count - n_rays]
+            np.maximum(part, d, out=part)
+    return reach
 
 
 def lidar_scan(
@@ -117,15 +210,22 @@ def lidar_scan(
     if not rng_max > start_r:
         raise WorldError(f"lidar_scan: max_range must exceed the robot radius plus {_RAY_START_GAP} m, got {max_range}")
     x, y, yaw = robot.pose
-    angles = yaw + lidar_angles(int(n_rays))
+    n = int(n_rays)
+    angles = yaw + lidar_angles(n)
     dirs = np.column_stack([np.cos(angles), np.sin(angles), np.zeros_like(angles)])
     origin = np.array([x, y, robot.spec.lidar_height])
-    starts = origin + start_r * dirs
-    ends = origin + rng_max * dirs
-    fractions, bodies = _cast(world, starts, ends, _own_bodies(robot))
-    ranges = start_r + fractions * (rng_max - start_r)
-    hit = bodies >= 0
-    ranges[~hit] = rng_max
+    own = _own_bodies(robot)
+    # cast only the rays that can hit something, and only as far as that can be
+    reach = _ray_reach(world, origin, yaw, n, rng_max, own)
+    cast = np.flatnonzero(reach > start_r)
+    ranges = np.full(n, rng_max)
+    hit = np.zeros(n, dtype=bool)
+    if len(cast):
+        ends = np.minimum(reach[cast], rng_max)
+        starts = origin + start_r * dirs[cast]
+        fractions, bodies = _cast(world, starts, origin + ends[:, None] * dirs[cast], own)
+        hit[cast] = bodies >= 0
+        ranges[cast] = np.where(bodies >= 0, start_r + fractions * (ends - start_r), rng_max)
     sigma = world.noise.lidar_sigma if noise is None else float(noise)
     if sigma > 0.0 and hit.any():
         ranges[hit] += world.rng.normal(0.0, sigma, int(hit.sum()))

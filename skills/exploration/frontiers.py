@@ -21,6 +21,8 @@ with ``origin = (ox, oy)`` the world position of cell ``(0, 0)``'s lower-left co
 
 from __future__ import annotations
 
+import math
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -57,7 +59,13 @@ def frontier_mask(occ: np.ndarray) -> np.ndarray:
     """Free cells with at least one unknown cell among their 8 neighbours (cells outside the grid are not unknown)."""
     grid = _check(occ)
     unknown = grid == UNKNOWN
-    near_unknown = ndimage.binary_dilation(unknown, structure=_EIGHT)
+    # the 8-neighbourhood dilation of the unknown cells, as shifted copies (cheaper than ndimage on a large map)
+    rows = unknown.copy()
+    rows[1:] |= unknown[:-1]
+    rows[:-1] |= unknown[1:]
+    near_unknown = rows.copy()
+    near_unknown[:, 1:] |= rows[:, :-1]
+    near_unknown[:, :-1] |= rows[:, 1:]
     return (grid == FREE) & near_unknown
 
 
@@ -75,6 +83,56 @@ class GainMap:
     gain: np.ndarray
     boundary: np.ndarray
     propagations: int
+
+
+#: Propagations remembered by :func:`_propagate` (a map changes in a few places between two readings;
+#: a reading of a 40 m field starts about 100; more memory finds no more).
+_CACHE_SIZE = 1024
+_PROPAGATIONS: OrderedDict[tuple[object, ...], tuple[int, bool, np.ndarray]] = OrderedDict()
+
+
+def _propagate(
+    win_unknown: np.ndarray, lr: int, lc: int, reach: int, edges: tuple[bool, bool, bool, bool]
+) -> tuple[int, bool, np.ndarray]:
+    """One wave front of Algorithm 1 in a window around its frontier cell ``(lr, lc)``.
+
+    Returns ``|A|``, the boundary relation and the cells next to the travelled
+    ones (the window's cells the wave front touched, before intersecting with
+    the frontier list). Depends on the window's unknown cells only, so the
+    results of the last propagations are remembered by the window's contents
+    (a reading of a map that changed in a few places repeats most of them).
+    """
+    key = (lr, lc, reach, edges, win_unknown.shape, np.packbits(win_unknown).tobytes())
+    known = _PROPAGATIONS.get(key)
+    if known is not None:
+        _PROPAGATIONS.move_to_end(key)
+        return known
+    seed = np.zeros(win_unknown.shape, dtype=bool)
+    # line 2: the unknown neighbours of f start the wave front
+    seed[max(0, lr - 1) : lr + 2, max(0, lc - 1) : lc + 2] = True
+    seed &= win_unknown
+    if not seed.any():
+        result = (0, False, np.zeros(win_unknown.shape, dtype=bool))
+    else:
+        # lines 3-6: the wave front travels across unknown cells, reach steps from f
+        travelled = seed
+        if reach > 1:  # (iterations=0 would mean: until nothing changes)
+            travelled = ndimage.binary_dilation(seed, structure=_EIGHT, iterations=reach - 1, mask=win_unknown) | seed
+        size = int(travelled.sum())  # line 7: InfoGain_f = |A|
+        # line 6: cells next to the map boundary (edges: the window touches the map's top, bottom, left, right)
+        top, bottom, left, right = edges
+        at_edge = bool(
+            (top and travelled[0].any())
+            or (bottom and travelled[-1].any())
+            or (left and travelled[:, 0].any())
+            or (right and travelled[:, -1].any())
+        )
+        result = (size, at_edge, ndimage.binary_dilation(travelled, structure=_EIGHT))
+    result[2].flags.writeable = False
+    _PROPAGATIONS[key] = result
+    if len(_PROPAGATIONS) > _CACHE_SIZE:
+        _PROPAGATIONS.popitem(last=False)
+    return result
 
 
 def information_gain(
@@ -103,7 +161,11 @@ def information_gain(
     gain = np.zeros(grid.shape, dtype=np.int64)
     boundary = np.zeros(grid.shape, dtype=bool)
     todo = mask.copy()  # the frontier cell list f_cells
-    cells = [tuple(c) for c in np.argwhere(mask)] if order is None else [(int(r), int(c)) for r, c in order]
+    if order is None:
+        found = np.nonzero(mask)
+        cells: list[tuple[int, int]] = list(zip(found[0].tolist(), found[1].tolist(), strict=True))
+    else:
+        cells = [(int(r), int(c)) for r, c in order]
     started = 0
     for r, c in cells:
         if not todo[r, c]:
@@ -111,40 +173,20 @@ def information_gain(
         # a window that holds every cell the wave front can reach (and their neighbours)
         r0, r1 = max(0, r - reach - 2), min(rows, r + reach + 3)
         c0, c1 = max(0, c - reach - 2), min(cols, c + reach + 3)
-        win_unknown = unknown[r0:r1, c0:c1]
-        seed = np.zeros(win_unknown.shape, dtype=bool)
-        # line 2: the unknown neighbours of f start the wave front
-        lr, lc = r - r0, c - c0
-        seed[max(0, lr - 1) : lr + 2, max(0, lc - 1) : lc + 2] = True
-        seed &= win_unknown
         started += 1
-        if not seed.any():
-            todo[r, c] = False
-            continue
-        # lines 3-6: the wave front travels across unknown cells, reach steps from f
-        travelled = seed
-        if reach > 1:  # (iterations=0 would mean: until nothing changes)
-            travelled = ndimage.binary_dilation(seed, structure=_EIGHT, iterations=reach - 1, mask=win_unknown) | seed
-        size = int(travelled.sum())  # line 7: InfoGain_f = |A|
-        # line 6: cells next to the map boundary
-        edge_rows = np.zeros(travelled.shape[0], dtype=bool)
-        edge_cols = np.zeros(travelled.shape[1], dtype=bool)
-        if r0 == 0:
-            edge_rows[0] = True
-        if r1 == rows:
-            edge_rows[-1] = True
-        if c0 == 0:
-            edge_cols[0] = True
-        if c1 == cols:
-            edge_cols[-1] = True
-        at_edge = bool((travelled[edge_rows, :].any()) or (travelled[:, edge_cols].any()))
+        size, at_edge, near = _propagate(
+            unknown[r0:r1, c0:c1], r - r0, c - c0, reach, (r0 == 0, r1 == rows, c0 == 0, c1 == cols)
+        )
         # line 5: the frontier cells the wave front touched; f itself among them
-        touched = ndimage.binary_dilation(travelled, structure=_EIGHT) & todo[r0:r1, c0:c1]
-        touched[lr, lc] = True
+        touched = near & todo[r0:r1, c0:c1]
+        touched[r - r0, c - c0] = True
+        tr, tc = np.nonzero(touched)
+        tr += r0
+        tc += c0
         # lines 13-16: store the result for the observed cells and remove them from the list
-        gain[r0:r1, c0:c1][touched] = size
-        boundary[r0:r1, c0:c1][touched] = at_edge
-        todo[r0:r1, c0:c1][touched] = False
+        gain[tr, tc] = size
+        boundary[tr, tc] = at_edge
+        todo[tr, tc] = False
     return GainMap(gain, boundary, started)
 
 
@@ -167,6 +209,32 @@ class FrontierCandidate:
     size: int
     gain: float
     boundary: bool
+
+
+def _clear(occupied: np.ndarray, rows: np.ndarray, cols: np.ndarray, resolution: float, clearance: float) -> np.ndarray:
+    """Which cells ``(rows, cols)`` lie at least ``clearance`` metres (centre to centre) from every occupied cell.
+
+    The same test as ``distance_transform_edt(~occupied) * resolution >= clearance``,
+    made only at the given cells: an occupied cell at offset ``(dr, dc)`` is too
+    close when ``sqrt(dr² + dc²) * resolution < clearance``.
+    """
+    keep = np.ones(len(rows), dtype=bool)
+    if len(rows) == 0 or not occupied.any():
+        return keep
+    n = math.ceil(clearance / resolution) + 1
+    dr, dc = np.mgrid[-n : n + 1, -n : n + 1]
+    close = np.sqrt((dr * dr + dc * dc).astype(float)) * resolution < clearance
+    # occupied cells per row up to each column (a leading 0): a run of columns is counted in two look-ups
+    counts = np.zeros((occupied.shape[0] + 2 * n, occupied.shape[1] + 2 * n + 1), dtype=np.int32)
+    np.cumsum(np.pad(occupied, n), axis=1, out=counts[:, 1:])
+    for i in range(2 * n + 1):
+        reach = np.flatnonzero(close[i])
+        if len(reach) == 0:
+            continue
+        lo, hi = int(dc[i, reach[0]]), int(dc[i, reach[-1]])  # the close columns of this row: one run
+        at = rows + n + int(dr[i, 0])
+        keep &= counts[at, cols + n + hi + 1] == counts[at, cols + n + lo]
+    return keep
 
 
 def extract_frontiers(
@@ -205,10 +273,10 @@ def extract_frontiers(
         return []
     result = information_gain(grid, max(1, round(reach / resolution)), mask)
     labels, _count = ndimage.label(mask, structure=_EIGHT)
-    usable = mask
-    if clearance > 0.0 and (grid == OCCUPIED).any():
-        usable = mask & (ndimage.distance_transform_edt(grid != OCCUPIED) * resolution >= clearance)
-    rows, cols = np.nonzero(usable)
+    rows, cols = np.nonzero(mask)
+    if clearance > 0.0:
+        keep = _clear(grid == OCCUPIED, rows, cols, resolution, clearance)
+        rows, cols = rows[keep], cols[keep]
     if len(rows) == 0:
         return []
     ox, oy = float(origin[0]), float(origin[1])
@@ -223,8 +291,11 @@ def extract_frontiers(
     inverse = inverse.reshape(-1)
     out: dict[str, FrontierCandidate] = {}
     cell_gain = result.gain[rows, cols]
+    # the cells of each key, in cell order (a stable sort by key)
+    by_key = np.argsort(inverse, kind="stable")
+    ends = np.cumsum(np.bincount(inverse, minlength=len(uniq)))
     for k in range(len(uniq)):
-        members = np.nonzero(inverse == k)[0]
+        members = by_key[ends[k - 1] if k else 0 : ends[k]]
         if len(members) < min_size:
             continue
         cx, cy = xs[members].mean(), ys[members].mean()

@@ -55,11 +55,10 @@ def current_map(
     without a world model (alone, with nowhere to share) the robot's own layer
     is the map.
     """
-    from alica.skills.mapping import map_scan, robot_mapper, team_map
+    from alica.skills.mapping import map_scan, robot_mapper, team_map, team_resolution
 
     world_model = context.world_model
-    existing = team_map(world_model) if world_model is not None else None
-    resolution = existing.resolution if existing is not None else MAP_RESOLUTION
+    resolution = team_resolution(world_model) or MAP_RESOLUTION
     mapper = robot_mapper(context, robot.name, world_bounds, resolution)
     map_scan(robot, mapper, max_range=MAPPING_RANGE, now=context.now())
     grid = team_map(world_model) if world_model is not None else None

@@ -55,6 +55,7 @@ __all__ = [
     "decode_tile",
     "encode_tile",
     "team_map",
+    "team_resolution",
 ]
 
 #: The register holding the map's frame.
@@ -323,6 +324,12 @@ class _Merged:
 
 
 _MERGED: weakref.WeakKeyDictionary[Any, _Merged] = weakref.WeakKeyDictionary()
+
+
+def team_resolution(world_model: WorldModelLike | None) -> float | None:
+    """The cell size of the team's map in ``world_model`` (what :func:`team_map` would have), without merging it."""
+    frame = _frame(world_model) if world_model is not None else None
+    return frame[0] if frame is not None else None
 
 
 def team_map(world_model: WorldModelLike | None) -> LogOddsGrid | None:

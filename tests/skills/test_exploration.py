@@ -124,6 +124,42 @@ def test_gain_properties_on_random_grids(occ, reach):
     assert result.propagations <= int(mask.sum())
 
 
+def test_remembered_wave_fronts_give_what_fresh_ones_give_after_the_map_changed():
+    from alica.skills.exploration import frontiers
+
+    rng = np.random.default_rng(3)
+    occ = np.full((60, 70), U, dtype=np.int8)
+    occ[20:40, 15:50] = F
+    occ[rng.random(occ.shape) < 0.03] = W
+    for _ in range(4):
+        first = information_gain(occ, reach=8)
+        frontiers._PROPAGATIONS.clear()
+        fresh = information_gain(occ, reach=8)
+        assert np.array_equal(first.gain, fresh.gain) and np.array_equal(first.boundary, fresh.boundary)
+        assert first.propagations == fresh.propagations
+        occ[rng.integers(0, 60, 40), rng.integers(0, 70, 40)] = F  # the robot saw some more
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    arrays(np.int8, st.tuples(st.integers(1, 14), st.integers(1, 14)), elements=st.sampled_from([F, W, U])),
+    st.sampled_from([0.05, 0.1, 0.25]),
+    st.floats(0.01, 0.6),
+)
+def test_clearance_is_the_distance_to_the_nearest_occupied_cell(occ, resolution, clearance):
+    from scipy import ndimage
+
+    from alica.skills.exploration.frontiers import _clear
+
+    rows, cols = np.nonzero(frontier_mask(occ))
+    kept = _clear(occ == W, rows, cols, resolution, clearance)
+    if (occ == W).any():
+        far = ndimage.distance_transform_edt(occ != W) * resolution >= clearance
+        assert np.array_equal(kept, far[rows, cols])
+    else:
+        assert kept.all()
+
+
 # -- candidates -----------------------------------------------------------------
 
 

@@ -50,6 +50,39 @@ def test_a_scan_marks_free_cells_along_the_rays_and_occupied_cells_at_the_hits()
     assert grid.take_dirty_tiles() and not grid.take_dirty_tiles()
 
 
+def _traced(grid: LogOddsGrid, pose, ranges, angles, max_range: float) -> np.ndarray:
+    """The cells a scan updates, sampled the plain way: every ray at every half cell (the reference)."""
+    x, y, yaw = pose
+    res, (ox, oy) = grid.resolution, grid.origin
+    hit = np.isfinite(ranges) & (ranges < max_range)
+    reach = np.where(hit, np.maximum(ranges, 0.0), max_range)
+    c, s = np.cos(yaw + angles), np.sin(yaw + angles)
+    along = np.arange(0.0, float(reach.max()), 0.5 * res)
+    keep = along[None, :] < reach[:, None]
+    fi = np.floor((x + c[:, None] * along[None, :] - ox) / res).astype(np.intp)[keep]
+    fj = np.floor((y + s[:, None] * along[None, :] - oy) / res).astype(np.intp)[keep]
+    ok = (fi >= 0) & (fi < grid.nx) & (fj >= 0) & (fj < grid.ny)
+    out = np.zeros((grid.ny, grid.nx), dtype=np.int8)
+    out[fj[ok], fi[ok]] = -1
+    hi = np.floor((x + c[hit] * reach[hit] - ox) / res).astype(np.intp)
+    hj = np.floor((y + s[hit] * reach[hit] - oy) / res).astype(np.intp)
+    ok = (hi >= 0) & (hi < grid.nx) & (hj >= 0) & (hj < grid.ny)
+    out[hj[ok], hi[ok]] = 1
+    return out
+
+
+@pytest.mark.parametrize("pose", [(0.0, 0.0, 0.3), (3.7, -3.2, -2.0), (-4.9, 4.95, 1.0)])
+def test_a_scan_updates_the_cells_of_every_half_cell_sample_inside_the_grid_or_at_its_edge(pose) -> None:
+    rng = np.random.default_rng(7)
+    angles = np.linspace(-math.pi, math.pi, 400, endpoint=False)
+    ranges = np.where(rng.random(400) < 0.3, 3.0, rng.uniform(0.1, 3.5, 400))
+    ranges[::37] = np.inf
+    grid = LogOddsGrid.covering((-5.0, -5.0, 5.0, 5.0), 0.05)
+    grid.update(pose, ranges, angles, max_range=3.0)
+    expected = _traced(grid, pose, ranges, angles, 3.0)
+    assert np.array_equal(np.sign(grid.logodds).astype(np.int8), expected)
+
+
 def test_the_grid_refuses_bad_input() -> None:
     with pytest.raises(ValueError, match="resolution"):
         LogOddsGrid.covering((0, 0, 1, 1), 0.0)

@@ -202,6 +202,28 @@ def test_each_kind_is_found_and_classified(skill_run, kind):
         world.close()
 
 
+def test_crop_candidate_renders_only_the_crops_part_of_the_frame_with_its_pixels(skill_run):
+    from alica.worldsim.robot_camera import robot_camera
+
+    world = _field(seed=2)
+    try:
+        world.noise = replace(world.noise, pixel_sigma=0.0, depth_sigma=0.0)
+        world.add_sample("a", "green-white-red", _ahead(world, 2.0, 10.0))
+        world.add_sample("b", "red-black-red", _ahead(world, 3.0, -12.0))
+        world.step(0.2)
+        scratch: dict[str, object] = {}
+        assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
+        crop_run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
+        assert crop_run.ok, crop_run.reason
+        crop = scratch["crop"]
+        whole = robot_camera(world.robots["scout"], width=752, height=480, pan=crop["pan"], believed=True)
+        u0, v0, u1, v1 = crop["box"]
+        assert np.array_equal(crop["rgb"], whole.rgb[v0:v1, u0:u1])
+        assert (u1 - u0) * (v1 - v0) < 752 * 480 // 10
+    finally:
+        world.close()
+
+
 def test_an_unknown_sample_is_named_after_its_kind(skill_run):
     world = _field()
     try:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -86,3 +87,35 @@ def test_a_believed_picture_carries_the_camera_pose_of_the_estimate(lunar_world)
     position, rotation = camera_pose(scout, (x + 0.5, y, yaw + 0.1), 0.3)
     assert np.allclose(believed.position, position) and np.allclose(believed.rotation, rotation)
     assert np.allclose(true.position, camera_pose(scout, pan=0.3)[0])
+
+
+def test_a_window_is_the_same_pixels_as_the_whole_frame_there(lunar_world):
+    scout = lunar_world.robots["scout"]
+    lunar_world.noise = dataclasses.replace(lunar_world.noise, pixel_sigma=0.0, depth_sigma=0.0)
+    whole = robot_camera(scout, width=160, height=120, pan=0.2)
+    part = robot_camera(scout, width=160, height=120, pan=0.2, window=(40, 50, 100, 90))
+    assert part.rgb.shape == (40, 60, 3) and part.offset == (40, 50) and part.frame == (160, 120)
+    assert part.frame_size == (160, 120) and whole.frame_size == (160, 120) and whole.offset == (0, 0)
+    assert np.array_equal(part.rgb, whole.rgb[50:90, 40:100])
+    finite = np.isfinite(whole.depth[50:90, 40:100])
+    assert np.array_equal(finite, np.isfinite(part.depth))
+    assert np.allclose(part.depth[finite], whole.depth[50:90, 40:100][finite], rtol=1e-4)
+    # the window's intrinsics project a world point onto the same pixel, shifted by the offset
+    point = whole.points(max_depth=5.0)[0]
+    u, v, d = whole.project(point)
+    pu, pv, pd = part.project(point)
+    assert (pu + 40, pv + 50, pd) == pytest.approx((u, v, d))
+
+
+@pytest.mark.parametrize(
+    ("window", "match"),
+    [
+        ((0, 0, 4, 40), "at least 8 pixels"),
+        ((150, 0, 170, 40), "must lie in the 160x120 frame"),
+        ((0.5, 0, 20, 20), "whole numbers"),
+        ((0, 0, 20), r"\(u0, v0, u1, v1\)"),
+    ],
+)
+def test_a_bad_window_is_refused(lunar_world, window, match):
+    with pytest.raises(WorldError, match=match):
+        robot_camera(lunar_world.robots["scout"], width=160, height=120, window=window)

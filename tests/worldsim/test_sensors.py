@@ -134,3 +134,31 @@ def test_set_sensor_noise_zero_gives_exact_positions(world: World) -> None:
     sample = world.add_sample("a", "green-black-green", (1.5, 0.0))
     r = world.add_robot("amparo", "r", (0.0, 0.0, 0.0))
     assert perceive(r)[0].position == pytest.approx(tuple(sample.position()))
+
+
+def test_lidar_casts_only_what_can_be_hit_and_reads_as_a_whole_scan() -> None:
+    """Rays that meet no body's box are not cast, the others only as far as the last box: the ranges are
+    those of every ray cast over the whole range (up to pybullet's precision)."""
+    from alica.worldsim.scenarios import lunar
+    from alica.worldsim.sensors import _cast, _own_bodies
+
+    world = lunar(seed=3, rocks=30, samples=3, size=24.0)
+    try:
+        robot = world.robots["stummel"]
+        rng = np.random.default_rng(0)
+        for _ in range(6):
+            x, y = rng.uniform(-10.0, 10.0, 2)
+            robot.set_pose(float(x), float(y), float(rng.uniform(-3.0, 3.0)))
+            for reach in (30.0, 6.0):
+                ranges = lidar_scan(robot, 720, reach, noise=0.0)
+                px, py, yaw = robot.pose
+                angles = yaw + lidar_angles(720)
+                dirs = np.column_stack([np.cos(angles), np.sin(angles), np.zeros(720)])
+                origin = np.array([px, py, robot.spec.lidar_height])
+                start = robot.spec.radius + 0.01
+                fractions, bodies = _cast(world, origin + start * dirs, origin + reach * dirs, _own_bodies(robot))
+                whole = np.where(bodies >= 0, start + fractions * (reach - start), reach)
+                assert np.array_equal(ranges < reach, whole < reach)
+                assert np.abs(ranges - whole).max() < 0.01
+    finally:
+        world.close()
