@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from alica.app.timed import add_fault_options, timed
+from alica.app.timed import add_fault_options, add_network_options, partition, timed
 from alica.errors import AlicaError
 
 
@@ -109,19 +109,7 @@ def _add_lunar(demos: Any) -> None:
         metavar="NAME@T",
         help="crash robot NAME at simulated second T, or NAME@grasp when it first holds a sample (repeatable)",
     )
-    lunar.add_argument(
-        "--loss", type=float, default=0.0, metavar="P", help="probability that a message is lost (default 0)"
-    )
-    lunar.add_argument(
-        "--delay", type=float, default=0.0, metavar="MS", help="message delay in milliseconds (default 0)"
-    )
-    lunar.add_argument(
-        "--partition",
-        action="append",
-        default=[],
-        metavar="A,B|C@T1-T2",
-        help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)",
-    )
+    add_network_options(lunar)
     lunar.add_argument(
         "--time-limit", type=float, default=900.0, metavar="S", help="simulated seconds before giving up (default 900)"
     )
@@ -148,8 +136,8 @@ def lunar_config(args: argparse.Namespace) -> Any:
         raise AlicaError(f"--delay must be >= 0 milliseconds, not {args.delay}")
     partitions = []
     for text in args.partition:
-        what, start, end = timed("--partition", text, span=True)
-        partitions.append(Partition(tuple(tuple(g.split(",")) for g in what.split("|")), start, end))
+        groups, start, end = partition(text)
+        partitions.append(Partition(tuple(tuple(g) for g in groups), start, end))
     config = LunarConfig(
         robots=tuple(r.strip() for r in args.robots.split(",") if r.strip()),
         samples=args.samples,
@@ -166,10 +154,6 @@ def lunar_config(args: argparse.Namespace) -> Any:
         partitions=tuple(partitions),
     )
     check_config(config)
-    for cut in config.partitions:
-        strangers = [r for g in cut.groups for r in g if r not in config.robots]
-        if strangers:
-            raise AlicaError(f"--partition: {', '.join(strangers)} not in the team ({', '.join(config.robots)})")
     return config
 
 

@@ -16,7 +16,7 @@ import sys
 from typing import Any
 
 from alica.app.skill_options import add_lunar_options, add_skills_option
-from alica.app.timed import add_fault_options
+from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
 
@@ -62,14 +62,7 @@ def add_parser(sub: Any) -> None:
         help="simulated seconds at most with --until-done (default 300)",
     )
     p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
-    p.add_argument(
-        "--loss",
-        type=float,
-        default=0.0,
-        metavar="P",
-        help="probability that a best-effort message is lost (default 0)",
-    )
-    p.add_argument("--delay", type=float, default=0.0, metavar="MS", help="message delay in milliseconds (default 0)")
+    add_network_options(p)
     p.add_argument(
         "--jitter", type=float, default=0.0, metavar="MS", help="random extra delay up to this many milliseconds"
     )
@@ -77,13 +70,6 @@ def add_parser(sub: Any) -> None:
         p,
         crash="crash agent NAME at simulated second T (repeatable)",
         recover="restart agent NAME at second T (repeatable)",
-    )
-    p.add_argument(
-        "--partition",
-        action="append",
-        default=[],
-        metavar="A,B|C@T1-T2",
-        help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)",
     )
     p.add_argument(
         "--fact",
@@ -235,8 +221,8 @@ def _run_team(
         who, at, _ = _timed("--recover", text)
         team.recover(who, at=at)
     for text in args.partition:
-        what, start, end = _timed("--partition", text, span=True)
-        team.partition([g.split(",") for g in what.split("|")], start=start, end=end)
+        groups, start, end = partition(text)
+        team.partition(groups, start=start, end=end)
     for text in args.fact:
         what, at, _ = _timed("--fact", text)
         team.set_facts(literals(what), at=at)

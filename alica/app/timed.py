@@ -14,6 +14,37 @@ def add_fault_options(parser: Any, crash: str, recover: str) -> None:
         parser.add_argument(option, action="append", default=[], metavar="NAME@T", help=text)
 
 
+def add_network_options(parser: Any) -> None:
+    """Add ``--loss P``, ``--delay MS`` and the repeatable ``--partition A,B|C@T1-T2`` (the simulated network's faults)."""
+    parser.add_argument(
+        "--loss",
+        type=float,
+        default=0.0,
+        metavar="P",
+        help="probability that a best-effort message is lost (default 0)",
+    )
+    parser.add_argument(
+        "--delay", type=float, default=0.0, metavar="MS", help="message delay in milliseconds (default 0)"
+    )
+    parser.add_argument(
+        "--partition",
+        action="append",
+        default=[],
+        metavar="A,B|C@T1-T2",
+        help="cut the network between groups from T1 to T2, or for good without -T2 (repeatable)",
+    )
+
+
+def partition(text: str) -> tuple[list[list[str]], float, float | None]:
+    """``A,B|C@T1-T2`` as ``([[A, B], [C]], T1, T2)`` (``T2`` None: for good).
+
+    Raises:
+        AlicaError: ``text`` is not of that form.
+    """
+    what, start, end = timed("--partition", text, span=True)
+    return [group.split(",") for group in what.split("|")], start, end
+
+
 _AT = re.compile(r"^(?P<what>.+)@(?P<start>[0-9.]+)(?:-(?P<end>[0-9.]+))?$")
 
 

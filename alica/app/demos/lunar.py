@@ -175,6 +175,10 @@ def check_config(config: LunarConfig) -> None:
     for crash in config.crashes:
         if crash.robot not in config.robots:
             raise AlicaError(f"--crash: '{crash.robot}' is not in the team ({', '.join(config.robots)})")
+    for cut in config.partitions:
+        strangers = [r for g in cut.groups for r in g if r not in config.robots]
+        if strangers:
+            raise AlicaError(f"--partition: {', '.join(strangers)} not in the team ({', '.join(config.robots)})")
 
 
 def goal_samples(goal: str) -> list[str]:
