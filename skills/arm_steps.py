@@ -39,7 +39,7 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.arm_world import find_object, place_area, write_held, write_placed, write_released
 from alica.skills.handling import PLACE_TOLERANCE, REACH, SETTLE, ArmSkill, Pickup, Putdown
-from alica.skills.world_skill import WorldSkill, distance
+from alica.skills.world_skill import WorldSkill, distance, number_param
 from alica.worldsim.interface import WorldThing
 
 #: Grasp attempts after which crowding objects are pushed aside (the plans give up after three).
@@ -48,18 +48,6 @@ GRASP_ATTEMPTS = 3
 REACH_SLACK = 0.25
 #: An object whose bottom is higher than this (m) does not lie on the ground.
 ON_GROUND = 0.03
-
-
-def _number(skill: WorldSkill, name: str, default: float | None, *, strict: bool = True) -> float:
-    """A numeric parameter > 0 (``strict``) or >= 0, or a clear SkillError."""
-    raw = skill.param(name, default)
-    try:
-        value = float(raw)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise SkillError(f"skill '{skill.name}': parameter '{name}' must be a number, got {raw!r}") from None
-    if not math.isfinite(value) or (value <= 0.0 if strict else value < 0.0):
-        raise SkillError(f"skill '{skill.name}': parameter '{name}' must be {'>' if strict else '>='} 0, got {raw!r}")
-    return value
 
 
 def _scratch(skill: WorldSkill) -> dict[str, Any]:
@@ -102,8 +90,8 @@ class AlignWithObject(ArmSkill):
         """Check the parameters; take the sides Grasp tried."""
         super().initialise()
         given = self.param("standoff")
-        self.standoff_m = None if given is None else _number(self, "standoff", None)
-        self.tolerance = _number(self, "tolerance", 0.02)
+        self.standoff_m = None if given is None else number_param(self, "standoff", None)
+        self.tolerance = number_param(self, "tolerance", 0.02)
         self.drives = 0
         tried = _scratch(self).get("tried_sides")
         if isinstance(tried, dict) and tried.get("object") == self.object_label():
@@ -167,7 +155,7 @@ class Grasp(Pickup):
     def initialise(self) -> None:
         """Check ``force``; count the attempt."""
         super().initialise()
-        self.force = _number(self, "force", 10.0)
+        self.force = number_param(self, "force", 10.0)
         self.retries = 1
         name = self.object_label()
         scratch = _scratch(self)
@@ -394,7 +382,7 @@ class ValidateGrip(WorldSkill):
 
     def initialise(self) -> None:
         """Check ``min_force``."""
-        self.min_force = _number(self, "min_force", 2.0, strict=False)
+        self.min_force = number_param(self, "min_force", 2.0, strict=False)
 
     def update(self) -> Status:
         """Read the finger force."""

@@ -34,7 +34,7 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.jobs import Job
 from alica.skills.sample_facts import seen_on_the_ground
-from alica.skills.world_skill import WorldSkill
+from alica.skills.world_skill import WorldSkill, number_param
 from alica.worldsim.objects import SAMPLE_KINDS
 
 if TYPE_CHECKING:
@@ -443,20 +443,6 @@ def decode_sections(
 # -- the skills --------------------------------------------------------------------------------------
 
 
-def _number(skill: WorldSkill, name: str, default: float, *, low: float = 0.0, strict: bool = True) -> float:
-    """A numeric parameter checked against a lower bound, or a clear SkillError."""
-    raw = skill.param(name, default)
-    try:
-        value = float(raw)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        raise SkillError(f"skill '{skill.name}': parameter '{name}' must be a number, got {raw!r}") from None
-    if not math.isfinite(value) or (value <= low if strict else value < low):
-        raise SkillError(
-            f"skill '{skill.name}': parameter '{name}' must be {'>' if strict else '>='} {low}, got {raw!r}"
-        )
-    return value
-
-
 class _Pipeline(WorldSkill):
     """A Verify2DObject step: the scratch space and the world model's candidate facts."""
 
@@ -514,10 +500,10 @@ class DetectCircles(_Pipeline):
 
     def initialise(self) -> None:
         """Check the parameters and start the scan."""
-        self.radius = _number(self, "radius", 0.03)
-        self.tolerance = _number(self, "tolerance", 0.01, strict=False)
-        self.max_range = _number(self, "max_range", 8.0)
-        self.period = _number(self, "period", 0.5)
+        self.radius = number_param(self, "radius", 0.03)
+        self.tolerance = number_param(self, "tolerance", 0.01, strict=False)
+        self.max_range = number_param(self, "max_range", 8.0)
+        self.period = number_param(self, "period", 0.5)
         raw_wait = self.param("wait", 0.0)
         try:
             self.wait = float(raw_wait)  # type: ignore[arg-type]
@@ -650,9 +636,9 @@ class CropCandidate(_Pipeline):
 
     def initialise(self) -> None:
         """Check the parameters, choose the candidate, turn the camera toward it and render."""
-        self.margin = _number(self, "margin", 0.1, strict=False)
-        self.max_range = _number(self, "max_range", 5.0)
-        self.retry = _number(self, "retry", 5.0, strict=False)
+        self.margin = number_param(self, "margin", 0.1, strict=False)
+        self.max_range = number_param(self, "max_range", 5.0)
+        self.retry = number_param(self, "retry", 5.0, strict=False)
         self.width = self._pixels("width", 752)
         self.height = self._pixels("height", 480)
         if not ({"camera", "stereo_camera"} & self.robot.spec.capabilities):
@@ -909,7 +895,7 @@ class ClassifySample(_Pipeline):
 
     def initialise(self) -> None:
         """Check the parameters."""
-        self.min_confidence = _number(self, "min_confidence", 0.3, strict=False)
+        self.min_confidence = number_param(self, "min_confidence", 0.3, strict=False)
         if self.min_confidence > 1.0:
             raise SkillError(
                 f"skill '{self.name}': parameter 'min_confidence' must be in [0, 1], got {self.min_confidence}"

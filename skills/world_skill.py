@@ -199,3 +199,23 @@ class WorldSkill(py_trees.behaviour.Behaviour):
 def distance(a: tuple[float, float], b: tuple[float, float]) -> float:
     """Euclidean distance of two points."""
     return math.hypot(a[0] - b[0], a[1] - b[1])
+
+
+def number_param(
+    skill: WorldSkill, name: str, default: float | None, *, low: float = 0.0, strict: bool = True
+) -> float:
+    """The numeric parameter ``name`` of ``skill``: finite and above ``low`` (``strict``) or at least ``low``.
+
+    Raises:
+        SkillError: not a number, or out of range (the message names the parameter and the bound).
+    """
+    raw = skill.param(name, default)
+    try:
+        value = float(raw)  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise SkillError(f"skill '{skill.name}': parameter '{name}' must be a number, got {raw!r}") from None
+    if not math.isfinite(value) or (value <= low if strict else value < low):
+        raise SkillError(
+            f"skill '{skill.name}': parameter '{name}' must be {'>' if strict else '>='} {low:g}, got {raw!r}"
+        )
+    return value
