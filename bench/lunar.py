@@ -11,7 +11,7 @@ picking the first two samples found:
 * ``nominal``: scout, stummel and amparo;
 * ``scout-crash``: Scout crashes at 20 s, Stummel explores;
 * ``amparo-crash``: Amparo crashes at ``--amparo-crash`` s, Stummel takes its transport;
-* ``amparo-grasp``: Amparo crashes when it first holds a sample (the sample falls; the team finds it again);
+* ``amparo-grasp``: Amparo crashes when it first lifts a sample it grasped (the sample falls; the team finds it again);
 * ``loss30``: 30 % of the messages are lost;
 * ``partition20``: Scout is cut off from the others from 10 s to 30 s;
 * ``robots1``, ``robots2``: stummel alone; scout and stummel (no faults).

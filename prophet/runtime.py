@@ -483,7 +483,7 @@ class ProblemRuntime:
                     now,
                 )
                 return
-            partial = reachable_goal(goal, world.outside)
+            partial = reachable_goal(goal, world.outside, world.fixed)
             if partial != goal:
                 if not partial or holds(partial, set(world.facts)):
                     self._wait_for_world(now, world, generation, _rest_holds(world))
@@ -724,7 +724,7 @@ class ProblemRuntime:
         ]
         goal = goal_literals(self.problem)
         world = self._read_world(self.problem, believed)
-        reachable = reachable_goal(goal, world.outside)
+        reachable = reachable_goal(goal, world.outside, world.fixed)
         # what the plan was made for, less what robots outside the team hold now (they may put it back)
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         order = [[step.index for step in steps] for steps in created.tasks]

@@ -47,9 +47,11 @@ class PlanningWorld:
         robots: the robots the plan may use, sorted.
         left_out: facts about robots outside the team that were left out (a
             block an opponent holds is missing from the world, say).
-        outside: the objects in those facts (the blocks opponents hold), and the goal's
-            objects that no fact mentions (a block falling), sorted: the team does not plan for them.
+        outside: the objects in those facts that no kept fact mentions (the blocks opponents
+            hold), and the goal's objects that no fact mentions (a block falling), sorted: the
+            team does not plan for them.
         others: the robots outside the team the facts name (opponents, crashed members), sorted.
+        fixed: the problem's own objects (a fixed place such as the collection point ``g``), sorted.
     """
 
     objects: tuple[tuple[str, str], ...]
@@ -58,6 +60,7 @@ class PlanningWorld:
     left_out: int = 0
     outside: tuple[str, ...] = ()
     others: tuple[str, ...] = ()
+    fixed: tuple[str, ...] = ()
 
     def object_types(self) -> dict[str, str]:
         """Object name -> type."""
@@ -166,8 +169,12 @@ def read_world(
             types.setdefault(str(value), type_name)
     robots = tuple(sorted(n for n, k in types.items() if k == robot_type)) if offline else members
     if not offline:
-        # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
         mentioned = {str(a) for fact in kept for a in fact.args}
+        # an object of a left-out relation that facts of the team still mention is planned for: a robot
+        # that crashed standing at a sample (at(r, s)) leaves it on the ground (onground(s)); one an
+        # opponent holds is mentioned by nothing else (clear(b) and ontable(b) went with the grasp)
+        outside -= mentioned
+        # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
         outside.update(
             str(a)
             for _, goal_fact in goal_literals(problem)
@@ -181,10 +188,11 @@ def read_world(
         left_out,
         tuple(sorted(outside)),
         tuple(sorted(others)),
+        tuple(sorted(fixed)) if not offline else (),
     )
 
 
-def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Literal, ...]:
+def reachable_goal(goal: Sequence[Literal], outside: Iterable[str], fixed: Iterable[str] = ()) -> tuple[Literal, ...]:
     """The goal literals not tied to any of the ``outside`` objects (those robots outside the team hold).
 
     The team cannot plan for a block an opponent holds; it plans for the
@@ -193,16 +201,19 @@ def reachable_goal(goal: Sequence[Literal], outside: Iterable[str]) -> tuple[Lit
     object of a literal tied to it: with ``on(d, f)`` and ``on(g, d)`` in
     the goal and ``f`` held, both are left out. Building ``g`` on ``d`` now
     would put up a stack that has to come down again once ``d`` can go onto
-    ``f``.
+    ``f``. The ``fixed`` objects (places the problem declares, such as the
+    collection point ``g``) tie nothing: with ``at(a, g)`` and ``at(b, g)``
+    in the goal and ``a`` held, ``b`` still goes to ``g``.
     """
+    anchors = {str(a) for a in fixed}
     tied = set(outside)
     grew = True
     while grew:
         grew = False
         for literal in goal:
             names = {str(a) for a in literal[1][1]}
-            if names & tied and not names <= tied:
-                tied |= names
+            if names & tied and not names - anchors <= tied:
+                tied |= names - anchors
                 grew = True
     return tuple(literal for literal in goal if not tied.intersection(literal[1][1]))
 

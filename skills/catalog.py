@@ -134,6 +134,16 @@ def _navigation(registry: SkillRegistry) -> None:
         implementation="alica.skills.navigation:DriveToFreeSpace",
     )
     registry.declare(
+        "DriveToDroppedSample",
+        _p("distance", "float", "stop within this many metres of where the dropped sample was last seen", default=1.5),
+        _p("period", "float", "seconds between two looks for a dropped sample while there is none", default=1.0),
+        _p("timeout", "float", "seconds of driving before the skill fails", default=120.0),
+        doc="stand still until a lost teammate held a sample (its gripper opened when it crashed), then drive near "
+        "where the sample was last seen, for the perception to find it again",
+        capabilities=("base",),
+        implementation="alica.skills.sample_search:DriveToDroppedSample",
+    )
+    registry.declare(
         "Localize",
         _p("timeout", "float", "seconds before the skill fails", default=30.0),
         _p("continuous", "bool", "keep correcting every period until the state is left", default=False),

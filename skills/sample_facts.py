@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from alica.worldmodel.protocol import WorldModelLike
 
-__all__ = ["seen_on_the_ground"]
+__all__ = ["dropped_samples", "seen_on_the_ground", "stale_verdicts"]
 
 
 def seen_on_the_ground(wm: WorldModelLike, sample: str) -> None:
@@ -16,3 +18,31 @@ def seen_on_the_ground(wm: WorldModelLike, sample: str) -> None:
     for fact in list(wm.facts()):
         if fact.predicate == "holding" and len(fact.args) == 2 and str(fact.args[1]) == sample:
             wm.retract_fact("holding", *fact.args)
+
+
+def dropped_samples(wm: WorldModelLike | None, belief: Any) -> list[tuple[str, str, tuple[float, float]]]:
+    """``(sample, holder, last_seen)`` of the samples held by teammates the agent believes lost, sorted.
+
+    ``belief`` answers ``role(r)`` (a teammate has one) and ``alive(r)``
+    (the engine's :class:`~alica.engine.belief.AgentBelief`); without it no
+    teammate is known lost. A sample whose last position is unknown is left out.
+    """
+    if wm is None or belief is None:
+        return []
+    out = []
+    for fact in wm.facts():
+        if fact.predicate != "holding" or len(fact.args) != 2:
+            continue
+        holder, sample = (str(a) for a in fact.args)
+        if belief.lookup("role", (holder,)) is None or belief.lookup("alive", (holder,)):
+            continue
+        seen = wm.get("pos", sample)
+        if isinstance(seen, (tuple, list)) and len(seen) >= 2:
+            out.append((sample, holder, (float(seen[0]), float(seen[1]))))
+    return sorted(out)
+
+
+def stale_verdicts(verdicts: dict[str, str], wm: WorldModelLike | None, belief: Any) -> set[str]:
+    """The candidates whose verdict named a sample a lost teammate held: the sample fell, look again."""
+    dropped = {sample for sample, _, _ in dropped_samples(wm, belief)}
+    return {cid for cid, name in verdicts.items() if name in dropped} if dropped else set()

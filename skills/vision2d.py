@@ -33,7 +33,7 @@ from py_trees.common import Status
 
 from alica.errors import SkillError
 from alica.skills.jobs import Job
-from alica.skills.sample_facts import seen_on_the_ground
+from alica.skills.sample_facts import seen_on_the_ground, stale_verdicts
 from alica.skills.world_skill import WorldSkill, number_param
 from alica.worldsim.objects import SAMPLE_KINDS
 
@@ -454,6 +454,17 @@ class _Pipeline(WorldSkill):
             scratch = self.__dict__.setdefault("_own_scratch", {})
         return cast("dict[str, object]", scratch)
 
+    def verdicts(self) -> dict[str, str]:
+        """Candidate -> verdict (a sample's name, or ``invalid``), less the stale ones, which are forgotten.
+
+        A verdict is stale when the sample it named was held by a teammate now
+        lost: the sample fell where it was, and its candidate is looked at again.
+        """
+        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
+        for cid in stale_verdicts(verdicts, self.world_model, getattr(self.context, "belief", None)):
+            del verdicts[cid]
+        return verdicts
+
     def reject_candidate(self, candidate: dict[str, Any], reason: str) -> None:
         """A closer look disagrees: retract the candidate (and a sample found there), record it as invalid."""
         cid = str(candidate["id"])
@@ -563,7 +574,7 @@ class DetectCircles(_Pipeline):
         self.job = None
         self.scans += 1
         out = self._candidates(circles)
-        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        verdicts = self.verdicts()
         fresh = [c for c in out if c["id"] not in verdicts]
         if self.wait > 0.0 and not fresh:
             waited = self.now() - self.started
@@ -589,7 +600,7 @@ class DetectCircles(_Pipeline):
     def _candidates(self, circles: list[Circle]) -> list[dict[str, Any]]:
         """Name the circles (a known candidate nearby keeps its id), write them to the scratch space and world model."""
         known = cast("dict[str, tuple[float, float]]", self.scratch.setdefault("candidate_ids", {}))
-        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        verdicts = self.verdicts()
         out = []
         wm = self.world_model
         for c in circles:
@@ -661,7 +672,7 @@ class CropCandidate(_Pipeline):
         from alica.worldsim.robot_camera import camera_pose
 
         circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
-        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        verdicts = self.verdicts()
         unseen = cast("dict[str, float]", self.scratch.get("unseen") or {})
         robot = self.robot
         spec = robot.spec
@@ -739,7 +750,7 @@ class CropCandidate(_Pipeline):
                 f"turning the camera to {self.target['id']} ({math.degrees(self.pan):.0f} deg) and taking a picture"
             )
         image: CameraImage = self.job.result()
-        verdicts = cast("dict[str, str]", self.scratch.get("verdicts") or {})
+        verdicts = self.verdicts()
         radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
         views = []
         reasons: list[str] = []

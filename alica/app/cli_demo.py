@@ -107,7 +107,7 @@ def _add_lunar(demos: Any) -> None:
         action="append",
         default=[],
         metavar="NAME@T",
-        help="crash robot NAME at simulated second T, or NAME@grasp when it first holds a sample (repeatable)",
+        help="crash robot NAME at simulated second T, or NAME@grasp when it first lifts a sample it grasped (repeatable)",
     )
     add_network_options(lunar)
     lunar.add_argument(

@@ -200,6 +200,15 @@ def test_the_part_of_the_goal_tied_to_a_held_block_is_left_out():
     assert reachable_goal(list(reversed(tower)) + alone, ["g"]) == tuple(alone)
 
 
+def test_a_fixed_place_in_the_goal_ties_nothing():
+    from alica.prophet.world import reachable_goal
+
+    # a lunar goal: a robot outside the team holds a; b still goes to the collection point g
+    goal = [(True, ("at", ("a", "g"))), (True, ("at", ("b", "g")))]
+    assert reachable_goal(goal, ["a"], fixed=["g"]) == (goal[1],)
+    assert reachable_goal(goal, ["a"]) == ()  # without g declared fixed, g ties b to a
+
+
 @given(
     st.lists(
         st.tuples(st.sampled_from(["on", "ontable"]), st.lists(st.sampled_from("abcdefg"), min_size=1, max_size=2)),

@@ -47,6 +47,8 @@ ROLES = {"scout": "Scout", "stummel": "Stummel", "amparo": "Amparo"}
 BASE = "g"
 #: A sample counts as delivered when it rests within this many metres of g (on the ground, in no gripper).
 DELIVERED_WITHIN = 1.0
+#: A crash "at the grasp" comes when the held sample's bottom is this many metres above the ground (the lift).
+LIFTED_ABOVE = 0.05
 #: Simulated seconds the run goes on once every chosen sample is delivered, for the team to notice it.
 SETTLE_S = 2.0
 #: Simulated seconds between two readings of the map's coverage (for the progress line).
@@ -55,7 +57,7 @@ COVERAGE_EVERY = 5.0
 
 @dataclass(frozen=True, slots=True)
 class Crash:
-    """A robot crashes at simulated second ``at``, or (``at`` None) when it first holds a sample."""
+    """A robot crashes at simulated second ``at``, or (``at`` None) when it first lifts a sample it grasped."""
 
     robot: str
     at: float | None = None
@@ -419,7 +421,7 @@ class _Run:
                 x, y = world.robots[name].pose[:2]
                 self.distance[name] += math.hypot(x - last[name][0], y - last[name][1])
                 last[name] = (x, y)
-                if name in at_grasp and name not in team.crashed and _holds_sample(world, name):
+                if name in at_grasp and name not in team.crashed and _lifts_sample(world, name):
                     team.crash(name)
                     at_grasp.discard(name)
                 if name in team.crashed and name not in self.crash_places:
@@ -541,10 +543,11 @@ def _held_name(robot: Any) -> str | None:
     return getattr(held, "name", None)
 
 
-def _holds_sample(world: Any, name: str) -> bool:
+def _lifts_sample(world: Any, name: str) -> bool:
+    """Whether robot ``name`` holds a sample lifted off the ground (the grasp is done; the lift is under way)."""
     held = _held_name(world.robots[name])
     obj = world.objects.get(held) if held is not None else None
-    return obj is not None and obj.kind == "sample"
+    return obj is not None and obj.kind == "sample" and float(obj.aabb()[0][2]) > LIFTED_ABOVE
 
 
 def summary_lines(result: LunarResult) -> list[str]:

@@ -1,0 +1,75 @@
+"""Looking for a sample a crashed teammate dropped: DriveToDroppedSample.
+
+A robot that loses power opens its gripper (the lunar robots' Jaco hands
+do), so a sample it held falls where it stood. Its teammates cannot know
+where exactly, and its last fact, ``holding(r, s)``, says otherwise; the
+planner leaves out a sample a robot outside the team holds. Someone has to
+look: this skill drives a teammate near where the sample was last seen
+(``pos(s)``), and the perception that runs next (Verify2DObject,
+SemanticPerception) finds it again. A detection of a sample standing on the
+ground retracts ``holding(r, s)`` (:func:`alica.skills.sample_facts.seen_on_the_ground`),
+and the planner plans with it again.
+
+A teammate counts as lost when the agent's team view says it is not alive
+(``alive(r)``, the engine's belief). Held samples of robots that are
+merely cut off (a partition) count as dropped too: the look finds nothing
+where they were seen, and the skill fails with that reason.
+"""
+
+from __future__ import annotations
+
+from py_trees.common import Status
+
+from alica.skills.navigation import MoveToPosition
+from alica.skills.sample_facts import dropped_samples
+
+__all__ = ["DriveToDroppedSample"]
+
+
+class DriveToDroppedSample(MoveToPosition):
+    """Stand still until a lost teammate held a sample, then drive within ``distance`` metres of where it was seen.
+
+    Runs (standing still, looking every ``period`` seconds) while no sample
+    is dropped; succeeds near the place, ready for the perception to look;
+    fails as MoveToPosition does (``timeout``, a blocked path). The place is
+    the sample's last known position ``pos(s)``: exact for a crash at the
+    grasp, where the sample was picked up for a crash on the way.
+    """
+
+    def initialise(self) -> None:
+        """Look for a dropped sample; drive when there is one."""
+        self.period = float(self.param("period", 1.0))  # type: ignore[arg-type]
+        self.sample: str | None = None
+        self.next_look = self.now()
+        self.robot.stop()
+        self._look()
+
+    def _look(self) -> bool:
+        belief = getattr(self.context, "belief", None)
+        dropped = dropped_samples(self.world_model, belief)
+        self.next_look = self.now() + self.period
+        if not dropped:
+            return False
+        here = self.robot.estimate
+        sample, holder, seen = min(dropped, key=lambda d: (d[2][0] - here[0]) ** 2 + (d[2][1] - here[1]) ** 2)
+        self.sample, self.holder = sample, holder
+        self.params["goal"] = list(seen)
+        self.params["tolerance"] = float(self.param("distance", 1.5))  # type: ignore[arg-type]
+        super().initialise()
+        return True
+
+    def update(self) -> Status:
+        """Wait for a dropped sample, then drive like MoveToPosition."""
+        if self.sample is None:
+            if self.now() < self.next_look - 1e-9 or not self._look():
+                return self.running("no teammate that held a sample is lost")
+        status = super().update()
+        if status == Status.SUCCESS:
+            return self.succeed(f"near where {self.sample} was last seen, which lost teammate {self.holder} held")
+        return status
+
+    def _arrived(self, here: tuple[float, float]) -> None:
+        """Near the place: no at-fact (the robot stands off, it is not at the sample)."""
+        wm = self.world_model
+        if wm is not None:
+            wm.set("pos", self.robot.name, value=(round(here[0], 3), round(here[1], 3)))
