@@ -102,7 +102,7 @@ def main() -> None:
     parser.add_argument("--rocks", type=int, default=60)
     parser.add_argument("--size", type=float, default=40.0)
     parser.add_argument("--time-limit", type=float, default=900.0)
-    parser.add_argument("--amparo-crash", type=float, default=120.0, help="when Amparo crashes in amparo-crash (s)")
+    parser.add_argument("--amparo-crash", type=float, default=45.0, help="when Amparo crashes in amparo-crash (s)")
     parser.add_argument("--out", default="build/lunar_bench.png")
     args = parser.parse_args()
     scenarios = [s.strip() for s in args.scenarios.split(",") if s.strip()]

@@ -135,7 +135,7 @@ def _navigation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "DriveToDroppedSample",
-        _p("distance", "float", "stop within this many metres of where the dropped sample was last seen", default=1.5),
+        _p("distance", "float", "look from this many metres off where the dropped sample was last seen", default=1.5),
         _p("period", "float", "seconds between two looks for a dropped sample while there is none", default=1.0),
         _p("timeout", "float", "seconds of driving before the skill fails", default=120.0),
         doc="stand still until a lost teammate held a sample (its gripper opened when it crashed), then drive near "

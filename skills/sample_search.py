@@ -18,6 +18,8 @@ where they were seen, and the skill fails with that reason.
 
 from __future__ import annotations
 
+import math
+
 from py_trees.common import Status
 
 from alica.skills.navigation import MoveToPosition
@@ -25,15 +27,22 @@ from alica.skills.sample_facts import dropped_samples
 
 __all__ = ["DriveToDroppedSample"]
 
+#: How close to its viewpoint the robot must come (metres).
+VIEWPOINT_TOLERANCE = 0.5
+
 
 class DriveToDroppedSample(MoveToPosition):
-    """Stand still until a lost teammate held a sample, then drive within ``distance`` metres of where it was seen.
+    """Stand still until a lost teammate held a sample, then drive to a viewpoint ``distance`` metres from where it was seen.
 
     Runs (standing still, looking every ``period`` seconds) while no sample
-    is dropped; succeeds near the place, ready for the perception to look;
+    is dropped; succeeds at the viewpoint, ready for the perception to look;
     fails as MoveToPosition does (``timeout``, a blocked path). The place is
     the sample's last known position ``pos(s)``: exact for a crash at the
-    grasp, where the sample was picked up for a crash on the way.
+    grasp, where the sample was picked up for a crash on the way. The
+    crashed robot stands beside the sample and may hide it, so the first
+    viewpoint lies on the far side from the holder's last known position
+    ``pos(r)``; each later run for the same sample (the look found nothing)
+    goes a third of the way round (``scratch["dropped_views"]``).
     """
 
     def initialise(self) -> None:
@@ -51,12 +60,29 @@ class DriveToDroppedSample(MoveToPosition):
         if not dropped:
             return False
         here = self.robot.estimate
-        sample, holder, seen = min(dropped, key=lambda d: (d[2][0] - here[0]) ** 2 + (d[2][1] - here[1]) ** 2)
+        sample, holder, seen = min(dropped, key=lambda d: math.dist(d[2], here[:2]))
         self.sample, self.holder = sample, holder
-        self.params["goal"] = list(seen)
-        self.params["tolerance"] = float(self.param("distance", 1.5))  # type: ignore[arg-type]
+        self.params["goal"] = list(self._viewpoint(sample, holder, seen))
+        self.params["tolerance"] = VIEWPOINT_TOLERANCE
         super().initialise()
         return True
+
+    def _viewpoint(self, sample: str, holder: str, seen: tuple[float, float]) -> tuple[float, float]:
+        """The next place to look from: ``distance`` from the sample, away from the holder first."""
+        reach = float(self.param("distance", 1.5))  # type: ignore[arg-type]
+        views = getattr(self.context, "scratch", None)
+        tries = views.setdefault("dropped_views", {}) if views is not None else {}
+        turn = int(tries.get(sample, 0))
+        tries[sample] = turn + 1
+        wm = self.world_model
+        at = wm.get("pos", holder) if wm is not None else None
+        if isinstance(at, (tuple, list)) and len(at) >= 2 and math.dist(at[:2], seen) > 1e-3:
+            away = math.atan2(seen[1] - float(at[1]), seen[0] - float(at[0]))
+        else:
+            here = self.robot.estimate
+            away = math.atan2(here[1] - seen[1], here[0] - seen[0])  # no holder position: from this side
+        angle = away + turn * 2.0 * math.pi / 3.0
+        return seen[0] + reach * math.cos(angle), seen[1] + reach * math.sin(angle)
 
     def update(self) -> Status:
         """Wait for a dropped sample, then drive like MoveToPosition."""
@@ -65,11 +91,11 @@ class DriveToDroppedSample(MoveToPosition):
                 return self.running("no teammate that held a sample is lost")
         status = super().update()
         if status == Status.SUCCESS:
-            return self.succeed(f"near where {self.sample} was last seen, which lost teammate {self.holder} held")
+            return self.succeed(f"looking at where {self.sample} was last seen, which lost teammate {self.holder} held")
         return status
 
     def _arrived(self, here: tuple[float, float]) -> None:
-        """Near the place: no at-fact (the robot stands off, it is not at the sample)."""
+        """At the viewpoint: no at-fact (the robot stands off, it is not at the sample)."""
         wm = self.world_model
         if wm is not None:
             wm.set("pos", self.robot.name, value=(round(here[0], 3), round(here[1], 3)))
