@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from alica.prophet.pipeline import ProblemPlanning, ProblemResult, ValidPlan, plan_problem
-    from alica.prophet.plugin import PLANNING, Planning, PlanningAgent, engine_config, latest_plans
+    from alica.prophet.plugin import PLANNING, Planning, PlanningAgent, engine_config, latest_plans, made_plans
     from alica.prophet.runtime import ProblemRuntime, SearchBudget
 
 _HOME = {
@@ -32,6 +32,7 @@ _HOME = {
     "PlanningAgent": "plugin",
     "engine_config": "plugin",
     "latest_plans": "plugin",
+    "made_plans": "plugin",
     "ProblemRuntime": "runtime",
     "SearchBudget": "runtime",
 }
@@ -47,6 +48,7 @@ __all__ = [
     "ValidPlan",
     "engine_config",
     "latest_plans",
+    "made_plans",
     "plan_problem",
 ]
 

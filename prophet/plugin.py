@@ -18,7 +18,7 @@ the agent enters.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
@@ -116,3 +116,13 @@ def latest_plans(engine: _Engine) -> Mapping[PlanKey, CreatedTasks]:
     """
     agent = engine.children.factory(PlanningProblem)
     return agent.board.latest if isinstance(agent, PlanningAgent) else {}
+
+
+def made_plans(engine: _Engine) -> Sequence[CreatedTasks]:
+    """Every plan generated for the planning problems an agent's engine ran, in the order it took them up.
+
+    Args:
+        engine: an agent's engine (:class:`alica.engine.AgentEngine`).
+    """
+    agent = engine.children.factory(PlanningProblem)
+    return tuple(agent.board.made) if isinstance(agent, PlanningAgent) else ()

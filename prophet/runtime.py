@@ -342,6 +342,8 @@ class ProblemRuntime:
         if created is not None:
             host.register_plan(created.plan, created.priorities(), created.pins())
             self.board.latest[self.key] = created
+            if all(made.plan.name != created.plan.name for made in self.board.made):
+                self.board.made.append(created)
         self.share = share
         self.revision += 1
         self.reason = share.reason

@@ -129,4 +129,5 @@ def test_the_mission_brings_the_chosen_samples_to_g_on_a_small_field(tmp_path):
     # Amparo and Stummel carried (Scout has no arm), and everything the demo writes is there
     carried = {name for name, robot in result["robots"].items() if robot["steps"]}
     assert carried <= {"amparo", "stummel"} and carried
-    assert {p.name for p in tmp_path.iterdir()} >= {"trace.jsonl", "map.png", "plan.yaml"}
+    assert {p.name for p in tmp_path.iterdir()} >= {"trace.jsonl", "map.png", "plan.yaml", "plans"}
+    assert len(list((tmp_path / "plans").glob("GetObjects_g*.yaml"))) == result["plans"]

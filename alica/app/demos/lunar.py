@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from alica.app.demos.common import StepCounter, plan_yaml_text, planning_leader
+from alica.app.demos.common import StepCounter, plan_yaml_text
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
 
@@ -293,7 +293,7 @@ def run_lunar(
     from alica.io import load_library
     from alica.lang import literals
     from alica.lang.skill_plugins import default_registry
-    from alica.prophet import engine_config, latest_plans
+    from alica.prophet import engine_config
     from alica.skills.motion import configure_ompl
     from alica.worldsim.scenarios import lunar
 
@@ -330,9 +330,8 @@ def run_lunar(
         wall = time.perf_counter()
         run.loop(on_second, counter)
         wall = time.perf_counter() - wall
-        leader = planning_leader(team)
-        created = next(iter(latest_plans(leader).values()), None) if leader is not None else None
-        plan_yaml = plan_yaml_text(created, MISSION, out) if created is not None else ""
+        made = _made_plans(team)
+        plan_yaml = plan_yaml_text(made[-1], MISSION, out) if made else ""
         coverage = run.coverage()
         if out is not None:
             out.mkdir(parents=True, exist_ok=True)
@@ -341,6 +340,11 @@ def run_lunar(
             draw_map(world, run.team_map(), run.operator, run.tracks, run.crash_places, out / "map.png")
             if plan_yaml:
                 (out / "plan.yaml").write_text(plan_yaml, encoding="utf-8")
+                folder = out / "plans"
+                folder.mkdir(exist_ok=True)
+                for created in made:
+                    text = plan_yaml_text(created, MISSION, folder)
+                    (folder / f"{created.plan.name}.yaml").write_text(text, encoding="utf-8")
         operator = run.operator
         delivered = run.delivered()
         success = bool(operator.chosen) and len(delivered) == len(operator.chosen)
@@ -374,6 +378,24 @@ def run_lunar(
         if trace is not None:
             trace.close()
         world.close()
+
+
+def _made_plans(team: Any) -> list[Any]:
+    """Every plan the team generated (each once, crashed agents' too), in the order of generation and version."""
+    import re
+
+    from alica.prophet import made_plans
+
+    seen: dict[str, Any] = {}
+    for engine in team.engines.values():
+        for created in made_plans(engine):
+            seen.setdefault(created.plan.name, created)
+
+    def order(name: str) -> tuple[int, int, str]:
+        match = re.search(r"_g(\d+)v(\d+)_", name)
+        return (int(match.group(1)), int(match.group(2)), name) if match else (0, 0, name)
+
+    return [seen[name] for name in sorted(seen, key=order)]
 
 
 def _gui(gui: bool) -> dict[str, Any]:

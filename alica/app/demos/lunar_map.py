@@ -51,6 +51,7 @@ def draw_map(
     else:
         ax.set_facecolor((0.75, 0.75, 0.75))
     found_at = dict(operator.places)
+    labelled: list[tuple[float, float]] = []  # sample labels so far: close ones are stacked, not overprinted
     for obj in world.objects.values():
         x, y = obj.position()[:2]
         if obj.kind == "rock":
@@ -60,7 +61,11 @@ def draw_map(
             near = [n for n, p in found_at.items() if np.hypot(p[0] - x, p[1] - y) < 0.5]
             label = obj.sample_kind + (f"\nfound as {near[0]}" if near else "\nnot found")
             weight = "bold" if near and near[0] in operator.chosen else "normal"
-            ax.annotate(label, (x, y), xytext=(4, 4), textcoords="offset points", fontsize=6, fontweight=weight)
+            below = sum(1 for p in labelled if np.hypot(p[0] - x, p[1] - y) < 1.5)
+            labelled.append((x, y))
+            ax.annotate(
+                label, (x, y), xytext=(4, 4 - 18 * below), textcoords="offset points", fontsize=6, fontweight=weight
+            )
         elif obj.kind == "marker":
             ax.plot(x, y, marker="*", markersize=12, color="gold", markeredgecolor="black")
             ax.annotate(obj.name, (x, y), xytext=(6, -10), textcoords="offset points", fontsize=8)
