@@ -127,9 +127,17 @@ class LunarResult:
     robots: dict[str, dict[str, Any]]
     plan_yaml: str = ""
     crashed: list[str] = field(default_factory=list)
+    replicas: dict[str, Any] = field(default_factory=dict)
 
     def as_json(self) -> dict[str, Any]:
-        """The summary as plain data."""
+        """The summary as plain data.
+
+        ``replicas`` compares the running robots' replicated world models at the
+        end of the run (see :func:`replica_views`): ``agree`` (every running
+        robot holds the same found samples and the same team map), ``found``
+        (robot -> its sorted ``found(s)`` samples) and ``map_digest`` (robot ->
+        a short hash of its team map grid, ``""`` before it has one).
+        """
         return {
             "success": self.success,
             "reason": self.reason,
@@ -144,6 +152,7 @@ class LunarResult:
             "messages": self.messages,
             "robots": self.robots,
             "crashed": self.crashed,
+            "replicas": self.replicas,
         }
 
 
@@ -274,8 +283,12 @@ def run_lunar(
     on_second: Callable[[dict[str, Any]], None] | None = None,
     out: Path | None = None,
     gui: bool = False,
+    prepare_world: Callable[[Any], None] | None = None,
 ) -> LunarResult:
     """Run the lunar mission once (see the module docstring).
+
+    The result's ``replicas`` (see :meth:`LunarResult.as_json`) tells whether the running
+    robots' world models agree at the end of the run: the same found samples, the same team map.
 
     Args:
         config: what to run.
@@ -285,6 +298,9 @@ def run_lunar(
         out: a folder for the trace (``trace.jsonl``), the map picture (``map.png``) and the
             generated plan (``plan.yaml``).
         gui: show the pybullet window.
+        prepare_world: called with the simulated world (:class:`alica.worldsim.World`) once the
+            field is built and before the team exists, to change it (add rocks, move a sample...);
+            for tests and experiments.
 
     Raises:
         AlicaError: a bad configuration.
@@ -306,6 +322,8 @@ def run_lunar(
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = engine_config(frequency=config.frequency)
     try:
+        if prepare_world is not None:
+            prepare_world(world)
         team = SimulatedTeam(
             library,
             PLAN,
@@ -373,6 +391,7 @@ def run_lunar(
             },
             plan_yaml=plan_yaml,
             crashed=sorted(team.crashed),
+            replicas=replica_views(team),
         )
     finally:
         if trace is not None:
@@ -396,6 +415,36 @@ def _made_plans(team: Any) -> list[Any]:
         return (int(match.group(1)), int(match.group(2)), name) if match else (0, 0, name)
 
     return [seen[name] for name in sorted(seen, key=order)]
+
+
+def replica_views(team: Any) -> dict[str, Any]:
+    """What each running robot's replica of the world model holds, and whether they agree.
+
+    Returns:
+        ``{"agree": bool, "found": {robot: sorted found samples}, "map_digest": {robot: hash}}``:
+        ``found`` lists the ``found(s)`` facts, ``map_digest`` is a short hash of the team map
+        grid (:func:`alica.skills.mapping.team_map`; ``""`` before the robot has a map), and
+        ``agree`` holds when every running robot has the same of both.
+    """
+    import hashlib
+
+    from alica.skills.mapping import team_map
+
+    found: dict[str, list[str]] = {}
+    digest: dict[str, str] = {}
+    for name, engine in team.engines.items():
+        if name in team.crashed:
+            continue
+        wm = engine.world_model
+        found[name] = sorted(str(f.args[0]) for f in wm.facts() if f.predicate == "found" and len(f.args) == 1)
+        grid = team_map(wm)
+        if grid is None:
+            digest[name] = ""
+        else:
+            frame = repr((grid.resolution, grid.origin, grid.logodds.shape)).encode()
+            digest[name] = hashlib.sha256(frame + grid.logodds.tobytes()).hexdigest()[:12]
+    agree = len({tuple(v) for v in found.values()}) <= 1 and len(set(digest.values())) <= 1
+    return {"agree": agree, "found": found, "map_digest": digest}
 
 
 def _gui(gui: bool) -> dict[str, Any]:
