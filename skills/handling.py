@@ -321,7 +321,7 @@ class ArmSkill(WorldSkill):
         Points overlapping another robot or an object (with a margin) are skipped;
         ``None`` when every side is taken (the skill waits and looks again).
         """
-        from alica.skills.navigation import planning_checker
+        from alica.skills.navigation import robot_checker
 
         robot = self.robot
         x, y, _ = robot.estimate
@@ -333,7 +333,7 @@ class ArmSkill(WorldSkill):
             if r is not robot
         ]
         # the motion planner's own check of a goal (static obstacles, blocks, other robots)
-        checker = planning_checker(self.world, robot.spec.radius).with_robots(others)
+        checker = robot_checker(self.world, robot, self.world_model).with_robots(others)
         for k in range(STANDOFF_TRIES):
             turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
             angle = heading + turn

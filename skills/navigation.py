@@ -1,37 +1,86 @@
 """Driving skills: MoveToPosition (and its primitive DriveTo), DriveToFreeSpace, Idle.
 
-MoveToPosition plans in SE2 with OMPL on the world's occupancy grid, inflated
-by the robot's radius (:func:`alica.skills.motion.plan_path`), checks the path
-exactly with FCL against the rocks' meshes and the other robots, follows it,
+MoveToPosition plans in SE2 with OMPL on an occupancy grid, inflated by the
+robot's radius (:func:`alica.skills.motion.plan_path`), follows the path,
 replans when another robot or a new obstacle blocks it, and when the robot is
 stuck (bumped, or no progress) drives into free space first. Planning runs as
 a job; ``update`` only polls. The robot drives by its pose *estimate*
 (``robot.estimate``: odometry, corrected by Localize), which is its true pose
 while the world's odometry drift is 0.
+
+Which grid depends on what the robot knows (:func:`planning_grid`):
+
+* **Map mode**: the skill's world model holds a team map
+  (:func:`alica.skills.mapping.team_map`, the lunar mission after BuildMap).
+  The robot plans on that map: occupied cells are obstacles, unknown cells
+  count as free (it drives into the unknown and replans when the map shows
+  an obstacle on its path: the path check reads the current team map), and
+  the cells of the robots' bodies (teammates' lidar sees them) are cleared
+  around the robots' current positions. There is no exact check against the
+  rocks' meshes: the map is all the robot knows of them. While it drives the
+  robot scans into its own layer of the team map (:func:`alica.skills.mapping.map_scan`),
+  so a robot that does not explore still maps the rocks on its way.
+* **Known-map mode**: without a team map (the blocks world, a skill run alone
+  in a test or by ``alica skill run``) the world's layout is known: the grid
+  is rasterised from the world's obstacles (tables, rocks, blocks) and a path
+  is checked exactly with FCL against the rocks' meshes and the tables.
+
+In both modes the other robots are the world's robot poses (``_others``): a
+stand-in for the positions robots broadcast in a real team.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from py_trees.common import Status
 
+from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
 from alica.skills.world_skill import WorldSkill, distance, world_cache
-from alica.worldsim.interface import RobotWorld
+from alica.worldmodel.protocol import WorldModelLike
+from alica.worldsim.interface import MobileRobot, RobotWorld
 
 if TYPE_CHECKING:
+    from alica.skills.mapping import LogOddsGrid
     from alica.skills.motion import FclChecker, GridChecker, PathFollower
     from alica.worldsim.grid import OccupancyGrid
 
 #: Replans (after being stuck or blocked) before MoveToPosition gives up.
 MAX_REPLANS = 5
+#: Simulated seconds between two reads of the team map by the driving skills (map mode).
+MAP_PERIOD = 1.0
+#: Metres beyond a robot's radius within which the team map's occupied cells count as that robot's body (map mode).
+BODY_MARGIN = 0.1
+#: Simulated seconds between two scans a driving robot adds to its layer of the team map (map mode).
+DRIVE_SCAN_PERIOD = 1.0
+#: Metres of lidar range a driving robot maps (map mode).
+DRIVE_SCAN_RANGE = 6.0
+#: Radius in metres of what the robot remembers it bumped into, just ahead of it (map mode).
+BUMP_RADIUS = 0.1
+#: Bumps remembered per drive (map mode).
+MAX_BUMPS = 8
 
 
-def planning_grid(world: RobotWorld) -> OccupancyGrid:
-    """The world's static obstacles as an occupancy grid (5 cm cells), built once per world layout."""
+def planning_grid(world: RobotWorld, world_model: WorldModelLike | None = None) -> OccupancyGrid:
+    """The grid the robot plans on: the team map when ``world_model`` holds one, else the world's obstacles.
+
+    Map mode (a team map in ``world_model``): the cells the team map shows
+    occupied are occupied, unknown and free cells are free (see :func:`map_planning`).
+    Known-map mode: the world's static obstacles (5 cm cells), built once per world layout.
+    """
+    nav = map_planning(world, world_model)
+    if nav is not None:
+        return nav.grid
+    return _known_grid(world)
+
+
+def _known_grid(world: RobotWorld) -> OccupancyGrid:
     from alica.worldsim.grid import OccupancyGrid
 
     cache = world_cache(world)
@@ -45,14 +94,18 @@ def planning_grid(world: RobotWorld) -> OccupancyGrid:
     return grid
 
 
-def exact_checker(world: RobotWorld, radius: float) -> FclChecker:
+def exact_checker(world: RobotWorld, radius: float, world_model: WorldModelLike | None = None) -> FclChecker | None:
     """FCL against the world's static obstacles (rocks as their convex meshes, tables) for a robot of ``radius``.
 
-    The final exact check of a path; movable objects (blocks, samples, held or not) are left to the grid.
+    The final exact check of a path in known-map mode; movable objects (blocks,
+    samples, held or not) are left to the grid. ``None`` in map mode (a team map
+    in ``world_model``): the robot knows the rocks only from its map.
     """
     from alica.skills.motion import FclChecker
 
-    planning_grid(world)  # drops stale checkers when the layout changed
+    if map_planning(world, world_model) is not None:
+        return None
+    _known_grid(world)  # drops stale checkers when the layout changed
     checkers = world_cache(world).setdefault("exact", {})
     checker: FclChecker | None = checkers.get(radius)
     if checker is None:
@@ -68,16 +121,134 @@ def exact_checker(world: RobotWorld, radius: float) -> FclChecker:
     return checker
 
 
-def planning_checker(world: RobotWorld, radius: float) -> GridChecker:
-    """The grid inflated for a robot of ``radius`` (a :class:`alica.skills.motion.GridChecker`), built once per radius."""
+def planning_checker(world: RobotWorld, radius: float, world_model: WorldModelLike | None = None) -> GridChecker:
+    """:func:`planning_grid` inflated for a robot of ``radius`` (a :class:`alica.skills.motion.GridChecker`).
+
+    Built once per radius and world layout (known-map mode), or kept up to date
+    tile by tile as the team map changes (map mode).
+    """
     from alica.skills.motion import GridChecker
 
-    grid = planning_grid(world)
+    nav = map_planning(world, world_model)
+    if nav is not None:
+        return nav.checker(radius)
+    grid = _known_grid(world)
     checkers = world_cache(world).setdefault("checkers", {})
     checker: GridChecker | None = checkers.get(radius)
     if checker is None:
         checker = checkers[radius] = GridChecker(grid, radius)
     return checker
+
+
+def robot_checker(world: RobotWorld, robot: MobileRobot, world_model: WorldModelLike | None = None) -> GridChecker:
+    """:func:`planning_checker` for ``robot``; in map mode without the cells of the robots' bodies.
+
+    A team map made with lidar shows the robots where teammates saw them. The
+    cells within :data:`BODY_MARGIN` of a robot's body are cleared around the
+    robot's pose estimate and the other robots' positions (the world's robot
+    poses, as ``MoveToPosition._others``), so that a robot can plan from where
+    it stands; the other robots are checked as robots.
+    """
+    radius = robot.spec.radius
+    checker = planning_checker(world, radius, world_model)
+    if map_planning(world, world_model) is None:
+        return checker
+    x, y, _ = robot.estimate
+    bodies = [(x, y, radius + BODY_MARGIN)]
+    bodies += [
+        (r.pose[0], r.pose[1], r.spec.radius + BODY_MARGIN) for _, r in sorted(world.robots.items()) if r is not robot
+    ]
+    return checker.with_cleared_disks(bodies)
+
+
+@dataclass
+class MapPlanning:
+    """The team map of one world-model replica as the driving skills plan on it (map mode).
+
+    Attributes:
+        source: the team map (:func:`alica.skills.mapping.team_map`) this was made from.
+        revision: the team map's revision it matches (:func:`alica.skills.mapping.team_map_changes`).
+        read_at: simulated time of the last read of the team map.
+        grid: occupied where the team map's cells are occupied, free elsewhere (unknown counts as free).
+        checkers: the grid inflated per robot radius, updated only in the tiles that changed.
+    """
+
+    source: LogOddsGrid
+    revision: int
+    read_at: float
+    grid: OccupancyGrid
+    checkers: dict[float, GridChecker] = field(default_factory=dict)
+
+    def checker(self, radius: float) -> GridChecker:
+        """The grid inflated for a robot of ``radius`` (unknown cells free)."""
+        from alica.skills.motion import GridChecker
+
+        checker = self.checkers.get(radius)
+        if checker is None:
+            checker = self.checkers[radius] = GridChecker(self.grid, radius, unknown_is_free=True)
+        return checker
+
+
+_MAP_PLANNING: weakref.WeakKeyDictionary[Any, MapPlanning] = weakref.WeakKeyDictionary()
+
+
+def _occupied_cells(source: LogOddsGrid, rows: slice = slice(None), cols: slice = slice(None)) -> np.ndarray:
+    from alica.skills.mapping.grid import THRESHOLD
+    from alica.worldsim.grid import FREE, OCCUPIED
+
+    return np.where(source.logodds[rows, cols] > THRESHOLD, OCCUPIED, FREE).astype(np.uint8)
+
+
+def map_planning(world: RobotWorld, world_model: WorldModelLike | None) -> MapPlanning | None:
+    """The team map in ``world_model`` as a planning grid, or ``None`` without a team map (known-map mode).
+
+    The team map is read at most every :data:`MAP_PERIOD` simulated seconds per
+    replica; only the tiles that changed since (the team map's tile revisions)
+    are thresholded and inflated again.
+    """
+    from alica.skills.mapping import TILE, team_map, team_map_changes, team_resolution
+    from alica.worldsim.grid import OccupancyGrid
+
+    if world_model is None or team_resolution(world_model) is None:
+        return None
+    try:
+        nav = _MAP_PLANNING.get(world_model)
+    except TypeError:  # not weakly referenceable: no cache
+        nav = None
+    now = world.now()
+    if nav is not None and 0.0 <= now - nav.read_at < MAP_PERIOD:
+        return nav
+    source = team_map(world_model)
+    if source is None:
+        return None
+    changes = team_map_changes(world_model, nav.revision if nav is not None else 0)
+    if nav is None or nav.source is not source or changes is None:
+        grid = OccupancyGrid(source.origin, source.resolution, source.nx, source.ny, _occupied_cells(source))
+        nav = MapPlanning(source, changes[0] if changes is not None else 0, now, grid)
+        try:
+            _MAP_PLANNING[world_model] = nav
+        except TypeError:
+            pass
+        return nav
+    revision, tiles = changes
+    nav.read_at = now
+    if revision == nav.revision:
+        return nav
+    cells = nav.grid.cells.copy()
+    windows: list[tuple[int, int, int, int]] = []
+    for tj, ti in zip(*np.nonzero(tiles), strict=True):
+        j0, i0 = int(tj) * TILE, int(ti) * TILE
+        j1, i1 = min(j0 + TILE, source.ny), min(i0 + TILE, source.nx)
+        fresh = _occupied_cells(source, slice(j0, j1), slice(i0, i1))
+        if not np.array_equal(fresh, cells[j0:j1, i0:i1]):
+            cells[j0:j1, i0:i1] = fresh
+            windows.append((j0, j1, i0, i1))
+    nav.revision = revision
+    if windows:
+        old = nav.grid
+        nav.grid = OccupancyGrid(old.origin, old.resolution, old.width, old.height, cells)
+        nav.checkers = {r: c.updated(nav.grid, windows) for r, c in nav.checkers.items()}
+    return nav
 
 
 #: Seconds to wait before planning again when another robot stands on the goal.
@@ -108,7 +279,22 @@ def drivable_goal(checker: GridChecker, goal: tuple[float, float], tolerance: fl
 
 
 class MoveToPosition(WorldSkill):
-    """Drive to ``goal`` within ``tolerance`` metres, or fail with a reason after ``timeout`` seconds."""
+    """Drive to ``goal`` within ``tolerance`` metres, or fail with a reason after ``timeout`` seconds.
+
+    Plans on the team map when the world model holds one (map mode), else on
+    the world's known layout (known-map mode); see the module docstring.
+
+    Attributes:
+        map_model: a world model whose team map to plan on when the skill's own
+            context has none (ExploreFrontier's inner drive, which writes no facts).
+    """
+
+    map_model: WorldModelLike | None = None
+
+    def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
+        super().__init__(name, params, context)
+        self.speed = 0.0
+        self.bumps: list[tuple[float, float]] = []
 
     def initialise(self) -> None:
         """Resolve the goal and start planning."""
@@ -125,9 +311,69 @@ class MoveToPosition(WorldSkill):
         self.reason = ""
         self.path_length = 0.0
         self.wait_until = 0.0
+        self.next_scan = self.started
+        self.speed = 0.0
+        self.bumps = []
         # a goal within an obstacle's clearance: drive to the nearest drivable point within the tolerance
-        self.target = drivable_goal(planning_checker(self.world, self.robot.spec.radius), self.goal, self.tolerance)
+        self.target = drivable_goal(self._checker(), self.goal, self.tolerance)
         self._plan(self.target or self.goal)
+
+    @property
+    def map_source(self) -> WorldModelLike | None:
+        """The world model whose team map the skill plans on (:attr:`map_model`, else its own), if any."""
+        return self.map_model if self.map_model is not None else self.world_model
+
+    def map_mode(self) -> bool:
+        """Whether the skill plans on a team map now (else on the world's known layout)."""
+        return map_planning(self.world, self.map_source) is not None
+
+    def _checker(self) -> GridChecker:
+        """The inflated grid to plan and check paths on.
+
+        In map mode without the robots' bodies' cells, and with what the robot
+        bumped into on this drive (:meth:`_remember_bump`).
+        """
+        checker = robot_checker(self.world, self.robot, self.map_source)
+        if self.bumps:
+            reach = checker.robot_radius + checker.margin + BUMP_RADIUS
+            checker = checker.with_blocked_disks(np.array(self.bumps), reach)
+        return checker
+
+    def _remember_bump(self) -> None:
+        """Map mode: remember an obstacle just ahead of where the robot drove when it bumped.
+
+        What the map does not show (a sample lying on the ground, a rock below
+        the lidar) stops the robot; a robot's bumper tells it, and the robot
+        plans around the spot and escapes away from it for the rest of this
+        drive. Bumps into another robot are not remembered (robots move).
+        """
+        if not self.map_mode() or abs(self.speed) < 1e-3:
+            return
+        x, y, yaw = self.robot.estimate
+        heading = yaw if self.speed > 0 else yaw + math.pi
+        reach = self.robot.spec.radius + BUMP_RADIUS
+        spot = (x + reach * math.cos(heading), y + reach * math.sin(heading))
+        if any(math.hypot(spot[0] - ox, spot[1] - oy) < r + BUMP_RADIUS for ox, oy, r in self._others()):
+            return
+        self.bumps = [*self.bumps[-(MAX_BUMPS - 1) :], spot]
+
+    def _grid(self) -> OccupancyGrid:
+        """The raw grid of :meth:`_checker` (for the search of free space)."""
+        return self._checker().grid
+
+    def _map_as_driving(self, now: float) -> None:
+        """Map mode: every :data:`DRIVE_SCAN_PERIOD` s a scan into the robot's layer of the team map."""
+        from alica.skills.mapping import map_scan, robot_mapper, team_resolution
+
+        wm = self.world_model
+        if wm is None or now < self.next_scan:
+            return
+        self.next_scan = now + DRIVE_SCAN_PERIOD
+        resolution = team_resolution(wm)
+        if resolution is None:
+            return
+        mapper = robot_mapper(self.context, self.robot.name, self.world.bounds, resolution)
+        map_scan(self.robot, mapper, max_range=min(DRIVE_SCAN_RANGE, self.robot.spec.lidar_range), now=now)
 
     def _others(self) -> list[tuple[float, float, float]]:
         return [
@@ -136,11 +382,17 @@ class MoveToPosition(WorldSkill):
             if r is not self.robot
         ]
 
+    def _replan(self) -> None:
+        """Plan again to the target; in map mode the drivable point near the goal is sought again (the map changed)."""
+        if self.map_mode():
+            self.target = drivable_goal(self._checker(), self.goal, self.tolerance)
+        self._plan(self.target or self.goal)
+
     def _plan(self, goal: tuple[float, float]) -> None:
         from alica.skills.motion import plan_path
 
-        checker = planning_checker(self.world, self.robot.spec.radius)
-        exact = exact_checker(self.world, self.robot.spec.radius)
+        checker = self._checker()
+        exact = exact_checker(self.world, self.robot.spec.radius, self.map_source)
         # An optimizing planner after the first path, when the run allows the time (real robots): anytime
         # planning by wall time is not repeatable, so simulated runs keep RRTConnect plus simplification.
         extra = self.context.extra if self.context is not None else {}
@@ -163,6 +415,7 @@ class MoveToPosition(WorldSkill):
         robot = self.robot
         now = self.now()
         dt, self.last = now - self.last, now
+        self._map_as_driving(now)
         here = (robot.estimate[0], robot.estimate[1])
         if not self.escaping and distance(here, self.goal) <= self.tolerance:
             robot.stop()
@@ -175,6 +428,8 @@ class MoveToPosition(WorldSkill):
             return self._poll_plan(now)
         v, w, done = self.follower.command(robot.estimate, dt)
         if robot.bumped or self.follower.stuck(robot.estimate, now):
+            if robot.bumped:
+                self._remember_bump()
             return self._stuck(now)
         if self._blocked():
             self.replans += 1
@@ -182,17 +437,18 @@ class MoveToPosition(WorldSkill):
                 robot.stop()
                 return self.fail(f"the path to {self.goal} stays blocked after {MAX_REPLANS} replans")
             robot.stop()
-            self._plan(self.target or self.goal)
+            self._replan()
             return self.running("path blocked by another robot or a new obstacle: replanning")
         if done:
             robot.stop()
             if self.escaping:
                 self.escaping = False
-                self._plan(self.target or self.goal)
+                self._replan()
                 return self.running("out of the tight spot: replanning")
-            self._plan(self.target or self.goal)  # the follower ended short of the goal: plan the rest
+            self._replan()  # the follower ended short of the goal: plan the rest
             return self.running("close to the goal: planning the last part")
         robot.drive(v, w)
+        self.speed = v
         return self.running(f"driving to {self.goal}")
 
     def _poll_plan(self, now: float) -> Status:
@@ -201,7 +457,7 @@ class MoveToPosition(WorldSkill):
         if self.job is None:
             if now < self.wait_until:
                 return self.running(f"waiting for another robot to clear the goal ({self.reason})")
-            self._plan(self.target or self.goal)
+            self._replan()
         job = self.job
         assert job is not None  # _plan submitted one
         if not job.done():
@@ -248,11 +504,11 @@ class MoveToPosition(WorldSkill):
             return self.fail(f"stuck on the way to {self.goal} after {MAX_REPLANS} escapes")
         # free space away from the other robots too: the robot it bumped into is often one of them
         spot = escape_goal(
-            planning_grid(self.world),
+            self._grid(),
             robot.estimate,
             clearance=robot.spec.radius + 0.3,
             max_distance=3.0,
-            other_robots=self._others(),
+            other_robots=self._others() + [(bx, by, BUMP_RADIUS) for bx, by in self.bumps],
             body_radius=robot.spec.radius,
         )
         if spot is None:
@@ -275,13 +531,16 @@ class MoveToPosition(WorldSkill):
         return self.running(f"stuck: driving into free space at ({spot[0]:.2f}, {spot[1]:.2f})")
 
     def _blocked(self) -> bool:
-        """Whether another robot or a new obstacle stands on the next metres of the path (checked every 0.3 s)."""
+        """Whether another robot or a new obstacle stands on the next metres of the path (checked every 0.3 s).
+
+        In map mode a new obstacle is one the team map shows now (read at most every :data:`MAP_PERIOD` s).
+        """
         follower = self.follower
         now = self.now()
         if follower is None or self.escaping or now < self.next_block_check:
             return False
         self.next_block_check = now + 0.3
-        checker = planning_checker(self.world, self.robot.spec.radius)  # rebuilt when the layout changed
+        checker = self._checker()  # rebuilt when the layout or the team map changed
         return bool(follower.blocked(checker, self.robot.estimate, other_robots=self._others(), horizon=4.0))
 
     def _arrived(self, here: tuple[float, float]) -> None:
@@ -312,6 +571,10 @@ class DriveToFreeSpace(MoveToPosition):
     (it got there first, or it is crashed there) the skill drives to the next
     free place instead of waiting for it to leave (up to ``MAX_REPLANS``
     times; then it waits as MoveToPosition does, until the timeout).
+
+    The free space is that of the grid MoveToPosition plans on (the team map
+    in map mode); the movable objects of ``keep_away`` are the world's (the
+    blocks world's known layout, where the skill is used).
     """
 
     def initialise(self) -> None:
@@ -328,7 +591,8 @@ class DriveToFreeSpace(MoveToPosition):
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
         away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
-        grid = planning_grid(self.world)
+        grid = self._grid()
+        # the work sites are the movable objects lying in the world (the blocks world's known layout)
         lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
         sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
         return escape_goal(
@@ -354,7 +618,7 @@ class DriveToFreeSpace(MoveToPosition):
                 self.spot = spot
                 self.params["goal"] = spot
                 self.goal = spot
-                self.target = drivable_goal(planning_checker(self.world, self.robot.spec.radius), spot, self.tolerance)
+                self.target = drivable_goal(self._checker(), spot, self.tolerance)
                 self.wait_until = 0.0
                 self._plan(self.target or spot)
                 return self.running(f"another robot took the free place: driving to ({spot[0]:.2f}, {spot[1]:.2f})")

@@ -158,8 +158,21 @@ class WorldSkill(py_trees.behaviour.Behaviour):
     def resolve_position(self, value: object) -> tuple[float, float]:
         """A goal as ``(x, y)``: a list of numbers, an object's name, or a term ``pos(name)``.
 
+        A name is looked up as ``pos(name)`` in the world model first. Without
+        it, what falls back to the world:
+
+        * the skill's own robot: its pose *estimate* (what the robot knows of itself);
+        * any object or robot of the world, when the world's layout counts as
+          known: no world model, or one without a team map (the blocks world,
+          a skill run alone, ``alica skill run``).
+
+        In a mission that maps (the world model holds a team map's frame:
+        :meth:`mapping_mission`), a name without ``pos(name)`` other than the
+        robot's own is an error: where things are comes from perception and the
+        mission's data, not from the simulator.
+
         Raises:
-            SkillError: the value names nothing in the world.
+            SkillError: the value names nothing the skill can locate.
         """
         if isinstance(value, (tuple, list)) and len(value) >= 2 and all(isinstance(v, (int, float)) for v in value[:2]):
             return float(value[0]), float(value[1])
@@ -170,6 +183,14 @@ class WorldSkill(py_trees.behaviour.Behaviour):
             known = wm.lookup("pos", (name,)) if wm is not None else None
             if isinstance(known, (tuple, list)) and len(known) >= 2:
                 return float(known[0]), float(known[1])
+            if self._robot is not None and name == self._robot.name:
+                x, y, _ = self._robot.estimate
+                return float(x), float(y)
+            if self.mapping_mission():
+                raise SkillError(
+                    f"skill '{self.name}': the world model has no pos({name}) (in a mission that maps, positions "
+                    "come from perception)"
+                )
             obj = self.world.objects.get(name)
             if obj is not None:
                 position = obj.position()
@@ -181,6 +202,12 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         raise SkillError(
             f"skill '{self.name}': cannot tell where {value!r} is (give [x, y], an object's name or pos(name))"
         )
+
+    def mapping_mission(self) -> bool:
+        """Whether the skill's world model holds a team map (the robots map; the world's layout is not known)."""
+        from alica.skills.mapping.sharing import team_resolution
+
+        return team_resolution(self.world_model) is not None
 
     def object_named(self, value: object) -> WorldThing:
         """The world object called ``value``.

@@ -308,6 +308,7 @@ class ExploreFrontier(WorldSkill):
             {"goal": [goal[0], goal[1]], "tolerance": self.tolerance, "timeout": DRIVE_TIMEOUT},
             context,
         )
+        inner.map_model = self.world_model  # it plans on the team map, though it writes no facts
         inner.setup(context=context)
         return inner
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from alica.skills.mapping.grid import FREE, OCCUPIED, TILE, UNKNOWN, LogOddsGrid
 from alica.skills.mapping.matching import Match, match_scan
-from alica.skills.mapping.sharing import RobotMapper, team_map, team_resolution
+from alica.skills.mapping.sharing import RobotMapper, team_map, team_map_changes, team_resolution
 from alica.skills.mapping.skills import MAPPER_KEY, BuildMap, Localize, lidar, map_scan, rays_for, robot_mapper
 
 __all__ = [
@@ -32,5 +32,6 @@ __all__ = [
     "rays_for",
     "robot_mapper",
     "team_map",
+    "team_map_changes",
     "team_resolution",
 ]

@@ -55,6 +55,7 @@ __all__ = [
     "decode_tile",
     "encode_tile",
     "team_map",
+    "team_map_changes",
     "team_resolution",
 ]
 
@@ -321,6 +322,8 @@ class _Merged:
     grid: LogOddsGrid
     seen: dict[tuple[str, int, int], tuple[int, np.ndarray]] = field(default_factory=dict)
     masks: dict[str, tuple[str, np.ndarray]] = field(default_factory=dict)
+    revision: int = 0
+    tile_revisions: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
 
 
 _MERGED: weakref.WeakKeyDictionary[Any, _Merged] = weakref.WeakKeyDictionary()
@@ -351,6 +354,7 @@ def team_map(world_model: WorldModelLike | None) -> LogOddsGrid | None:
         res, x0, y0, nx, ny = frame
         grid = LogOddsGrid((x0, y0), res, nx, ny)
         merged = _Merged(frame, np.zeros(grid.logodds.shape, dtype=np.int32), grid)
+        merged.tile_revisions = np.zeros(grid.tile_shape, dtype=np.int64)
         try:
             _MERGED[world_model] = merged
         except TypeError:
@@ -360,6 +364,27 @@ def team_map(world_model: WorldModelLike | None) -> LogOddsGrid | None:
         for tj, ti, value in _tiles_of(world_model, robot, grid, merged.masks):
             _merge_tile(merged, (robot, tj, ti), value)
     return grid
+
+
+def team_map_changes(world_model: WorldModelLike | None, since: int) -> tuple[int, np.ndarray] | None:
+    """What changed in :func:`team_map`'s cached grid of ``world_model`` since its revision ``since``.
+
+    Returns ``(revision, tiles)``: the grid's revision now (it grows by one with
+    every tile merged into it) and a boolean ``tile_shape`` mask of the tiles
+    merged after revision ``since``. ``None`` when the replica keeps no cached
+    grid (no map yet, or a world model that cannot be weakly referenced): then
+    every :func:`team_map` call gives a new grid. Call :func:`team_map` first;
+    this only reads its cache.
+    """
+    if world_model is None:
+        return None
+    try:
+        merged = _MERGED.get(world_model)
+    except TypeError:
+        return None
+    if merged is None:
+        return None
+    return merged.revision, merged.tile_revisions > since
 
 
 def _merge_tile(merged: _Merged, key: tuple[str, int, int], value: tuple[object, ...]) -> None:
@@ -379,4 +404,6 @@ def _merge_tile(merged: _Merged, key: tuple[str, int, int], value: tuple[object,
         window -= old[1]
     window += tile
     merged.seen[key] = (int(value[0]), tile)  # type: ignore[call-overload]
+    merged.revision += 1
+    merged.tile_revisions[key[1], key[2]] = merged.revision
     grid.logodds[rows, cols] = np.clip(window * np.float32(QUANTUM), L_MIN, L_MAX)

@@ -20,7 +20,7 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from ompl import base as ob
 
-from alica.worldsim.grid import OCCUPIED, UNKNOWN, OccupancyGrid
+from alica.worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 __all__ = ["GridChecker", "Robot", "SegmentValidator", "check_robots", "default_margin", "densify"]
 
@@ -170,6 +170,86 @@ class GridChecker:
         twin = self.with_robots(self.robots)
         twin._set_blocked(blocked)
         return twin
+
+    def updated(self, grid: OccupancyGrid, windows: Iterable[tuple[int, int, int, int]]) -> GridChecker:
+        """A checker for ``grid``, which differs from this checker's grid only inside ``windows``.
+
+        ``windows`` are cell ranges ``(j0, j1, i0, i1)`` (rows ``j0:j1``, columns
+        ``i0:i1``); only they are inflated again (from ``grid``'s cells around them),
+        so a map that changed in a few tiles costs a few small inflations, not a whole
+        one. The result equals ``GridChecker(grid, ...)`` with this checker's radius,
+        margin, unknown handling and other robots. This checker is left unchanged.
+
+        Raises:
+            ValueError: ``grid`` has another frame (origin, resolution or size).
+        """
+        g = self.grid
+        if (grid.origin, grid.resolution, grid.width, grid.height) != (g.origin, g.resolution, g.width, g.height):
+            raise ValueError("updated() needs a grid of the same origin, resolution and size")
+        blocked = self._blocked.copy()
+        k = self._reach_cells()  # a changed cell changes the blocked cells up to k cells around it
+        for j0, j1, i0, i1 in windows:
+            self._inflate_window(grid, blocked, j0 - k, j1 + k, i0 - k, i1 + k)
+        twin = self.with_robots(self.robots)
+        twin.grid = grid
+        twin._set_blocked(blocked)
+        return twin
+
+    def with_cleared_disks(self, disks: Iterable[Sequence[float]]) -> GridChecker:
+        """A checker as if no cell whose centre lies within a disk ``(x, y, radius)`` were occupied.
+
+        For a map made with lidar, where the robots' own bodies show as occupied
+        cells: clearing them (the robots are checked as robots instead) lets a
+        robot plan from where it stands. The returned checker's ``grid`` is the
+        cleared raw grid; only the cells around the disks are inflated again.
+        """
+        g = self.grid
+        cells: np.ndarray | None = None
+        windows: list[tuple[int, int, int, int]] = []
+        res = g.resolution
+        for x, y, r in check_robots(disks):
+            i, j = g.world_to_cell(x, y)
+            k = math.ceil(r / res) + 1
+            i0, i1 = max(0, i - k), min(g.width, i + k + 1)
+            j0, j1 = max(0, j - k), min(g.height, j + k + 1)
+            if i0 >= i1 or j0 >= j1:
+                continue
+            cx = g.origin[0] + (np.arange(i0, i1) + 0.5) * res
+            cy = g.origin[1] + (np.arange(j0, j1) + 0.5) * res
+            inside = (cx[None, :] - x) ** 2 + (cy[:, None] - y) ** 2 <= r * r
+            source = g.cells if cells is None else cells
+            window = source[j0:j1, i0:i1]
+            hit = inside & (window == OCCUPIED)
+            if not hit.any():
+                continue
+            if cells is None:
+                cells = g.cells.copy()
+            cells[j0:j1, i0:i1][hit] = FREE
+            windows.append((j0, j1, i0, i1))
+        if cells is None:
+            return self
+        return self.updated(OccupancyGrid(g.origin, g.resolution, g.width, g.height, cells), windows)
+
+    def _reach_cells(self) -> int:
+        """Cells around an occupied cell that its inflation can block (and one more)."""
+        return math.floor((self.robot_radius + self.margin) / self.grid.resolution + 1e-9) + 1
+
+    def _inflate_window(self, grid: OccupancyGrid, blocked: np.ndarray, j0: int, j1: int, i0: int, i1: int) -> None:
+        """Set ``blocked[j0:j1, i0:i1]`` from ``grid``'s cells around it, as the whole grid's inflation would."""
+        radius = self.robot_radius + self.margin
+        k = self._reach_cells()
+        j0, j1 = max(0, j0), min(grid.height, j1)
+        i0, i1 = max(0, i0), min(grid.width, i1)
+        if j0 >= j1 or i0 >= i1:
+            return
+        a0, a1 = max(0, j0 - k), min(grid.height, j1 + k)
+        b0, b1 = max(0, i0 - k), min(grid.width, i1 + k)
+        local = OccupancyGrid(grid.origin, grid.resolution, b1 - b0, a1 - a0, grid.cells[a0:a1, b0:b1])
+        inflated = local.inflate(radius).cells[j0 - a0 : j1 - a0, i0 - b0 : i1 - b0]
+        part = inflated == OCCUPIED
+        if not self.unknown_is_free:
+            part |= inflated == UNKNOWN
+        blocked[j0:j1, i0:i1] = part
 
     # --------------------------------------------------------------- states
     def __call__(self, state: ob.State) -> bool:

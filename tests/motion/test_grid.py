@@ -125,3 +125,38 @@ def test_bad_arguments() -> None:
     with pytest.raises(ValueError, match="kind"):
         Obstacle2D("cone", 0, 0, radius=1)
     assert OccupancyGrid.from_obstacles([], (0, 0, 1, 0.5), 0.1).cells.shape == (5, 10)
+
+
+def test_checker_updated_in_windows_equals_a_new_checker() -> None:
+    from alica.skills.motion import GridChecker
+
+    rng = np.random.default_rng(1)
+    cells = (rng.random((300, 400)) < 0.01).astype(np.uint8)
+    cells[rng.random((300, 400)) < 0.05] = 255  # unknown
+    grid = OccupancyGrid((-3.0, 2.0), 0.05, 400, 300, cells)
+    for unknown_is_free in (True, False):
+        checker = GridChecker(grid, 0.3, unknown_is_free=unknown_is_free)
+        changed = cells.copy()
+        windows = [(32, 64, 64, 96), (0, 32, 0, 32), (288, 300, 384, 400)]
+        for j0, j1, i0, i1 in windows:
+            changed[j0:j1, i0:i1] = rng.random((j1 - j0, i1 - i0)) < 0.02
+        new = OccupancyGrid(grid.origin, grid.resolution, grid.width, grid.height, changed)
+        updated = checker.updated(new, windows)
+        assert updated.grid is new
+        assert np.array_equal(updated.blocked, GridChecker(new, 0.3, unknown_is_free=unknown_is_free).blocked)
+        assert np.array_equal(checker.blocked, GridChecker(grid, 0.3, unknown_is_free=unknown_is_free).blocked)
+
+
+def test_checker_with_cleared_disks_forgets_the_cells_in_them() -> None:
+    from alica.skills.motion import GridChecker
+
+    # a robot's body as a teammate's lidar maps it: a ring of occupied cells around where it stands
+    grid = OccupancyGrid.from_obstacles([Obstacle2D("circle", 2.0, 2.0, radius=0.3)], (0.0, 0.0, 6.0, 4.0), 0.05)
+    grid.add_obstacles([Obstacle2D("circle", 4.5, 2.0, radius=0.3)])
+    checker = GridChecker(grid, 0.3)
+    assert not checker.valid_xy(2.0, 2.0)
+    cleared = checker.with_cleared_disks([(2.0, 2.0, 0.4)])
+    assert cleared.valid_xy(2.0, 2.0) and not cleared.valid_xy(4.5, 2.0)  # the other obstacle stays
+    assert np.array_equal(cleared.blocked, GridChecker(cleared.grid, 0.3).blocked)
+    assert not checker.valid_xy(2.0, 2.0)  # the checker itself is unchanged
+    assert checker.with_cleared_disks([(1.0, 1.0, 0.2)]) is checker  # nothing to clear
