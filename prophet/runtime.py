@@ -83,6 +83,12 @@ SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareSt
 #: A step that fails this many times for the same reason while the world stays the same fails the problem
 #: (the team runs the AlternativePlan): planning the same plan again would fail the same way for ever.
 GIVE_UP_AFTER = 3
+#: A step that fails this many times for the same reason fails the problem whatever the world does meanwhile
+#: (a robot that moves a little on every new plan changes the world, but not what makes the step fail).
+GIVE_UP_ANYWAY_AFTER = 2 * GIVE_UP_AFTER
+#: Simulated seconds the leader waits, when no plan exists with the robots in the team while robots outside
+#: it are named in the world (teammates cut off by a partition, or crashed), before the problem fails.
+TEAM_WAIT = 30.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -154,6 +160,9 @@ class ProblemRuntime:
         self.blocked: set[Fact] | None = None
         self.predicates: dict[str, tuple[str, ...]] | None = None
         self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
+        self.step_failures_any: dict[str, int] = {}
+        self.team_wait_until: float | None = None
+        """While no plan exists without robots outside the team: when the leader stops waiting for them."""
         self.overrides = dict(host.override(self.model.name))
         now = host.now()
         # a share received lately is current (the leader repeats it every UpdateTime); an older one is stale
@@ -406,6 +415,9 @@ class ProblemRuntime:
             if now >= self.next_update and set(self._read_world(self.problem).facts) != self.blocked:
                 self.blocked = None
                 self._start_search(now, "the world changed while planning was blocked")
+            elif self.team_wait_until is not None and now >= self.team_wait_until:
+                self.blocked = None
+                self._start_search(now, f"waited {TEAM_WAIT:g} s for the robots outside the team")
         elif (
             share is None
             or share.status == SEARCHING
@@ -439,9 +451,15 @@ class ProblemRuntime:
         generation = self._next_generation()
         same = (reason.split(": ", 1)[-1], frozenset(self._read_world(self.problem).facts))
         self.step_failures[same] = count = self.step_failures.get(same, 0) + 1
-        if count >= GIVE_UP_AFTER:
+        self.step_failures_any[same[0]] = total = self.step_failures_any.get(same[0], 0) + 1
+        if count >= GIVE_UP_AFTER or total >= GIVE_UP_ANYWAY_AFTER:
             self.step_failures.clear()
-            message = f"gave up: the same step failed {count} times while the world stayed the same: {same[0]}"
+            self.step_failures_any.clear()
+            message = (
+                f"gave up: the same step failed {count} times while the world stayed the same: {same[0]}"
+                if count >= GIVE_UP_AFTER
+                else f"gave up: the same step failed {total} times: {same[0]}"
+            )
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=message)
             self._publish_failure(now, generation, message)
             return
@@ -525,6 +543,23 @@ class ProblemRuntime:
             now,
         )
         self.next_update = now + self.model.update_time
+
+    def _wait_for_team(self, now: float, world: PlanningWorld, status: PlanStatus) -> bool:
+        """Whether to wait for robots outside the team (a partition heals, a crashed robot restarts) before failing.
+
+        The wait starts with the first unsolvable search while the world names robots outside the
+        team, lasts :data:`TEAM_WAIT` seconds, and ends early when the world changes (the leader
+        plans again); a plan found ends it.
+        """
+        if status is not PlanStatus.UNSOLVABLE or not world.others:
+            self.team_wait_until = None
+            return False
+        if self.team_wait_until is None:
+            self.team_wait_until = now + TEAM_WAIT
+        if now < self.team_wait_until:
+            return True
+        self.team_wait_until = None  # waited long enough: the problem fails
+        return False
 
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
         """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
@@ -638,6 +673,13 @@ class ProblemRuntime:
                     )
                     self._wait_for_world(now, search.world, search.generation, reason)
                     return
+                if self._wait_for_team(now, search.world, finished.status):
+                    reason = (
+                        f"{message} with the robots in the team ({', '.join(search.world.robots)}); waiting up to "
+                        f"{TEAM_WAIT:g} s for those outside it ({', '.join(search.world.others)}): they may be back"
+                    )
+                    self._wait_for_world(now, search.world, search.generation, reason)
+                    return
                 self._publish_failure(now, search.generation, message)
             return
         if search.shared_cost is None:
@@ -667,6 +709,7 @@ class ProblemRuntime:
 
     def _share_plan(self, now: float, search: _Search, plan: ValidPlan) -> None:
         steps = plan.steps
+        self.team_wait_until = None
         search.version += 1
         search.shared_cost = plan.plan.cost  # the cost as the planner gave it (the trace shows it)
         self.host.emit(

@@ -37,6 +37,8 @@ class StepCounter:
         self.plans: set[tuple[str, int]] = set()
         self.replans = 0
         self.plan_length = 0
+        self.gave_up = ""
+        """Why the problem last failed (the team ran its AlternativePlan), if it did."""
 
     def __call__(self, event: dict[str, Any]) -> None:
         kind = event["event"]
@@ -62,6 +64,8 @@ class StepCounter:
         elif kind == "planner" and event.get("what") == "plan":
             self.plans.add((key, int(event.get("generation", 0))))
             self.plan_length = int(event.get("steps", 0))
+        elif kind == "problem" and event.get("phase") == "alternative" and event.get("reason"):
+            self.gave_up = str(event["reason"])
 
     def _carried_out(self, agent: str, step: _Step) -> None:
         self.steps[agent] = self.steps.get(agent, 0) + 1

@@ -366,7 +366,7 @@ def run_lunar(
         operator = run.operator
         delivered = run.delivered()
         success = bool(operator.chosen) and len(delivered) == len(operator.chosen)
-        reason = "" if success else (operator.reason or run.why_not())
+        reason = "" if success else (operator.reason or run.why_not(counter))
         return LunarResult(
             success=success,
             reason=reason,
@@ -598,14 +598,15 @@ class _Run:
             "replans": counter.replans,
         }
 
-    def why_not(self) -> str:
+    def why_not(self, counter: StepCounter) -> str:
         operator = self.operator
         if not operator.chosen:
             return f"no choice within {self.config.time_limit:g} s: found {', '.join(operator.order) or 'nothing'}"
         missing = [s for s in operator.chosen if s not in self.delivered()]
         if self.world.now() >= self.config.time_limit:
             return f"time limit: {', '.join(missing)} not at {BASE} after {self.config.time_limit:g} s"
-        return f"the mission ended with {', '.join(missing)} not at {BASE}"
+        ended = f"the mission ended with {', '.join(missing)} not at {BASE}"
+        return f"{ended}; GetObjects failed ({counter.gave_up}) and the team ran ReturnToBase" if counter.gave_up else ended
 
 
 def _held_name(robot: Any) -> str | None:
