@@ -606,7 +606,11 @@ class _Run:
         if self.world.now() >= self.config.time_limit:
             return f"time limit: {', '.join(missing)} not at {BASE} after {self.config.time_limit:g} s"
         ended = f"the mission ended with {', '.join(missing)} not at {BASE}"
-        return f"{ended}; GetObjects failed ({counter.gave_up}) and the team ran ReturnToBase" if counter.gave_up else ended
+        return (
+            f"{ended}; GetObjects failed ({counter.gave_up}) and the team ran ReturnToBase"
+            if counter.gave_up
+            else ended
+        )
 
 
 def _held_name(robot: Any) -> str | None:
