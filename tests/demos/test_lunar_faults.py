@@ -166,6 +166,12 @@ def test_a_20_s_partition_while_exploring_heals_and_the_replicas_converge(tmp_pa
     back = [e for e in _events(trace, "team") if e["change"] == "back" and e["t"] >= end]
     assert {e["agent"] for e in lost} == {"scout", "stummel", "amparo"}
     assert {e["agent"] for e in back} == {"scout", "stummel", "amparo"}
+    # nobody gave up: a side that cannot plan alone (Scout has no arm) waits for the others to be back
+    assert not [e for e in _events(trace, "problem") if e.get("phase") == "alternative"]
+    alone = [e for e in _events(trace, "planner") if e.get("what") == "done" and e.get("status") == "unsolvable"]
+    waited = [e for e in _events(trace, "planner") if e.get("what") == "waiting"]
+    assert all(e["agent"] == "scout" and start <= e["t"] <= end for e in alone), alone
+    assert not alone or any("waiting up to 30 s for those outside it" in e["reason"] for e in waited), waited
     # after the heal every replica holds every sample found, and the same team map
     replicas = result["replicas"]
     found = sorted(result["found"])
