@@ -83,8 +83,9 @@ SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareSt
 #: A step that fails this many times for the same reason while the world stays the same fails the problem
 #: (the team runs the AlternativePlan): planning the same plan again would fail the same way for ever.
 GIVE_UP_AFTER = 3
-#: A step that fails this many times for the same reason fails the problem whatever the world does meanwhile
-#: (a robot that moves a little on every new plan changes the world, but not what makes the step fail).
+#: A step that fails this many times for the same reason, with no step of the team carried out in between,
+#: fails the problem whatever the world does meanwhile (a robot that moves a little on every new plan
+#: changes the world, but not what makes the step fail).
 GIVE_UP_ANYWAY_AFTER = 2 * GIVE_UP_AFTER
 #: Simulated seconds the leader waits, when no plan exists with the robots in the team while robots outside
 #: it are named in the world (teammates cut off by a partition, or crashed), before the problem fails.
@@ -161,6 +162,7 @@ class ProblemRuntime:
         self.predicates: dict[str, tuple[str, ...]] | None = None
         self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
         self.step_failures_any: dict[str, int] = {}
+        self.steps_done = 0
         self.team_wait_until: float | None = None
         """While no plan exists without robots outside the team: when the leader stops waiting for them."""
         self.overrides = dict(host.override(self.model.name))
@@ -440,7 +442,8 @@ class ProblemRuntime:
         """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step).
 
         A failed step (``settle``) that failed :data:`GIVE_UP_AFTER` times for the same reason in the
-        same world fails the problem instead: the team runs the AlternativePlan.
+        same world, or :data:`GIVE_UP_ANYWAY_AFTER` times with no step carried out in between, fails
+        the problem instead: the team runs the AlternativePlan.
         """
         self.host.counters["replans"] += 1
         self.host.emit("replan", key=key_text(self.key), reason=reason)
@@ -451,6 +454,10 @@ class ProblemRuntime:
         generation = self._next_generation()
         same = (reason.split(": ", 1)[-1], frozenset(self._read_world(self.problem).facts))
         self.step_failures[same] = count = self.step_failures.get(same, 0) + 1
+        done = sum(1 for fact in self.host.world.facts() if fact.predicate == STEP_DONE)
+        if done != self.steps_done:  # a step was carried out since the last failure: count afresh
+            self.steps_done = done
+            self.step_failures_any.clear()
         self.step_failures_any[same[0]] = total = self.step_failures_any.get(same[0], 0) + 1
         if count >= GIVE_UP_AFTER or total >= GIVE_UP_ANYWAY_AFTER:
             self.step_failures.clear()
