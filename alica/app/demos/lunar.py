@@ -355,7 +355,7 @@ def run_lunar(
             out.mkdir(parents=True, exist_ok=True)
             from alica.app.demos.lunar_map import draw_map
 
-            draw_map(world, run.team_map(), run.operator, run.tracks, run.crash_places, out / "map.png")
+            draw_map(world, run.team_map(), run.operator, run.tracks, run.crash_places, out / "map.png", run.targets)
             if plan_yaml:
                 (out / "plan.yaml").write_text(plan_yaml, encoding="utf-8")
                 folder = out / "plans"

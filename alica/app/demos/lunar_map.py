@@ -19,6 +19,7 @@ def draw_map(
     tracks: Mapping[str, Sequence[tuple[float, float]]],
     crashes: Mapping[str, tuple[float, float]],
     path: Path,
+    bodies: Mapping[str, str] | None = None,
 ) -> None:
     """Write a PNG of the run to ``path``.
 
@@ -29,6 +30,8 @@ def draw_map(
     Args:
         world: the lunar world (ground truth, drawn for comparison).
         grid: the team map (``LogOddsGrid``), or None when nobody mapped.
+        bodies: found name -> the world's sample it is, where known (the chosen ones: they move); the
+            others are matched by kind and place.
         operator: the demo's operator (found samples, their places, the chosen ones).
         tracks: each robot's positions, one per simulated second.
         crashes: where robots crashed.
@@ -51,6 +54,7 @@ def draw_map(
     else:
         ax.set_facecolor((0.75, 0.75, 0.75))
     found_at = dict(operator.places)
+    named = dict(bodies or {})
     labelled: list[tuple[float, float]] = []  # sample labels so far: close ones are stacked, not overprinted
     for obj in world.objects.values():
         x, y = obj.position()[:2]
@@ -58,7 +62,12 @@ def draw_map(
             ax.add_patch(Circle((x, y), obj.radius, fill=False, edgecolor="tab:red", linewidth=0.5))
         elif obj.kind == "sample":
             ax.plot(x, y, marker="o", markersize=5, color="tab:purple")
-            near = [n for n, p in found_at.items() if np.hypot(p[0] - x, p[1] - y) < 0.5]
+            # the chosen samples by their bodies (they moved); the others by kind, found nearest
+            off = {n: float(np.hypot(p[0] - x, p[1] - y)) for n, p in found_at.items() if n not in named}
+            near = [n for n, body in named.items() if body == obj.name] or sorted(
+                (n for n, d in off.items() if d < 0.5 and operator.found.get(n, "") in (obj.sample_kind, "")),
+                key=off.__getitem__,
+            )
             label = obj.sample_kind + (f"\nfound as {near[0]}" if near else "\nnot found")
             weight = "bold" if near and near[0] in operator.chosen else "normal"
             below = sum(1 for p in labelled if np.hypot(p[0] - x, p[1] - y) < 1.5)
