@@ -135,6 +135,33 @@ def test_amparo_crashes_while_driving_to_its_sample_and_stummel_takes_its_transp
     assert not [e for e in trace if e["agent"] == "amparo" and e["t"] > crash_at and e["event"] != "fault"]
 
 
+def test_amparo_crashes_after_a_grasp_and_the_team_finds_the_fallen_sample_again(tmp_path):
+    # where the paper's plan failed: Amparo lifts a sample, loses power, its gripper opens and the sample falls
+    result = run_lunar_cli(tmp_path, "--crash", "amparo@grasp", seed=3)
+    _assert_delivered(result)
+    assert result["crashed"] == ["amparo"]
+    trace = read_trace(tmp_path)
+    crash_at = next(e["t"] for e in _events(trace, "fault", "amparo"))
+    # Amparo had grasped (the grasp succeeded) and was lifting when it crashed
+    grasps = [e for e in _events(trace, "behaviour", "amparo") if e["behaviour"] == "GraspSample"]
+    assert grasps and grasps[-1]["status"] == "success" and grasps[-1]["t"] <= crash_at
+    # the Verify robot drove to the dropped sample and verified it again, after the crash
+    searched = [
+        e
+        for e in _events(trace, "behaviour")
+        if e["behaviour"] == "GoToDroppedSample" and e["status"] == "success" and e["t"] > crash_at
+    ]
+    assert searched, "nobody drove to the dropped sample"
+    seen_again = [
+        e
+        for e in _events(trace, "behaviour", searched[0]["agent"])
+        if e["behaviour"] == "ClassifyDrillSample" and e["status"] == "success" and e["t"] > searched[0]["t"]
+    ]
+    assert seen_again and "LookThere" in seen_again[0]["key"]
+    # and Stummel brought both in
+    assert result["robots"]["stummel"]["steps"] >= 6, _explain(result)
+
+
 # -- 3. 30 % message loss -------------------------------------------------------------
 
 
