@@ -62,6 +62,7 @@ from alica.prophet.tasks import (
     STEP_DONE,
     CreatedTasks,
     Literal,
+    Step,
     StepKind,
     conjunction,
     create_tasks,
@@ -157,6 +158,8 @@ class ProblemRuntime:
         self.invalid_once = False
         self.request: ReplanRequest | None = None
         self.marked: set[str] = set()
+        self.effected: set[str] = set()
+        """Steps under way whose effect was written early (their skills had written its positive part)."""
         self.pending: tuple[float, str] | None = None
         self.blocked: set[Fact] | None = None
         self.predicates: dict[str, tuple[str, ...]] | None = None
@@ -288,6 +291,7 @@ class ProblemRuntime:
         plan executor applies an action's effects when it completes: the skills write what they sense
         (``holding``, ``onground``), but a fact of the planning domain that no skill writes (the robot's
         ``at`` a sample it has picked up, deleted by Pickup) would otherwise keep a stale value.
+        A step under way whose effect's positive part holds already is treated alike, once.
         """
         node, created = self.slot.node, self.created
         if node is None or created is None or node.plan is not created.plan or node.ep is None:
@@ -301,10 +305,28 @@ class ProblemRuntime:
             token = step_token(created.plan.name, step.index)
             if token not in self.marked:
                 self.marked.add(token)
-                effect = for_robot(step.effect, step.robot, me)
-                for positive, fact in sorted(effect, key=lambda literal: literal[0]):  # deletes first
-                    (world.assert_fact if positive else world.retract_fact)(fact.predicate, *fact.args)
+                if token not in self.effected:
+                    self._write_effect(step, me)
                 world.assert_fact(STEP_DONE, token)
+        if place.kind is StepKind.RUN and place.step < len(created.tasks[place.task]):
+            # a step under way whose effects the skills wrote already (the grasp is done, the lift is not)
+            # has done its work: its whole effect is written now, so that a replan before it ends (a
+            # teammate's step failed) does not plan from a robot still 'at' the sample it holds
+            step = created.tasks[place.task][place.step]
+            token = step_token(created.plan.name, step.index)
+            if token not in self.effected:
+                effect = for_robot(step.effect, step.robot, me)
+                now_true = {Fact(f.predicate, tuple(str(a) for a in f.args)) for f in world.facts()}
+                if all(fact in now_true for positive, fact in effect if positive):
+                    self.effected.add(token)
+                    self._write_effect(step, me)
+
+    def _write_effect(self, step: Step, me: str) -> None:
+        """Write a step's effect for this agent to the world model (deletes first)."""
+        world = self.host.world
+        effect = for_robot(step.effect, step.robot, me)
+        for positive, fact in sorted(effect, key=lambda literal: literal[0]):
+            (world.assert_fact if positive else world.retract_fact)(fact.predicate, *fact.args)
 
     def stop(self) -> None:
         """The agent leaves the state: stop planning, forget the generated plan."""
