@@ -28,6 +28,11 @@ outside. A plan for part of the goal runs to its end; then the leader plans
 for what is left, or, with nothing left to plan for, the team waits in the
 WaitPlan until the world changes.
 
+When no plan exists with the robots in the team while the world names
+robots outside it (teammates cut off by a partition, say), the leader waits
+up to :data:`TEAM_WAIT` seconds for them, and plans again as soon as the
+world changes, before the problem fails.
+
 Every UpdateTime it repeats its latest share (for agents that come late) and,
 while the team executes, checks that what is left of the plan still reaches
 the goal from the current world (:func:`alica.prophet.world.remaining_fits`); twice

@@ -5,15 +5,16 @@ do), so a sample it held falls where it stood. Its teammates cannot know
 where exactly, and its last fact, ``holding(r, s)``, says otherwise; the
 planner leaves out a sample a robot outside the team holds. Someone has to
 look: this skill drives a teammate near where the sample was last seen
-(``pos(s)``), and the perception that runs next (Verify2DObject,
-SemanticPerception) finds it again. A detection of a sample standing on the
+(``pos(s)``), and the perception that runs next (Verify2DObject in the
+lunar mission's WaitForPlan) finds it again. A detection of a sample standing on the
 ground retracts ``holding(r, s)`` (:func:`alica.skills.sample_facts.seen_on_the_ground`),
 and the planner plans with it again.
 
 A teammate counts as lost when the agent's team view says it is not alive
 (``alive(r)``, the engine's belief). Held samples of robots that are
 merely cut off (a partition) count as dropped too: the look finds nothing
-where they were seen, and the skill fails with that reason.
+where they were seen, the plan gives up after a while (WaitForPlan's
+NothingThere) and nothing is retracted.
 """
 
 from __future__ import annotations
