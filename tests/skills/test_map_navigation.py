@@ -24,16 +24,6 @@ def _team_map_model(world, robot, edit=None):
     return wm
 
 
-def _free_goal(world, robot, distance=8.0):
-    x, y, _ = world.robots[robot].pose
-    for angle in [i * math.pi / 8 for i in range(16)]:
-        gx, gy = x + distance * math.cos(angle), y + distance * math.sin(angle)
-        xmin, ymin, xmax, ymax = world.bounds
-        if xmin + 1 < gx < xmax - 1 and ymin + 1 < gy < ymax - 1 and world.is_free(gx, gy, 0.6):
-            return gx, gy
-    raise AssertionError("no free goal")
-
-
 def _recorder(robot):
     paths, bumps = [], []
 
@@ -55,9 +45,9 @@ def _distance_to_path(path, point):
     return float(np.min(np.hypot(pts[:, 0] - point[0], pts[:, 1] - point[1])))
 
 
-def test_a_rock_the_map_does_not_show_is_planned_through_then_replanned_around(lunar_world, skill_run):
+def test_a_rock_the_map_does_not_show_is_planned_through_then_replanned_around(lunar_world, skill_run, free_goal):
     world, robot = lunar_world, lunar_world.robots["scout"]
-    goal = _free_goal(world, "scout")
+    goal = free_goal(world, "scout")
     x, y, _ = robot.pose
     rock = (x + 0.5 * (goal[0] - x), y + 0.5 * (goal[1] - y))
     world.add_rock("unmapped", (rock[0], rock[1], 0.0), 0.5)
@@ -71,9 +61,9 @@ def test_a_rock_the_map_does_not_show_is_planned_through_then_replanned_around(l
     assert not bumps
 
 
-def test_an_obstacle_only_the_map_shows_is_avoided(lunar_world, skill_run):
+def test_an_obstacle_only_the_map_shows_is_avoided(lunar_world, skill_run, free_goal):
     world, robot = lunar_world, lunar_world.robots["scout"]
-    goal = _free_goal(world, "scout")
+    goal = free_goal(world, "scout")
     x, y, _ = robot.pose
     mid = np.array([x + 0.5 * (goal[0] - x), y + 0.5 * (goal[1] - y)])
     across = np.array([-(goal[1] - y), goal[0] - x]) / math.hypot(goal[0] - x, goal[1] - y)
@@ -104,12 +94,12 @@ def test_known_map_mode_without_a_team_map_plans_on_the_world(lunar_world):
     assert not planning_grid(lunar_world, mapped).occupied_mask().any()  # the map knows no rock yet
 
 
-def test_in_a_mission_that_maps_positions_come_from_the_world_model(lunar_world, skill_run):
+def test_in_a_mission_that_maps_positions_come_from_the_world_model(lunar_world, skill_run, free_goal):
     wm = _team_map_model(lunar_world, "scout")
     with pytest.raises(SkillError, match=r"no pos\(amparo\)"):
         skill_run("MoveToPosition", lunar_world, "scout", {"goal": "pos(amparo)"}, world_model=wm)
     run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": "pos(scout)"}, world_model=wm)
     assert run.ok  # the robot itself: its pose estimate
-    wm.set("pos", "depot", value=_free_goal(lunar_world, "scout", 3.0))
+    wm.set("pos", "depot", value=free_goal(lunar_world, "scout", 3.0))
     run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": "pos(depot)"}, world_model=wm)
     assert run.ok, run.reason

@@ -11,18 +11,8 @@ from alica.errors import SkillError
 from alica.lang.fact import Fact
 
 
-def _far_free_goal(world, robot, distance=8.0):
-    x, y, _ = world.robots[robot].pose
-    for angle in [i * math.pi / 8 for i in range(16)]:
-        gx, gy = x + distance * math.cos(angle), y + distance * math.sin(angle)
-        xmin, ymin, xmax, ymax = world.bounds
-        if xmin + 1 < gx < xmax - 1 and ymin + 1 < gy < ymax - 1 and world.is_free(gx, gy, 0.6):
-            return gx, gy
-    raise AssertionError("no free goal")
-
-
-def test_move_to_position_reaches_a_goal_around_rocks(lunar_world, skill_run):
-    goal = _far_free_goal(lunar_world, "scout")
+def test_move_to_position_reaches_a_goal_around_rocks(lunar_world, skill_run, free_goal):
+    goal = free_goal(lunar_world, "scout")
     run = skill_run("MoveToPosition", lunar_world, "scout", {"goal": list(goal), "tolerance": 0.3})
     assert run.ok, (run.reason, run.trace[-5:])
     x, y, _ = lunar_world.robots["scout"].pose
@@ -186,8 +176,8 @@ def test_putdown_on_top_of_a_block(blocks_world, skill_run):
     assert Fact("on", ("c", "b")) in run.facts
 
 
-def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run):
-    goal = _far_free_goal(lunar_world, "scout")
+def test_move_to_position_replans_around_a_new_obstacle(lunar_world, skill_run, free_goal):
+    goal = free_goal(lunar_world, "scout")
     robot = lunar_world.robots["scout"]
     dropped = []
 
