@@ -122,8 +122,8 @@ class PlanBoard:
         self.requests: dict[PlanKey, list[ReplanRequest]] = {}
         self.latest: dict[PlanKey, CreatedTasks] = {}
         """The latest generated plan per planning problem, kept after the problem's state is left."""
-        self.made: list[CreatedTasks] = []
-        """Every generated plan this agent took up, in order (each once)."""
+        self.made: list[tuple[int, int, CreatedTasks]] = []
+        """Every generated plan this agent took up (each once), in order, with its generation and version."""
         self.behind: set[PlanKey] = set()
         """Problems whose leader shared an older plan than this board holds (a restarted leader): tell it."""
 

@@ -118,8 +118,8 @@ def latest_plans(engine: _Engine) -> Mapping[PlanKey, CreatedTasks]:
     return agent.board.latest if isinstance(agent, PlanningAgent) else {}
 
 
-def made_plans(engine: _Engine) -> Sequence[CreatedTasks]:
-    """Every plan generated for the planning problems an agent's engine ran, in the order it took them up.
+def made_plans(engine: _Engine) -> Sequence[tuple[int, int, CreatedTasks]]:
+    """``(generation, version, plan)`` of every plan generated for the problems an agent's engine ran, in the order it took them up.
 
     Args:
         engine: an agent's engine (:class:`alica.engine.AgentEngine`).

@@ -321,8 +321,7 @@ class ProblemRuntime:
             token = step_token(created.plan.name, step.index)
             if token not in self.effected:
                 effect = for_robot(step.effect, step.robot, me)
-                now_true = {Fact(f.predicate, tuple(str(a) for a in f.args)) for f in world.facts()}
-                if all(fact in now_true for positive, fact in effect if positive):
+                if all(world.holds(fact.predicate, *fact.args) for positive, fact in effect if positive):
                     self.effected.add(token)
                     self._write_effect(step, me)
 
@@ -380,8 +379,8 @@ class ProblemRuntime:
         if created is not None:
             host.register_plan(created.plan, created.priorities(), created.pins())
             self.board.latest[self.key] = created
-            if all(made.plan.name != created.plan.name for made in self.board.made):
-                self.board.made.append(created)
+            if all(made.plan.name != created.plan.name for _, _, made in self.board.made):
+                self.board.made.append((share.generation, share.version, created))
         self.share = share
         self.revision += 1
         self.reason = share.reason

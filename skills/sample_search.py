@@ -43,7 +43,9 @@ class DriveToDroppedSample(MoveToPosition):
     crashed robot stands beside the sample and may hide it, so the first
     viewpoint lies on the far side from the holder's last known position
     ``pos(r)``; each later run for the same sample (the look found nothing)
-    goes a third of the way round (``scratch["dropped_views"]``).
+    goes a third of the way round (``scratch["dropped_views"]``). On arrival
+    it writes ``pos(self)`` but no at-fact: the goal is a point, and the robot
+    stands off the sample.
     """
 
     def initialise(self) -> None:
@@ -94,9 +96,3 @@ class DriveToDroppedSample(MoveToPosition):
         if status == Status.SUCCESS:
             return self.succeed(f"looking at where {self.sample} was last seen, which lost teammate {self.holder} held")
         return status
-
-    def _arrived(self, here: tuple[float, float]) -> None:
-        """At the viewpoint: no at-fact (the robot stands off, it is not at the sample)."""
-        wm = self.world_model
-        if wm is not None:
-            wm.set("pos", self.robot.name, value=(round(here[0], 3), round(here[1], 3)))

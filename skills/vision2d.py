@@ -573,8 +573,8 @@ class DetectCircles(_Pipeline):
         circles: list[Circle] = self.job.result()
         self.job = None
         self.scans += 1
-        out = self._candidates(circles)
         verdicts = self.verdicts()
+        out = self._candidates(circles, verdicts)
         fresh = [c for c in out if c["id"] not in verdicts]
         if self.wait > 0.0 and not fresh:
             waited = self.now() - self.started
@@ -597,10 +597,9 @@ class DetectCircles(_Pipeline):
             f"({near['x']:.2f}, {near['y']:.2f}), {near['range']:.2f} m"
         )
 
-    def _candidates(self, circles: list[Circle]) -> list[dict[str, Any]]:
+    def _candidates(self, circles: list[Circle], verdicts: dict[str, str]) -> list[dict[str, Any]]:
         """Name the circles (a known candidate nearby keeps its id), write them to the scratch space and world model."""
         known = cast("dict[str, tuple[float, float]]", self.scratch.setdefault("candidate_ids", {}))
-        verdicts = self.verdicts()
         out = []
         wm = self.world_model
         for c in circles:

@@ -162,6 +162,9 @@ class WorldFacts(Protocol):
     def facts(self) -> list[Fact]:
         """Every fact that holds."""
 
+    def holds(self, predicate: str, *args: object) -> bool:
+        """Whether one fact holds (without listing them all)."""
+
     def types(self) -> list[str]:
         """The types of the typed objects it knows."""
 

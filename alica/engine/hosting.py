@@ -43,6 +43,9 @@ class _World:
     def facts(self) -> list[Fact]:
         return [Fact.of(f) for f in self._model.facts()]
 
+    def holds(self, predicate: str, *args: object) -> bool:
+        return bool(self._model.holds(predicate, *args))
+
     def types(self) -> list[str]:
         return list(self._model.types())
 

@@ -401,20 +401,13 @@ def run_lunar(
 
 def _made_plans(team: Any) -> list[Any]:
     """Every plan the team generated (each once, crashed agents' too), in the order of generation and version."""
-    import re
-
     from alica.prophet import made_plans
 
-    seen: dict[str, Any] = {}
+    seen: dict[str, tuple[int, int, Any]] = {}
     for engine in team.engines.values():
-        for created in made_plans(engine):
-            seen.setdefault(created.plan.name, created)
-
-    def order(name: str) -> tuple[int, int, str]:
-        match = re.search(r"_g(\d+)v(\d+)_", name)
-        return (int(match.group(1)), int(match.group(2)), name) if match else (0, 0, name)
-
-    return [seen[name] for name in sorted(seen, key=order)]
+        for generation, version, created in made_plans(engine):
+            seen.setdefault(created.plan.name, (generation, version, created))
+    return [created for _, _, created in sorted(seen.values(), key=lambda m: (m[0], m[1], m[2].plan.name))]
 
 
 def replica_views(team: Any) -> dict[str, Any]:
