@@ -290,6 +290,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_skills_option(p)
     p.set_defaults(run=_cmd_list_skills)
 
+    from alica.app.cli_agent import add_parser as add_agent_parser
     from alica.app.cli_demo import add_parser as add_demo_parser
     from alica.app.cli_plan import add_parser as add_plan_parser
     from alica.app.cli_run import add_parser as add_run_parser
@@ -297,6 +298,7 @@ def build_parser() -> argparse.ArgumentParser:
     from alica.app.cli_solve import add_parser as add_solve_parser
 
     add_run_parser(sub)
+    add_agent_parser(sub)
     add_skill_parser(sub)
     add_plan_parser(sub)
     add_solve_parser(sub)

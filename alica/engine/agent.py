@@ -140,6 +140,10 @@ class AgentEngine:
         for topic in self.children.routes:
             transport.subscribe(topic)
         self._world_changed = False
+        self._liveliness = bool(getattr(transport, "tracks_liveliness", False))
+        """The transport reports who is alive (liveliness tokens): a teammate gone is taken out at once."""
+        self._peers: frozenset[str] = frozenset()
+        self._greeted: set[str] = set()
         self._refresh = getattr(world_model, "refresh", None)
         if hasattr(world_model, "on_change"):
             world_model.on_change(self._on_world_change)
@@ -171,6 +175,8 @@ class AgentEngine:
                 changed, revived = self.team.integrate(payload, now)
                 if revived:
                     self._welcome(payload.sender)
+                elif payload.sender not in self._greeted:
+                    self._greet(payload.sender)
                 if changed and self.root is None:
                     self._next_root_try = now  # a teammate's plans changed: maybe the root can start now
                 for key in changed:
@@ -181,6 +187,8 @@ class AgentEngine:
                 continue
             if self.team.heard(envelope.sender, envelope.sent_at, now):
                 self._welcome(envelope.sender)  # any message is a sign of life
+            elif envelope.sender not in self._greeted:
+                self._greet(envelope.sender)
             if topic == SYNC_TOPIC and isinstance(payload, SyncTalk):
                 self._receive_sync(payload, now)
             elif topic == WORLD_TOPIC:
@@ -190,8 +198,21 @@ class AgentEngine:
         if authority:
             self.allocator.apply_authority(now)
 
+    def _greet(self, who: str) -> None:
+        """The first message of a teammate: send it what this agent knows of the world, if anything.
+
+        A teammate that joins a running team (or restarts before it was missed)
+        has not seen the changes sent before it subscribed.
+        """
+        self._greeted.add(who)
+        if who in self.team.mates:
+            snapshot = self.world_model.snapshot()
+            if len(snapshot):
+                self._publish(WORLD_TOPIC, snapshot, QoS.RELIABLE)
+
     def _welcome(self, who: str) -> None:
         """A teammate taken out spoke again: take it back into the assignments and send it the world."""
+        self._greeted.add(who)
         self.emit("team", change="back", who=who)
         self._invalidate_all()
         self._next_root_try = self.now()
@@ -202,6 +223,13 @@ class AgentEngine:
         now = self.now()
         self.stats["ticks"] += 1
         lost = self.team.update(now)
+        if self._liveliness:
+            peers = self.transport.peers()
+            for who in sorted(self._peers - peers):
+                if self.team.depart(who, now):
+                    lost.append(who)
+                self._greeted.discard(who)  # when it comes back, it gets the world again
+            self._peers = peers
         if lost:
             for who in lost:
                 self.emit("team", change="lost", who=who)

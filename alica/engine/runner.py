@@ -28,6 +28,26 @@ from alica.model import PlanLibrary, RoleSet
 from alica.worldmodel import WorldModel
 
 
+def root_status(engine: AgentEngine) -> str:
+    """``running``, ``success`` or ``failure``: how an agent's root plan stands."""
+    if engine.root is None:
+        return "running"
+    return engine.root.status.value if engine.root.status is not ChildStatus.WAITING else "running"
+
+
+def describe_agent(engine: AgentEngine, status: str) -> dict[str, Any]:
+    """One agent of a run summary: role, status, its tasks root first, where it is, its counters."""
+    path = []
+    node = engine.root
+    tasks = []
+    while node is not None:
+        if node.ep is not None:
+            tasks.append(node.plan.entry_point(node.ep).task)
+        path.append(f"{node.plan.name}:{node.state or 'idle'}")
+        node = next((s.node for s in node.slots if s.node is not None), None)
+    return {"role": engine.role, "status": status, "tasks": tasks, "path": " > ".join(path), **engine.stats}
+
+
 def pick_roleset(library: PlanLibrary, roles: Iterable[str | None], name: str | None = None) -> RoleSet:
     """The role set to allocate with: ``name``, or the one holding every given role (``None``: no role given).
 
@@ -347,30 +367,11 @@ class SimulatedTeam:
         """``crashed``, ``running``, ``success`` or ``failure`` (of the root plan)."""
         if name in self.crashed:
             return "crashed"
-        engine = self.engines[name]
-        if engine.root is None:
-            return "running"
-        return engine.root.status.value if engine.root.status is not ChildStatus.WAITING else "running"
+        return root_status(self.engines[name])
 
     def summary(self) -> dict[str, Any]:
         """What happened: per agent and for the team, as plain data."""
-        agents = {}
-        for name, engine in self.engines.items():
-            path = []
-            node = engine.root
-            tasks = []
-            while node is not None:
-                if node.ep is not None:
-                    tasks.append(node.plan.entry_point(node.ep).task)
-                path.append(f"{node.plan.name}:{node.state or 'idle'}")
-                node = next((s.node for s in node.slots if s.node is not None), None)
-            agents[name] = {
-                "role": engine.role,
-                "status": self.status_of(name),
-                "tasks": tasks,
-                "path": " > ".join(path),
-                **engine.stats,
-            }
+        agents = {name: describe_agent(engine, self.status_of(name)) for name, engine in self.engines.items()}
         stats = self.network.stats
         statuses = [a["status"] for a in agents.values() if a["status"] != "crashed"]
         return {

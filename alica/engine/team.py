@@ -81,6 +81,8 @@ class Teammate:
     claims: dict[PlanKey, Claim] | None = None
     authority: tuple[AuthorityClaim, ...] = ()
     changed_at: float = float("-inf")
+    departed_at: float = float("-inf")
+    """When the transport last reported it gone (its liveliness token vanished)."""
 
 
 class TeamView:
@@ -176,12 +178,28 @@ class TeamView:
         if mate is None:
             return False
         heard = min(sent_at, now)
-        if heard <= mate.last_heard:
+        if heard <= mate.last_heard or heard <= mate.departed_at:
             return False
         mate.last_heard = heard
         if mate.alive or now - heard > self.timeout:
             return False
         mate.alive = True
+        self._alive_cache = None
+        return True
+
+    def depart(self, agent: str, now: float) -> bool:
+        """The transport says ``agent`` is gone (a crash, a partition): take it out now; returns whether it was in.
+
+        Messages it sent before ``now`` that arrive late do not bring it back;
+        a message sent after does (a restart, a healed link).
+        """
+        mate = self.mates.get(agent)
+        if mate is None:
+            return False
+        mate.departed_at = now
+        if not mate.alive:
+            return False
+        mate.alive = False
         self._alive_cache = None
         return True
 

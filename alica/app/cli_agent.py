@@ -1,0 +1,281 @@
+"""``alica agent``: one agent of a team in its own process, on the wall clock, over eclipse-zenoh.
+
+This is how a team runs on robots: every robot starts ``alica agent`` with
+the same plan file and the same roster (``--agents``), names itself with
+``--name`` and says where its teammates are (``--connect``/``--listen``
+zenoh endpoints). The engine ticks at ``--frequency`` in real time
+(:class:`alica.engine.realtime.RealTimeLoop`); the team is whoever is alive
+on the network (zenoh liveliness). ``alica run --processes`` starts one
+``alica agent`` per agent on loopback (:mod:`alica.app.processes`).
+
+Skills: any skill that needs no shared simulated world, and with
+``--stand-ins`` scripted stand-ins for the others.
+
+With ``--json`` it prints one JSON object per line on standard output: a
+``status`` line whenever its root plan's status changes, and a ``summary``
+line when it stops (the agent's part of ``alica run``'s summary plus its
+transport's counters and its world model's digest).
+
+Exit codes: 0 the root plan succeeded, 1 it failed or is still running when
+the agent stops (time limit, Ctrl-C, SIGTERM), 2 wrong usage.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import signal
+import sys
+import threading
+from typing import Any
+
+from alica.app.skill_options import add_skills_option
+from alica.app.timed import timed
+from alica.errors import AlicaError
+
+
+def add_parser(sub: Any) -> None:
+    """Add the ``agent`` subcommand to the ``alica`` parser."""
+    p = sub.add_parser(
+        "agent",
+        help="run one agent of a team in this process, on the wall clock, over zenoh",
+        description="Run one agent of a team as one would on a robot: its own engine, ticking in real time, talking "
+        "to its teammates over eclipse-zenoh. Start one per robot with the same plan and --agents roster. "
+        "Exit 0 when the root plan succeeded, 1 when it failed or had not ended when the agent stopped.",
+    )
+    p.add_argument("plan", metavar="PLAN", help="a plan file")
+    p.add_argument("--name", required=True, help="this agent's name (its id in the team)")
+    p.add_argument("--role", help="this agent's role (default: from --agents, or the role called like the agent)")
+    p.add_argument(
+        "--agents",
+        metavar="NAME:ROLE,...",
+        help="the whole team, this agent included, as for alica run (default: this agent alone)",
+    )
+    p.add_argument("--root", metavar="PLAN", help="the root plan (default: the file's top-level plan)")
+    p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
+    p.add_argument(
+        "--connect",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="a zenoh endpoint to connect to, e.g. tcp/192.168.1.10:7447 (repeatable)",
+    )
+    p.add_argument(
+        "--listen",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help="a zenoh endpoint to listen on, e.g. tcp/0.0.0.0:7447 (repeatable)",
+    )
+    p.add_argument("--mode", choices=("peer", "client"), default="peer", help="zenoh mode (client: through a router)")
+    p.add_argument(
+        "--key-prefix",
+        default="alica",
+        metavar="PREFIX",
+        help="the team's zenoh key prefix; teams with different prefixes do not hear each other (default alica)",
+    )
+    p.add_argument(
+        "--zenoh",
+        action="append",
+        default=[],
+        metavar="KEY=JSON",
+        help="more zenoh configuration, e.g. scouting/multicast/enabled=true (repeatable)",
+    )
+    p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the agent's random choices (default 0)")
+    p.add_argument(
+        "--start-at",
+        type=float,
+        metavar="EPOCH",
+        help="the team's start, in seconds since the epoch, for the times of --fact and --max-time (default: now)",
+    )
+    p.add_argument(
+        "--fact",
+        action="append",
+        default=[],
+        metavar="LITERALS@T",
+        help="the operator sets facts in this agent's world model T seconds after the start (repeatable)",
+    )
+    p.add_argument(
+        "--max-time", type=float, metavar="S", help="stop S seconds after the start (default: run until stopped)"
+    )
+    p.add_argument("--until-done", action="store_true", help="stop one second after the root plan succeeded or failed")
+    p.add_argument(
+        "--stand-ins",
+        action="store_true",
+        help="run scripted stand-ins for skills without an implementation and for skills that act on a robot",
+    )
+    add_skills_option(p)
+    p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace")
+    p.add_argument("--json", action="store_true", help="print status and summary lines as JSON")
+    p.set_defaults(run=cmd_agent)
+
+
+def _zenoh_settings(items: list[str]) -> dict[str, object]:
+    settings: dict[str, object] = {}
+    for item in items:
+        key, sep, value = item.partition("=")
+        if not sep or not key.strip():
+            raise AlicaError(f"--zenoh: '{item}' is not KEY=JSON, e.g. scouting/multicast/enabled=true")
+        try:
+            settings[key.strip()] = json.loads(value)
+        except json.JSONDecodeError:
+            settings[key.strip()] = value  # a bare word: a string
+    return settings
+
+
+def cmd_agent(args: argparse.Namespace) -> int:
+    """Run ``alica agent``; returns the exit code."""
+    from alica.app.cli import _load, _roots
+    from alica.app.cli_run import _agents, _roles
+    from alica.app.run_skills import plan_skills, skill_wiring
+    from alica.app.skill_options import skill_registry
+    from alica.io import Loader
+
+    if args.frequency <= 0:
+        raise AlicaError(f"--frequency must be > 0, got {args.frequency}")
+    registry = skill_registry(args)
+    library, entry = _load(args.plan, Loader(skills=registry))
+    plan = args.root
+    if plan is None:
+        roots = [r for r in _roots(library, entry, None) if r in library.plans]
+        if not roots:
+            raise AlicaError(f"{args.plan} defines no plan to run; give one with --root")
+        plan = roots[0]
+    agents = _agents(args.agents) if args.agents else {args.name: args.role}
+    if args.name not in agents:
+        raise AlicaError(f"--name {args.name} is not in --agents ({', '.join(agents)}); the roster names every agent")
+    if args.role is not None:
+        agents[args.name] = args.role
+    roles = _roles(library, agents, args.roleset)
+    facts = [timed("--fact", text) for text in args.fact]
+    wiring = skill_wiring(registry, plan_skills(library, plan), world=False, stand_ins=args.stand_ins, plan=plan)
+    settings = _zenoh_settings(args.zenoh)
+    return _run(args, library, plan, roles, wiring, facts, settings)
+
+
+def _run(
+    args: argparse.Namespace,
+    library: Any,
+    plan: str,
+    roles: dict[str, Any],
+    wiring: Any,
+    facts: list[tuple[str, float, float | None]],
+    settings: dict[str, object],
+) -> int:
+    from alica.allocation import AgentSpec, assign_roles
+    from alica.clock import SystemClock
+    from alica.comm.zenoh_transport import ZenohTransport
+    from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset
+    from alica.engine.realtime import RealTimeLoop
+    from alica.engine.runner import describe_agent, root_status
+    from alica.lang import literals
+    from alica.prophet import engine_config
+    from alica.testing import default_fallback
+    from alica.worldmodel import WorldModel
+
+    clock = SystemClock()
+    start = args.start_at if args.start_at is not None else clock.now()
+    specs = {n: r if isinstance(r, AgentSpec) else AgentSpec(role=r) for n, r in sorted(roles.items())}
+    roleset = pick_roleset(library, (s.role for s in specs.values()), args.roleset)
+    roster = assign_roles(specs, roleset)
+    config = engine_config(frequency=args.frequency, planner_seconds=0.3 / args.frequency)
+    trace = JsonlTrace(args.trace) if args.trace else None
+    observers = (trace,) if trace is not None else ()
+    stop = threading.Event()
+    previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGTERM, signal.SIGINT)}
+    pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])
+    try:
+        transport = ZenohTransport(
+            args.name,
+            connect=args.connect,
+            listen=args.listen,
+            team=args.key_prefix,
+            mode=args.mode,
+            clock=clock,
+            config=settings,
+        )
+    except ValueError as exc:
+        raise AlicaError(f"alica agent {args.name}: {exc}") from None
+    fallback = default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None
+    try:
+        engine = AgentEngine(
+            args.name,
+            roster,
+            library,
+            plan,
+            roleset,
+            transport,
+            WorldModel(args.name, clock=clock, relay=False),
+            clock,
+            config=config,
+            skills=SkillBinder(None, wiring.registry, fallback),
+            seed=args.seed,
+            observers=observers,
+            listen_first=2 * config.broadcast_interval,
+        )
+        status = ["running"]
+
+        def operator(now: float) -> None:
+            while pending and now >= start + pending[0][0]:
+                _, literals_now = pending.pop(0)
+                for positive, pred, fact_args in literals_now:
+                    (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
+
+        def report(now: float) -> None:
+            current = root_status(engine)
+            if current != status[0]:
+                status[0] = current
+                if args.json:
+                    _line({"event": "status", "agent": args.name, "status": current, "t": round(now - start, 3)})
+
+        if args.json:
+            _line({"event": "started", "agent": args.name, "t": round(clock.now() - start, 3)})
+        loop = RealTimeLoop(engine, stop)
+        why = loop.run(
+            until_done=args.until_done,
+            end_at=None if args.max_time is None else start + args.max_time,
+            before_tick=operator,
+            after_tick=report,
+        )
+        summary = describe_agent(engine, root_status(engine))
+        summary.update(
+            name=args.name,
+            ended=why,
+            overruns=loop.overruns,
+            time_s=round(clock.now() - start, 3),
+            transport=_counters(transport),
+            world_digest=_digest(engine.world_model),
+        )
+    finally:
+        transport.close()
+        if trace is not None:
+            trace.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+    if args.json:
+        _line({"event": "summary", **summary})
+    else:
+        print(
+            f"{args.name} ({summary['role']}): {summary['status']} after {summary['time_s']:.2f} s ({why}); "
+            f"{summary['ticks']} ticks, {summary['messages_out']} sent, {summary['messages_in']} received; "
+            f"at {summary['path'] or '-'}"
+        )
+    return 0 if summary["status"] == "success" else 1
+
+
+def _counters(transport: Any) -> dict[str, int]:
+    stats = transport.stats
+    return {name: getattr(stats, name) for name in stats.__slots__}
+
+
+def _digest(world_model: Any) -> str:
+    """A short fingerprint of the world model's state: equal on two agents when their states are equal."""
+    import hashlib
+
+    return hashlib.blake2b(world_model.dumps().encode("utf-8"), digest_size=8).hexdigest()
+
+
+def _line(record: dict[str, Any]) -> None:
+    sys.stdout.write(json.dumps(record, sort_keys=True, default=str) + "\n")
+    sys.stdout.flush()
