@@ -181,7 +181,10 @@ def _run(
     roster = assign_roles(specs, roleset)
     config = engine_config(frequency=args.frequency, planner_seconds=0.3 / args.frequency)
     trace = JsonlTrace(args.trace) if args.trace else None
-    observers = (trace,) if trace is not None else ()
+    observers: tuple[Any, ...] = ()
+    if trace is not None:
+        sink = trace
+        observers = (lambda event: sink({**event, "t": round(event["t"] - start, 6)}),)  # seconds since the start
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGTERM, signal.SIGINT)}
     pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])

@@ -13,6 +13,7 @@ import argparse
 import json
 import re
 import sys
+import time
 from typing import Any
 
 from alica.app.skill_options import add_lunar_options, add_skills_option
@@ -101,6 +102,13 @@ def add_parser(sub: Any) -> None:
         "that act on a robot) instead of stopping with an error",
     )
     add_skills_option(p)
+    p.add_argument(
+        "--processes",
+        action="store_true",
+        help="run every agent in its own process (alica agent) over zenoh on loopback, on the wall clock; "
+        "--crash is then a kill -9, --recover a restart, --partition cuts the links between groups; "
+        "times are wall seconds",
+    )
     p.set_defaults(run=cmd_run)
 
 
@@ -175,6 +183,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     wiring = skill_wiring(
         registry, plan_skills(library, plan), world=args.world is not None, stand_ins=args.stand_ins, plan=plan
     )
+    if args.processes:
+        return _run_processes(args, plan, list(agents), wiring)
     with run_world(args, sorted(agents)) as (world, perception):
         return _run_team(args, library, plan, roles, wiring, world, perception)
 
@@ -245,6 +255,102 @@ def _run_team(
     else:
         _print_summary(summary, args.trace)
     return 0 if summary["success"] else 1
+
+
+def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring: Any) -> int:
+    """``alica run --processes``: one ``alica agent`` per agent (:mod:`alica.app.processes`)."""
+    import tempfile
+    from pathlib import Path
+
+    from alica.app.processes import ProcessTeam
+
+    unsupported = [
+        option
+        for option, used in (
+            ("--world", args.world is not None),
+            ("--ticks", args.ticks is not None),
+            ("--show-tree", args.show_tree),
+            ("--loss", args.loss > 0),
+            ("--delay", args.delay > 0),
+            ("--jitter", args.jitter > 0),
+            ("--trace-messages", args.trace_messages),
+        )
+        if used
+    ]
+    if unsupported:
+        raise AlicaError(
+            f"--processes runs the agents on a real network and the wall clock: {', '.join(unsupported)} "
+            "only work in the simulated run (leave out --processes)"
+        )
+    faults: list[tuple[float, str, Any]] = []
+    for text in args.crash:
+        who, at, _ = _timed("--crash", text)
+        faults.append((at, "crash", who))
+    for text in args.recover:
+        who, at, _ = _timed("--recover", text)
+        faults.append((at, "recover", who))
+    for text in args.partition:
+        groups, start, end = partition(text)
+        faults.append((start, "partition", (groups, start, end)))
+        if end is not None:
+            faults.append((end, "heal", None))
+    for _, kind, what in faults:
+        if kind in ("crash", "recover") and what not in names:
+            raise AlicaError(f"--{kind}: no agent named '{what}' in the team; agents: {', '.join(names)}")
+    faults.sort(key=lambda fault: fault[0])
+    options = ["--frequency", repr(args.frequency), "--seed", str(args.seed)]
+    options += [arg for text in args.fact for arg in ("--fact", text)]
+    options += [arg for module in args.skills for arg in ("--skills", module)]
+    if args.name:
+        options += ["--root", args.name]
+    if args.roleset:
+        options += ["--roleset", args.roleset]
+    if args.stand_ins:
+        options.append("--stand-ins")
+    with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
+        team = ProcessTeam(args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition))
+        interrupted = False
+        try:
+            team.launch()
+            while not team.done() and team.now() < args.max_time:
+                while faults and team.now() >= faults[0][0]:
+                    _, kind, what = faults.pop(0)
+                    if kind == "crash":
+                        team.crash(what)
+                    elif kind == "recover":
+                        team.recover(what)
+                    elif kind == "partition":
+                        team.partition(*what)
+                    else:
+                        team.heal()
+                team.exited()
+                time.sleep(0.05)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            team.stop()
+        summary = team.summary(plan, args.seed)
+        if args.trace:
+            team.trace(Path(args.trace))
+    summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
+    for name, agent in summary["agents"].items():
+        agent.setdefault("reason", None if agent["status"] == "success" else _process_reason(agent))
+    if args.json:
+        print(json.dumps(summary, indent=2, sort_keys=True))
+    else:
+        _print_summary(summary, args.trace)
+    if interrupted:
+        return 130
+    return 0 if summary["success"] else 1
+
+
+def _process_reason(agent: dict[str, Any]) -> str:
+    status = agent["status"]
+    if status == "crashed":
+        return "killed (kill -9)"
+    if status == "exited":
+        return "its process exited by itself (see the log line in the trace folder)"
+    return f"ended {status} at {agent.get('path') or 'no plan'}"
 
 
 def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running_tree: Any) -> None:
@@ -327,8 +433,9 @@ def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
         if summary["success"]
         else ("not finished" if not summary["done"] else "failed" if failed else "ended")
     )
+    clock = "wall-clock, one process per agent" if summary.get("processes") else "simulated"
     print(
-        f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s simulated ({summary['ticks']} ticks), seed {summary['seed']}"
+        f"{summary['plan']}: {verdict} after {summary['sim_time_s']:.2f} s {clock} ({summary['ticks']} ticks), seed {summary['seed']}"
     )
     header = f"{'agent':<12} {'role':<12} {'status':<8} {'transitions':>11} {'allocations':>11} {'sent':>6} {'recv':>6} {'repairs':>7}  where"
     print(header)
@@ -344,6 +451,9 @@ def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
         print(f"scripted stand-ins (--stand-ins): {', '.join(skills['stand_ins'])}")
     m = summary["messages"]
     print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
+    if "world_models_agree" in summary:
+        agree = "agree" if summary["world_models_agree"] else "DIFFER"
+        print(f"world models of the running agents: {agree}")
     if not summary["success"]:
         for name, a in summary["agents"].items():
             if a["reason"]:
