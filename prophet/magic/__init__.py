@@ -16,7 +16,7 @@ a simulated network give the same round for the same seed.
 
 from __future__ import annotations
 
-from alica.prophet.magic.leader import RoundOutcome, MagicLeader
+from alica.prophet.magic.leader import MagicLeader, RoundOutcome
 from alica.prophet.magic.messages import (
     SHARE_SEARCHES,
     Final,

@@ -307,7 +307,9 @@ class MagicLeader:
         message = next((m for s, m in self._failed.values() if s is status and m), "every share failed")
         self._finish(status, None, None, None, message)
 
-    def _finish(self, status: PlanStatus, plan: Plan | None, solver: str | None, index: int | None, message: str) -> None:
+    def _finish(
+        self, status: PlanStatus, plan: Plan | None, solver: str | None, index: int | None, message: str
+    ) -> None:
         if self._own is not None:
             self._own.stop()
         self._own = None
