@@ -272,7 +272,13 @@ class MagicLeader:
         )
 
     def _receive(self, payload: object) -> None:
-        if not isinstance(payload, Result) or payload.to != self.name or payload.round_id != self._round:
+        if (
+            not isinstance(payload, Result)
+            or payload.to != self.name
+            or payload.round_id != self._round
+            or not 0 < payload.index < len(self._agents)
+            or self._agents[payload.index] != payload.worker
+        ):
             self.counts.ignored += 1
             return
         self.counts.results_received += 1

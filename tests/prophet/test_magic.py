@@ -7,6 +7,7 @@ simulated network (:func:`alica.app.magic.run_lockstep`) on Rovers problems.
 
 from __future__ import annotations
 
+import io
 import pickle
 from functools import cache
 from pathlib import Path
@@ -128,13 +129,22 @@ def test_shares_differ_and_share_zero_is_the_default_search() -> None:
         share_searches(0)
 
 
+class AlicaOnly(pickle.Unpickler):
+    """An unpickler that finds classes of ``alica.`` modules only, as a transport's would."""
+
+    def find_class(self, module: str, name: str) -> object:
+        if not module.startswith("alica."):
+            raise pickle.UnpicklingError(f"{module}.{name} is not allowed")
+        return super().find_class(module, name)
+
+
 def test_messages_are_plain_data_that_pickle() -> None:
     share = Share(1, "a", "b", 1, "(d)", "(p)", FirstSearch("ff", 3.0, 7), 2.5)
     result = Result(1, "a", "b", 1, (PlanStep("go", ("x",)),), PlanStatus.SOLVED, 12, 0.5)
-    final = Final(1, "a", "b", None, PlanStatus.UNSOLVABLE)
+    final = Final(1, "a", "b", (PlanStep("go", ("x",)),), PlanStatus.SOLVED, 1.0, "b")
     for message in (share, result, final):
-        assert pickle.loads(pickle.dumps(message)) == message
-        assert type(message).__module__.startswith("alica.")
+        data = pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL)
+        assert AlicaOnly(io.BytesIO(data)).load() == message
     assert (share.to, result.to, final.to) == ("b", "a", "b")
 
 
@@ -303,6 +313,10 @@ def test_an_invalid_plan_from_a_teammate_is_not_taken() -> None:
         outcome = leader.step(100)
     assert (outcome.status, outcome.solver) == (PlanStatus.SOLVED, "a")
     assert leader.counts.results_received == 1 and leader.counts.ignored == 1
+    b.send(Result(1, "a", "b", 5, None, PlanStatus.UNSOLVABLE, 1, 0))  # no such share: ignored
+    b.send(Result(1, "a", "c", 1, None, PlanStatus.UNSOLVABLE, 1, 0))  # share 1 is b's, not c's: ignored
+    leader.step()
+    assert leader.counts.ignored == 3 and outcome.status is PlanStatus.SOLVED
     assert [f.steps == outcome.plan.steps for f in sent(team, Final)] == [True]
 
 
