@@ -1,0 +1,653 @@
+"""The :class:`Transport` over eclipse-zenoh, for agents in separate processes or hosts.
+
+It keeps the meanings of the simulated network (:mod:`alica.comm.transport`):
+
+* **Reliable** messages reach every live subscriber in send order, once, also
+  across a partition. Zenoh alone loses what is published while a link is
+  down, so the transport does not rely on it: each agent keeps its reliable
+  messages (:attr:`ZenohTransport.history` seconds of them) and heartbeats
+  the last reliable number per topic; a receiver that sees a gap, or a
+  heartbeat ahead of what it has, fetches the missing messages from the
+  sender's history with a zenoh query, holds later ones back until the gap is
+  filled, and drops duplicates by sequence number.
+* **Best-effort** messages keep the latest value per sender and topic.
+* **Liveliness tokens** say who is alive: :meth:`ZenohTransport.peers` is the
+  set of agents whose token this session sees; a clean exit or a ``kill -9``
+  removes it within milliseconds, a partition after the zenoh lease.
+* A **restarted** agent (a new process with the same id) is a new
+  incarnation: receivers start over with its numbers, and deliver from it
+  every reliable message sent after they subscribed.
+
+Everything arriving is handled by zenoh's threads (callbacks) and a daemon
+timer thread (heartbeats, query time-outs), under one lock; the engine's
+thread only drains the inbox in :meth:`ZenohTransport.poll`. Always close the
+transport (``with ZenohTransport(...) as t:`` or ``close()`` in ``finally``):
+a zenoh session with Python callbacks keeps its process alive until closed.
+
+The settings follow ``reference/comms_notes.md``: no multicast scouting and
+no gossip (links are the endpoints given), shared memory off, timestamping
+on, a lease of 2 s.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import threading
+import time
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import zenoh
+
+from alica.clock import Clock, SystemClock
+from alica.comm.codec import CodecError, decode, encode
+from alica.comm.transport import Envelope, QoS, Transport
+
+_CHUNK = re.compile(r"[^/*$?#\s]+")
+
+# A frame: (incarnation, sender, topic, seq, rseq, gseq, sent_at, payload). ``seq`` counts the
+# sender's messages on the topic, ``rseq`` its reliable ones on the topic (0 for best-effort) and
+# ``gseq`` its reliable ones on every topic (0 for best-effort): receivers find gaps by ``rseq``
+# and deliver a sender's reliable messages in ``gseq`` order, whatever their topic.
+Frame = tuple[int, str, str, int, int, int, float, object]
+_FRAME_LEN = 8
+_SYNC = ("sync",)
+_SYNC_BYTES = encode(_SYNC)
+
+
+def _check_topic(topic: object) -> str:
+    if not isinstance(topic, str) or not topic:
+        raise ValueError(f"topic must be a non-empty string, got {topic!r}")
+    if not all(_CHUNK.fullmatch(chunk) for chunk in topic.split("/")):
+        raise ValueError(
+            f"topic must be a non-empty string of '/'-separated names without '*', '$', '?', '#' or spaces, got {topic!r}"
+        )
+    return topic
+
+
+def _check_name(what: str, name: object) -> str:
+    if not isinstance(name, str) or not _CHUNK.fullmatch(name):
+        raise ValueError(f"{what} must be a non-empty name without '/', '*', '$', '?', '#' or spaces, got {name!r}")
+    return name
+
+
+@dataclass(slots=True)
+class _Stream:
+    """What a receiver knows of one sender's reliable messages on one topic."""
+
+    next: int | None = None
+    """The next reliable number to deliver; ``None`` until the sender's history said where to start."""
+    held: dict[int, tuple[int, Envelope]] = field(default_factory=dict)
+    """Reliable messages not delivered yet, by number: (gseq, envelope)."""
+    last_gseq: int = 0
+    """The sender-wide number of the last message delivered from this stream."""
+
+    def gapped(self) -> bool:
+        """Whether a message is known to be missing before the held ones (or where to start is unknown)."""
+        return self.next is None or (bool(self.held) and self.next not in self.held)
+
+
+@dataclass(slots=True)
+class _Sender:
+    """What a receiver knows of one sender (one incarnation of it)."""
+
+    incarnation: int
+    streams: dict[str, _Stream] = field(default_factory=dict)
+    offset: dict[str, int] = field(default_factory=dict)
+    """Per topic: added to the incarnation's numbers, so that numbers grow across restarts."""
+    last_seq: dict[str, int] = field(default_factory=dict)
+    """Per topic: the last number delivered from this sender (offset included)."""
+    asked_at: float | None = None
+    """When a history query to this sender went out (``None``: none outstanding)."""
+
+    def stream(self, topic: str) -> _Stream:
+        found = self.streams.get(topic)
+        if found is None:
+            found = self.streams[topic] = _Stream()
+        return found
+
+
+@dataclass(frozen=True, slots=True)
+class ZenohStats:
+    """What one transport did so far.
+
+    Attributes:
+        sent: publish calls.
+        delivered: envelopes handed out by :meth:`ZenohTransport.poll`.
+        recovered: reliable messages fetched from a sender's history (lost on the way, or sent in a partition).
+        duplicates: reliable messages that arrived twice and were dropped.
+        superseded: best-effort messages replaced by a newer one before a poll, or older than one delivered.
+        lost: reliable messages a sender no longer had in its history when asked for (a very long partition).
+        queries: history queries sent.
+        undecodable: messages that could not be decoded (another version, a foreign class).
+    """
+
+    sent: int
+    delivered: int
+    recovered: int
+    duplicates: int
+    superseded: int
+    lost: int
+    queries: int
+    undecodable: int
+
+
+class ZenohTransport(Transport):
+    """One agent's connection to its team over a zenoh session.
+
+    Args:
+        agent_id: the agent's id, unique in the team.
+        connect: zenoh endpoints to connect to, e.g. ``("tcp/127.0.0.1:7447",)``.
+        listen: zenoh endpoints to listen on.
+        team: the key prefix of the team; teams with different prefixes share
+            a network without hearing each other.
+        mode: ``"peer"`` (default) or ``"client"`` (through a zenoh router).
+        lease: zenoh's link lease in seconds: a peer cut off is declared gone
+            (its liveliness token dropped) after about this long.
+        heartbeat: seconds between two heartbeats with the last reliable
+            numbers; a message lost at the tail of a partition is fetched
+            at most this long after the link is back.
+        history: seconds a sender keeps its reliable messages for receivers
+            that missed them (a partition longer than this loses what the
+            sender trimmed; :attr:`ZenohStats.lost` counts it).
+        clock: the time of ``sent_at`` (and of the history); agents of one
+            team need comparable clocks, so the default is
+            :class:`~alica.clock.SystemClock` (hosts synchronised by NTP).
+        config: more zenoh configuration, key path -> JSON-able value, e.g.
+            ``{"scouting/multicast/enabled": True}``; applied last.
+        query_timeout: seconds before an unanswered history query is sent again.
+
+    Raises:
+        ValueError: a bad id, team, endpoint list, or zenoh configuration.
+    """
+
+    def __init__(
+        self,
+        agent_id: str,
+        *,
+        connect: Iterable[str] = (),
+        listen: Iterable[str] = (),
+        team: str = "alica",
+        mode: str = "peer",
+        lease: float = 2.0,
+        heartbeat: float = 0.25,
+        history: float = 600.0,
+        clock: Clock | None = None,
+        config: Mapping[str, object] | None = None,
+        query_timeout: float = 1.0,
+    ) -> None:
+        self._id = _check_name("agent id", agent_id)
+        self._team = _check_name("team", team)
+        if mode not in ("peer", "client"):
+            raise ValueError(f"mode must be 'peer' or 'client', got {mode!r}")
+        for name, value in (("lease", lease), ("heartbeat", heartbeat), ("history", history)):
+            if not isinstance(value, int | float) or value <= 0:
+                raise ValueError(f"{name} must be a number of seconds > 0, got {value!r}")
+        self._clock = clock or SystemClock()
+        self._heartbeat = float(heartbeat)
+        self._history_s = float(history)
+        self._query_timeout = float(query_timeout)
+        self._incarnation = time.time_ns()
+        self._lock = threading.Lock()
+        self._closed = False
+        # sending
+        self._seq: dict[str, int] = {}
+        self._rseq: dict[str, int] = {}
+        self._gseq = 0
+        self._history: dict[str, list[tuple[int, float, bytes]]] = {}
+        self._publishers: dict[tuple[str, QoS], Any] = {}
+        # receiving
+        self._subscribed: dict[str, float] = {}
+        self._senders: dict[str, _Sender] = {}
+        self._inbox: list[Envelope | None] = []
+        self._pending: dict[tuple[str, str], int] = {}
+        self._alive: set[str] = set()
+        self._counts = dict.fromkeys(ZenohStats.__slots__, 0)
+        self._subscribers: list[Any] = []
+        self._session = zenoh.open(self._config(tuple(connect), tuple(listen), mode, lease, config))
+        try:
+            prefix = f"{self._team}"
+            liveliness = self._session.liveliness()
+            # One subscriber for every topic, so that zenoh hands over each sender's messages in the order
+            # they were sent (two subscribers' callbacks may run at once); poll() filters by topic.
+            self._subscribers += [
+                liveliness.declare_subscriber(f"{prefix}/alive/*", self._on_liveliness, history=True),
+                liveliness.declare_token(f"{prefix}/alive/{self._id}"),
+                self._session.declare_subscriber(f"{prefix}/m/**", self._on_message),
+                self._session.declare_subscriber(f"{prefix}/hb/*", self._on_heartbeat),
+                self._session.declare_queryable(f"{prefix}/hist/{self._id}", self._on_query),
+            ]
+            self._hb_publisher = self._session.declare_publisher(
+                f"{prefix}/hb/{self._id}", congestion_control=zenoh.CongestionControl.DROP, express=True
+            )
+        except BaseException:
+            self._session.close()
+            raise
+        self._sync()
+        self._stop = threading.Event()
+        self._timer = threading.Thread(target=self._tick, name=f"zenoh-{self._id}", daemon=True)
+        self._timer.start()
+
+    @staticmethod
+    def _config(
+        connect: tuple[str, ...], listen: tuple[str, ...], mode: str, lease: float, extra: Mapping[str, object] | None
+    ) -> zenoh.Config:
+        for endpoint in (*connect, *listen):
+            if not isinstance(endpoint, str) or "/" not in endpoint:
+                raise ValueError(f"a zenoh endpoint looks like 'tcp/127.0.0.1:7447', got {endpoint!r}")
+        settings: dict[str, object] = {
+            "mode": mode,
+            "connect/endpoints": list(connect),
+            "listen/endpoints": list(listen),
+            "scouting/multicast/enabled": False,
+            "scouting/gossip/enabled": False,
+            "transport/shared_memory/enabled": False,
+            "transport/link/tx/lease": int(lease * 1000),
+            "timestamping/enabled": {"router": True, "peer": True, "client": True},
+            "connect/retry": {"period_init_ms": 100, "period_max_ms": 1000, "period_increase_factor": 2},
+        }
+        settings.update(extra or {})
+        config = zenoh.Config()
+        for key, value in settings.items():
+            try:
+                config.insert_json5(key, json.dumps(value))
+            except Exception as exc:  # (zenoh reports a bad key or value as a generic error)
+                raise ValueError(f"zenoh configuration {key} = {value!r} is not accepted: {exc}") from None
+        return config
+
+    # ------------------------------------------------------------------ the Transport interface
+
+    @property
+    def agent_id(self) -> str:
+        """The id of the agent this transport belongs to."""
+        return self._id
+
+    @property
+    def tracks_liveliness(self) -> bool:
+        """True: :meth:`peers` comes from liveliness tokens, so a teammate that is gone leaves it at once."""
+        return True
+
+    def publish(self, topic: str, payload: object, qos: QoS = QoS.BEST_EFFORT) -> None:
+        """See :meth:`Transport.publish`; the payload is pickled (:mod:`alica.comm.codec`)."""
+        self._check_open("publish")
+        _check_topic(topic)
+        if not isinstance(qos, QoS):
+            raise ValueError(f"qos must be a QoS (QoS.RELIABLE or QoS.BEST_EFFORT), got {qos!r}")
+        seq = self._seq[topic] = self._seq.get(topic, 0) + 1
+        reliable = qos is QoS.RELIABLE
+        now = self._clock.now()
+        if reliable:
+            with self._lock:
+                rseq = self._rseq[topic] = self._rseq.get(topic, 0) + 1
+                self._gseq += 1
+                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, payload))
+                self._history.setdefault(topic, []).append((rseq, now, data))
+        else:
+            data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, payload))
+        publisher = self._publishers.get((topic, qos))
+        if publisher is None:
+            publisher = self._publishers[(topic, qos)] = self._session.declare_publisher(
+                f"{self._team}/m/{self._id}/{topic}",
+                congestion_control=zenoh.CongestionControl.BLOCK if reliable else zenoh.CongestionControl.DROP,
+                express=True,
+            )
+        publisher.put(data)
+        self._counts["sent"] += 1
+
+    def subscribe(self, topic: str) -> None:
+        """See :meth:`Transport.subscribe`."""
+        self._check_open("subscribe")
+        _check_topic(topic)
+        with self._lock:
+            if topic in self._subscribed:
+                return
+            self._subscribed[topic] = self._clock.now()
+
+    def _sync(self) -> None:
+        """Wait (a round trip, at most the query time-out) until every linked peer knows this session's subscriber.
+
+        A query travels the same ordered links as the declarations before it:
+        once every peer's history queryable answered, every peer routes
+        messages to this session, so what they publish from then on arrives.
+        """
+        try:
+            for _ in self._session.get(
+                f"{self._team}/hist/*",
+                payload=encode(_SYNC),
+                timeout=self._query_timeout,
+                consolidation=zenoh.ConsolidationMode.NONE,
+            ):
+                pass
+        except Exception:  # (nobody to ask, or closing: nothing to wait for)
+            return
+
+    def poll(self) -> list[Envelope]:
+        """See :meth:`Transport.poll`: what arrived, in arrival order (reliable ones in send order per sender)."""
+        self._check_open("poll")
+        with self._lock:
+            inbox = self._inbox
+            if not inbox:
+                return []
+            self._inbox = []
+            self._pending.clear()
+        out = [envelope for envelope in inbox if envelope is not None]
+        self._counts["delivered"] += len(out)
+        return out
+
+    def peers(self) -> frozenset[str]:
+        """The agents whose liveliness token this session sees (never this agent itself)."""
+        with self._lock:
+            return frozenset(self._alive)
+
+    def close(self) -> None:
+        """Leave the team: the token goes, the session closes. Closing twice is harmless."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            self._inbox = []
+        self._stop.set()
+        try:
+            self._session.close()
+        finally:
+            self._timer.join(timeout=2.0)
+
+    @property
+    def stats(self) -> ZenohStats:
+        """Counters of what this transport did (:class:`ZenohStats`)."""
+        with self._lock:
+            return ZenohStats(**self._counts)
+
+    @property
+    def closed(self) -> bool:
+        """Whether :meth:`close` was called."""
+        return self._closed
+
+    def __repr__(self) -> str:
+        return f"ZenohTransport({self._id!r}, team={self._team!r})"
+
+    # ------------------------------------------------------------------ sending heartbeats (timer thread)
+
+    def _tick(self) -> None:
+        while not self._stop.wait(self._heartbeat):
+            try:
+                self._beat()
+            except Exception:  # (the session closed under us: the next wait ends the loop)
+                if self._stop.is_set():
+                    return
+
+    def _beat(self) -> None:
+        now = self._clock.now()
+        horizon = now - self._history_s
+        with self._lock:
+            if self._closed:
+                return
+            for kept in self._history.values():
+                if kept and kept[0][1] < horizon:
+                    del kept[: next((i for i, item in enumerate(kept) if item[1] >= horizon), len(kept))]
+            # every reliable counter, also of topics whose history is trimmed: a receiver learns what it lost
+            beat = dict(self._rseq)
+            retry = []
+            for sender, state in self._senders.items():
+                if state.asked_at is not None and now - state.asked_at > self._query_timeout:
+                    state.asked_at = now
+                    retry.append(sender)
+        self._hb_publisher.put(encode((self._incarnation, self._id, beat)))
+        for sender in retry:
+            self._ask(sender)
+
+    # ------------------------------------------------------------------ receiving (zenoh threads)
+
+    def _on_liveliness(self, sample: Any) -> None:
+        name = str(sample.key_expr).rsplit("/", 1)[-1]
+        if name == self._id:
+            return
+        with self._lock:
+            if sample.kind == zenoh.SampleKind.PUT:
+                self._alive.add(name)
+            else:
+                self._alive.discard(name)
+
+    def _decode(self, data: bytes, size: int) -> Any:
+        """The tuple of ``size`` items in ``data``, or ``None`` (counted) when it is something else (lock held)."""
+        try:
+            value = decode(data)
+        except CodecError:
+            value = None
+        if not isinstance(value, tuple) or len(value) != size:
+            self._counts["undecodable"] += 1
+            return None
+        return value
+
+    def _on_message(self, sample: Any) -> None:
+        data = sample.payload.to_bytes()
+        with self._lock:
+            if self._closed:
+                return
+            frame = self._decode(data, _FRAME_LEN)
+            ask = self._receive(frame) if frame is not None else None
+        if ask is not None:
+            self._ask(ask)
+
+    def _receive(self, frame: Frame) -> str | None:
+        """Take in one frame (lock held); returns the sender when its history must be asked."""
+        incarnation, sender, topic, seq, rseq, gseq, sent_at, payload = frame
+        if topic not in self._subscribed or sender == self._id:
+            return None
+        state = self._sender(sender, incarnation)
+        if state is None:
+            return None
+        shown = state.offset.get(topic, 0) + seq
+        if rseq == 0:
+            if shown <= state.last_seq.get(topic, 0):
+                self._counts["superseded"] += 1
+                return None
+            state.last_seq[topic] = shown
+            key = (sender, topic)
+            old = self._pending.get(key)
+            if old is not None:
+                self._inbox[old] = None
+                self._counts["superseded"] += 1
+            self._pending[key] = len(self._inbox)
+            self._inbox.append(Envelope(topic, sender, shown, payload, sent_at, QoS.BEST_EFFORT))
+            return None
+        stream = state.stream(topic)
+        if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
+            self._counts["duplicates"] += 1
+            return None
+        stream.held[rseq] = (gseq, Envelope(topic, sender, shown, payload, sent_at, QoS.RELIABLE))
+        self._release(state)
+        return self._want(sender, state) if stream.gapped() else None
+
+    def _sender(self, sender: str, incarnation: int) -> _Sender | None:
+        """The receiver's state of ``sender``, started over for a new incarnation; ``None`` for an old one."""
+        state = self._senders.get(sender)
+        if state is None:
+            state = self._senders[sender] = _Sender(incarnation)
+        elif incarnation > state.incarnation:
+            numbers = dict(state.last_seq)
+            state = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
+        elif incarnation < state.incarnation:
+            return None
+        return state
+
+    def _release(self, state: _Sender) -> None:
+        """Deliver the sender's held reliable messages that can go, in its send order (lock held).
+
+        A message goes when its topic has no gap before it and no other topic
+        of the sender has a gap that may hold an earlier message.
+        """
+        streams = state.streams
+        while True:
+            gate = min((s.last_gseq for s in streams.values() if s.gapped()), default=None)
+            best: _Stream | None = None
+            for stream in streams.values():
+                if stream.next is not None and stream.next in stream.held:
+                    if best is None or stream.held[stream.next][0] < best.held[best.next][0]:  # type: ignore[index]
+                        best = stream
+            if best is None or best.next is None:
+                return
+            gseq, envelope = best.held[best.next]
+            if gate is not None and gseq > gate:
+                return
+            del best.held[best.next]
+            best.next += 1
+            best.last_gseq = gseq
+            if envelope.seq > state.last_seq.get(envelope.topic, 0):
+                state.last_seq[envelope.topic] = envelope.seq
+            self._inbox.append(envelope)
+
+    def _want(self, sender: str, state: _Sender) -> str | None:
+        """``sender`` when no history query to it is outstanding (then one counts as sent now)."""
+        if state.asked_at is not None:
+            return None
+        state.asked_at = self._clock.now()
+        return sender
+
+    def _on_heartbeat(self, sample: Any) -> None:
+        data = sample.payload.to_bytes()
+        with self._lock:
+            if self._closed:
+                return
+            beat = self._decode(data, 3)
+            if beat is None:
+                return
+            incarnation, sender, last = beat
+            if sender == self._id or not isinstance(last, dict):
+                return
+            state = self._sender(sender, incarnation)
+            if state is None:
+                return
+            behind = False
+            for topic, number in last.items():
+                if topic in self._subscribed:
+                    stream = state.stream(topic)
+                    behind = behind or stream.next is None or stream.next <= number
+            ask = self._want(sender, state) if behind else None
+        if ask is not None:
+            self._ask(ask)
+
+    def _ask(self, sender: str) -> None:
+        """Query ``sender``'s history for what this receiver lacks on every topic it subscribed to."""
+        with self._lock:
+            state = self._senders.get(sender)
+            if self._closed or state is None:
+                return
+            wanted = {topic: (state.stream(topic).next, since) for topic, since in self._subscribed.items()}
+            request = (self._id, state.incarnation, wanted)
+            self._counts["queries"] += 1
+        try:
+            self._session.get(
+                f"{self._team}/hist/{sender}",
+                self._on_reply,
+                payload=encode(request),
+                timeout=self._query_timeout,
+                consolidation=zenoh.ConsolidationMode.NONE,
+            )
+        except Exception:  # (closed meanwhile, or the sender gone: the time-out asks again)
+            return
+
+    def _on_query(self, query: Any) -> None:
+        """Answer a receiver's history query: the kept reliable messages it lacks, in send order."""
+        payload = query.payload
+        data = payload.to_bytes() if payload is not None else b""
+        if data == _SYNC_BYTES:
+            try:
+                query.reply(f"{self._team}/hist/{self._id}", b"")
+            except Exception:  # (the asker left)
+                pass
+            return
+        with self._lock:
+            if self._closed or not data:
+                return
+            request = self._decode(data, 3)
+            if request is None or not isinstance(request[2], dict):
+                return
+            _who, incarnation, wanted = request
+            frames: list[tuple[int, bytes]] = []
+            start: dict[str, int] = {}
+            oldest: dict[str, int] = {}
+            for topic, (first, since) in wanted.items():
+                kept = self._history.get(topic, [])
+                last = self._rseq.get(topic, 0)
+                if first is None or incarnation != self._incarnation:
+                    # its first question (or about an earlier life of this agent): all since it subscribed
+                    frames += [(number, data) for number, at, data in kept if at >= since]
+                else:
+                    frames += [(number, data) for number, _, data in kept if number >= first]
+                start[topic] = last + 1
+                oldest[topic] = kept[0][0] if kept else last + 1
+        answer = encode((self._incarnation, self._id, tuple(data for _, data in frames), start, oldest))
+        try:
+            query.reply(f"{self._team}/hist/{self._id}", answer)
+        except Exception:  # (the asker left)
+            return
+
+    def _on_reply(self, reply: Any) -> None:
+        sample = getattr(reply, "ok", None)
+        if sample is None:
+            return
+        data = sample.payload.to_bytes()
+        with self._lock:
+            if self._closed:
+                return
+            answer = self._decode(data, 5)
+            if answer is None:
+                return
+            incarnation, sender, frames, start, oldest = answer
+            state = self._sender(sender, incarnation)
+            if state is None:
+                return
+            state.asked_at = None
+            decoded = [frame for frame in (self._decode(d, _FRAME_LEN) for d in frames) if frame is not None]
+            first_answer = {topic for topic in start if topic in self._subscribed and state.stream(topic).next is None}
+            for topic in first_answer:
+                stream = state.stream(topic)
+                numbers = [f[4] for f in decoded if f[2] == topic]
+                stream.next = min(numbers) if numbers else int(start[topic])
+                for number in [n for n in stream.held if n < stream.next]:
+                    del stream.held[number]  # sent before this agent subscribed
+            for topic, first in oldest.items():
+                known = state.streams.get(topic)
+                if topic not in first_answer and known is not None and known.next is not None and first > known.next:
+                    self._counts["lost"] += first - known.next
+                    known.next = first
+            for frame in decoded:
+                _, _, topic, seq, rseq, gseq, sent_at, payload = frame
+                known = state.streams.get(topic)
+                if known is None or known.next is None or rseq < known.next or rseq in known.held:
+                    continue
+                shown = state.offset.get(topic, 0) + seq
+                known.held[rseq] = (gseq, Envelope(topic, sender, shown, payload, sent_at, QoS.RELIABLE))
+                self._counts["recovered"] += topic not in first_answer
+            self._release(state)
+
+    def _check_open(self, what: str) -> None:
+        if self._closed:
+            raise ValueError(f"transport of {self._id!r} is closed; it can no longer {what}")
+
+
+def free_endpoints(count: int, host: str = "127.0.0.1") -> list[str]:
+    """``count`` TCP endpoints on ``host`` whose ports are free now (for agents started on loopback).
+
+    Args:
+        count: how many.
+        host: the address to bind.
+
+    Returns:
+        Endpoints such as ``tcp/127.0.0.1:40123``, all different.
+    """
+    import socket
+
+    sockets = []
+    try:
+        for _ in range(count):
+            s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            s.bind((host, 0))
+            sockets.append(s)
+        return [f"tcp/{host}:{s.getsockname()[1]}" for s in sockets]
+    finally:
+        for s in sockets:
+            s.close()
