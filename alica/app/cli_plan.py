@@ -87,7 +87,14 @@ def add_parser(sub: Any) -> None:
     p.add_argument(
         "--json",
         action="store_true",
-        help='print {"solved", "cost", "plan", "time_first_s", "time_s", "expansions"} as JSON',
+        help='print {"solved", "cost", "plan", "time_first_s", "time_s", "expansions"} as JSON '
+        '(with --parallel also "agents" and "messages")',
+    )
+    p.add_argument(
+        "--parallel",
+        type=_agents,
+        metavar="N",
+        help="MAGiC: split the search over N agent processes on loopback (zenoh), the first valid plan wins",
     )
     p.set_defaults(run=cmd_plan)
 
@@ -99,6 +106,16 @@ def _positive(text: str) -> float:
         raise argparse.ArgumentTypeError(f"'{text}' is not a number of seconds") from None
     if not value > 0:
         raise argparse.ArgumentTypeError(f"the time limit must be positive, not {text}")
+    return value
+
+
+def _agents(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a number of agents") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"--parallel needs at least 1 agent, not {text}")
     return value
 
 
@@ -135,6 +152,8 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
         )
     if args.emit_plan or args.problem_name or args.world or args.goal:
         raise AlicaError("--problem, --world, --goal and --emit-plan go with a plan file, not with PDDL files")
+    if args.parallel is not None:
+        return _plan_parallel(args, limits)
     try:
         domain = read_domain(args.domain, limits)
         problem = read_problem(args.problem, domain, limits)
@@ -150,21 +169,63 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
     return _report(args, planner.name, result, lambda plan: _validated_cost(planner.name, (domain, problem), plan))
 
 
+def _plan_parallel(args: argparse.Namespace, limits: Limits) -> int:
+    """``--parallel N``: MAGiC over N agent processes (the builtin planner's first plan, not anytime)."""
+    from alica.app.magic_processes import run_processes
+    from alica.prophet.pddl import PddlError
+
+    if args.planner != "builtin" or args.anytime:
+        raise AlicaError("--parallel runs MAGiC with the builtin planner's first plan: drop --planner and --anytime")
+    try:
+        texts = Path(args.domain).read_text(encoding="utf-8"), Path(args.problem).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise AlicaError(f"cannot read {exc.filename}: {exc.strerror}") from None
+    remaining = limits.remaining()
+    try:
+        run = run_processes(
+            *texts,
+            args.parallel,
+            timeout=args.time_limit if remaining is None else remaining,
+            memory_mb=args.memory_limit,
+        )
+    except PddlError as exc:
+        print(str(exc), file=sys.stderr)
+        return EXIT_ERROR
+    message = "" if run.outcome is None else run.outcome.message
+    if run.outcome is None:
+        message = f"time limit {args.time_limit:g} s reached before the round ended"
+    result = PlanResult(run.status, run.plan, "magic", run.first_plan_s, run.wall_s, run.expansions, message)
+    return _report(
+        args,
+        "magic",
+        result,
+        lambda plan: plan.cost,  # validated by the leader
+        lambda: {"agents": run.agents, "messages": run.messages},
+        always=True,
+    )
+
+
 def _report(
     args: argparse.Namespace,
     name: str,
     result: PlanResult,
     cost_of: Callable[[Plan], float],
     extra: Callable[[], dict[str, Any]] | None = None,
+    *,
+    always: bool = False,
 ) -> int:
-    """Print the result; ``cost_of`` validates the plan (raising when it is not valid); ``extra`` adds fields (and lines)."""
+    """Print the result; ``cost_of`` validates the plan (raising when it is not valid); ``extra`` adds fields (and lines).
+
+    ``extra`` is asked only with a plan, unless ``always``.
+    """
     if result.status is PlanStatus.ERROR and result.plan is None:
         raise AlicaError(f"planner '{name}' failed: {result.message or 'no reason given'}")
     cost = None
     more: dict[str, Any] = {}
     if result.plan is not None:
         cost = cost_of(result.plan)
-        more = extra() if extra is not None else {}
+    if extra is not None and (always or result.plan is not None):
+        more = extra()
     if args.json:
         print(json.dumps({**_summary(result, cost), **more}))
     else:

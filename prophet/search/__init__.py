@@ -7,7 +7,7 @@ grounded task directly).
 
 from __future__ import annotations
 
-from alica.prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+from alica.prophet.search.anytime import DEFAULT_WEIGHTS, FIRST_HEURISTICS, FirstSearch, search_task
 from alica.prophet.search.planner import BuiltinPlanner
 
-__all__ = ["DEFAULT_WEIGHTS", "BuiltinPlanner", "search_task"]
+__all__ = ["DEFAULT_WEIGHTS", "FIRST_HEURISTICS", "BuiltinPlanner", "FirstSearch", "search_task"]

@@ -2,6 +2,9 @@
 
 1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
    finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
+   A :class:`FirstSearch` chooses another heuristic, a weight or a
+   tie-breaking seed for this search (MAGiC gives each agent its own); the
+   default is the search just described.
 2. Quick window sweeps on it (:mod:`alica.prophet.search.windows`: stretches of the
    plan replanned among their own objects).
 3. Restarts: unbounded lazy searches with other heuristics and weights, each
@@ -26,6 +29,7 @@ comes only for a plan cheaper than every one before.
 from __future__ import annotations
 
 from collections.abc import Generator, Iterator, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 from alica.prophet.planner import Done, Improved, Plan, PlanStatus, PlanStep, SearchEvent
@@ -42,6 +46,50 @@ NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
 """The first and the largest state limit of the neighbourhood rounds after each plan."""
 RESTART_BUDGET = 20
 """The expansion budget of each restart, in multiples of the first search's expansions."""
+FIRST_HEURISTICS: tuple[str, ...] = ("ff", "ff_add_unit", "ff_cost")
+"""The heuristics the first search may use (methods of :class:`~alica.prophet.search.heuristics.Relaxed`)."""
+
+
+@dataclass(frozen=True, slots=True)
+class FirstSearch:
+    """How the search for the first plan runs: lazy GBFS or lazy weighted A*.
+
+    ``FirstSearch()`` is the builtin planner's own first search (greedy, FF
+    with h_max supporters, the operators' order); other values lead to other
+    first plans, which is what MAGiC's shares differ in.
+
+    Attributes:
+        heuristic: ``"ff"`` (h_max supporters, plan length), ``"ff_add_unit"``
+            (h_add supporters, plan length) or ``"ff_cost"`` (h_add supporters,
+            plan cost).
+        weight: ``None`` for greedy search, else the weight w of ``g + w*h``.
+        seed: a tie-breaking seed (successors inserted in a shuffled order);
+            ``None``: the operators' order.
+
+    Raises:
+        ValueError: an unknown heuristic, or a weight that is not a finite number > 0.
+    """
+
+    heuristic: str = "ff"
+    weight: float | None = None
+    seed: int | None = None
+
+    def __post_init__(self) -> None:
+        if self.heuristic not in FIRST_HEURISTICS:
+            raise ValueError(
+                f"unknown first-search heuristic {self.heuristic!r}; choose one of {', '.join(FIRST_HEURISTICS)}"
+            )
+        if self.weight is not None and (
+            isinstance(self.weight, bool) or not isinstance(self.weight, int | float) or not 0 < self.weight < INF
+        ):
+            raise ValueError(f"the first search's weight must be a finite number > 0 or None, got {self.weight!r}")
+        if self.seed is not None and (isinstance(self.seed, bool) or not isinstance(self.seed, int)):
+            raise ValueError(f"the first search's seed must be an int or None, got {self.seed!r}")
+
+    def __str__(self) -> str:
+        weight = "greedy" if self.weight is None else f"w={self.weight:g}"
+        seed = "" if self.seed is None else f" seed={self.seed}"
+        return f"{self.heuristic} {weight}{seed}"
 
 
 def to_plan(ct: CompiledTask, ops: Sequence[int]) -> Plan:
@@ -69,6 +117,7 @@ def search_task(
     weights: Sequence[float] = DEFAULT_WEIGHTS,
     progress_every: int = 1000,
     optimal_pass: bool = True,
+    first: FirstSearch | None = None,
 ) -> Iterator[SearchEvent]:
     """Search a grounded task (``GroundTask`` shape), yielding planner events.
 
@@ -80,6 +129,7 @@ def search_task(
         optimal_pass: include the A* pass with h_max in the rounds; without it
             (and with inadmissible passes only) the run ends with
             ``Done(SOLVED)`` after one round.
+        first: how the first plan is searched; ``None`` is ``FirstSearch()``.
 
     Yields:
         ``Progress``, ``Improved`` for each cheaper plan, one final ``Done``.
@@ -94,7 +144,9 @@ def search_task(
         yield Done(PlanStatus.UNSOLVABLE, 0, "the goal is unreachable even ignoring deletes")
         return
     relaxed = Relaxed(ct)
-    ops, _exhausted = yield from lazy_search(ct, relaxed.ff, stats)
+    first = FirstSearch() if first is None else first
+    evaluate: Evaluator = getattr(relaxed, first.heuristic)
+    ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
     if ops is None:
         yield Done(PlanStatus.UNSOLVABLE, stats.expansions, "every reachable state was expanded")
         return
@@ -208,4 +260,4 @@ def _polish(ct: CompiledTask, plan: list[int], stats: Stats) -> Generator[Search
     return plan, False
 
 
-__all__ = ["DEFAULT_WEIGHTS", "INF", "search_task", "to_plan"]
+__all__ = ["DEFAULT_WEIGHTS", "FIRST_HEURISTICS", "INF", "FirstSearch", "search_task", "to_plan"]

@@ -5,7 +5,10 @@ estimate and are evaluated only when popped. Two open lists alternate: all
 successors, and the successors through preferred operators; each time the
 search finds a state with a lower estimate than before, the preferred list
 gets ``boost`` extra turns. Ties go to the earliest insertion, and states
-are plain ``int`` bitsets, so a run is deterministic.
+are plain ``int`` bitsets, so a run is deterministic. A ``seed`` shuffles
+the order in which each state's successors are inserted (so ties between
+siblings break another way, the same for the same seed); without one the
+order is the operators' own.
 
 The searches are generators: they yield :class:`~alica.prophet.planner.Progress`
 every ``progress_every`` expansions and *return* the plan (compiled operator
@@ -15,6 +18,7 @@ ids) or ``None``, and whether the open lists ran dry; use
 
 from __future__ import annotations
 
+import random
 from collections.abc import Generator
 from dataclasses import dataclass
 from heapq import heappop, heappush
@@ -67,6 +71,7 @@ def lazy_search(
     bound: float = INF,
     boost: int = 1000,
     max_expansions: float = INF,
+    seed: int | None = None,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """Lazy GBFS (``weight=None``) or lazy weighted A* with preferred operators.
 
@@ -78,6 +83,8 @@ def lazy_search(
         bound: successors with ``g >= bound`` are pruned.
         boost: extra turns for the preferred list after progress.
         max_expansions: give up after this many expansions.
+        seed: shuffle each state's successors with this seed before inserting them
+            (another tie-breaking); ``None`` keeps the operators' order.
 
     Returns:
         ``(plan, exhausted)``: the plan as compiled operator ids, or ``None``;
@@ -101,6 +108,7 @@ def lazy_search(
     count = 0
     expanded = 0
     best_h = INF
+    shuffle = random.Random(seed).shuffle if seed is not None else None
     entry: tuple[float, int, int, int, int] | None = (0.0, 0, -1, -1, 0)
     while True:
         if entry is None:
@@ -144,7 +152,13 @@ def lazy_search(
             best_h = h
             if pref:
                 prio[1] -= boost
-        for o in applicable(state):
+        successors = applicable(state)
+        if shuffle is not None:
+            successors = list(successors)
+            shuffle(successors)
+            pref = list(pref)
+            shuffle(pref)
+        for o in successors:
             g2 = g + op_cost[o]
             if g2 >= bound:
                 continue

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator, Sequence
 
 from alica.prophet.planner import Feature, Limits, Planner, SearchEvent
-from alica.prophet.search.anytime import DEFAULT_WEIGHTS, search_task
+from alica.prophet.search.anytime import DEFAULT_WEIGHTS, FirstSearch, search_task
 
 BYTES_PER_OPERATOR = 512
 """The search's memory estimate per operator besides its masks (three masks of half the facts' bits on average)."""
@@ -17,6 +17,8 @@ class BuiltinPlanner(Planner):
     Args:
         weights: the weighted A* weights of the anytime phase.
         progress_every: expansions between two ``Progress`` events.
+        first: how the first plan is searched (:class:`~alica.prophet.search.anytime.FirstSearch`);
+            ``None``: the default first search.
     """
 
     name = "builtin"
@@ -33,9 +35,16 @@ class BuiltinPlanner(Planner):
 
     takes_limits = True
 
-    def __init__(self, *, weights: Sequence[float] = DEFAULT_WEIGHTS, progress_every: int = 1000) -> None:
+    def __init__(
+        self,
+        *,
+        weights: Sequence[float] = DEFAULT_WEIGHTS,
+        progress_every: int = 1000,
+        first: FirstSearch | None = None,
+    ) -> None:
         self.weights = tuple(weights)
         self.progress_every = progress_every
+        self.first = first
 
     def _search(
         self, domain: object, problem: object, *, anytime: bool, limits: Limits | None = None
@@ -55,4 +64,6 @@ class BuiltinPlanner(Planner):
                 n_ops * (BYTES_PER_OPERATOR + 3 * n_facts // 16),
                 f"{n_ops} ground operators over {n_facts} facts",
             )
-        yield from search_task(task, anytime=anytime, weights=self.weights, progress_every=self.progress_every)
+        yield from search_task(
+            task, anytime=anytime, weights=self.weights, progress_every=self.progress_every, first=self.first
+        )

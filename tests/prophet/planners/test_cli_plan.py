@@ -129,3 +129,23 @@ def test_a_failing_back_end_is_an_error(alica, blocks, monkeypatch: pytest.Monke
     run = alica("plan", *blocks("4-0"), "--json")
     assert run.code == 1 and run.out == ""
     assert "planner 'scripted' failed: it broke" in run.err
+
+
+def test_parallel_runs_magic_over_agent_processes(alica, rovers) -> None:
+    domain, problem = rovers("p03")
+    run = alica("plan", domain, problem, "--parallel", "3", "--json", "--time-limit", "60")
+    assert run.code == 0, run.err
+    summary = json.loads(run.out)
+    assert set(summary) == JSON_KEYS | {"agents", "messages"}
+    check_json(json.dumps({k: v for k, v in summary.items() if k in JSON_KEYS}), domain, problem)
+    assert summary["agents"] == 3
+    assert 0 < summary["messages"] <= 6
+
+
+def test_parallel_proves_unsolvable_and_refuses_other_planners(alica, unsolvable, rovers) -> None:
+    run = alica("plan", *unsolvable, "--parallel", "2", "--json", "--time-limit", "60")
+    assert run.code == 3, run.err
+    summary = json.loads(run.out)
+    assert (summary["solved"], summary["agents"]) == (False, 2) and summary["messages"] <= 3
+    run = alica("plan", *rovers("p01"), "--parallel", "2", "--anytime")
+    assert run.code == 1 and "--parallel runs MAGiC" in run.err

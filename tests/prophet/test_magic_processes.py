@@ -1,0 +1,22 @@
+"""MAGiC over agent processes linked by zenoh on loopback (the leader in the test's process)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from alica.app.magic_processes import run_processes
+from alica.prophet.pddl import parse_domain, parse_problem
+from alica.prophet.planner import PlanStatus
+from alica.prophet.validate import validate_plan
+
+ROVERS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl" / "rovers"
+
+
+def test_three_agent_processes_give_a_valid_plan_within_the_message_bound() -> None:
+    domain, problem = (ROVERS / "domain.pddl").read_text(), (ROVERS / "p05.pddl").read_text()
+    run = run_processes(domain, problem, 3, timeout=60)
+    assert run.status is PlanStatus.SOLVED and run.plan is not None
+    parsed = parse_domain(domain)
+    assert validate_plan((parsed, parse_problem(problem, "p05", parsed)), run.plan).valid
+    assert 4 <= run.messages <= 6  # two shares and two finals at least
+    assert run.agents == 3 and run.first_plan_s is not None
