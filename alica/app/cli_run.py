@@ -333,7 +333,7 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
         if args.trace:
             team.trace(Path(args.trace))
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
-    for name, agent in summary["agents"].items():
+    for agent in summary["agents"].values():
         agent.setdefault("reason", None if agent["status"] == "success" else _process_reason(agent))
     if args.json:
         print(json.dumps(summary, indent=2, sort_keys=True))
