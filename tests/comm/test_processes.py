@@ -1,0 +1,129 @@
+"""A team of processes over zenoh: ``alica run --processes`` end to end, with kill -9, restart and a partition.
+
+Every run is bounded by ``--max-time`` (wall seconds) and talks on loopback
+only; the partition cuts the relays between the agents' links, never the
+host's network. The 3-agent lunar mission with stand-ins takes about 15 s.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from alica.app.cli import main
+from tests.conftest import PLANS
+
+LUNAR = str(PLANS / "lunar" / "mission.yaml")
+TEAM = ["--stand-ins", "--agents", "scout,stummel,amparo", "--fact", "found(a) and found(b)@3"]
+TEAM_TIMEOUT = 3.0
+TICK = 1 / 30
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, dict]:
+    code = main(["run", LUNAR, *TEAM, "--processes", "--max-time", "60", "--json", *argv])
+    return code, json.loads(capsys.readouterr().out)
+
+
+def events(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
+
+
+def team_changes(trace: list[dict], change: str, who: str) -> dict[str, float]:
+    """When each agent saw ``who`` lost or back (the first time)."""
+    seen: dict[str, float] = {}
+    for e in trace:
+        if e["event"] == "team" and e["change"] == change and e["who"] == who:
+            seen.setdefault(e["agent"], e["t"])
+    return seen
+
+
+def test_a_lunar_team_of_processes_succeeds(capsys, tmp_path):
+    code, summary = run(capsys, "--trace", str(tmp_path / "run.jsonl"))
+    assert code == 0, summary
+    assert summary["processes"] and summary["clock"] == "wall"
+    assert {name: a["status"] for name, a in summary["agents"].items()} == dict.fromkeys(
+        ("scout", "stummel", "amparo"), "success"
+    )
+    assert summary["world_models_agree"]
+    assert summary["messages"]["delivered"] > 0 and summary["messages"]["dropped"] == 0
+    trace = events(tmp_path / "run.jsonl")
+    assert {e["agent"] for e in trace} >= {"scout", "stummel", "amparo"}
+    assert [e["t"] for e in trace] == sorted(e["t"] for e in trace)
+
+
+def test_kill_9_takes_an_agent_out_and_its_restart_catches_up(capsys, tmp_path):
+    trace_file = tmp_path / "run.jsonl"
+    code, summary = run(capsys, "--crash", "stummel@6", "--recover", "stummel@9", "--trace", str(trace_file))
+    assert code == 0, summary
+    assert summary["agents"]["stummel"]["incarnations"] == 2
+    assert summary["world_models_agree"]
+    trace = events(trace_file)
+    crash = next(e["t"] for e in trace if e["event"] == "fault" and e["fault"] == "crash")
+    recover = next(e["t"] for e in trace if e["event"] == "fault" and e["fault"] == "recover")
+    lost = team_changes(trace, "lost", "stummel")
+    assert set(lost) == {"scout", "amparo"}
+    for t in lost.values():  # liveliness: well within the team timeout
+        assert crash <= t <= crash + TEAM_TIMEOUT + 2 * TICK
+    back = team_changes(trace, "back", "stummel")
+    assert set(back) == {"scout", "amparo"} and all(t >= recover for t in back.values())
+
+
+def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
+    trace_file = tmp_path / "run.jsonl"
+    code, summary = run(capsys, "--partition", "scout|stummel,amparo@4-8", "--trace", str(trace_file))
+    assert code == 0, summary
+    assert summary["world_models_agree"] and summary["messages"]["dropped"] == 0
+    trace = events(trace_file)
+    assert set(team_changes(trace, "lost", "scout")) == {"stummel", "amparo"}
+    assert set(team_changes(trace, "lost", "stummel")) == {"scout"}
+    back = team_changes(trace, "back", "scout")
+    assert set(back) == {"stummel", "amparo"} and all(t >= 8.0 for t in back.values())
+    # both sides went on while cut off: the far side's behaviours changed during the cut
+    assert any(
+        e["event"] == "behaviour" and e["agent"] in ("stummel", "amparo") and 4.5 < e["t"] < 8.0 for e in trace
+    )
+
+
+def test_ctrl_c_stops_every_agent_process(tmp_path):
+    argv = [sys.executable, "-m", "alica.app.cli", "run", LUNAR, *TEAM, "--processes", "--max-time", "60", "--json"]
+    process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+    time.sleep(4.0)  # a real process tree on the wall clock: let the agents start
+    os.kill(process.pid, signal.SIGINT)
+    out, err = process.communicate(timeout=30)
+    assert process.returncode == 130, err
+    summary = json.loads(out)
+    assert all(a["status"] == "running" for a in summary["agents"].values())  # stopped mid-mission, each reported
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--world", "lunar"], "--world only work in the simulated run"),
+        (["--loss", "0.1"], "--loss only work in the simulated run"),
+        (["--crash", "nobody@3"], "no agent named 'nobody'"),
+    ],
+)
+def test_process_runs_refuse_what_only_simulation_does(capsys, argv, message):
+    assert main(["run", LUNAR, *TEAM, "--processes", *argv]) == 1
+    assert message in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--name", "zorro", "--agents", "scout,stummel"], "--name zorro is not in --agents"),
+        (["--name", "scout", "--zenoh", "nonsense"], "is not KEY=JSON"),
+        (["--name", "scout", "--connect", "localhost"], "a zenoh endpoint looks like"),
+        (["--name", "scout", "--frequency", "0"], "--frequency must be > 0"),
+    ],
+)
+def test_alica_agent_explains_bad_input(capsys, argv, message):
+    assert main(["agent", LUNAR, "--stand-ins", *argv]) == 1
+    assert message in capsys.readouterr().err
