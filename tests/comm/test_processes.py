@@ -86,9 +86,7 @@ def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
     back = team_changes(trace, "back", "scout")
     assert set(back) == {"stummel", "amparo"} and all(t >= 8.0 for t in back.values())
     # both sides went on while cut off: the far side's behaviours changed during the cut
-    assert any(
-        e["event"] == "behaviour" and e["agent"] in ("stummel", "amparo") and 4.5 < e["t"] < 8.0 for e in trace
-    )
+    assert any(e["event"] == "behaviour" and e["agent"] in ("stummel", "amparo") and 4.5 < e["t"] < 8.0 for e in trace)
 
 
 def test_ctrl_c_stops_every_agent_process(tmp_path):

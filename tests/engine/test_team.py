@@ -225,3 +225,54 @@ def test_a_planning_problem_runs_its_wait_plan_until_a_plan_exists(tmp_path):
     for agent in ("w", "h"):
         assert where(sim, agent, 1) == ("Watch", "Parked")
         assert sim.engines[agent].root.slots[0].node.plan.name == "Park"
+
+
+class _Tokens:
+    """A simulated transport whose peers come from liveliness tokens the test sets (as zenoh's do)."""
+
+    tracks_liveliness = True
+
+    def __init__(self, inner, alive):
+        self._inner = inner
+        self.alive = set(alive)
+
+    def peers(self):
+        return frozenset(self.alive)
+
+    def __getattr__(self, name):
+        return getattr(self._inner, name)
+
+
+def test_a_teammate_whose_token_vanishes_is_taken_out_at_once(tmp_path):
+    lib = library(tmp_path, PLANS)
+    sim, trace = team(lib, "Shop", {"w": "Worker", "h": "Helper"}, SKILLS)
+    tokens = _Tokens(sim.engines["h"].transport, {"w"})
+    sim.engines["h"] = sim._make_engine("h", tokens)
+    sim.run(ticks=3)
+    assert where(sim, "w") == ("Work", "Working") and where(sim, "h") == ("Help", "Helping")
+    crashed_at = sim.now()
+    sim.crash("w")
+    tokens.alive.clear()  # kill -9: its token goes within milliseconds
+    sim.run(ticks=2)  # 0.2 s, far less than the team timeout of 0.5 s
+    [lost] = trace.of("team", agent="h", change="lost", who="w")
+    assert lost["t"] <= crashed_at + sim.config.period + 1e-9  # the next tick, not the team timeout
+    assert where(sim, "h") == ("Work", "Working")
+    sim.recover("w")
+    tokens.alive.add("w")
+    sim.run(ticks=10)
+    assert trace.of("team", agent="h", change="back", who="w")
+    assert where(sim, "w") == ("Work", "Working")
+
+
+def test_late_messages_from_before_a_departure_do_not_revive():
+    from alica.engine.team import TeamView
+
+    view = TeamView("a", {"a": "R", "b": "R"}, 0.0, 3.0)
+    assert view.heard("b", 1.0, 1.0) is False  # alive already
+    assert view.depart("b", 2.0) is True
+    assert view.depart("b", 2.1) is False  # already out
+    assert not view.is_alive("b")
+    assert view.heard("b", 1.5, 2.5) is False  # sent before it left: it stays out
+    assert view.heard("b", 2.2, 2.5) is True  # sent after: back
+    assert view.is_alive("b")
+    assert view.depart("nobody", 3.0) is False
