@@ -111,6 +111,10 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(run=cmd_agent)
 
 
+WORLD_TRACE_GAP = 0.1
+"""Seconds between two ``world`` trace events (the world model's digest) at most."""
+
+
 def _zenoh_settings(items: list[str]) -> dict[str, object]:
     settings: dict[str, object] = {}
     for item in items:
@@ -225,7 +229,17 @@ def _run(
                 for positive, pred, fact_args in literals_now:
                     (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
 
+        world = {"changed": True, "at": float("-inf"), "digest": ""}
+        engine.world_model.on_change(lambda _keys: world.update(changed=True))
+
         def report(now: float) -> None:
+            if trace is not None and world["changed"] and now - float(world["at"]) >= WORLD_TRACE_GAP:
+                # the world model's fingerprint in the trace: when two agents' agree, their states are equal
+                world.update(changed=False, at=now)
+                digest = _digest(engine.world_model)
+                if digest != world["digest"]:
+                    world["digest"] = digest
+                    engine.emit("world", digest=digest, facts=len(engine.world_model.facts()))
             current = root_status(engine)
             if current != status[0]:
                 status[0] = current
@@ -249,6 +263,7 @@ def _run(
             time_s=round(clock.now() - start, 3),
             transport=_counters(transport),
             world_digest=_digest(engine.world_model),
+            world_facts=[str(fact) for fact in engine.world_model.facts()],
         )
     finally:
         transport.close()

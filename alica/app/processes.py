@@ -67,6 +67,7 @@ class ProcessTeam:
         options: more ``alica agent`` options for every agent (``--stand-ins``, ``--fact``, ...).
         workdir: where the agents' traces and logs go.
         relays: link the agents through relays, so that :meth:`partition` can cut them.
+        own: more options for single agents, by name (one robot's operator, say).
     """
 
     def __init__(
@@ -78,10 +79,12 @@ class ProcessTeam:
         workdir: Path,
         *,
         relays: bool = False,
+        own: dict[str, list[str]] | None = None,
     ) -> None:
         self.plan = plan
         self.roster = agents
         self.options = list(options)
+        self.own = dict(own or {})
         self.workdir = workdir
         self.start = time.time()
         self.faults: list[dict[str, Any]] = []
@@ -130,6 +133,7 @@ class ProcessTeam:
             str(trace),
             "--json",
             *self.options,
+            *self.own.get(agent.name, ()),
         ]
         agent.log = (self.workdir / f"{agent.name}.{agent.incarnation}.log").open("w", encoding="utf-8")
         agent.process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=agent.log, text=True, bufsize=1)
@@ -305,7 +309,12 @@ class ProcessTeam:
                 )
                 if key in last
             }
-            agents[name].update(status=status, incarnations=agent.incarnation, overruns=last.get("overruns", 0))
+            agents[name].update(
+                status=status,
+                incarnations=agent.incarnation,
+                overruns=last.get("overruns", 0),
+                world_facts=last.get("world_facts"),
+            )
             for summary in agent.summaries:
                 counters = summary.get("transport", {})
                 sent += int(counters.get("sent", 0))

@@ -125,3 +125,34 @@ def test_process_runs_refuse_what_only_simulation_does(capsys, argv, message):
 def test_alica_agent_explains_bad_input(capsys, argv, message):
     assert main(["agent", LUNAR, "--stand-ins", *argv]) == 1
     assert message in capsys.readouterr().err
+
+
+def test_writes_on_both_sides_of_a_partition_reach_everyone_once_it_heals(tmp_path):
+    from alica.app.processes import ProcessTeam
+
+    team = ProcessTeam(
+        LUNAR,
+        "scout,stummel,amparo",
+        ["scout", "stummel", "amparo"],
+        ["--stand-ins", "--max-time", "40"],
+        tmp_path,
+        relays=True,
+        own={"scout": ["--fact", "found(a)@5"], "amparo": ["--fact", "found(b)@6"]},  # one robot's operator each
+    )
+    try:
+        team.launch()
+        while team.now() < 3.5:
+            time.sleep(0.05)
+        team.partition([["scout"], ["stummel", "amparo"]], 3.5, 8.0)
+        while team.now() < 8.0:
+            time.sleep(0.05)
+        team.heal()
+        while not team.done() and team.now() < 40:
+            time.sleep(0.05)
+    finally:
+        team.stop()
+    summary = team.summary("LunarMission", 0)
+    assert summary["success"], summary
+    assert summary["world_models_agree"]
+    for agent in summary["agents"].values():
+        assert {"found(a)", "found(b)"} <= set(agent["world_facts"])
