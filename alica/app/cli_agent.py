@@ -229,16 +229,16 @@ def _run(
                 for positive, pred, fact_args in literals_now:
                     (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
 
-        world = {"changed": True, "at": float("-inf"), "digest": ""}
-        engine.world_model.on_change(lambda _keys: world.update(changed=True))
+        world = _WorldTrace()
+        engine.world_model.on_change(world.touch)
 
         def report(now: float) -> None:
-            if trace is not None and world["changed"] and now - float(world["at"]) >= WORLD_TRACE_GAP:
+            if trace is not None and world.changed and now - world.at >= WORLD_TRACE_GAP:
                 # the world model's fingerprint in the trace: when two agents' agree, their states are equal
-                world.update(changed=False, at=now)
+                world.changed, world.at = False, now
                 digest = _digest(engine.world_model)
-                if digest != world["digest"]:
-                    world["digest"] = digest
+                if digest != world.digest:
+                    world.digest = digest
                     engine.emit("world", digest=digest, facts=len(engine.world_model.facts()))
             current = root_status(engine)
             if current != status[0]:
@@ -280,6 +280,18 @@ def _run(
             f"at {summary['path'] or '-'}"
         )
     return 0 if summary["status"] == "success" else 1
+
+
+class _WorldTrace:
+    """When the world model changed and its last digest in the trace."""
+
+    def __init__(self) -> None:
+        self.changed = True
+        self.at = float("-inf")
+        self.digest = ""
+
+    def touch(self, _keys: object) -> None:
+        self.changed = True
 
 
 def _counters(transport: Any) -> dict[str, int]:
