@@ -26,6 +26,7 @@ from alica.engine.child import ChildHost, ChildSlot, PlanKey
 from alica.engine.config import EngineConfig
 from alica.model import PlanningProblem
 from alica.prophet.board import PLAN_TOPIC, PlanBoard
+from alica.prophet.magic.team import TeamMagic
 from alica.prophet.runtime import ProblemRuntime, SearchBudget
 from alica.prophet.tasks import CreatedTasks
 
@@ -41,10 +42,12 @@ class Planning:
 
     budget: SearchBudget = field(default_factory=SearchBudget)
     topic: str | None = PLAN_TOPIC
+    parallel: bool = False
+    """MAGiC: the leader splits its search over the agents in the problem's state (:mod:`alica.prophet.magic.team`)."""
 
     def __call__(self, host: ChildHost) -> PlanningAgent:
         """Attach to one agent's engine."""
-        return PlanningAgent(host, self.budget)
+        return PlanningAgent(host, self.budget, parallel=self.parallel)
 
 
 class PlanningAgent:
@@ -55,18 +58,21 @@ class PlanningAgent:
         budget: the leader's search budget per tick.
     """
 
-    def __init__(self, host: ChildHost, budget: SearchBudget) -> None:
+    def __init__(self, host: ChildHost, budget: SearchBudget, *, parallel: bool = False) -> None:
         self.host = host
         self.budget = budget
         self.board = PlanBoard()
+        self.magic = TeamMagic(host, budget.expansions, budget.seconds) if parallel else None
         host.counters.setdefault("replans", 0)
 
     def __call__(self, slot: ChildSlot) -> ProblemRuntime:
         """The runtime of a planning-problem child (the agent enters its state)."""
-        return ProblemRuntime(self.host, slot, self.board, self.budget)
+        return ProblemRuntime(self.host, slot, self.board, self.budget, self.magic)
 
     def receive(self, payload: object, now: float) -> None:
-        """A plan share or a replan request arrived."""
+        """A plan share, a replan request or a MAGiC message arrived."""
+        if self.magic is not None and self.magic.receive(payload):
+            return
         self.board.receive(payload, now)
 
 
@@ -79,6 +85,7 @@ def engine_config(
     *,
     planner_expansions: int = 1000,
     planner_seconds: float | None = None,
+    parallel_planning: bool = False,
     **settings: Any,
 ) -> EngineConfig:
     """An engine configuration with pRoPhEt MAS plugged in for planning problems.
@@ -89,13 +96,16 @@ def engine_config(
             (deterministic: the same run plans the same way).
         planner_seconds: a wall-time budget per tick instead (for real robots);
             ``None`` uses ``planner_expansions``.
+        parallel_planning: MAGiC: the leader splits each search over the agents in
+            the planning problem's state, each searching one share with its own budget
+            (:mod:`alica.prophet.magic.team`); the first valid plan wins.
         **settings: other :class:`~alica.engine.config.EngineConfig` settings.
 
     Raises:
         ValueError: a setting is out of range.
     """
     base = config or EngineConfig()
-    planning = Planning(SearchBudget(planner_expansions, planner_seconds))
+    planning = Planning(SearchBudget(planner_expansions, planner_seconds), parallel=parallel_planning)
     return replace(base, children={**base.children, PlanningProblem: planning}, **settings)
 
 

@@ -60,8 +60,11 @@ from alica.errors import AlicaError, PlannerError
 from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
-from alica.prophet.pipeline import Found, ProblemEvent, Rejected, ValidPlan, plan_problem
-from alica.prophet.planner import Done, PlanStatus
+from alica.prophet.magic.leader import MagicLeader
+from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
+from alica.prophet.pddl.writer import write_domain, write_problem
+from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
+from alica.prophet.planner import Done, PlanStatus, Progress
 from alica.prophet.problem import predicate_types
 from alica.prophet.tasks import (
     STEP_DONE,
@@ -143,7 +146,9 @@ class ProblemRuntime:
         TypeError: the child is not a planning problem.
     """
 
-    def __init__(self, host: ChildHost, slot: ChildSlot, board: PlanBoard, budget: SearchBudget) -> None:
+    def __init__(
+        self, host: ChildHost, slot: ChildSlot, board: PlanBoard, budget: SearchBudget, magic: TeamMagic | None = None
+    ) -> None:
         element = slot.element
         if not isinstance(element, PlanningProblem):
             raise TypeError(f"pRoPhEt MAS runs planning problems, not {element!r}")
@@ -151,6 +156,8 @@ class ProblemRuntime:
         self.slot = slot
         self.board = board
         self.budget = budget
+        self.magic = magic
+        """The agent's MAGiC (parallel planning on): the leader searches with the teammates in the state."""
         self.model = element
         self.key: PlanKey = slot.key
         self.share: PlanShare | None = None
@@ -255,6 +262,8 @@ class ProblemRuntime:
     def update(self, now: float) -> None:
         """Take in shares, lead when this agent is the leader, repeat a pending replan request."""
         host = self.host
+        if self.magic is not None:
+            self.magic.tick(self.slot.members)  # search a share of the leader's, if one came
         latest = self.board.shares.get(self.key)
         if (
             latest is not None
@@ -544,7 +553,12 @@ class ProblemRuntime:
                     return
                 problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
             options = {"progress_every": 100} if problem.planner == "builtin" else {}
-            events = plan_problem(problem, host.library, world, options=options).search(anytime=True)
+            planning = plan_problem(problem, host.library, world, options=options)
+            team = [a for a in self.slot.members() if a != me]
+            if self.magic is not None and problem.planner == "builtin" and team:
+                events = self._magic_events(planning, generation, self.magic)
+            else:
+                events = planning.search(anytime=True)
         except (PlannerError, AlicaError) as exc:
             host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
@@ -576,6 +590,51 @@ class ProblemRuntime:
             now,
         )
         self.next_update = now + self.model.update_time
+
+    def _magic_events(self, planning: ProblemPlanning, generation: int, magic: TeamMagic) -> Iterator[ProblemEvent]:
+        """A MAGiC round over the agents in the state as the leader's search events; its first valid plan wins."""
+        host = self.host
+        members = self.slot.members
+        leader = MagicLeader(
+            magic.leader_link(members),
+            write_domain(planning.domain),
+            write_problem(planning.pddl),
+            seed=generation,
+            seconds=self.model.timeout,
+            clock=host.now,
+            progress_every=STEP_EXPANSIONS,
+            first_round=generation,
+        )
+        agents = (host.name, *sorted(a for a in members() if a != host.name))
+        leader.start(agents)
+        host.emit("planner", key=key_text(self.key), what="magic", round=generation, agents=list(agents))
+        expansions = 0
+        while True:
+            outcome = leader.step(1)
+            if outcome is None:
+                expansions += STEP_EXPANSIONS
+                yield Progress(expansions)
+                continue
+            host.emit(
+                "planner",
+                key=key_text(self.key),
+                what="magic done",
+                round=generation,
+                status=outcome.status.value,
+                solver=outcome.solver,
+                messages=outcome.messages,
+                lost=list(outcome.lost),
+                seconds=round(outcome.seconds, 6),
+            )
+            if outcome.plan is None:
+                yield Done(outcome.status, outcome.expansions, outcome.message)
+                return
+            try:
+                yield Found(planning.validated(outcome.plan), outcome.expansions)
+            except PlannerError as exc:
+                yield Rejected(str(exc), outcome.expansions)
+            yield Done(PlanStatus.SOLVED, outcome.expansions, "MAGiC: the first valid plan wins")
+            return
 
     def _wait_for_team(self, now: float, world: PlanningWorld, status: PlanStatus) -> bool:
         """Whether to wait for robots outside the team (a partition heals, a crashed robot restarts) before failing.

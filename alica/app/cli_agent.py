@@ -105,6 +105,11 @@ def add_parser(sub: Any) -> None:
         action="store_true",
         help="run scripted stand-ins for skills without an implementation and for skills that act on a robot",
     )
+    p.add_argument(
+        "--parallel-planning",
+        action="store_true",
+        help="MAGiC: as the leader of a planning problem, split the search over the agents in its state",
+    )
     add_skills_option(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace")
     p.add_argument("--json", action="store_true", help="print status and summary lines as JSON")
@@ -183,7 +188,9 @@ def _run(
     specs = {n: r if isinstance(r, AgentSpec) else AgentSpec(role=r) for n, r in sorted(roles.items())}
     roleset = pick_roleset(library, (s.role for s in specs.values()), args.roleset)
     roster = assign_roles(specs, roleset)
-    config = engine_config(frequency=args.frequency, planner_seconds=0.3 / args.frequency)
+    config = engine_config(
+        frequency=args.frequency, planner_seconds=0.3 / args.frequency, parallel_planning=args.parallel_planning
+    )
     trace = JsonlTrace(args.trace) if args.trace else None
     observers: tuple[Any, ...] = ()
     if trace is not None:
@@ -267,6 +274,8 @@ def _run(
         )
     finally:
         transport.close()
+        for what, count in sorted(transport.errors.items()):
+            print(f"alica agent {args.name}: {count} message(s) could not be decoded, from {what}", file=sys.stderr)
         if trace is not None:
             trace.close()
         for sig, handler in previous.items():

@@ -103,6 +103,11 @@ def add_parser(sub: Any) -> None:
     )
     add_skills_option(p)
     p.add_argument(
+        "--parallel-planning",
+        action="store_true",
+        help="MAGiC: the leader of a planning problem splits its search over the agents in the problem's state",
+    )
+    p.add_argument(
         "--processes",
         action="store_true",
         help="run every agent in its own process (alica agent) over zenoh on loopback, on the wall clock; "
@@ -212,7 +217,9 @@ def _run_team(
         plan,
         roles,
         seed=args.seed,
-        config=engine_config(frequency=args.frequency),  # planning problems run with pRoPhEt MAS
+        config=engine_config(  # planning problems run with pRoPhEt MAS
+            frequency=args.frequency, parallel_planning=args.parallel_planning
+        ),
         roleset=args.roleset,
         loss=args.loss,
         delay=args.delay / 1000.0,
@@ -307,6 +314,8 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
         options += ["--roleset", args.roleset]
     if args.stand_ins:
         options.append("--stand-ins")
+    if args.parallel_planning:
+        options.append("--parallel-planning")
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
         team = ProcessTeam(args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition))
         interrupted = False

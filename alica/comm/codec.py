@@ -3,10 +3,10 @@
 The simulated network passes payloads by reference; a transport between
 processes must turn them into bytes. Payloads are plain immutable data
 (:mod:`alica.comm.transport`): tuples, ``str``, numbers, ``None``, and frozen
-dataclasses and enums made of those. :func:`encode` pickles them (the C
+dataclasses, named tuples and enums made of those. :func:`encode` pickles them (the C
 pickler is the fastest encoder of such data in the standard library);
 :func:`decode` unpickles with an unpickler that loads no class except the
-dataclasses and enums of the modules it is allowed (``alica.`` and whatever a
+dataclasses, named tuples and enums of the modules it is allowed (``alica.`` and whatever a
 user's skills add with :func:`allow_module`). A peer on the network therefore
 cannot make a receiver import a module or call a function: a plain
 ``pickle.loads`` would run any code the sender asked for.
@@ -79,10 +79,16 @@ class _Unpickler(pickle.Unpickler):
             found = getattr(importlib.import_module(module), name)
         except (ImportError, AttributeError) as exc:
             raise CodecError(f"a payload names {module}.{name}, which this process does not have: {exc}") from None
-        if not isinstance(found, type) or not (dataclasses.is_dataclass(found) or issubclass(found, enum.Enum)):
-            raise CodecError(f"a payload names {module}.{name}, which is not a dataclass or an enum")
+        if not isinstance(found, type) or not (
+            dataclasses.is_dataclass(found) or issubclass(found, enum.Enum) or _named_tuple(found)
+        ):
+            raise CodecError(f"a payload names {module}.{name}, which is not a dataclass, a named tuple or an enum")
         _CACHE[key] = found
         return found
+
+
+def _named_tuple(cls: type) -> bool:
+    return issubclass(cls, tuple) and isinstance(getattr(cls, "_fields", None), tuple)
 
 
 def encode(payload: object) -> bytes:

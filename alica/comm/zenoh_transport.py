@@ -47,13 +47,15 @@ from alica.comm.transport import Envelope, QoS, Transport
 
 _CHUNK = re.compile(r"[^/*$?#\s]+")
 
-# A frame: (incarnation, sender, topic, seq, rseq, gseq, sent_at, payload). ``seq`` counts the
+# A frame: (incarnation, sender, topic, seq, rseq, gseq, sent_at, payload bytes). ``seq`` counts the
 # sender's messages on the topic, ``rseq`` its reliable ones on the topic (0 for best-effort) and
 # ``gseq`` its reliable ones on every topic (0 for best-effort): receivers find gaps by ``rseq``
-# and deliver a sender's reliable messages in ``gseq`` order, whatever their topic.
+# and deliver a sender's reliable messages in ``gseq`` order, whatever their topic. The payload
+# is encoded on its own: one a receiver cannot decode is counted and skipped, and its stream goes on.
 Frame = tuple[int, str, str, int, int, int, float, object]
 _FRAME_LEN = 8
 _SYNC = ("sync",)
+_UNDECODABLE = object()
 _SYNC_BYTES = encode(_SYNC)
 
 
@@ -79,8 +81,8 @@ class _Stream:
 
     next: int | None = None
     """The next reliable number to deliver; ``None`` until the sender's history said where to start."""
-    held: dict[int, tuple[int, Envelope]] = field(default_factory=dict)
-    """Reliable messages not delivered yet, by number: (gseq, envelope)."""
+    held: dict[int, tuple[int, Envelope | None]] = field(default_factory=dict)
+    """Reliable messages not delivered yet, by number: (gseq, envelope; ``None`` when it cannot be decoded)."""
     last_gseq: int = 0
     """The sender-wide number of the last message delivered from this stream."""
 
@@ -205,6 +207,8 @@ class ZenohTransport(Transport):
         self._pending: dict[tuple[str, str], int] = {}
         self._alive: set[str] = set()
         self._counts = dict.fromkeys(ZenohStats.__slots__, 0)
+        self.errors: dict[str, int] = {}
+        """Why payloads could not be decoded (sender, topic, reason) and how often."""
         self._subscribers: list[Any] = []
         self._session = zenoh.open(self._config(tuple(connect), tuple(listen), mode, lease, config))
         try:
@@ -282,10 +286,10 @@ class ZenohTransport(Transport):
             with self._lock:
                 rseq = self._rseq[topic] = self._rseq.get(topic, 0) + 1
                 self._gseq += 1
-                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, payload))
+                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, encode(payload)))
                 self._history.setdefault(topic, []).append((rseq, now, data))
         else:
-            data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, payload))
+            data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, encode(payload)))
         publisher = self._publishers.get((topic, qos))
         if publisher is None:
             publisher = self._publishers[(topic, qos)] = self._session.declare_publisher(
@@ -433,14 +437,17 @@ class ZenohTransport(Transport):
 
     def _receive(self, frame: Frame) -> str | None:
         """Take in one frame (lock held); returns the sender when its history must be asked."""
-        incarnation, sender, topic, seq, rseq, gseq, sent_at, payload = frame
+        incarnation, sender, topic, seq, rseq, gseq, sent_at, data = frame
         if topic not in self._subscribed or sender == self._id:
             return None
         state = self._sender(sender, incarnation)
         if state is None:
             return None
         shown = state.offset.get(topic, 0) + seq
+        payload = self._payload(data, sender, topic)
         if rseq == 0:
+            if payload is _UNDECODABLE:
+                return None
             if shown <= state.last_seq.get(topic, 0):
                 self._counts["superseded"] += 1
                 return None
@@ -457,9 +464,26 @@ class ZenohTransport(Transport):
         if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
             self._counts["duplicates"] += 1
             return None
-        stream.held[rseq] = (gseq, Envelope(topic, sender, shown, payload, sent_at, QoS.RELIABLE))
+        stream.held[rseq] = (gseq, self._envelope(topic, sender, shown, payload, sent_at))
         self._release(state)
         return self._want(sender, state) if stream.gapped() else None
+
+    def _payload(self, data: object, sender: str, topic: str) -> object:
+        """The decoded payload, or :data:`_UNDECODABLE` (counted, its reason kept) (lock held)."""
+        if not isinstance(data, bytes):
+            self._counts["undecodable"] += 1
+            return _UNDECODABLE
+        try:
+            return decode(data)
+        except CodecError as exc:
+            self._counts["undecodable"] += 1
+            self.errors.setdefault(f"{sender} on {topic}: {exc}", 0)
+            self.errors[f"{sender} on {topic}: {exc}"] += 1
+            return _UNDECODABLE
+
+    @staticmethod
+    def _envelope(topic: str, sender: str, seq: int, payload: object, sent_at: float) -> Envelope | None:
+        return None if payload is _UNDECODABLE else Envelope(topic, sender, seq, payload, sent_at, QoS.RELIABLE)
 
     def _sender(self, sender: str, incarnation: int) -> _Sender | None:
         """The receiver's state of ``sender``, started over for a new incarnation; ``None`` for an old one."""
@@ -495,6 +519,8 @@ class ZenohTransport(Transport):
             del best.held[best.next]
             best.next += 1
             best.last_gseq = gseq
+            if envelope is None:
+                continue  # a payload this process cannot decode: counted, skipped
             if envelope.seq > state.last_seq.get(envelope.topic, 0):
                 state.last_seq[envelope.topic] = envelope.seq
             self._inbox.append(envelope)
@@ -615,12 +641,13 @@ class ZenohTransport(Transport):
                     self._counts["lost"] += first - known.next
                     known.next = first
             for frame in decoded:
-                _, _, topic, seq, rseq, gseq, sent_at, payload = frame
+                _, _, topic, seq, rseq, gseq, sent_at, data = frame
                 known = state.streams.get(topic)
                 if known is None or known.next is None or rseq < known.next or rseq in known.held:
                     continue
                 shown = state.offset.get(topic, 0) + seq
-                known.held[rseq] = (gseq, Envelope(topic, sender, shown, payload, sent_at, QoS.RELIABLE))
+                payload = self._payload(data, sender, topic)
+                known.held[rseq] = (gseq, self._envelope(topic, sender, shown, payload, sent_at))
                 self._counts["recovered"] += topic not in first_answer
             self._release(state)
 

@@ -106,6 +106,9 @@ class MagicLeader:
         clock: the leader's clock (the budget of its own searches, the outcome's times).
         memory_mb: the memory bound of the leader's own searches; ``None``: none.
         progress_every: expansions between two planner events (one search step).
+        first_round: the number of the first round; a leader that is made anew for each
+            planning run (the planning runtime, one per generation) gives numbers that keep
+            growing, so its teammates take each new round's share as newer.
 
     Raises:
         PddlError: the domain or the problem is not valid PDDL.
@@ -122,6 +125,7 @@ class MagicLeader:
         clock: Callable[[], float] = time.monotonic,
         memory_mb: float | None = None,
         progress_every: int = PROGRESS_EVERY,
+        first_round: int = 1,
     ) -> None:
         from alica.prophet.pddl import parse_domain, parse_problem  # lazy: the reader only here
 
@@ -134,7 +138,10 @@ class MagicLeader:
         self._clock = clock
         self._memory_mb = memory_mb
         self._progress_every = progress_every
-        self._round = 0
+        if first_round < 1:
+            raise ValueError(f"MAGiC rounds count from 1, got first_round={first_round}")
+        self._round = first_round - 1
+        self._first = first_round
         self._agents: tuple[str, ...] = ()
         self._shares: tuple[FirstSearch, ...] = ()
         self._pending: dict[int, str] = {}
@@ -165,7 +172,7 @@ class MagicLeader:
     @property
     def running(self) -> bool:
         """Whether a round is on and has not ended."""
-        return self._round > 0 and self.outcome is None
+        return self._round >= self._first and self.outcome is None
 
     def start(self, agents: Sequence[str]) -> int:
         """Start a round over ``agents`` (the leader among them): one share each.
@@ -351,5 +358,5 @@ class MagicLeader:
         )
 
     def __repr__(self) -> str:
-        state = "idle" if self._round == 0 else ("running" if self.running else "ended")
+        state = "idle" if self._round < self._first else ("running" if self.running else "ended")
         return f"<MagicLeader {self.name} round {self._round} {state}>"

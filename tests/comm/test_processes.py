@@ -156,3 +156,22 @@ def test_writes_on_both_sides_of_a_partition_reach_everyone_once_it_heals(tmp_pa
     assert summary["world_models_agree"]
     for agent in summary["agents"].values():
         assert {"found(a)", "found(b)"} <= set(agent["world_facts"])
+
+
+def test_a_planning_team_of_processes_plans_with_magic_across_them(capsys, tmp_path):
+    blocks = str(PLANS / "blocksworld" / "mission.yaml")
+    facts = (
+        "ontable(a) and on(c, a) and clear(c) and ontable(b) and clear(b) "
+        "and handempty(r1) and handempty(r2) and handempty(r3)@0"
+    )
+    trace_file = tmp_path / "run.jsonl"
+    argv = ["run", blocks, "--agents", "r1:Manipulator,r2:Manipulator,r3:Manipulator", "--stand-ins", "--fact", facts]
+    code = main([*argv, "--parallel-planning", "--processes", "--max-time", "60", "--json", "--trace", str(trace_file)])
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0, summary
+    assert summary["messages"]["dropped"] == 0
+    trace = events(trace_file)
+    [start] = [e for e in trace if e["event"] == "planner" and e["what"] == "magic"][:1]
+    assert start["agents"] == ["r1", "r2", "r3"]
+    rounds = [e for e in trace if e["event"] == "planner" and e["what"] == "magic done"]
+    assert rounds and rounds[0]["status"] == "solved" and all(e["messages"] <= 6 for e in rounds)

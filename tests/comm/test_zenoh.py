@@ -210,3 +210,42 @@ plain = st.recursive(
 @given(plain)
 def test_plain_data_survives_the_codec(value):
     assert decode(encode(value)) == value
+
+
+def test_a_payload_the_receiver_cannot_decode_is_skipped_and_the_stream_goes_on(endpoints):
+    from fractions import Fraction
+
+    a, b = pair(endpoints)
+    try:
+        b.subscribe("news")
+        a.publish("news", "first", QoS.RELIABLE)
+        a.publish("news", Fraction(1, 3), QoS.RELIABLE)  # pickles, but no receiver may build it
+        a.publish("news", "third", QoS.RELIABLE)
+        assert [e.payload for e in drain(b, 2)] == ["first", "third"]
+        assert b.stats.undecodable == 1
+        [(why, count)] = b.errors.items()
+        assert count == 1 and why.startswith("a on news:") and "fractions" in why
+    finally:
+        a.close()
+        b.close()
+
+
+def test_every_payload_of_a_planning_team_crosses_the_codec(monkeypatch):
+    """What the engine, the world model and pRoPhEt MAS (MAGiC included) publish, encoded and decoded."""
+    from alica.app.cli import main
+    from alica.comm import simnet
+    from tests.conftest import PLANS
+
+    publish = simnet.SimNetwork._publish
+    kinds: set[str] = set()
+
+    def checked(self, state, topic, payload, qos):
+        assert decode(encode(payload)) == payload
+        kinds.add(type(payload).__name__)
+        return publish(self, state, topic, payload, qos)
+
+    monkeypatch.setattr(simnet.SimNetwork, "_publish", checked)
+    facts = "ontable(a) and on(c, a) and clear(c) and ontable(b) and clear(b) and handempty(r1) and handempty(r2)@0"
+    argv = ["--agents", "r1:Manipulator,r2:Manipulator", "--stand-ins", "--fact", facts, "--parallel-planning"]
+    assert main(["run", str(PLANS / "blocksworld" / "mission.yaml"), *argv]) == 0
+    assert {"TeamMessage", "Delta", "PlanShare", "Share", "Final"} <= kinds
