@@ -13,8 +13,11 @@ short grace is terminated.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import queue
+import signal
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from alica.app.magic import MagicRun, TransportLink, agent_names
@@ -63,6 +66,7 @@ def run_processes(
     timeout: float = 60.0,
     memory_mb: float | None = None,
     progress_every: int = 50,
+    kill_after: Mapping[str, float] | None = None,
 ) -> MagicRun:
     """One MAGiC round over ``agents`` processes (this one the leader) linked by zenoh on loopback.
 
@@ -76,6 +80,8 @@ def run_processes(
             reached, the run ends with ``TIMEOUT``.
         memory_mb: each agent's memory bound for its search; ``None``: none.
         progress_every: expansions between two planner events.
+        kill_after: faults: ``kill -9`` of a worker process (``agent2``, ...) this many
+            seconds after the round started.
 
     Returns:
         The run; ``first_plan_s`` counts from the round's start (the processes are up by then).
@@ -114,9 +120,18 @@ def run_processes(
                     continue
                 ready.add(name)
             leader.start(names)
+            started = time.monotonic()
+            kills = sorted((at, name) for name, at in (kill_after or {}).items())
             outcome = None
             while outcome is None and time.monotonic() < end:
+                while kills and time.monotonic() - started >= kills[0][0]:
+                    _, name = kills.pop(0)
+                    victim = processes[names.index(name) - 1]
+                    if victim.pid is not None:
+                        os.kill(victim.pid, signal.SIGKILL)
                 outcome = leader.step(1)
+                if outcome is None and leader.idle:
+                    time.sleep(0.001)  # waiting for the teammates: leave the interpreter to zenoh's threads
             grace = min(end, time.monotonic() + GRACE)
             while len(reports) < len(processes) and time.monotonic() < grace:
                 try:

@@ -1,8 +1,10 @@
-"""Team communication: the transport interface and an in-memory simulated network.
+"""Team communication: the transport interface, an in-memory simulated network, and zenoh.
 
 The engine talks to a :class:`Transport` only; :class:`SimNetwork` gives every
 agent a :class:`SimTransport` on a seeded, simulated-time network with loss,
-delay, partitions and crashes. See ``docs/comm.md``.
+delay, partitions and crashes; :class:`alica.comm.zenoh_transport.ZenohTransport`
+connects agents in separate processes or hosts over eclipse-zenoh (imported
+on demand, so the simulation does not load zenoh). See ``docs/comm.md``.
 """
 
 from __future__ import annotations

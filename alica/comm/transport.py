@@ -4,15 +4,16 @@ The engine sees only a :class:`Transport`: it publishes payloads on topics,
 subscribes to topics and drains what arrived once per tick with
 :meth:`Transport.poll`. Draining once per tick keeps the engine
 single-threaded and deterministic. The simulated network
-(:mod:`alica.comm.simnet`) implements this interface; a middleware transport
-(zenoh) will implement the same meanings later, so nothing here mentions
-simulated time, seeds or fault injection.
+(:mod:`alica.comm.simnet`) and the eclipse-zenoh transport between processes
+(:mod:`alica.comm.zenoh_transport`) implement it with the same meanings, so
+nothing here mentions simulated time, seeds or fault injection.
 
 Payloads are plain immutable Python data: tuples, ``str``, ``int``,
-``float``, ``bool``, ``None`` and frozen dataclasses made of those. A
-transport passes them **by reference** (the simulated network never copies
-them, because the engine sends tens of thousands of messages per simulated
-second), so a receiver must never mutate a payload it got.
+``float``, ``bool``, ``None`` and frozen dataclasses, named tuples and enums
+made of those. The simulated network passes them **by reference** (it never
+copies them, because the engine sends tens of thousands of messages per
+simulated second), so a receiver must never mutate a payload it got; a
+transport between processes sends a copy (:mod:`alica.comm.codec`).
 """
 
 from __future__ import annotations
@@ -92,12 +93,22 @@ class Transport(ABC):
                 :class:`QoS`, or the transport is closed.
         """
 
+    @property
+    def tracks_liveliness(self) -> bool:
+        """Whether :meth:`peers` says who is alive (middleware liveliness) rather than who was heard lately.
+
+        The engine then takes a teammate out as soon as it leaves :meth:`peers`,
+        instead of waiting for the team timeout.
+        """
+        return False
+
     @abstractmethod
     def subscribe(self, topic: str) -> None:
         """Receive messages other agents publish on ``topic`` from now on.
 
         Subscribing to a topic twice is harmless. Messages published before
-        the subscription are not delivered.
+        the subscription are not delivered (reliable ones are, when sent after
+        it, also across processes).
 
         Args:
             topic: a non-empty topic name.
@@ -124,12 +135,14 @@ class Transport(ABC):
 
     @abstractmethod
     def peers(self) -> frozenset[str]:
-        """The agents this transport heard from within the liveliness lease.
+        """The agents this transport knows to be alive; never this agent itself.
 
         Returns:
             Ids of the agents whose messages arrived here within the lease
             (a duration the network or session is configured with) before
-            now; never this agent itself.
+            now; or, when :attr:`tracks_liveliness`, whose liveliness the
+            middleware reports (gone within milliseconds of a crash, after
+            the lease in a partition).
         """
 
     @abstractmethod

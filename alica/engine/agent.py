@@ -140,7 +140,7 @@ class AgentEngine:
         for topic in self.children.routes:
             transport.subscribe(topic)
         self._world_changed = False
-        self._liveliness = bool(getattr(transport, "tracks_liveliness", False))
+        self._liveliness = transport.tracks_liveliness
         """The transport reports who is alive (liveliness tokens): a teammate gone is taken out at once."""
         self._peers: frozenset[str] = frozenset()
         self._greeted: set[str] = set()

@@ -174,6 +174,11 @@ class MagicLeader:
         """Whether a round is on and has not ended."""
         return self._round >= self._first and self.outcome is None
 
+    @property
+    def idle(self) -> bool:
+        """Whether the leader has nothing of its own to search now (it waits for its teammates' results)."""
+        return self._own is None and not self._queue
+
     def start(self, agents: Sequence[str]) -> int:
         """Start a round over ``agents`` (the leader among them): one share each.
 
