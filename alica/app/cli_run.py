@@ -333,6 +333,8 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
                     else:
                         team.heal()
                 team.exited()
+                if team.all_down() and not any(kind == "recover" for _, kind, _ in faults):
+                    break  # nobody left, and nobody comes back
                 time.sleep(0.05)
         except KeyboardInterrupt:
             interrupted = True
@@ -343,7 +345,7 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
             team.trace(Path(args.trace))
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
     for agent in summary["agents"].values():
-        agent.setdefault("reason", None if agent["status"] == "success" else _process_reason(agent))
+        agent["reason"] = None if agent["status"] == "success" else _process_reason(agent)
     if args.json:
         print(json.dumps(summary, indent=2, sort_keys=True))
     else:
@@ -358,7 +360,8 @@ def _process_reason(agent: dict[str, Any]) -> str:
     if status == "crashed":
         return "killed (kill -9)"
     if status == "exited":
-        return "its process exited by itself (see the log line in the trace folder)"
+        last = agent.get("reason")
+        return f"its process exited by itself{f': {last}' if last else ''}"
     return f"ended {status} at {agent.get('path') or 'no plan'}"
 
 

@@ -211,6 +211,11 @@ class ProcessTeam:
                     gone.append(agent.name)
         return gone
 
+    def all_down(self) -> bool:
+        """Whether no agent process runs (every one crashed or exited)."""
+        with self._lock:
+            return all(a.status in ("crashed", "exited") for a in self.agents.values())
+
     def done(self) -> bool:
         """Whether every agent that runs has finished its root plan."""
         with self._lock:
