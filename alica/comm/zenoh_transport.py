@@ -35,6 +35,7 @@ import json
 import re
 import threading
 import time
+from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -154,6 +155,9 @@ class ZenohTransport(Transport):
         history: seconds a sender keeps its reliable messages for receivers
             that missed them (a partition longer than this loses what the
             sender trimmed; :attr:`ZenohStats.lost` counts it).
+        history_mb: the most the kept reliable messages may take, in MB; past it,
+            the oldest messages of the topic being published go first (a topic
+            flooding reliable messages cannot exhaust the agent's memory).
         clock: the time of ``sent_at`` (and of the history); agents of one
             team need comparable clocks, so the default is
             :class:`~alica.clock.SystemClock` (hosts synchronised by NTP).
@@ -176,6 +180,7 @@ class ZenohTransport(Transport):
         lease: float = 2.0,
         heartbeat: float = 0.25,
         history: float = 600.0,
+        history_mb: float = 64.0,
         clock: Clock | None = None,
         config: Mapping[str, object] | None = None,
         query_timeout: float = 1.0,
@@ -184,7 +189,12 @@ class ZenohTransport(Transport):
         self._team = _check_name("team", team)
         if mode not in ("peer", "client"):
             raise ValueError(f"mode must be 'peer' or 'client', got {mode!r}")
-        for name, value in (("lease", lease), ("heartbeat", heartbeat), ("history", history)):
+        for name, value in (
+            ("lease", lease),
+            ("heartbeat", heartbeat),
+            ("history", history),
+            ("history_mb", history_mb),
+        ):
             if not isinstance(value, int | float) or value <= 0:
                 raise ValueError(f"{name} must be a number of seconds > 0, got {value!r}")
         self._clock = clock or SystemClock()
@@ -197,8 +207,11 @@ class ZenohTransport(Transport):
         # sending
         self._seq: dict[str, int] = {}
         self._rseq: dict[str, int] = {}
+        self._put_rseq: dict[str, int] = {}
+        self._kept_bytes = 0
+        self._history_bytes = float(history_mb) * 1024 * 1024
         self._gseq = 0
-        self._history: dict[str, list[tuple[int, float, bytes]]] = {}
+        self._history: dict[str, deque[tuple[int, float, bytes]]] = {}
         self._publishers: dict[tuple[str, QoS], Any] = {}
         # receiving
         self._subscribed: dict[str, float] = {}
@@ -283,11 +296,18 @@ class ZenohTransport(Transport):
         reliable = qos is QoS.RELIABLE
         now = self._clock.now()
         if reliable:
+            inner = encode(payload)
             with self._lock:
                 rseq = self._rseq[topic] = self._rseq.get(topic, 0) + 1
                 self._gseq += 1
-                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, encode(payload)))
-                self._history.setdefault(topic, []).append((rseq, now, data))
+                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, inner))
+                kept = self._history.get(topic)
+                if kept is None:
+                    kept = self._history[topic] = deque()
+                kept.append((rseq, now, data))
+                self._kept_bytes += len(data)
+                while self._kept_bytes > self._history_bytes and len(kept) > 1:
+                    self._kept_bytes -= len(kept.popleft()[2])  # the flooding topic gives way first
         else:
             data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, encode(payload)))
         publisher = self._publishers.get((topic, qos))
@@ -298,6 +318,9 @@ class ZenohTransport(Transport):
                 express=True,
             )
         publisher.put(data)
+        if reliable:
+            with self._lock:
+                self._put_rseq[topic] = rseq  # the heartbeat announces only what is on its way
         self._counts["sent"] += 1
 
     def subscribe(self, topic: str) -> None:
@@ -389,10 +412,10 @@ class ZenohTransport(Transport):
             if self._closed:
                 return
             for kept in self._history.values():
-                if kept and kept[0][1] < horizon:
-                    del kept[: next((i for i, item in enumerate(kept) if item[1] >= horizon), len(kept))]
+                while kept and kept[0][1] < horizon:
+                    self._kept_bytes -= len(kept.popleft()[2])
             # every reliable counter, also of topics whose history is trimmed: a receiver learns what it lost
-            beat = dict(self._rseq)
+            beat = dict(self._put_rseq)
             retry = []
             for sender, state in self._senders.items():
                 if state.asked_at is not None and now - state.asked_at > self._query_timeout:
@@ -596,7 +619,7 @@ class ZenohTransport(Transport):
             start: dict[str, int] = {}
             oldest: dict[str, int] = {}
             for topic, (first, since) in wanted.items():
-                kept = self._history.get(topic, [])
+                kept = self._history.get(topic, deque())
                 last = self._rseq.get(topic, 0)
                 if first is None or incarnation != self._incarnation:
                     # its first question (or about an earlier life of this agent): all since it subscribed

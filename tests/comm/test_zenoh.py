@@ -97,6 +97,31 @@ def test_what_a_sender_no_longer_keeps_is_counted_lost():
         relay.close()
 
 
+def test_the_history_is_bounded_in_bytes_and_what_it_drops_is_counted_lost():
+    ea, eb = free_endpoints(2)
+    relay = LinkRelay(ea)
+    a = ZenohTransport("a", listen=[ea], team="unit", history_mb=0.002)  # about 2 KB: a dozen of these messages
+    b = ZenohTransport("b", listen=[eb], connect=[relay.endpoint], team="unit")
+    try:
+        b.subscribe("news")
+        assert wait_for(lambda: b.peers() == {"a"})
+        a.publish("news", -1, QoS.RELIABLE)
+        assert [e.payload for e in drain(b, 1)] == [-1]
+        relay.cut()
+        assert wait_for(lambda: b.peers() == frozenset())
+        for i in range(50):
+            a.publish("news", (i, "x" * 100), QoS.RELIABLE)
+        relay.heal()
+        assert wait_for(lambda: b.stats.lost > 0)
+        got = [e.payload[0] for e in drain(b, 50 - b.stats.lost)]
+        assert got == list(range(b.stats.lost, 50))  # the newest ones, in order; the oldest were dropped
+        assert 5 < len(got) < 30
+    finally:
+        a.close()
+        b.close()
+        relay.close()
+
+
 def test_a_partition_shorter_than_the_history_loses_nothing():
     ea, eb = free_endpoints(2)
     relay = LinkRelay(ea)
