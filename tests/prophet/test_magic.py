@@ -32,24 +32,9 @@ from alica.prophet.pddl import PddlError, parse_domain, parse_problem
 from alica.prophet.planner import PlanStatus, PlanStep
 from alica.prophet.search import BuiltinPlanner, FirstSearch
 from alica.prophet.validate import validate_plan
+from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
 
 ROVERS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl" / "rovers"
-
-UNSOLVABLE_DOMAIN = """\
-(define (domain switch)
-  (:requirements :strips)
-  (:predicates (on) (off))
-  (:action turn-on
-    :parameters ()
-    :precondition (off)
-    :effect (and (on) (not (off)))))
-"""
-UNSOLVABLE_PROBLEM = """\
-(define (problem both-at-once)
-  (:domain switch)
-  (:init (off))
-  (:goal (and (on) (off))))
-"""
 
 
 @cache

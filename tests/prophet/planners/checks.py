@@ -13,6 +13,23 @@ from alica.prophet.validate import validate_plan
 
 JSON_KEYS = {"solved", "cost", "plan", "time_first_s", "time_s", "expansions"}
 
+#: A task no plan solves: the goal wants the switch on and off at once.
+UNSOLVABLE_DOMAIN = """\
+(define (domain switch)
+  (:requirements :strips)
+  (:predicates (on) (off))
+  (:action turn-on
+    :parameters ()
+    :precondition (off)
+    :effect (and (on) (not (off)))))
+"""
+UNSOLVABLE_PROBLEM = """\
+(define (problem both-at-once)
+  (:domain switch)
+  (:init (off))
+  (:goal (and (on) (off))))
+"""
+
 
 def valid_cost(domain: Path, problem: Path, steps: list[PlanStep] | tuple[PlanStep, ...]) -> float:
     """The cost of a plan that must be valid for the task in the files."""

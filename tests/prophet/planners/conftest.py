@@ -9,25 +9,9 @@ from pathlib import Path
 import pytest
 
 from alica.app.cli import main
+from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
-
-UNSOLVABLE_DOMAIN = """\
-(define (domain switch)
-  (:requirements :strips)
-  (:predicates (on) (off))
-  (:action turn-on
-    :parameters ()
-    :precondition (off)
-    :effect (and (on) (not (off)))))
-"""
-
-UNSOLVABLE_PROBLEM = """\
-(define (problem both-at-once)
-  (:domain switch)
-  (:init (off))
-  (:goal (and (on) (off))))
-"""
 
 
 @dataclass(frozen=True)
