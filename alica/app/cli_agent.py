@@ -191,7 +191,7 @@ def _run(
     config = engine_config(
         frequency=args.frequency, planner_seconds=0.3 / args.frequency, parallel_planning=args.parallel_planning
     )
-    trace = JsonlTrace(args.trace) if args.trace else None
+    trace = JsonlTrace(args.trace, line_buffered=True) if args.trace else None  # kept up to a kill -9
     observers: tuple[Any, ...] = ()
     if trace is not None:
         sink = trace

@@ -36,12 +36,14 @@ class JsonlTrace:
 
     Args:
         path: the file to write (created or truncated).
+        line_buffered: write each event through at once (an agent process that
+            may be killed keeps its trace up to the kill); else in blocks.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, line_buffered: bool = False) -> None:
         self.path = Path(path)
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._file: IO[str] | None = self.path.open("w", encoding="utf-8")
+        self._file: IO[str] | None = self.path.open("w", encoding="utf-8", buffering=1 if line_buffered else -1)
         self.count = 0
 
     def __call__(self, event: dict[str, Any]) -> None:

@@ -73,6 +73,9 @@ def test_kill_9_takes_an_agent_out_and_its_restart_catches_up(capsys, tmp_path):
         assert crash <= t <= crash + TEAM_TIMEOUT + 2 * TICK
     back = team_changes(trace, "back", "stummel")
     assert set(back) == {"scout", "amparo"} and all(t >= recover for t in back.values())
+    # the killed process's trace is kept up to the kill, then its restart's
+    lives = {e.get("incarnation") for e in trace if e.get("agent") == "stummel" and e["event"] != "fault"}
+    assert lives == {1, 2}
 
 
 def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
