@@ -484,7 +484,16 @@ def main() -> None:
     parser.add_argument("--max-time", type=float, default=45.0, help="wall (simulated) seconds per run at most")
     parser.add_argument("--no-sim", action="store_true", help="leave out the simulated reference")
     parser.add_argument("--keep", metavar="DIR", help="keep the merged traces of the process runs here")
+    parser.add_argument(
+        "--cpu",
+        metavar="SIZES",
+        default="",
+        help="only measure CPU per agent process of teams of these sizes, e.g. 10,20 (the lunar mission, 30 s)",
+    )
     args = parser.parse_args()
+    if args.cpu:
+        cpu_table([int(n) for n in args.cpu.split(",") if n.strip()], 20.0 if args.quick else 30.0)
+        return
     repeat = 1 if args.quick else args.repeat
     victims = [v.strip() for v in args.victims.split(",") if v.strip()]
     unknown = [v for v in victims if v not in NAMES]
@@ -550,6 +559,40 @@ def main() -> None:
     if failures:
         print("Runs with an error or without success:\n")
         print("\n".join(failures))
+
+
+def cpu_table(sizes: list[int], seconds: float) -> None:
+    """CPU per ``alica agent`` process of lunar teams of ``sizes`` agents, each run ``seconds`` on the wall clock."""
+    import subprocess
+
+    print(
+        f"CPU per `alica agent` process at 30 Hz, the lunar mission with stand-ins (no operator: the team explores), "
+        f"{seconds:g} s per team; % of one core while ticking (start-up left out), {os.cpu_count()} CPUs.\n"
+    )
+    print(
+        "| agents | CPU per process, mean / max | ticks | ticks that overran the period | messages sent / delivered |"
+    )
+    print("|---:|---|---:|---:|---|")
+    for n in sizes:
+        roster = ",".join(f"r{i}:{('Scout', 'Stummel', 'Amparo')[i % 3]}" for i in range(n))
+        argv = [sys.executable, "-m", "alica.app.cli", "run", PLAN, "--stand-ins", "--agents", roster]
+        out = subprocess.run(
+            [*argv, "--processes", "--max-time", str(seconds), "--json"], capture_output=True, text=True, check=False
+        ).stdout
+        try:
+            summary = json.loads(out)
+        except json.JSONDecodeError:
+            print(f"| {n} | run failed | | | |")
+            continue
+        cpu = [a["cpu_percent"] for a in summary["agents"].values() if a.get("cpu_percent") is not None]
+        overruns = sum(a.get("overruns", 0) for a in summary["agents"].values())
+        m = summary["messages"]
+        mean = statistics.mean(cpu) if cpu else float("nan")
+        print(
+            f"| {n} | {mean:.1f} % / {max(cpu, default=float('nan')):.1f} % | {summary['ticks']} | {overruns} "
+            f"| {m['sent']} / {m['delivered']} |"
+        )
+    print()
 
 
 def _progress(label: str, run: Run) -> None:

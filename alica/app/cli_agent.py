@@ -24,9 +24,11 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
 import threading
+import time
 from typing import Any
 
 from alica.app.skill_options import add_skills_option
@@ -256,6 +258,7 @@ def _run(
         if args.json:
             _line({"event": "started", "agent": args.name, "t": round(clock.now() - start, 3)})
         loop = RealTimeLoop(engine, stop)
+        began, began_cpu = time.monotonic(), sum(os.times()[:2])
         why = loop.run(
             until_done=args.until_done,
             end_at=None if args.max_time is None else start + args.max_time,
@@ -268,6 +271,9 @@ def _run(
             ended=why,
             overruns=loop.overruns,
             time_s=round(clock.now() - start, 3),
+            cpu_s=round(sum(os.times()[:2]), 3),  # this process's user and system time (zenoh's threads too)
+            # of one core, while ticking (start-up left out)
+            cpu_percent=round(100 * (sum(os.times()[:2]) - began_cpu) / max(1e-9, time.monotonic() - began), 2),
             transport=_counters(transport),
             world_digest=_digest(engine.world_model),
             world_facts=[str(fact) for fact in engine.world_model.facts()],

@@ -318,6 +318,7 @@ class ProcessTeam:
                 status=status,
                 incarnations=agent.incarnation,
                 overruns=last.get("overruns", 0),
+                cpu_percent=last.get("cpu_percent"),
                 world_facts=last.get("world_facts"),
             )
             for summary in agent.summaries:
