@@ -195,8 +195,9 @@ class ZenohTransport(Transport):
             ("history", history),
             ("history_mb", history_mb),
         ):
-            if not isinstance(value, int | float) or value <= 0:
-                raise ValueError(f"{name} must be a number of seconds > 0, got {value!r}")
+            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+                unit = "MB" if name == "history_mb" else "seconds"
+                raise ValueError(f"{name} must be a number of {unit} > 0, got {value!r}")
         self._clock = clock or SystemClock()
         self._heartbeat = float(heartbeat)
         self._history_s = float(history)
@@ -223,9 +224,15 @@ class ZenohTransport(Transport):
         self.errors: dict[str, int] = {}
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
         self._subscribers: list[Any] = []
-        self._session = zenoh.open(self._config(tuple(connect), tuple(listen), mode, lease, config))
+        connect, listen = tuple(connect), tuple(listen)
         try:
-            prefix = f"{self._team}"
+            self._session = zenoh.open(self._config(connect, listen, mode, lease, config))
+        except zenoh.ZError as exc:
+            raise ValueError(
+                f"zenoh could not open a session listening on {list(listen)} and connecting to {list(connect)}: {exc}"
+            ) from None
+        try:
+            prefix = self._team
             liveliness = self._session.liveliness()
             # One subscriber for every topic, so that zenoh hands over each sender's messages in the order
             # they were sent (two subscribers' callbacks may run at once); poll() filters by topic.

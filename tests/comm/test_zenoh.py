@@ -274,3 +274,9 @@ def test_every_payload_of_a_planning_team_crosses_the_codec(monkeypatch):
     argv = ["--agents", "r1:Manipulator,r2:Manipulator", "--stand-ins", "--fact", facts, "--parallel-planning"]
     assert main(["run", str(PLANS / "blocksworld" / "mission.yaml"), *argv]) == 0
     assert {"TeamMessage", "Delta", "PlanShare", "Share", "Final"} <= kinds
+
+
+def test_a_busy_port_is_a_clear_error(endpoints):
+    with ZenohTransport("a", listen=[endpoints[0]], team="unit"):
+        with pytest.raises(ValueError, match="could not open a session listening on .* already in use"):
+            ZenohTransport("b", listen=[endpoints[0]], team="unit")
