@@ -349,13 +349,19 @@ class ArmSkill(WorldSkill):
         return any(distance(xy, side) < SIDE_TRIED for side in self.tried_sides)
 
     def _scene(self) -> ArmScene:
-        from alica.skills.manipulation import ArmScene
+        from alica.skills.manipulation import ArmPlanningModel, ArmScene
 
         cache = world_cache(self.world)
         key = f"arm-scene:{self.robot.name}"
         scene = cache.get(key)
         if scene is None:
-            scene = cache[key] = ArmScene(self.arm.urdf_path, self.arm.base_pose(), seed=self.world.seed)
+            # one planning model (pybullet client, arm, collision bodies) per kind of arm, shared by
+            # the robots' scenes: a model costs about 40 MB, a scene of its own only its state
+            models = cache.setdefault("arm-planning-models", {})
+            model = models.get(self.arm.urdf_path)
+            if model is None:
+                model = models[self.arm.urdf_path] = ArmPlanningModel(self.arm.urdf_path)
+            scene = cache[key] = ArmScene(self.arm.urdf_path, self.arm.base_pose(), seed=self.world.seed, model=model)
         scene.set_base_pose(self.arm.base_pose())
         left_out = self.scene_exclusions()
         boxes = [

@@ -93,8 +93,10 @@ class Arm(GripperMixin):
             float(mount_offset[1]),
             float(mount_offset[2]),
         )
+        # Without the detailed visual meshes (World(arm_visuals=False)) pybullet draws the collision hulls.
+        flags = c.URDF_USE_INERTIA_FROM_FILE | (0 if world.arm_visuals else c.URDF_IGNORE_VISUAL_SHAPES)
         with quiet_stdout(world.quiet):
-            self.body_id: int = c.loadURDF(self.urdf_path, useFixedBase=True, flags=c.URDF_USE_INERTIA_FROM_FILE)
+            self.body_id: int = c.loadURDF(self.urdf_path, useFixedBase=True, flags=flags)
         self.joint_indices: tuple[int, ...] = _ARM_JOINTS
         self.finger_indices: tuple[int, ...] = _FINGER_JOINTS
         self.ee_link = _EE_LINK

@@ -45,6 +45,7 @@ def blocksworld(
     time_step: float = 1.0 / 240.0,
     opponents: int = 0,
     gui: bool = False,
+    arm_visuals: bool | None = None,
 ) -> World:
     """A blocks world: stacks of blocks on the ground in a row, manipulators ``r1..rN`` around them, opponents ``o1..oK``.
 
@@ -63,6 +64,8 @@ def blocksworld(
             :data:`OPPONENT_EXTRA_Y` in y, so that every robot can drive around the stacks.
             Without opponents the field is unchanged.
         gui: show the pybullet window (when a display is available).
+        arm_visuals: the arms' detailed visual meshes (see :class:`World`); default only with ``gui``:
+            they cost about 48 MB per robot, and pictures without them show the arms' collision hulls.
 
     Raises:
         WorldError: empty stacks, repeated block names, or fewer than 0 agents or opponents.
@@ -79,7 +82,14 @@ def blocksworld(
     if opponents:
         half_x = max(half_x, abs(_opponent_x(opponents - 1, row)) + OPPONENT_ROOM)  # the outermost opponent
     half_y = ROBOT_STANDOFF + 1.5 + (OPPONENT_EXTRA_Y if opponents else 0.0)
-    world = World(seed, gui=gui, time_step=time_step, bounds=(-half_x, -half_y, half_x, half_y), rest_when_still=True)
+    world = World(
+        seed,
+        gui=gui,
+        time_step=time_step,
+        bounds=(-half_x, -half_y, half_x, half_y),
+        rest_when_still=True,
+        arm_visuals=gui if arm_visuals is None else arm_visuals,
+    )
     for i, stack in enumerate(stacks):
         x = -0.5 * row + i * STACK_SPACING
         for level, name in enumerate(stack):

@@ -1,7 +1,8 @@
 """Arm motion planning for the manipulation skills (Pickup, Putdown, Stack, Unstack and their steps).
 
-Works from plain data (a URDF, the base pose, boxes), in its own pybullet
-DIRECT client per :class:`ArmScene`; plans are returned as data (configurations
+Works from plain data (a URDF, the base pose, boxes), in a pybullet DIRECT
+client per :class:`ArmPlanningModel`, which the :class:`ArmScene` s of arms of
+the same kind may share; plans are returned as data (configurations
 and joint paths) for someone else to execute. See ``docs/manipulation.md``.
 """
 
@@ -13,11 +14,12 @@ from alica.skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
 from alica.skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps
 from alica.skills.manipulation.ik import IKResult, solve_ik
 from alica.skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
-from alica.skills.manipulation.scene import ArmScene, Box, default_urdf
+from alica.skills.manipulation.scene import ArmPlanningModel, ArmScene, Box, default_urdf
 from alica.skills.manipulation.transport import TransportPlan, plan_transport
 
 __all__ = [
     "ArmPath",
+    "ArmPlanningModel",
     "ArmScene",
     "Box",
     "Grasp",

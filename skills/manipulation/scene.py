@@ -1,4 +1,4 @@
-"""The planning scene of one arm: its own pybullet DIRECT client, the arm, the ground and box obstacles.
+"""The planning scene of one arm: a pybullet DIRECT client with the arm, the ground and box obstacles.
 
 The scene is a *planning* copy of the world, built from plain data (a URDF,
 the base pose, boxes). It never simulates: every query sets the joint values
@@ -10,6 +10,13 @@ about 1 mm, so a distance margin cannot be read off ``getContactPoints``.
 Instead every obstacle box is inflated by ``margin`` and the ground plane is
 raised by ``margin``; a state is in collision if any contact point has a
 negative distance. Self-collision and the held object are not inflated.
+
+Sharing: a pybullet client with a loaded arm costs about 40 MB, whatever the
+scene. The scenes of several arms of the same kind can share one
+:class:`ArmPlanningModel` (the client, the arm body with its collision meshes
+and kinematics, the ground, box and held-object bodies): each
+:class:`ArmScene` keeps its own base pose, obstacles and joint values and
+puts them into the shared client whenever it is used after another scene.
 """
 
 from __future__ import annotations
@@ -93,17 +100,174 @@ def default_urdf() -> str:
     return os.path.join(pybullet_data.getDataPath(), "franka_panda", "panda.urdf")
 
 
-class ArmScene:
-    """A fixed-base arm in its own pybullet DIRECT client, for IK, collision checks and planning.
+class ArmPlanningModel:
+    """The planning model of one kind of arm: a pybullet DIRECT client with the arm, shared by :class:`ArmScene` s.
+
+    Holds what is the same for every arm of that kind (the client, the arm body
+    with its collision meshes, self-collision filter and kinematics, the
+    ground slab, the obstacle and held-object bodies and their shapes). The
+    scenes using it take turns: a scene puts its base pose, obstacles and
+    joint values into the client when it is used after another one. Scenes
+    sharing a model must not be used concurrently (they are not thread-safe).
 
     Args:
         urdf_path: arm URDF; default the pybullet_data Franka Panda.
+        margin: safety distance in metres by which obstacles and the ground are inflated.
+
+    Raises:
+        ValueError: a margin outside [0, 0.1) m, a missing URDF, or an arm with fewer than 7 movable joints.
+    """
+
+    def __init__(self, urdf_path: str | None = None, *, margin: float = 0.003) -> None:
+        if not (math.isfinite(margin) and 0.0 <= margin < 0.1):
+            raise ValueError(f"margin must be in [0, 0.1) m, got {margin!r}")
+        path = urdf_path if urdf_path is not None else default_urdf()
+        if not os.path.isfile(path):
+            raise ValueError(f"URDF not found: {path}")
+        self.urdf_path = path
+        self.margin = float(margin)
+        #: The scene whose base pose, obstacles and joints the client holds (None: none yet).
+        self.owner: ArmScene | None = None
+        with quiet_stdout():  # pybullet prints 'argv[0]=' for every client it connects
+            self._c: BulletClient | None = BulletClient(connection_mode=pybullet.DIRECT)
+        try:
+            self._build(path)
+        except BaseException:
+            self.close()
+            raise
+
+    def _build(self, path: str) -> None:
+        c = self.client
+        # No visual meshes: a planning scene never renders, and the Panda's cost pybullet about 48 MB.
+        flags = (
+            pybullet.URDF_USE_SELF_COLLISION
+            | pybullet.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
+            | pybullet.URDF_IGNORE_VISUAL_SHAPES
+        )
+        self.robot = c.loadURDF(path, (0.0, 0.0, 0.0), IDENTITY_QUAT, useFixedBase=True, flags=flags)
+        self.model: ArmModel = read_arm_model(c, self.robot)
+        for a, b in self.model.allowed_self_pairs:
+            c.setCollisionFilterPair(self.robot, self.robot, a, b, 0)
+        # The ground: a wide thin slab (not an infinite plane, whose bounding box would pair it with
+        # every link in Bullet's broad phase) kept centred under the base; its top is at z = margin.
+        slab = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=(_GROUND_HALF, _GROUND_HALF, 0.5))
+        self.ground = c.createMultiBody(0.0, slab, basePosition=self.ground_center((0.0, 0.0, 0.0)))
+        for link in self.model.base_links:
+            c.setCollisionFilterPair(self.robot, self.ground, link, -1, 0)
+        # Bound client functions, looked up once: BulletClient's attribute lookup costs ~2 us per call.
+        self.reset_joints = c.resetJointStatesMultiDof
+        self.detect = c.performCollisionDetection
+        self.contacts = c.getContactPoints
+        self.link_state = c.getLinkState
+        self.reset_base = c.resetBasePositionAndOrientation
+        self.arm_joints = list(self.model.arm_joints)
+        self.gripper_value = float("nan")
+        self.set_gripper(self.model.gripper_open)
+        # The bodies in the client: obstacles (of the scene that last used it) and held objects.
+        self.obstacles: dict[Box, int] = {}
+        self._box_shapes: dict[Vec3, int] = {}
+        self.held_bodies: dict[Vec3, int] = {}
+        self.active_held: int | None = None
+        self.last_held: Box | None = None
+        self.held_local: Pose = ((0.0, 0.0, 0.0), IDENTITY_QUAT)
+        self.held_grip = self.model.gripper_open
+
+    @property
+    def client(self) -> BulletClient:
+        """The model's pybullet client (DIRECT)."""
+        if self._c is None:
+            raise ValueError("the arm planning model is closed")
+        return self._c
+
+    def close(self) -> None:
+        """Disconnect the client (idempotent); the scenes using the model cannot be used any more."""
+        if self._c is not None:
+            try:
+                self._c.disconnect()
+            except pybullet.error:  # already disconnected
+                pass
+            self._c = None
+        self.owner = None
+
+    # ----------------------------------------------------------------- client state
+    def ground_center(self, base_position: Sequence[float]) -> Vec3:
+        """Centre of the ground slab under a base at ``base_position`` (its top at z = margin)."""
+        return (float(base_position[0]), float(base_position[1]), self.margin - 0.5)
+
+    def place_base(self, frame: Pose) -> None:
+        """Put the arm's base link frame (and the ground under it) at ``frame``."""
+        # pybullet places a body by its centre of mass; the caller gives the URDF frame.
+        position, orientation = pose_multiply(frame, self.model.base_inertial)
+        self.reset_base(self.robot, position, orientation)
+        self.reset_base(self.ground, self.ground_center(frame[0]), IDENTITY_QUAT)
+
+    def place_obstacles(self, boxes: Sequence[Box]) -> None:
+        """Make ``boxes`` the client's obstacle bodies; boxes already there keep their bodies."""
+        c = self.client
+        keep = set(boxes)
+        for box in [b for b in self.obstacles if b not in keep]:
+            c.removeBody(self.obstacles.pop(box))
+        for box in boxes:
+            if box not in self.obstacles:
+                hx, hy, hz = box.half_extents
+                half: Vec3 = (hx + self.margin, hy + self.margin, hz + self.margin)
+                shape = self._box_shapes.get(half)
+                if shape is None:  # one shape per size: pybullet keeps a shape after its body is removed
+                    shape = self._box_shapes[half] = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
+                self.obstacles[box] = c.createMultiBody(
+                    0.0, shape, basePosition=box.center, baseOrientation=quat_from_yaw(box.yaw)
+                )
+
+    def set_gripper(self, value: float) -> None:
+        """Put the finger joints at ``value``."""
+        joints = self.model.gripper_joints
+        if joints:
+            self.client.resetJointStatesMultiDof(self.robot, joints, [[value]] * len(joints))
+        self.gripper_value = value
+
+    def joint_values(self) -> list[float]:
+        """The current values of the movable joints (arm, then gripper)."""
+        return [s[0] for s in self.client.getJointStates(self.robot, list(self.model.movable_joints))]
+
+    def held_body(self, half_extents: Vec3) -> int:
+        """The (parked or active) body of a held object of this size."""
+        body = self.held_bodies.get(half_extents)
+        if body is None:
+            c = self.client
+            shape = c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(half_extents))
+            # A (never simulated) mass makes the body dynamic, so Bullet checks it against static boxes.
+            body = c.createMultiBody(0.1, shape, basePosition=(0.0, 0.0, _PARK_Z + 10.0 * len(self.held_bodies)))
+            for link in self.model.gripper_links:
+                c.setCollisionFilterPair(body, self.robot, -1, link, 0)
+            self.held_bodies[half_extents] = body
+        return body
+
+    def park_held(self) -> None:
+        """Move the active held-object body back to its place far above everything."""
+        body = self.active_held
+        if body is not None:
+            index = list(self.held_bodies.values()).index(body)
+            self.reset_base(body, (0.0, 0.0, _PARK_Z + 10.0 * index), (0.0, 0.0, 0.0, 1.0))
+        self.active_held = None
+
+
+class ArmScene:
+    """A fixed-base arm in a pybullet DIRECT client, for IK, collision checks and planning.
+
+    Args:
+        urdf_path: arm URDF; default the pybullet_data Franka Panda (or that of ``model``).
         base_pose: ``((x, y, z), quat_xyzw)`` of the arm's base link.
         obstacles: static boxes (see :meth:`set_obstacles`).
         seed: seed of :attr:`rng`, used by :meth:`random_configuration` when no generator is given.
         margin: safety distance in metres by which obstacles and the ground are inflated.
         rest_q: IK seed / rest configuration; default the Panda "ready" pose.
         home_q: transport configuration; default the Panda folded over its base.
+        model: an :class:`ArmPlanningModel` to share with other scenes of the same arm (its URDF and
+            margin must match ``urdf_path`` and ``margin``); default a model of the scene's own,
+            closed with it.
+
+    Raises:
+        ValueError: bad arguments, or a ``model`` of another URDF or margin.
     """
 
     def __init__(
@@ -116,72 +280,79 @@ class ArmScene:
         margin: float = 0.003,
         rest_q: Sequence[float] | None = None,
         home_q: Sequence[float] | None = None,
+        model: ArmPlanningModel | None = None,
     ) -> None:
         if not (math.isfinite(margin) and 0.0 <= margin < 0.1):
             raise ValueError(f"margin must be in [0, 0.1) m, got {margin!r}")
-        path = urdf_path if urdf_path is not None else default_urdf()
+        path = urdf_path if urdf_path is not None else (model.urdf_path if model is not None else default_urdf())
         if not os.path.isfile(path):
             raise ValueError(f"URDF not found: {path}")
-        position, orientation = as_pose(base_pose, "base_pose")
+        if model is not None and (
+            os.path.realpath(path) != os.path.realpath(model.urdf_path) or float(margin) != model.margin
+        ):
+            raise ValueError(
+                f"the shared arm model is of {model.urdf_path} with margin {model.margin}, "
+                f"the scene asks for {path} with margin {margin}"
+            )
+        self._base_frame: Pose = as_pose(base_pose, "base_pose")
         self._margin = float(margin)
         self.rng = np.random.default_rng(seed)
-        with quiet_stdout():  # pybullet prints 'argv[0]=' for every client it connects
-            self._c = BulletClient(connection_mode=pybullet.DIRECT)
+        self._owns_model = model is None
+        self._m: ArmPlanningModel | None = ArmPlanningModel(path, margin=margin) if model is None else model
+        self._boxes: tuple[Box, ...] = ()
+        self._joints: list[float] | None = None  # the joint values while another scene uses the model
         try:
-            self._build(path, position, orientation, obstacles, rest_q, home_q)
+            m = self._model_in_use()
+            self._model: ArmModel = m.model
+            self.rest_q = self._default_q(rest_q, self._model.rest_q, "rest_q")
+            self.home_q = self._default_q(home_q, self._model.home_q, "home_q")
+            self.set_obstacles(obstacles)
         except BaseException:
             self.close()
             raise
 
-    def _build(
-        self,
-        path: str,
-        position: Vec3,
-        orientation: tuple[float, float, float, float],
-        obstacles: Iterable[Box],
-        rest_q: Sequence[float] | None,
-        home_q: Sequence[float] | None,
-    ) -> None:
-        flags = pybullet.URDF_USE_SELF_COLLISION | pybullet.URDF_USE_SELF_COLLISION_EXCLUDE_PARENT
-        self._robot = self._c.loadURDF(path, position, orientation, useFixedBase=True, flags=flags)
-        self._model: ArmModel = read_arm_model(self._c, self._robot)
-        for a, b in self._model.allowed_self_pairs:
-            self._c.setCollisionFilterPair(self._robot, self._robot, a, b, 0)
-        # The ground: a wide thin slab (not an infinite plane, whose bounding box would pair it with
-        # every link in Bullet's broad phase) kept centred under the base; its top is at z = margin.
-        slab = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=(_GROUND_HALF, _GROUND_HALF, 0.5))
-        self._ground = self._c.createMultiBody(0.0, slab, basePosition=self._ground_center(position))
-        for link in self._model.base_links:
-            self._c.setCollisionFilterPair(self._robot, self._ground, link, -1, 0)
-        # Bound client functions, looked up once: BulletClient's attribute lookup costs ~2 us per call.
-        self._reset_joints = self._c.resetJointStatesMultiDof
-        self._detect = self._c.performCollisionDetection
-        self._contacts = self._c.getContactPoints
-        self._link_state = self._c.getLinkState
-        self._reset_base = self._c.resetBasePositionAndOrientation
-        self._arm_joints = list(self._model.arm_joints)
-        self._gripper_value = float("nan")
-        self._set_gripper(self._model.gripper_open)
-        self._obstacles: dict[Box, int] = {}
-        self._held_bodies: dict[Vec3, int] = {}
-        self._active_held: int | None = None
-        self._last_held: Box | None = None
-        self._held_local: Pose = ((0.0, 0.0, 0.0), IDENTITY_QUAT)
-        self._held_grip = self._model.gripper_open
-        self.rest_q = self._default_q(rest_q, self._model.rest_q, "rest_q")
-        self.home_q = self._default_q(home_q, self._model.home_q, "home_q")
-        self.set_obstacles(obstacles)
+    # ----------------------------------------------------------------- sharing
+    def _model_in_use(self) -> ArmPlanningModel:
+        """The model, holding this scene's base pose, obstacles and joint values."""
+        m = self._m
+        if m is None:
+            raise ValueError("the arm scene is closed")
+        if m.owner is not self:
+            self._take_over(m)
+        return m
+
+    def _take_over(self, m: ArmPlanningModel) -> None:
+        previous = m.owner
+        if previous is not None:  # it finds its joints as it left them when it comes back
+            previous._joints = m.joint_values()
+        m.owner = self
+        m.place_base(self._base_frame)
+        m.place_obstacles(self._boxes)
+        if self._joints is None:  # a new scene: the URDF's zeros, the gripper open
+            joints = [0.0] * len(m.model.arm_joints) + [m.model.gripper_open] * len(m.model.gripper_joints)
+        else:
+            joints = self._joints
+        m.reset_joints(m.robot, list(m.model.movable_joints), [[v] for v in joints])
+        m.gripper_value = joints[-1] if m.model.gripper_joints else m.gripper_value
+        self._joints = None
+
+    @property
+    def model(self) -> ArmPlanningModel:
+        """The (possibly shared) planning model: client, arm body and collision bodies."""
+        if self._m is None:
+            raise ValueError("the arm scene is closed")
+        return self._m
 
     # ----------------------------------------------------------------- properties
     @property
     def client(self) -> BulletClient:
-        """The scene's own pybullet client (DIRECT)."""
-        return self._c
+        """The scene's pybullet client (DIRECT), holding this scene's state (shared with the model's other scenes)."""
+        return self._model_in_use().client
 
     @property
     def robot_id(self) -> int:
         """Body id of the arm in :attr:`client`."""
-        return self._robot
+        return self._model_in_use().robot
 
     @property
     def joint_indices(self) -> tuple[int, ...]:
@@ -221,7 +392,7 @@ class ArmScene:
     @property
     def obstacles(self) -> tuple[Box, ...]:
         """The current obstacle boxes (as given, not inflated)."""
-        return tuple(self._obstacles)
+        return self._boxes
 
     @property
     def reach(self) -> float:
@@ -234,17 +405,17 @@ class ArmScene:
 
     def base_pose(self) -> Pose:
         """Current world pose of the base link's URDF frame (as ``loadURDF``'s ``basePosition``)."""
-        pos, quat = self._c.getBasePositionAndOrientation(self._robot)  # centre of mass frame
+        m = self._model_in_use()
+        pos, quat = m.client.getBasePositionAndOrientation(m.robot)  # centre of mass frame
         return pose_multiply((tuple(pos), tuple(quat)), pose_inverse(self._model.base_inertial))
 
     # ----------------------------------------------------------------- world edits
     def set_base_pose(self, pose: Pose) -> None:
         """Move the arm's base (e.g. after the mobile base drove)."""
         frame = as_pose(pose, "base_pose")
-        # pybullet places a body by its centre of mass; the caller gives the URDF frame.
-        position, orientation = pose_multiply(frame, self._model.base_inertial)
-        self._c.resetBasePositionAndOrientation(self._robot, position, orientation)
-        self._c.resetBasePositionAndOrientation(self._ground, self._ground_center(frame[0]), IDENTITY_QUAT)
+        m = self._model_in_use()
+        self._base_frame = frame
+        m.place_base(frame)
 
     def set_obstacles(self, boxes: Iterable[Box]) -> None:
         """Replace the static obstacles; boxes equal to current ones keep their bodies.
@@ -261,18 +432,9 @@ class ArmScene:
             if box.name in names:
                 raise ValueError(f"duplicate obstacle name {box.name!r}")
             names.add(box.name)
-        keep = set(new)
-        for box in [b for b in self._obstacles if b not in keep]:
-            self._c.removeBody(self._obstacles.pop(box))
-        for box in new:
-            if box not in self._obstacles:
-                half = [h + self._margin for h in box.half_extents]
-                shape = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=half)
-                self._obstacles[box] = self._c.createMultiBody(
-                    0.0, shape, basePosition=box.center, baseOrientation=quat_from_yaw(box.yaw)
-                )
-        # Keep the insertion order of the request (for :attr:`obstacles`).
-        self._obstacles = {box: self._obstacles[box] for box in new}
+        m = self._model_in_use()
+        self._boxes = tuple(new)  # the order of the request (for :attr:`obstacles`)
+        m.place_obstacles(self._boxes)
 
     # ----------------------------------------------------------------- queries
     def within_limits(self, q: Sequence[float] | np.ndarray) -> bool:
@@ -309,48 +471,56 @@ class ArmScene:
 
     def collides(self, q: Sequence[float] | np.ndarray, held: Box | None = None) -> bool:
         """:meth:`in_collision` without argument checks (for planners' inner loops)."""
-        self._reset_joints(self._robot, self._arm_joints, [[float(v)] for v in q])
+        m = self._m
+        if m is None or m.owner is not self:
+            m = self._model_in_use()
+        m.reset_joints(m.robot, m.arm_joints, [[float(v)] for v in q])
         if held is None:
-            if self._active_held is not None:
-                self._park_held()
-            if self._gripper_value != self._model.gripper_open:
-                self._set_gripper(self._model.gripper_open)
+            if m.active_held is not None:
+                m.park_held()
+            if m.gripper_value != self._model.gripper_open:
+                m.set_gripper(self._model.gripper_open)
         else:
-            body = self._held_body(held.half_extents)
-            if self._active_held is not None and self._active_held != body:
-                self._park_held()
-            self._active_held = body
-            if held is not self._last_held:
-                self._last_held = held
-                self._held_local = (held.center, quat_from_yaw(held.yaw))
-                self._held_grip = self._grip_value(held)
-            if self._held_grip != self._gripper_value:
-                self._set_gripper(self._held_grip)
-            state = self._link_state(self._robot, self._model.ee_link, computeForwardKinematics=True)
-            pos, quat = pose_multiply((state[4], state[5]), self._held_local)
-            self._reset_base(body, pos, quat)
-        self._detect()
+            body = m.held_body(held.half_extents)
+            if m.active_held is not None and m.active_held != body:
+                m.park_held()
+            m.active_held = body
+            if held is not m.last_held:
+                m.last_held = held
+                m.held_local = (held.center, quat_from_yaw(held.yaw))
+                m.held_grip = self._grip_value(held)
+            if m.held_grip != m.gripper_value:
+                m.set_gripper(m.held_grip)
+            state = m.link_state(m.robot, self._model.ee_link, computeForwardKinematics=True)
+            pos, quat = pose_multiply((state[4], state[5]), m.held_local)
+            m.reset_base(body, pos, quat)
+        m.detect()
         # Only pairs with a moving body (arm links, held object) are ever in contact: static boxes
         # and the ground are not tested against each other, so one query covers everything.
-        return any(cp[8] < 0.0 for cp in self._contacts())
+        return any(cp[8] < 0.0 for cp in m.contacts())
 
     def set_joints(self, q: Sequence[float] | np.ndarray) -> None:
         """Set the 7 arm joints of the planning body (no checks; for inner loops)."""
-        self._reset_joints(self._robot, self._model.arm_joints, [[float(v)] for v in q])
+        m = self._m
+        if m is None or m.owner is not self:
+            m = self._model_in_use()
+        m.reset_joints(m.robot, m.arm_joints, [[float(v)] for v in q])
 
     def current_tool_pose(self) -> Pose:
         """World pose of :attr:`ee_link` at the joint values last set (forward kinematics recomputed)."""
-        state = self._link_state(self._robot, self._model.ee_link, computeForwardKinematics=True)
+        m = self._model_in_use()
+        state = m.link_state(m.robot, self._model.ee_link, computeForwardKinematics=True)
         return tuple(state[4]), tuple(state[5])
 
     def close(self) -> None:
-        """Disconnect the scene's client (idempotent)."""
-        if self._c is not None:
-            try:
-                self._c.disconnect()
-            except pybullet.error:  # already disconnected
-                pass
-            self._c = None
+        """Leave the shared model, or disconnect the scene's own one (idempotent)."""
+        m = self._m
+        if m is not None:
+            if self._owns_model:
+                m.close()
+            elif m.owner is self:
+                m.owner = None
+            self._m = None
 
     def __enter__(self) -> Self:
         return self
@@ -359,41 +529,14 @@ class ArmScene:
         self.close()
 
     # ----------------------------------------------------------------- internals
-    def _ground_center(self, base_position: Sequence[float]) -> Vec3:
-        return (float(base_position[0]), float(base_position[1]), self._margin - 0.5)
-
     def _default_q(self, given: Sequence[float] | None, model_q: np.ndarray, name: str) -> np.ndarray:
         q = model_q.copy() if given is None else as_configuration(given, 7, name)
         if not self.within_limits(q):
             raise ValueError(f"{name} lies outside the joint limits: {q.tolist()}")
         return q
 
-    def _set_gripper(self, value: float) -> None:
-        joints = self._model.gripper_joints
-        if joints:
-            self._c.resetJointStatesMultiDof(self._robot, joints, [[value]] * len(joints))
-        self._gripper_value = value
-
     def _grip_value(self, held: Box) -> float:
         """Finger joint value closing the gripper on ``held`` (width across the tool y axis)."""
         hx, hy, _ = held.half_extents
         half_width = abs(math.sin(held.yaw)) * hx + abs(math.cos(held.yaw)) * hy
         return float(min(self._model.gripper_open, max(self._model.gripper_closed, half_width)))
-
-    def _held_body(self, half_extents: Vec3) -> int:
-        body = self._held_bodies.get(half_extents)
-        if body is None:
-            shape = self._c.createCollisionShape(pybullet.GEOM_BOX, halfExtents=list(half_extents))
-            # A (never simulated) mass makes the body dynamic, so Bullet checks it against static boxes.
-            body = self._c.createMultiBody(0.1, shape, basePosition=(0.0, 0.0, _PARK_Z + 10.0 * len(self._held_bodies)))
-            for link in self._model.gripper_links:
-                self._c.setCollisionFilterPair(body, self._robot, -1, link, 0)
-            self._held_bodies[half_extents] = body
-        return body
-
-    def _park_held(self) -> None:
-        body = self._active_held
-        if body is not None:
-            index = list(self._held_bodies.values()).index(body)
-            self._c.resetBasePositionAndOrientation(body, (0.0, 0.0, _PARK_Z + 10.0 * index), (0.0, 0.0, 0.0, 1.0))
-        self._active_held = None

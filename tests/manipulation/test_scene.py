@@ -136,3 +136,45 @@ def test_scenes_are_independent_and_close_is_idempotent() -> None:
         b.close()
         b.close()
     assert default_urdf().endswith("panda.urdf")
+
+
+def test_scenes_sharing_a_model_answer_as_scenes_of_their_own() -> None:
+    from alica.skills.manipulation import ArmPlanningModel, solve_ik
+
+    poses = [((0.0, 0.0, 0.3), (0.0, 0.0, 0.0, 1.0)), ((2.0, 1.0, 0.3), (0.0, 0.0, 0.7071068, 0.7071068))]
+    walls = [
+        [Box("wall", (0.45, 0.0, 0.4), (0.02, 0.3, 0.4)), Box("a", (0.5, 0.2, 0.025), (0.025, 0.025, 0.025))],
+        [Box("a", (2.0, 1.5, 0.025), (0.025, 0.025, 0.025))],
+    ]
+    held = Box("h", (0.0, 0.0, 0.03), (0.025, 0.025, 0.025))
+    model = ArmPlanningModel()
+    shared = [ArmScene(base_pose=p, obstacles=w, model=model) for p, w in zip(poses, walls, strict=True)]
+    alone = [ArmScene(base_pose=p, obstacles=w) for p, w in zip(poses, walls, strict=True)]
+    try:
+        rng = np.random.default_rng(3)
+        qs = [shared[0].random_configuration(rng) for _ in range(40)]
+        for k, q in enumerate(qs):  # the two shared scenes take turns, query by query
+            i = k % 2
+            h = held if k % 3 == 0 else None
+            assert shared[i].collides(q, h) == alone[i].collides(q, h)
+            assert shared[i].fk(q) == alone[i].fk(q)
+            assert shared[i].base_pose() == alone[i].base_pose()
+        shared[0].set_joints(qs[0])
+        shared[1].set_joints(qs[1])
+        assert shared[0].current_tool_pose() == alone[0].fk(qs[0])  # its joints were kept for it
+        for i in (0, 1):
+            target = alone[i].fk(alone[i].rest_q)
+            a = solve_ik(shared[i], target[0], target[1], rng=np.random.default_rng(1))
+            b = solve_ik(alone[i], target[0], target[1], rng=np.random.default_rng(1))
+            assert a.ok == b.ok and (a.q is None or np.array_equal(a.q, b.q))
+        assert shared[0].obstacles == tuple(walls[0]) and shared[1].obstacles == tuple(walls[1])
+        with pytest.raises(ValueError, match="margin"):
+            ArmScene(model=model, margin=0.01)
+        shared[0].close()
+        with pytest.raises(ValueError, match="closed"):
+            shared[0].collides(qs[0])
+        assert not shared[1].collides(shared[1].home_q)  # the model lives on for the other scene
+    finally:
+        for s in shared + alone:
+            s.close()
+        model.close()
