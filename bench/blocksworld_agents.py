@@ -28,9 +28,9 @@ ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "build" / "bench"
 
 
-def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
-    """One demo run in a fresh process; its JSON summary (``error`` set when it did not run)."""
-    argv = [
+def demo_argv(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> list[str]:
+    """The command of one ``alica demo blocksworld`` run with a JSON summary, in a fresh interpreter."""
+    return [
         sys.executable,
         "-m",
         "alica.app.cli",
@@ -49,6 +49,11 @@ def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: flo
         "--json",
         "--no-progress",
     ]
+
+
+def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
+    """One demo run in a fresh process; its JSON summary (``error`` set when it did not run)."""
+    argv = demo_argv(agents, opponents, blocks, seed, time_limit)
     started = time.perf_counter()
     done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, timeout=time_limit * 4 + 120)
     line = next((row for row in reversed(done.stdout.splitlines()) if row.startswith("{")), None)

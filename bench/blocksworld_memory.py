@@ -21,6 +21,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from blocksworld_agents import demo_argv  # bench/ is on the path when this script runs
+
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "build" / "bench"
 COLUMNS = ("agents", "opponents", "blocks", "seed", "success", "peak_rss_mb", "sim_time_s", "replans")
@@ -28,25 +30,7 @@ COLUMNS = ("agents", "opponents", "blocks", "seed", "success", "peak_rss_mb", "s
 
 def run_one(agents: int, opponents: int, blocks: int, seed: int, time_limit: float) -> dict[str, object]:
     """One demo run in a fresh process: its JSON summary with ``peak_rss_mb`` (``error`` when it did not run)."""
-    argv = [
-        sys.executable,
-        "-m",
-        "alica.app.cli",
-        "demo",
-        "blocksworld",
-        "--agents",
-        str(agents),
-        "--opponents",
-        str(opponents),
-        "--blocks",
-        str(blocks),
-        "--seed",
-        str(seed),
-        "--time-limit",
-        str(time_limit),
-        "--json",
-        "--no-progress",
-    ]
+    argv = demo_argv(agents, opponents, blocks, seed, time_limit)
     with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
         proc = subprocess.Popen(argv, cwd=ROOT, stdout=out, stderr=err, text=True)
         _, status, usage = os.wait4(proc.pid, 0)  # reaps the child: its own rusage, not the sum of all children

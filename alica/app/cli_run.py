@@ -13,7 +13,6 @@ import argparse
 import json
 import re
 import sys
-import time
 from typing import Any
 
 from alica.app.skill_options import add_lunar_options, add_skills_option
@@ -321,21 +320,7 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
         interrupted = False
         try:
             team.launch()
-            while not team.done() and team.now() < args.max_time:
-                while faults and team.now() >= faults[0][0]:
-                    _, kind, what = faults.pop(0)
-                    if kind == "crash":
-                        team.crash(what)
-                    elif kind == "recover":
-                        team.recover(what)
-                    elif kind == "partition":
-                        team.partition(*what)
-                    else:
-                        team.heal()
-                team.exited()
-                if team.all_down() and not any(kind == "recover" for _, kind, _ in faults):
-                    break  # nobody left, and nobody comes back
-                time.sleep(0.05)
+            team.run(faults, args.max_time, on_started=_announce)
         except KeyboardInterrupt:
             interrupted = True
         finally:
@@ -353,6 +338,11 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
     if interrupted:
         return 130
     return 0 if summary["success"] else 1
+
+
+def _announce(count: int, at: float) -> None:
+    print(f"alica run: {count} agent processes started after {at:.1f} s (Ctrl-C stops them all)", file=sys.stderr)
+    sys.stderr.flush()
 
 
 def _process_reason(agent: dict[str, Any]) -> str:

@@ -26,7 +26,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -36,6 +36,8 @@ from alica.comm.relay import LinkRelay
 from alica.comm.zenoh_transport import free_endpoints
 from alica.errors import AlicaError
 
+POLL = 0.05
+"""Seconds between two looks at the agents and the faults due."""
 STOP_GRACE = 10.0
 """Seconds an agent process has to exit after SIGTERM before it is killed."""
 
@@ -157,6 +159,44 @@ class ProcessTeam:
                     agent.status = str(record.get("status"))
                 elif record.get("event") == "summary":
                     agent.summaries.append(record)
+
+    def run(
+        self,
+        faults: Sequence[tuple[float, str, Any]],
+        max_time: float,
+        *,
+        on_started: Callable[[int, float], None] | None = None,
+    ) -> None:
+        """Apply ``faults`` at their times until every running agent finished, ``max_time``, or nobody is left.
+
+        Args:
+            faults: ``(t, kind, what)`` in seconds since the start: ``("crash", name)``,
+                ``("recover", name)``, ``("partition", (groups, start, end))`` or ``("heal", None)``.
+            max_time: seconds since the start at most.
+            on_started: called once with the number of agents and the time, when every
+                agent process has started (reported its first line).
+        """
+        pending = sorted(faults, key=lambda fault: fault[0])
+        announced = on_started is None
+        while not self.done() and self.now() < max_time:
+            while pending and self.now() >= pending[0][0]:
+                _, kind, what = pending.pop(0)
+                if kind == "crash":
+                    self.crash(what)
+                elif kind == "recover":
+                    self.recover(what)
+                elif kind == "partition":
+                    self.partition(*what)
+                else:
+                    self.heal()
+            self.exited()
+            if not announced and all(a.status != "starting" for a in self.agents.values()):
+                announced = True
+                assert on_started is not None
+                on_started(len(self.agents), self.now())
+            if self.all_down() and not any(kind == "recover" for _, kind, _ in pending):
+                return  # nobody left, and nobody comes back
+            time.sleep(POLL)
 
     def now(self) -> float:
         """Seconds since the team's start."""

@@ -313,8 +313,8 @@ class ZenohTransport(Transport):
                     kept = self._history[topic] = deque()
                 kept.append((rseq, now, data))
                 self._kept_bytes += len(data)
-                while self._kept_bytes > self._history_bytes and len(kept) > 1:
-                    self._kept_bytes -= len(kept.popleft()[2])  # the flooding topic gives way first
+                while len(kept) > 1 and (self._kept_bytes > self._history_bytes or kept[0][1] < now - self._history_s):
+                    self._kept_bytes -= len(kept.popleft()[2])  # too old, or the flooding topic gives way first
         else:
             data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, encode(payload)))
         publisher = self._publishers.get((topic, qos))

@@ -14,13 +14,18 @@ from alica.comm import Envelope, QoS, Transport
 from tests.comm.harness import FACTORIES, Harness
 
 
-@pytest.fixture(params=sorted(FACTORIES))
-def harness(request: pytest.FixtureRequest) -> Iterator[Harness]:
-    made = FACTORIES[request.param]()
+def _made(name: str) -> Iterator[Harness]:
+    """A fresh harness of the set-up ``name``, closed after the test."""
+    made = FACTORIES[name]()
     try:
         yield made
     finally:
         made.close()
+
+
+@pytest.fixture(params=sorted(FACTORIES))
+def harness(request: pytest.FixtureRequest) -> Iterator[Harness]:
+    yield from _made(request.param)
 
 
 def team(harness: Harness, *names: str, topics: tuple[str, ...] = ("state",)) -> list[Transport]:
@@ -42,11 +47,22 @@ LOSSLESS = sorted(name for name, make in FACTORIES.items() if make().lossless)
 
 @pytest.fixture(params=LOSSLESS)
 def lossless_harness(request: pytest.FixtureRequest) -> Iterator[Harness]:
-    made = FACTORIES[request.param]()
-    try:
-        yield made
-    finally:
-        made.close()
+    yield from _made(request.param)
+
+
+#: Set-ups whose peers are the agents heard within the lease, and those whose peers follow liveliness tokens.
+HEARD = sorted(name for name, make in FACTORIES.items() if make().liveness == "heard")
+TOKENS = sorted(name for name, make in FACTORIES.items() if make().liveness == "token")
+
+
+@pytest.fixture(params=HEARD)
+def heard_harness(request: pytest.FixtureRequest) -> Iterator[Harness]:
+    yield from _made(request.param)
+
+
+@pytest.fixture(params=TOKENS)
+def token_harness(request: pytest.FixtureRequest) -> Iterator[Harness]:
+    yield from _made(request.param)
 
 
 # ---------------------------------------------------------------------- delivery
@@ -227,9 +243,8 @@ def test_crashed_agent_neither_sends_nor_receives(harness: Harness) -> None:
     assert [e.payload for e in got_a] == ["hello"]
 
 
-def test_peers_are_the_agents_heard_within_the_lease(harness: Harness) -> None:
-    if harness.liveness != "heard":
-        pytest.skip("this transport's peers come from liveliness tokens (test_peers_follow_liveliness_tokens)")
+def test_peers_are_the_agents_heard_within_the_lease(heard_harness: Harness) -> None:
+    harness = heard_harness
     a, b, c = team(harness, "a", "b", "c")
     assert a.peers() == frozenset()
     for _ in range(20):
@@ -251,9 +266,8 @@ def test_peers_are_the_agents_heard_within_the_lease(harness: Harness) -> None:
     assert a.peers() == frozenset()
 
 
-def test_peers_follow_liveliness_tokens(harness: Harness) -> None:
-    if harness.liveness != "token":
-        pytest.skip("this transport's peers are the agents heard within the lease")
+def test_peers_follow_liveliness_tokens(token_harness: Harness) -> None:
+    harness = token_harness
     a, b, c = team(harness, "a", "b", "c")
     harness.wait(0.2)
     assert (a.peers(), b.peers(), c.peers()) == ({"b", "c"}, {"a", "c"}, {"a", "b"})

@@ -12,7 +12,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -95,7 +94,9 @@ def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
 def test_ctrl_c_stops_every_agent_process(tmp_path):
     argv = [sys.executable, "-m", "alica.app.cli", "run", LUNAR, *TEAM, "--processes", "--max-time", "60", "--json"]
     process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
-    time.sleep(4.0)  # a real process tree on the wall clock: let the agents start
+    assert process.stderr is not None
+    started = process.stderr.readline()  # the run says when every agent process is up
+    assert "3 agent processes started" in started, started
     os.kill(process.pid, signal.SIGINT)
     out, err = process.communicate(timeout=30)
     assert process.returncode == 130, err
@@ -144,14 +145,7 @@ def test_writes_on_both_sides_of_a_partition_reach_everyone_once_it_heals(tmp_pa
     )
     try:
         team.launch()
-        while team.now() < 3.5:
-            time.sleep(0.05)
-        team.partition([["scout"], ["stummel", "amparo"]], 3.5, 8.0)
-        while team.now() < 8.0:
-            time.sleep(0.05)
-        team.heal()
-        while not team.done() and team.now() < 40:
-            time.sleep(0.05)
+        team.run([(3.5, "partition", ([["scout"], ["stummel", "amparo"]], 3.5, 8.0)), (8.0, "heal", None)], 40)
     finally:
         team.stop()
     summary = team.summary("LunarMission", 0)

@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from alica.clock import ManualClock
 from alica.comm import QoS
 from alica.comm.codec import CodecError, allow_module, decode, encode
 from alica.comm.relay import LinkRelay
@@ -76,8 +77,9 @@ def test_a_restarted_agent_is_a_new_incarnation_whose_numbers_go_on(endpoints):
 def test_what_a_sender_no_longer_keeps_is_counted_lost():
     ea, eb = free_endpoints(2)
     relay = LinkRelay(ea)
-    a = ZenohTransport("a", listen=[ea], team="unit", history=0.3, heartbeat=0.05)
-    b = ZenohTransport("b", listen=[eb], connect=[relay.endpoint], team="unit")
+    clock = ManualClock(time.time())  # the history's age is on the agents' clock, moved by hand here
+    a = ZenohTransport("a", listen=[ea], team="unit", history=0.3, clock=clock)
+    b = ZenohTransport("b", listen=[eb], connect=[relay.endpoint], team="unit", clock=clock)
     try:
         b.subscribe("news")
         assert wait_for(lambda: b.peers() == {"a"})
@@ -85,10 +87,10 @@ def test_what_a_sender_no_longer_keeps_is_counted_lost():
         assert [e.payload for e in drain(b, 1)] == ["seen"]
         relay.cut()
         a.publish("news", "missed", QoS.RELIABLE)
-        time.sleep(0.6)  # longer than a's history: it drops "missed"
+        clock.advance(0.6)  # longer than a's history: publishing "after" drops "missed"
+        a.publish("news", "after", QoS.RELIABLE)
         relay.heal()
         assert wait_for(lambda: b.peers() == {"a"})
-        a.publish("news", "after", QoS.RELIABLE)
         assert [e.payload for e in drain(b, 1)] == ["after"]
         assert b.stats.lost == 1
     finally:
