@@ -10,12 +10,19 @@ simulated time against agents to ``build/bench/``.
 The paper's trends are the bar. Without opponents the time falls as agents
 are added. With opponents it is higher, because the team has to replan.
 
-Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 6] [--seeds 3] [--time-limit 900] [--jobs 2]``
+Several block counts run in one go (``--blocks 8,12``); the plot of each
+shows, beside the curves measured now, the curve recorded before issue 19
+(``bench/blocksworld_before.tsv``: the mean simulated times without
+opponents at commit 5405f13, seeds 0-9, measured with
+``bench/blocksworld_timeline.py``).
+
+Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 8,12] [--seeds 10] [--time-limit 600] [--jobs 2]``
 """
 
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import statistics
 import subprocess
@@ -77,7 +84,7 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--agents", default="1-5", help="range of team sizes (default 1-5)")
     parser.add_argument("--opponents", type=int, default=2, help="opponents in the runs with opponents (default 2)")
-    parser.add_argument("--blocks", type=int, default=6, help="blocks (default 6)")
+    parser.add_argument("--blocks", default="8", help="block counts, comma-separated (default 8)")
     parser.add_argument("--seeds", type=int, default=3, help="seeds per cell (default 3)")
     parser.add_argument("--time-limit", type=float, default=900.0, help="simulated seconds per run (default 900)")
     parser.add_argument(
@@ -87,14 +94,30 @@ def main() -> int:
         help="runs at once, each in its own process (default 1; wall times are then shared-machine figures)",
     )
     args = parser.parse_args()
+    counts = [int(b) for b in str(args.blocks).split(",")]
     cells = [(opponents, agents) for opponents in (0, args.opponents) for agents in _range(args.agents)]
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         futures = {
-            (o, a, seed): pool.submit(run_one, a, o, args.blocks, seed, args.time_limit)
+            (blocks, o, a, seed): pool.submit(run_one, a, o, blocks, seed, args.time_limit)
+            for blocks in counts
             for o, a in cells
             for seed in range(args.seeds)
         }
-        results = {key: future.result() for key, future in futures.items()}
+        every = {key: future.result() for key, future in futures.items()}
+    OUT.mkdir(parents=True, exist_ok=True)
+    for blocks in counts:
+        results = {key[1:]: r for key, r in every.items() if key[0] == blocks}
+        _report(args, blocks, cells, results)
+    return 0
+
+
+def _report(
+    args: argparse.Namespace,
+    blocks: int,
+    cells: list[tuple[int, int]],
+    results: dict[tuple[int, int, int], dict[str, object]],
+) -> None:
+    """Print the table of one block count, write its TSVs and its plot."""
     rows = []
     for opponents, agents in cells:
         runs = [results[(opponents, agents, seed)] for seed in range(args.seeds)]
@@ -117,15 +140,9 @@ def main() -> int:
                 "errors": "; ".join(str(r["error"]) for r in runs if "error" in r),
             }
         )
-        last = rows[-1]
-        print(
-            f"agents {agents} opponents {opponents}: {last['success']} ok, sim {last['sim_mean']:.1f} s",
-            file=sys.stderr,
-            flush=True,
-        )
     header = ["agents", "opponents", "success", "sim time mean s", "min", "max", "replans mean", "wall mean s"]
     print(
-        f"Blocks world, {args.blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n"
+        f"\nBlocks world, {blocks} blocks, {args.seeds} seeds per cell, time limit {args.time_limit:.0f} s simulated\n"
     )
     print("| " + " | ".join(header) + " |")
     print("|" + "---|" * len(header))
@@ -133,11 +150,18 @@ def main() -> int:
         print(
             f"| {r['agents']} | {r['opponents']} | {r['success']} | {r['sim_mean']:.1f} | {r['sim_min']:.1f} | {r['sim_max']:.1f} | {r['replans']:.1f} | {r['wall_mean']:.1f} |"
         )
+    free = [r for r in rows if r["opponents"] == 0]
+    falls = all(float(b["sim_mean"]) < float(a["sim_mean"]) for a, b in itertools.pairwise(free))  # type: ignore[arg-type]
+    if len(free) >= 2:
+        ratio = float(free[-1]["sim_mean"]) / float(free[0]["sim_mean"])  # type: ignore[arg-type]
+        print(
+            f"\nwithout opponents: the mean falls at every added agent: {'yes' if falls else 'no'}; "
+            f"{free[-1]['agents']} agents take {ratio:.2f}x the time of {free[0]['agents']}"
+        )
     errors = [f"agents {r['agents']} opponents {r['opponents']}: {r['errors']}" for r in rows if r["errors"]]
     if errors:
         print("\nruns that did not finish: " + " | ".join(errors))
-    OUT.mkdir(parents=True, exist_ok=True)
-    with (OUT / "blocksworld_agents.tsv").open("w", encoding="utf-8") as f:
+    with (OUT / f"blocksworld_agents_b{blocks}.tsv").open("w", encoding="utf-8") as f:
         f.write(
             "\t".join(["agents", "opponents", "success", "sim_mean", "sim_min", "sim_max", "replans", "wall_mean"])
             + "\n"
@@ -159,20 +183,32 @@ def main() -> int:
                 )
                 + "\n"
             )
-    with (OUT / "blocksworld_runs.tsv").open("w", encoding="utf-8") as f:
+    with (OUT / f"blocksworld_runs_b{blocks}.tsv").open("w", encoding="utf-8") as f:
         f.write("agents\topponents\tseed\tsuccess\tsim_time_s\twall_time_s\treplans\terror\n")
         for (opponents, agents, seed), r in sorted(results.items()):
             f.write(
                 f"{agents}\t{opponents}\t{seed}\t{r.get('success', '')}\t{r.get('sim_time_s', '')}\t{r.get('wall_time_s', '')}\t{r.get('replans', '')}\t{r.get('error', '')}\n"
             )
-    _plot(rows, OUT / "blocksworld_agents.png", args)
-    print(
-        f"\nwrote {OUT / 'blocksworld_agents.tsv'}, {OUT / 'blocksworld_runs.tsv'} (every run) and {OUT / 'blocksworld_agents.png'}"
-    )
-    return 0
+    _plot(rows, OUT / f"blocksworld_agents_b{blocks}.png", args, blocks)
+    print(f"\nwrote blocksworld_agents_b{blocks}.tsv, blocksworld_runs_b{blocks}.tsv (every run) and the plot to {OUT}")
 
 
-def _plot(rows: list[dict[str, object]], path: Path, args: argparse.Namespace) -> None:
+#: The mean simulated times recorded before issue 19 (no opponents): blocks, agents, seconds.
+BEFORE = Path(__file__).resolve().parent / "blocksworld_before.tsv"
+
+
+def _before(blocks: int) -> dict[int, float]:
+    if not BEFORE.exists():
+        return {}
+    out = {}
+    for line in BEFORE.read_text(encoding="utf-8").splitlines()[1:]:
+        b, a, sim = line.split("\t")[:3]
+        if int(b) == blocks:
+            out[int(a)] = float(sim)
+    return out
+
+
+def _plot(rows: list[dict[str, object]], path: Path, args: argparse.Namespace, blocks: int) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -186,10 +222,14 @@ def _plot(rows: list[dict[str, object]], path: Path, args: argparse.Namespace) -
         low = [float(r["sim_mean"]) - float(r["sim_min"]) for r in mine]  # type: ignore[arg-type]
         high = [float(r["sim_max"]) - float(r["sim_mean"]) for r in mine]  # type: ignore[arg-type]
         ax.errorbar(xs, ys, yerr=[low, high], fmt=style, capsize=3, label=f"{opponents} opponents")
+    before = _before(blocks)
+    if before:
+        xs = sorted(before)
+        ax.plot(xs, [before[a] for a in xs], ":", color="grey", marker="x", label="0 opponents, before (5405f13)")
     ax.set_xticks(_range(args.agents))
     ax.set_xlabel("agents")
     ax.set_ylabel("execution time (simulated s)")
-    ax.set_title(f"Blocks world, {args.blocks} blocks (cf. IMPERA Fig. 22)")
+    ax.set_title(f"Blocks world, {blocks} blocks (cf. IMPERA Fig. 22)")
     ax.legend()
     ax.grid(alpha=0.3)
     fig.tight_layout()

@@ -148,7 +148,7 @@ def _sample(engine: Any, robot: Any) -> dict[str, Any]:
         phase = getattr(bt, "phase", None)
         if phase is not None:
             row["phase"] = phase
-        row["fb"] = (bt.feedback_message or "")[:40]
+        row["fb"] = (bt.feedback_message or "")[:160]
     if robot is not None:
         row["xy"] = [round(float(robot.pose[0]), 3), round(float(robot.pose[1]), 3)]
         arm = getattr(robot, "arm", None)

@@ -387,10 +387,56 @@ def _predecessors(tasks: Sequence[Sequence[Step]]) -> dict[int, list[int]]:
     return out
 
 
+def work_site(step: Step) -> str | None:
+    """The object where ``step`` is carried out: the first object its precondition names outside the robot's own facts.
+
+    ``Stack(x, y)``: ``y`` (``holding(r, x)`` is the robot's own); ``Unstack(x, y)`` and ``Pickup(x)``: ``x``;
+    ``Putdown(x)``: none (anywhere free).
+    """
+    for positive, (_, args) in step.pre:
+        if positive and args and step.robot not in args:
+            return str(args[0])
+    return None
+
+
+def finished_object(step: Step, later: Sequence[Step]) -> str | None:
+    """The object ``step`` leaves where the plan wants it: its first object, when no later step touches it.
+
+    ``None`` when the step leaves the robot holding something, or a later
+    step touches one of its objects (say, stacks onto the block it placed).
+    """
+    if not step.bindings or any(positive and step.robot in args for positive, (_, args) in step.effect):
+        return None
+    touched = _objects(step)
+    if any(touched & _objects(other) for other in later):
+        return None
+    return step.bindings[0][1]
+
+
+def _standby_ref(standby: str, variables: frozenset[str], **values: str | None) -> ChildRef:
+    """The WaitPlan as a child, with the variables it declares bound to the values given."""
+    bind = tuple(Binding(var, value) for var, value in values.items() if var in variables and value is not None)
+    return ChildRef(standby, bind)
+
+
 def build_plan(
-    name: str, tasks: Sequence[Sequence[Step]], robot: str | None = None, standby: str | None = None
+    name: str,
+    tasks: Sequence[Sequence[Step]],
+    robot: str | None = None,
+    standby: str | None = None,
+    standby_variables: Iterable[str] = (),
+    settled: Iterable[str] = (),
 ) -> tuple[Plan, tuple[Task, ...], dict[str, Place]]:
     """The multi-agent plan of the tasks (see the module docstring); ``standby`` names the WaitPlan.
+
+    When the WaitPlan declares the variable ``near`` (``standby_variables``),
+    an agent that waits for its next step runs the WaitPlan with ``near`` bound
+    to the step's work site (:func:`work_site`); when it declares ``guard``,
+    an agent whose task is done runs it with ``guard`` bound to what its last
+    step finished (:func:`finished_object`), so that it can keep opponents
+    off that part of the goal; the agents standing by get ``guard`` bound to
+    the objects of ``settled`` (those of the world) that no step touches,
+    space-separated (each guards the nearest one no one else guards).
 
     Returns:
         The plan, its tasks, and where each state of a task is (:attr:`CreatedTasks.places`).
@@ -398,6 +444,8 @@ def build_plan(
     entry_points, states, transitions, task_defs = [], [], [], []
     places: dict[str, Place] = {}
     after = _predecessors(tasks)
+    waits = frozenset(standby_variables) if standby is not None else frozenset()
+    by_index = sorted((s for task in tasks for s in task), key=lambda s: s.index)
     for i, task in enumerate(tasks):
         task_name = f"{name}_T{i}"
         task_defs.append(Task(task_name, description=", ".join(s.label for s in task)))
@@ -411,7 +459,10 @@ def build_plan(
             following = f"T{i}_Wait{k + 1}" if k + 1 < len(task) else f"T{i}_Done"
             places[wait] = Place(i, k, StepKind.WAIT)
             places[run] = Place(i, k, StepKind.RUN)
-            states.append(State(wait, description=f"wait until {step.label} can run"))
+            wait_children = (
+                (_standby_ref(standby, waits, near=work_site(step)),) if standby is not None and "near" in waits else ()
+            )
+            states.append(State(wait, children=wait_children, description=f"wait until {step.label} can run"))
             bind = tuple(Binding(var, value) for var, value in step.bindings)
             states.append(State(run, children=(ChildRef(step.skill.name, bind),), description=step.label))
             transitions.append(
@@ -428,7 +479,13 @@ def build_plan(
             transitions.append(
                 Transition(f"{run}->T{i}_Failed", run, f"T{i}_Failed", Condition(ConditionKind.TRANSITION, "failed"))
             )
-        states.append(State(f"T{i}_Done", StateKind.SUCCESS))
+        last = task[-1]
+        done_children = (
+            (_standby_ref(standby, waits, guard=finished_object(last, by_index[last.index + 1 :])),)
+            if standby is not None and "guard" in waits
+            else ()
+        )
+        states.append(State(f"T{i}_Done", StateKind.SUCCESS, children=done_children))
         states.append(State(f"T{i}_Failed", StateKind.FAILURE))
         places[f"T{i}_Done"] = Place(i, len(task), StepKind.DONE)
         places[f"T{i}_Failed"] = Place(i, 0, StepKind.FAILED)
@@ -436,7 +493,9 @@ def build_plan(
         task_name = f"{name}_{STANDBY}"
         task_defs.append(Task(task_name, description=f"stand by in {standby} while no task needs the agent"))
         entry_points.append(EntryPoint(STANDBY, task_name, STANDBY, min=0, success_required=False))
-        states.append(State(STANDBY, children=(ChildRef(standby),), description=f"keep out of the way ({standby})"))
+        untouched = " ".join(sorted(set(settled) - {o for step in by_index for o in _objects(step)}))
+        ref = _standby_ref(standby, waits, guard=untouched or None)
+        states.append(State(STANDBY, children=(ref,), description=f"keep out of the way ({standby})"))
     plan = Plan(
         name,
         tuple(entry_points),
@@ -498,7 +557,11 @@ def create_tasks(
     team = _robots(robots)
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _parallelise(steps, init, team)
-    plan, task_defs, places = build_plan(name, tasks, standby=standby)
+    wait_plan = library.plans.get(standby) if standby is not None else None
+    variables = tuple(v.name for v in wait_plan.variables) if wait_plan is not None else ()
+    members = set(team)
+    objects = {str(a) for _, args in init for a in args if a not in members}
+    plan, task_defs, places = build_plan(name, tasks, standby=standby, standby_variables=variables, settled=objects)
     return CreatedTasks(
         tuple(tuple(t) for t in tasks),
         plan,

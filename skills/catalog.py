@@ -134,6 +134,30 @@ def _navigation(registry: SkillRegistry) -> None:
         implementation="alica.skills.navigation:DriveToFreeSpace",
     )
     registry.declare(
+        "WaitAside",
+        _p("clearance", "float", "distance in metres to keep from obstacles and robots", default=1.0),
+        _p("max_distance", "float", "farthest the robot may drive to find a place to wait", default=3.0),
+        _p(
+            "keep_away",
+            "float",
+            "distance in metres to keep from every block or sample lying in the world but the work site's (0: none)",
+            default=0.0,
+        ),
+        _p("near", "object", "the work site of the robot's next step: wait on a ring around it", required=False),
+        _p(
+            "guard",
+            "object",
+            "a finished part of the goal: stay within guard_radius of it, so that opponents leave it alone",
+            required=False,
+        ),
+        _p("guard_radius", "float", "metres from the guarded object within which the robot stays", default=0.9),
+        doc="wait out of the way of the team's work: near the next work site, guarding a finished stack, or away "
+        "from every stack; clear of the other robots and of the stand-off points teammates reserved; moves on when "
+        "a teammate needs the place; runs until its state is left",
+        capabilities=("base",),
+        implementation="alica.skills.waiting:WaitAside",
+    )
+    registry.declare(
         "DriveToDroppedSample",
         _p("distance", "float", "look from this many metres off where the dropped sample was last seen", default=1.5),
         _p("period", "float", "seconds between two looks for a dropped sample while there is none", default=1.0),

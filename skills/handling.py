@@ -31,6 +31,7 @@ import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
+from alica.skills import reservations
 from alica.skills.arm_world import area_spots, find_object, place_area, write_held, write_placed, write_released
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
@@ -235,12 +236,17 @@ class ArmSkill(WorldSkill):
         self.settle_until = 0.0
         self.blocked_since: float | None = None
         self.tried_sides: list[tuple[float, float]] = []
+        self.goal_moves = 0
+        self.reserved_xy: tuple[float, float] | None = None
+        self.reserved_at = 0.0
         self.followed: list[np.ndarray] = []
         self.released = False
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if self.context is not None else 0)
 
     def update(self) -> Status:
-        """One step of the current phase."""
+        """One step of the current phase (a held stand-off reservation is refreshed now and then)."""
+        if self.reserved_xy is not None and self.now() - self.reserved_at >= reservations.REFRESH_PERIOD:
+            self._reserve(self.reserved_xy)
         handler = getattr(self, f"_phase_{self.phase}")
         return handler()
 
@@ -285,8 +291,10 @@ class ArmSkill(WorldSkill):
             gap = distance((x, y), site)
             facing = abs(wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw))
             if abs(gap - self.standoff()) <= self.approach_slack() and facing < 0.15 and not self._side_tried((x, y)):
+                self._reserve((float(x), float(y)))
                 return self.approached()
             goal = self._standoff(site)
+            self.goal_moves = 0
             if goal is None:
                 if self.blocked_since is None:
                     self.blocked_since = self.now()
@@ -302,11 +310,14 @@ class ArmSkill(WorldSkill):
                 self.context,
             )
             self.mover.setup(context=self.context)
+            self._reserve(goal)
         if self.mover.status != Status.SUCCESS:
             self.mover.tick_once()
             if self.mover.status == Status.FAILURE:
                 return self.fail(f"cannot get to {site}: {self.mover.feedback_message}")
             if self.mover.status == Status.RUNNING:
+                if self._goal_taken() and self._switch_side(site):
+                    return self.running("approaching: another robot stands on the stand-off point, taking another side")
                 return self.running(f"approaching: {self.mover.feedback_message}")
         error = wrap_angle(math.atan2(site[1] - y, site[0] - x) - yaw)
         if abs(error) > 0.03:
@@ -315,11 +326,15 @@ class ArmSkill(WorldSkill):
         robot.stop()
         return self.approached()
 
-    def _standoff(self, site: tuple[float, float]) -> tuple[float, float] | None:
+    def _standoff(
+        self, site: tuple[float, float], skip: tuple[float, float] | None = None
+    ) -> tuple[float, float] | None:
         """A free point facing ``site`` at the arm's reach: the nearest side first, then around it.
 
-        Points overlapping another robot or an object (with a margin) are skipped;
-        ``None`` when every side is taken (the skill waits and looks again).
+        Points overlapping another robot, a point a teammate reserved
+        (:mod:`alica.skills.reservations`) or an object (with a margin) are
+        skipped, and so is ``skip`` (a side found taken); ``None`` when every
+        side is taken (the skill waits and looks again).
         """
         from alica.skills.navigation import robot_checker
 
@@ -332,17 +347,54 @@ class ArmSkill(WorldSkill):
             for r in self.world.robots.values()
             if r is not robot
         ]
+        others += [(rx, ry, rr + STANDOFF_MARGIN) for rx, ry, rr in reservations.reserved(self)]
         # the motion planner's own check of a goal (static obstacles, blocks, other robots)
         checker = robot_checker(self.world, robot, self.world_model).with_robots(others)
         for k in range(STANDOFF_TRIES):
             turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
             angle = heading + turn
             goal = (site[0] - standoff * math.cos(angle), site[1] - standoff * math.sin(angle))
-            if self._side_tried(goal):
+            if self._side_tried(goal) or (skip is not None and distance(goal, skip) < SIDE_TRIED):
                 continue
             if distance(goal, (x, y)) < 0.05 or checker.valid_xy(goal[0], goal[1]):
                 return goal
         return None
+
+    def _reserve(self, xy: tuple[float, float]) -> None:
+        """Tell the teammates where this robot will stand to work (refreshed by :meth:`update`)."""
+        reservations.reserve(self, xy)
+        self.reserved_xy = xy
+        self.reserved_at = self.now()
+
+    def _goal_taken(self) -> bool:
+        """Whether the approach waits for another robot to leave its stand-off point."""
+        mover = self.mover
+        return mover is not None and mover.job is None and mover.follower is None and self.now() < mover.wait_until
+
+    def _switch_side(self, site: tuple[float, float]) -> bool:
+        """Drive to another free side of ``site`` instead of waiting for the robot on this one.
+
+        The robot on the stand-off point may wait itself (for what this robot
+        does next), or be crashed there. Up to :data:`STANDOFF_TRIES` switches.
+        """
+        mover = self.mover
+        if mover is None or self.goal_moves >= STANDOFF_TRIES:
+            return False
+        current = (float(mover.goal[0]), float(mover.goal[1]))
+        goal = self._standoff(site, skip=current)
+        if goal is None:
+            return False
+        self.goal_moves += 1
+        mover.stop(Status.INVALID)
+        self.mover = MoveToPosition(
+            f"{self.name}/approach",
+            {"goal": goal, "tolerance": self.approach_tolerance(), "timeout": 60.0},
+            self.context,
+        )
+        self.mover.setup(context=self.context)
+        self._reserve(goal)
+        self.mover.tick_once()
+        return True
 
     def _side_tried(self, xy: tuple[float, float]) -> bool:
         """Whether the arm found no plan from a stand-off point this close to ``xy`` already."""
@@ -519,6 +571,9 @@ class ArmSkill(WorldSkill):
         """
         if self.mover is not None and self.mover.status == Status.RUNNING:
             self.mover.stop(Status.INVALID)
+        if getattr(self, "reserved_xy", None) is not None and self.has_robot:
+            reservations.release(self)
+            self.reserved_xy = None
         if self.has_robot:
             self.robot.stop()
             if new_status != Status.SUCCESS:

@@ -251,6 +251,8 @@ def map_planning(world: RobotWorld, world_model: WorldModelLike | None) -> MapPl
     return nav
 
 
+#: Seconds a robot waits for another robot to leave its path before it plans around it.
+ROBOT_YIELD = 2.0
 #: Seconds to wait before planning again when another robot stands on the goal.
 GOAL_WAIT = 1.0
 #: Radial step in metres of the search for a drivable point near a goal inside an obstacle's clearance.
@@ -314,6 +316,7 @@ class MoveToPosition(WorldSkill):
         self.next_scan = self.started
         self.speed = 0.0
         self.bumps = []
+        self.yield_since: float | None = None
         # a goal within an obstacle's clearance: drive to the nearest drivable point within the tolerance
         self.target = drivable_goal(self._checker(), self.goal, self.tolerance)
         self._plan(self.target or self.goal)
@@ -431,7 +434,19 @@ class MoveToPosition(WorldSkill):
             if robot.bumped:
                 self._remember_bump()
             return self._stuck(now)
-        if self._blocked():
+        blocked = self._blocked()
+        if blocked == "robot" and now - (self.yield_since if self.yield_since is not None else now) < ROBOT_YIELD:
+            # another robot crosses the path: wait for it to pass (a replan would route around a moving robot)
+            if self.yield_since is None:
+                self.yield_since = now
+            robot.stop()
+            self.speed = 0.0
+            self.follower.reset_stuck()  # an intended pause, not a lack of progress
+            return self.running("another robot is on the path: letting it pass")
+        if not blocked:
+            self.yield_since = None
+        if blocked:
+            self.yield_since = None
             self.replans += 1
             if self.replans > MAX_REPLANS:
                 robot.stop()
@@ -530,18 +545,25 @@ class MoveToPosition(WorldSkill):
         robot.bumped = False
         return self.running(f"stuck: driving into free space at ({spot[0]:.2f}, {spot[1]:.2f})")
 
-    def _blocked(self) -> bool:
-        """Whether another robot or a new obstacle stands on the next metres of the path (checked every 0.3 s).
+    def _blocked(self) -> str:
+        """What stands on the next metres of the path: ``"robot"`` (only other robots), ``"obstacle"``, or ``""``.
 
-        In map mode a new obstacle is one the team map shows now (read at most every :data:`MAP_PERIOD` s).
+        Checked every 0.3 s; in between the last answer holds while the robot
+        waits for another to pass. In map mode a new obstacle is one the team
+        map shows now (read at most every :data:`MAP_PERIOD` s).
         """
         follower = self.follower
         now = self.now()
-        if follower is None or self.escaping or now < self.next_block_check:
-            return False
+        if follower is None or self.escaping:
+            return ""
+        if now < self.next_block_check:
+            return "robot" if self.yield_since is not None else ""
         self.next_block_check = now + 0.3
         checker = self._checker()  # rebuilt when the layout or the team map changed
-        return bool(follower.blocked(checker, self.robot.estimate, other_robots=self._others(), horizon=4.0))
+        pose = self.robot.estimate
+        if not follower.blocked(checker, pose, other_robots=self._others(), horizon=4.0):
+            return ""
+        return "obstacle" if follower.blocked(checker, pose, horizon=4.0) else "robot"
 
     def _arrived(self, here: tuple[float, float]) -> None:
         wm = self.world_model

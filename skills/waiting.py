@@ -1,0 +1,220 @@
+"""WaitAside: where a robot waits while the team works (IMPERA 8.2: "every agent drives to a free position").
+
+A robot waits in three situations, and the skill serves all three:
+
+* **Standing by** (no task needs it): it keeps ``keep_away`` from every block
+  or sample lying in the world, as :class:`~alica.skills.navigation.DriveToFreeSpace`.
+* **Waiting for its next step** (``near`` names the step's work site, say the
+  block it will stack on): it waits within :data:`NEAR_SPAN` of the site,
+  beyond the stand-off point of the robot that works there first; when it
+  is not there, it drives to the free point of the rings :data:`NEAR_RING`
+  around the site nearest to it. It is close when its turn comes, and out
+  of the worker's way until then.
+* **Guarding** (``guard`` names the top of a finished part of the goal): it
+  stays within ``guard_radius`` of it. Opponents leave a stack alone while
+  a robot stands that close (``blocking_radius`` of
+  :class:`~alica.skills.opponent.RandomBlockSkill`), so they cannot undo it
+  (IMPERA 8.2: "the opponents often were not able to act, because the stack
+  was blocked by an agent").
+
+Every waiting place is clear of the other robots and of the stand-off points
+teammates reserved (:mod:`alica.skills.reservations`). Once there the robot
+stands still, and every :data:`CHECK_PERIOD` seconds it looks again: when a
+teammate reserved the point it stands on, or a robot came too close, it
+moves to another place. The skill never ends by itself; it runs until its
+state is left.
+"""
+
+from __future__ import annotations
+
+import math
+
+from py_trees.common import Status
+
+from alica.skills import reservations
+from alica.skills.navigation import DriveToFreeSpace, drivable_goal
+from alica.skills.world_skill import distance
+
+#: Radii (m) of the rings around a step's work site where a robot waits for its turn.
+NEAR_RING = (0.8, 0.88)
+#: A robot this far (m) from its next work site already waits near it.
+NEAR_SPAN = (0.0, 0.95)
+#: Default of ``guard_radius``: metres from a guarded block within which the robot stays.
+GUARD_RADIUS = 0.9
+#: Radii (m) of the ring around a guarded block where a guard that has to move looks for a place.
+GUARD_RING = (0.8, 0.88)
+#: Directions tried on each ring.
+RING_POINTS = 24
+#: Simulated seconds between two looks at the reservations and the robots around a waiting robot.
+CHECK_PERIOD = 1.0
+#: Room (m) kept between a waiting robot's body and another robot's body or reserved stand-off point.
+ROOM = 0.1
+
+
+class WaitAside(DriveToFreeSpace):
+    """Wait out of the way: near the next work site, guarding a finished stack, or away from every stack.
+
+    See the module docstring. Parameters: those of ``DriveToFreeSpace``, and
+    ``near`` / ``guard`` (an object's name; anything that names no object of
+    the world counts as not given) and ``guard_radius``.
+    """
+
+    def initialise(self) -> None:
+        """Choose the waiting place and drive there (or stay, when the robot already waits well)."""
+        self.waiting = False
+        self.next_check = 0.0
+        super().initialise()
+
+    # -- where to wait -----------------------------------------------------------
+
+    def _site(self, name: str) -> tuple[float, float] | None:
+        """Where the object the parameter ``name`` names lies (``None``: no such object, or it is held).
+
+        ``guard`` may name several objects, space-separated: the nearest one
+        that no other robot guards yet (stands within ``guard_radius`` of) is
+        taken, or none when every one is guarded.
+        """
+        value = self.param(name)
+        if not isinstance(value, str):
+            return None
+        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+        radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
+        found: list[tuple[float, tuple[float, float]]] = []
+        for label in value.split():
+            obj = self.world.objects.get(label)
+            if obj is None or any(r.arm is not None and r.arm.held is obj for r in self.world.robots.values()):
+                continue  # no such object, or held: its work site is elsewhere
+            position = obj.position()
+            xy = (float(position[0]), float(position[1]))
+            if name == "guard" and any(distance(xy, (x, y)) <= radius for x, y, _ in super()._others()):
+                continue  # another robot guards it already
+            found.append((distance(xy, here), xy))
+        return min(found)[1] if found else None
+
+    def _crowding(self) -> list[tuple[float, float, float]]:
+        """Discs a waiting robot's centre must stay out of: other robots and reserved stand-off points."""
+        mine = self.robot.spec.radius + ROOM
+        return [(x, y, r + mine) for x, y, r in self._others()]
+
+    def _free(self, xy: tuple[float, float], discs: list[tuple[float, float, float]]) -> bool:
+        return all(math.hypot(xy[0] - x, xy[1] - y) >= r for x, y, r in discs)
+
+    def _away_from_sites(self, xy: tuple[float, float], own: tuple[float, float] | None, away: float) -> bool:
+        """Whether ``xy`` keeps ``away`` from every block lying in the world but those of the site ``own``."""
+        if away <= 0:
+            return True
+        for fp in self.world.ground_truth_obstacles(include_samples=True):
+            if self.world.objects[fp.name].kind not in ("block", "sample"):
+                continue
+            if own is not None and math.hypot(fp.x - own[0], fp.y - own[1]) < 0.3:
+                continue
+            if math.hypot(xy[0] - fp.x, xy[1] - fp.y) < away:
+                return False
+        return True
+
+    def _acceptable(self, xy: tuple[float, float]) -> bool:
+        """Whether the robot may wait at ``xy``: clear of robots and reservations, and where its duty wants it.
+
+        Guarding: within ``guard_radius`` of the guarded object. Waiting for a
+        step: within :data:`NEAR_SPAN` of its work site. Standing by: ``keep_away`` from every block.
+        """
+        if not self._free(xy, self._crowding()):
+            return False
+        guard = self._site("guard")
+        if guard is not None:
+            return distance(xy, guard) <= float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
+        near = self._site("near")
+        if near is not None:
+            gap = distance(xy, near)
+            return NEAR_SPAN[0] <= gap <= NEAR_SPAN[1]
+        return self._away_from_sites(xy, None, float(self.param("keep_away", 0.0)))  # type: ignore[arg-type]
+
+    def _ring_place(self, centre: tuple[float, float], radii: tuple[float, ...]) -> tuple[float, float] | None:
+        """The free point on rings around ``centre`` nearest to the robot."""
+        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+        discs = self._crowding()
+        checker = self._checker()
+        away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
+        for keep in (away, 0.5 * away, 0.0):  # a crowded field: crowd the other stacks a little rather than not wait
+            best: tuple[float, tuple[float, float]] | None = None
+            for radius in radii:
+                for k in range(RING_POINTS):
+                    a = 2.0 * math.pi * k / RING_POINTS
+                    p = (centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a))
+                    if not checker.valid_xy(*p) or not self._free(p, discs):
+                        continue
+                    if not self._away_from_sites(p, centre, keep):
+                        continue
+                    d = distance(p, here)
+                    if best is None or d < best[0]:
+                        best = (d, p)
+            if best is not None:
+                return best[1]
+        return None
+
+    def _free_place(self) -> tuple[float, float] | None:
+        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+        if self._acceptable(here):
+            return here
+        guard = self._site("guard")
+        if guard is not None:
+            place = self._ring_place(guard, GUARD_RING)
+            if place is not None:
+                return place
+        near = self._site("near")
+        if near is not None:
+            place = self._ring_place(near, NEAR_RING)
+            if place is not None:
+                return place
+        return super()._free_place()
+
+    def _others(self) -> list[tuple[float, float, float]]:
+        """The other robots, with the points teammates reserved as robots standing there (for the path too)."""
+        return super()._others() + reservations.reserved(self)
+
+    # -- waiting -------------------------------------------------------------------
+
+    def update(self) -> Status:
+        """Drive to the place, then stand there and look around now and then; never ends by itself."""
+        now = self.now()
+        if self.waiting:
+            if now < self.next_check:
+                return self.running("waiting aside")
+            self.next_check = now + CHECK_PERIOD
+            here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+            if self._acceptable(here):
+                return self.running("waiting aside")
+            self._move_on("a teammate needs this place")
+            return self.running("making way for a teammate")
+        if self.spot is None:
+            self.robot.stop()
+            if now >= self.next_check:
+                self.next_check = now + CHECK_PERIOD
+                self._move_on("looking for a free place again")
+            return self.running("no free place to wait in now: waiting here")
+        status = super().update()
+        if status == Status.RUNNING:
+            return status
+        self.robot.stop()
+        self.waiting = True
+        self.next_check = now + CHECK_PERIOD
+        if status == Status.FAILURE:
+            return self.running(f"waiting here ({self.feedback_message})")
+        return self.running("waiting aside")
+
+    def _move_on(self, why: str) -> None:
+        """Choose a new place and drive there."""
+        self.spot = self._free_place()
+        self.waiting = False
+        if self.spot is None:
+            return
+        self.params["goal"] = self.spot
+        self.goal = self.spot
+        self.started = self.now()
+        self.replans = 0
+        self.moved_goal = 0
+        self.target = drivable_goal(self._checker(), self.spot, self.tolerance)
+        self.wait_until = 0.0
+        self.escaping = False
+        self.reason = why
+        self._plan(self.target or self.spot)
