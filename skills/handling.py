@@ -54,6 +54,8 @@ SETTLE = 0.5
 PUTDOWN_TURNS = (0.0, 0.6, -0.6, 1.2, -1.2, 1.8, -1.8, 3.14)
 #: Free room (m) a put-down spot needs around it.
 PUTDOWN_ROOM = 0.15
+#: Room (m) between a put-down spot and the field's edge: robots must find sides of the block to stand on.
+EDGE_ROOM = 0.8
 #: Free room (m) a spot in an area (the collection point) needs: the hand descends beside what stands there.
 AREA_ROOM = 0.25
 #: Sides of a work site tried for the stand-off point (the nearest first).
@@ -356,6 +358,8 @@ class ArmSkill(WorldSkill):
             goal = (site[0] - standoff * math.cos(angle), site[1] - standoff * math.sin(angle))
             if self._side_tried(goal) or (skip is not None and distance(goal, skip) < SIDE_TRIED):
                 continue
+            if not inside_field(self.world, goal, robot.spec.radius + STANDOFF_MARGIN):
+                continue  # the robot's body would leave the field: it cannot stand there
             if distance(goal, (x, y)) < 0.05 or checker.valid_xy(goal[0], goal[1]):
                 return goal
         return None
@@ -628,10 +632,18 @@ def _mount_ahead(robot: MobileRobot) -> float:
     return float(robot.arm.mount_offset[0]) if robot.arm is not None else 0.0
 
 
+def inside_field(world: RobotWorld, xy: tuple[float, float], margin: float) -> bool:
+    """Whether ``xy`` lies at least ``margin`` metres inside the world's field."""
+    xmin, ymin, xmax, ymax = world.bounds
+    return xmin + margin <= xy[0] <= xmax - margin and ymin + margin <= xy[1] <= ymax - margin
+
+
 def putdown_spots(world: RobotWorld, robot: MobileRobot) -> list[tuple[float, float]]:
     """The spots at the arm's reach where ``robot`` could put a block down, straight ahead first, then turned.
 
-    Only spots with :data:`PUTDOWN_ROOM` free of objects and other robots are listed.
+    Only spots with :data:`PUTDOWN_ROOM` free of objects and other robots are listed, and
+    only those :data:`EDGE_ROOM` inside the field: a robot stands beside a block to take
+    it, and a block at the edge leaves it few sides to stand on.
     """
     from alica.worldsim.queries import blocker
 
@@ -640,6 +652,8 @@ def putdown_spots(world: RobotWorld, robot: MobileRobot) -> list[tuple[float, fl
     spots = []
     for turn in PUTDOWN_TURNS:
         spot = (x + ahead * math.cos(yaw + turn), y + ahead * math.sin(yaw + turn))
+        if not inside_field(world, spot, EDGE_ROOM):
+            continue
         hit = blocker(world, spot[0], spot[1], PUTDOWN_ROOM)
         if hit is None or hit == f"robot '{robot.name}'":
             spots.append(spot)

@@ -251,6 +251,8 @@ def map_planning(world: RobotWorld, world_model: WorldModelLike | None) -> MapPl
     return nav
 
 
+#: Replans around other robots on the path before MoveToPosition gives up (robots move on; the timeout bounds it too).
+MAX_TRAFFIC_REPLANS = 20
 #: Seconds a robot waits for another robot to leave its path before it plans around it.
 ROBOT_YIELD = 2.0
 #: Seconds to wait before planning again when another robot stands on the goal.
@@ -317,6 +319,7 @@ class MoveToPosition(WorldSkill):
         self.speed = 0.0
         self.bumps = []
         self.yield_since: float | None = None
+        self.robot_replans = 0
         # a goal within an obstacle's clearance: drive to the nearest drivable point within the tolerance
         self.target = drivable_goal(self._checker(), self.goal, self.tolerance)
         self._plan(self.target or self.goal)
@@ -447,13 +450,21 @@ class MoveToPosition(WorldSkill):
             self.yield_since = None
         if blocked:
             self.yield_since = None
-            self.replans += 1
-            if self.replans > MAX_REPLANS:
+            # robots move on: traffic costs time (the timeout bounds it), only obstacles count toward giving up
+            if blocked == "robot":
+                self.robot_replans += 1
+            else:
+                self.replans += 1
+            if self.replans > MAX_REPLANS or self.robot_replans > MAX_TRAFFIC_REPLANS:
                 robot.stop()
-                return self.fail(f"the path to {self.goal} stays blocked after {MAX_REPLANS} replans")
+                return self.fail(
+                    f"the path to {self.goal} stays blocked after {self.replans + self.robot_replans} replans"
+                )
             robot.stop()
             self._replan()
-            return self.running("path blocked by another robot or a new obstacle: replanning")
+            return self.running(
+                f"path blocked by {'another robot' if blocked == 'robot' else 'an obstacle'}: replanning"
+            )
         if done:
             robot.stop()
             if self.escaping:

@@ -32,6 +32,7 @@ import math
 from py_trees.common import Status
 
 from alica.skills import reservations
+from alica.skills.handling import inside_field
 from alica.skills.navigation import DriveToFreeSpace, drivable_goal
 from alica.skills.world_skill import distance
 
@@ -142,6 +143,8 @@ class WaitAside(DriveToFreeSpace):
                     a = 2.0 * math.pi * k / RING_POINTS
                     p = (centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a))
                     if not checker.valid_xy(*p) or not self._free(p, discs):
+                        continue
+                    if not inside_field(self.world, p, self.robot.spec.radius + ROOM):
                         continue
                     if not self._away_from_sites(p, centre, keep):
                         continue
