@@ -405,8 +405,10 @@ def finished_object(step: Step, later: Sequence[Step]) -> str | None:
     ``None`` when the step leaves the robot holding something, or a later
     step touches one of its objects (say, stacks onto the block it placed).
     """
-    if not step.bindings or any(positive and step.robot in args for positive, (_, args) in step.effect):
-        return None
+    if not step.bindings or any(
+        positive and step.robot in args and set(args) - {step.robot} for positive, (_, args) in step.effect
+    ):
+        return None  # the robot holds something of the step after it (holding(r, x))
     touched = _objects(step)
     if any(touched & _objects(other) for other in later):
         return None

@@ -43,9 +43,11 @@ NEAR_SPAN = (0.0, 0.95)
 #: Default of ``guard_radius``: metres from a guarded block within which the robot stays.
 GUARD_RADIUS = 0.9
 #: Radii (m) of the ring around a guarded block where a guard that has to move looks for a place.
-GUARD_RING = (0.8, 0.88)
+GUARD_RING = (0.78, 0.82)
 #: Directions tried on each ring.
 RING_POINTS = 24
+#: Goal tolerance (m) of the drive to a waiting place: a guard must end up within ``guard_radius``.
+TOLERANCE = 0.06
 #: Simulated seconds between two looks at the reservations and the robots around a waiting robot.
 CHECK_PERIOD = 1.0
 #: Room (m) kept between a waiting robot's body and another robot's body or reserved stand-off point.
@@ -64,6 +66,8 @@ class WaitAside(DriveToFreeSpace):
         """Choose the waiting place and drive there (or stay, when the robot already waits well)."""
         self.waiting = False
         self.next_check = 0.0
+        self.placing = False
+        self.params.setdefault("tolerance", TOLERANCE)
         super().initialise()
 
     # -- where to wait -----------------------------------------------------------
@@ -95,7 +99,8 @@ class WaitAside(DriveToFreeSpace):
     def _crowding(self) -> list[tuple[float, float, float]]:
         """Discs a waiting robot's centre must stay out of: other robots and reserved stand-off points."""
         mine = self.robot.spec.radius + ROOM
-        return [(x, y, r + mine) for x, y, r in self._others()]
+        discs = super()._others() + reservations.reserved(self)
+        return [(x, y, r + mine) for x, y, r in discs]
 
     def _free(self, xy: tuple[float, float], discs: list[tuple[float, float, float]]) -> bool:
         return all(math.hypot(xy[0] - x, xy[1] - y) >= r for x, y, r in discs)
@@ -169,11 +174,24 @@ class WaitAside(DriveToFreeSpace):
             place = self._ring_place(near, NEAR_RING)
             if place is not None:
                 return place
-        return super()._free_place()
+        self.placing = True  # every reserved point counts when choosing the place (see _others)
+        try:
+            return super()._free_place()
+        finally:
+            self.placing = False
 
     def _others(self) -> list[tuple[float, float, float]]:
-        """The other robots, with the points teammates reserved as robots standing there (for the path too)."""
-        return super()._others() + reservations.reserved(self)
+        """The other robots, with the points teammates reserved as robots standing there (for the path too).
+
+        For the path, a reserved point the robot stands on is left out: it is driving away from it.
+        """
+        x, y = float(self.robot.estimate[0]), float(self.robot.estimate[1])
+        mine = self.robot.spec.radius
+        return super()._others() + [
+            (rx, ry, rr)
+            for rx, ry, rr in reservations.reserved(self)
+            if self.placing or math.hypot(rx - x, ry - y) >= rr + mine
+        ]
 
     # -- waiting -------------------------------------------------------------------
 

@@ -228,3 +228,15 @@ def test_a_crashed_holder_drops_its_block_and_the_team_plans_again():
     assert len(crashed) == 1, "a robot held a block"
     assert revived == [True]  # the recovered robot's body takes commands again
     assert result.success and result.replans >= 1, result.as_json()
+
+
+def test_with_ten_blocks_four_agents_finish_sooner_than_two():
+    # issue 19: more robots pay off. Simulated times over a fixed set of seeds, not wall times.
+    seeds = (0, 1)
+    two = [run_demo(DemoConfig(agents=2, blocks=10, seed=s, time_limit=400)) for s in seeds]
+    four = [run_demo(DemoConfig(agents=4, blocks=10, seed=s, time_limit=400)) for s in seeds]
+    assert all(r.success for r in two + four)
+    assert sum(r.sim_time_s for r in four) < sum(r.sim_time_s for r in two), (
+        [r.sim_time_s for r in two],
+        [r.sim_time_s for r in four],
+    )

@@ -251,3 +251,48 @@ def test_the_generated_plan_says_where_each_state_is_in_the_tasks(blocks):
     tasks = {ep.task for ep in plan.entry_points}
     for role, priorities in created.priorities().items():
         assert {p.task for p in priorities} == tasks, role
+
+
+def test_waiting_agents_run_the_wait_plan_near_their_next_step_and_guard_what_they_finished(blocks):
+    from alica.prophet.tasks import STANDBY, StepKind
+
+    roleset = next(iter(blocks.rolesets.values()))
+    created = create_tasks("Gen", PLAN, blocks, SUSSMAN, "r", roleset, "Default", standby="DriveToFreePosition")
+    plan = created.plan
+    bound = {}
+    for state in plan.states:
+        place = created.place(state.name)
+        if place is None or place.kind in (StepKind.RUN, StepKind.FAILED):
+            continue
+        ((ref,),) = (state.children,)
+        assert ref.name == "DriveToFreePosition"
+        bound[state.name] = {b.variable: b.value for b in ref.bindings}
+    waits = {
+        s.name: created.tasks[created.place(s.name).task][created.place(s.name).step].label
+        for s in plan.states
+        if (p := created.place(s.name)) is not None and p.kind is StepKind.WAIT
+    }
+    # the work site of each step: the block it takes, or the block it stacks on; none for Putdown
+    sites = {"Unstack(c, a)": "c", "Putdown(c)": None, "Pickup(b)": "b", "Stack(b, c)": "c", "Pickup(a)": "a"}
+    sites["Stack(a, b)"] = "b"
+    for state, label in waits.items():
+        assert bound[state] == ({"near": sites[label]} if sites[label] else {}), (state, label)
+    # the last task ends with Stack(a, b): nothing touches a or b after it, the robot guards a
+    done = {s.name: bound[s.name] for s in plan.states if (p := created.place(s.name)) and p.kind is StepKind.DONE}
+    last = created.place(plan.entry_points[len(created.tasks) - 1].state).task
+    assert done[f"T{last}_Done"] == {"guard": "a"}
+    # Putdown(c) is followed by Stack(b, c): c is not finished, its robot guards nothing
+    first = [s.label for s in created.tasks[0]]
+    assert first == ["Unstack(c, a)", "Putdown(c)"] and done["T0_Done"] == {}
+    # every block is touched by the plan: the agents standing by have nothing to guard
+    (standby,) = plan.state(STANDBY).children
+    assert standby.bindings == ()
+
+
+def test_without_the_variables_the_wait_plan_runs_only_for_standing_by(blocks):
+    from alica.prophet.tasks import STANDBY, build_plan
+
+    tasks = parallelise(steps_of(PLAN, blocks, "r"), SUSSMAN, "r")
+    plan, _, places = build_plan("Gen", tasks, standby="DriveToFreePosition", standby_variables=())
+    with_children = {s.name for s in plan.states if s.children}
+    assert with_children == {STANDBY} | {name for name, p in places.items() if p.kind.value == "run"}
