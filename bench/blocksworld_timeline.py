@@ -156,7 +156,7 @@ def _sample(engine: Any, robot: Any) -> dict[str, Any]:
     return row
 
 
-def run_one(agents: int, blocks: int, seed: int, out: Path, time_limit: float) -> dict[str, Any]:
+def run_one(agents: int, blocks: int, seed: int, out: Path, time_limit: float, opponents: int = 0) -> dict[str, Any]:
     """Run the demo once with the sampler; write ``run.json`` and ``samples.jsonl`` to ``out``."""
     from alica.app.demos.blocksworld import DemoConfig, run_demo
     from alica.prophet import made_plans
@@ -176,7 +176,7 @@ def run_one(agents: int, blocks: int, seed: int, out: Path, time_limit: float) -
             samples.write(json.dumps(row, separators=(",", ":")) + "\n")
         team.at(team.now() + team.config.period * 0.5, "timeline sampler", lambda: tick(team))
 
-    config = DemoConfig(agents=agents, opponents=0, blocks=blocks, seed=seed, time_limit=time_limit)
+    config = DemoConfig(agents=agents, opponents=opponents, blocks=blocks, seed=seed, time_limit=time_limit)
     try:
         result = run_demo(config, actions=[(0.0, tick)], out=out)
     finally:
@@ -658,11 +658,12 @@ def main() -> int:
     parser.add_argument("--out", type=Path, default=OUT, help="where the run folders go")
     parser.add_argument("--reuse", action="store_true", help="analyse run folders that exist instead of running again")
     parser.add_argument("--one", nargs=4, metavar=("A", "B", "S", "DIR"), help="run one run in this process")
+    parser.add_argument("--opponents", type=int, default=0, help="opponents in the --one run (default 0)")
     parser.add_argument("--detail", type=Path, metavar="DIR", help="print one run folder's steps and timelines")
     args = parser.parse_args()
     if args.one:
         a, b, s, d = args.one
-        run_one(int(a), int(b), int(s), Path(d), args.time_limit)
+        run_one(int(a), int(b), int(s), Path(d), args.time_limit, args.opponents)
         return 0
     if args.detail:
         print(detail(args.detail))

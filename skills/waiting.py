@@ -2,16 +2,24 @@
 
 A robot waits in three situations, and the skill serves all three:
 
-* **Standing by** (no task needs it): it keeps ``keep_away`` from every block
-  or sample lying in the world, as :class:`~alica.skills.navigation.DriveToFreeSpace`.
+* **Standing by** (no task needs it, or the team waits for a plan): it stays
+  where it is, unless it stands within ``keep_away`` of a block a teammate
+  works at (a stand-off point reserved near it); then it drives to a place
+  ``keep_away`` from every block or sample lying in the world, as
+  :class:`~alica.skills.navigation.DriveToFreeSpace`. A robot that stays
+  where it worked keeps opponents off that stack while the team replans.
+  It also leaves :data:`HOLDER_ROOM` to any other robot that holds
+  something: an opponent with nowhere free to put a block down would hold
+  it for good, and the team would wait for it for good.
 * **Waiting for its next step** (``near`` names the step's work site, say the
   block it will stack on): it waits within :data:`NEAR_SPAN` of the site,
-  beyond the stand-off point of the robot that works there first; when it
-  is not there, it drives to the free point of the rings :data:`NEAR_RING`
-  around the site nearest to it. It is close when its turn comes, and out
-  of the worker's way until then.
-* **Guarding** (``guard`` names the top of a finished part of the goal): it
-  stays within ``guard_radius`` of it. Opponents leave a stack alone while
+  beside it as a worker stands, on a side no teammate reserved; when it is
+  not there, it drives to the free point of the rings :data:`NEAR_RING`
+  around the site nearest to it. It is ready when its turn comes, and
+  opponents leave that stack alone meanwhile.
+* **Guarding** (``guard`` names the top of a finished part of the goal, or
+  several objects, space-separated, of which it takes the nearest one no
+  other robot guards): it stays within ``guard_radius`` of it. Opponents leave a stack alone while
   a robot stands that close (``blocking_radius`` of
   :class:`~alica.skills.opponent.RandomBlockSkill`), so they cannot undo it
   (IMPERA 8.2: "the opponents often were not able to act, because the stack
@@ -46,6 +54,10 @@ GUARD_RADIUS = 0.9
 GUARD_RING = (0.78, 0.82)
 #: Directions tried on each ring.
 RING_POINTS = 24
+#: Room (m) a robot standing by leaves around another robot that holds something, to put it down.
+HOLDER_ROOM = 1.8
+#: A block this close (m) to a reserved stand-off point is being worked at.
+WORKED = 1.2
 #: Goal tolerance (m) of the drive to a waiting place: a guard must end up within ``guard_radius``.
 TOLERANCE = 0.06
 #: Simulated seconds between two looks at the reservations and the robots around a waiting robot.
@@ -105,14 +117,23 @@ class WaitAside(DriveToFreeSpace):
     def _free(self, xy: tuple[float, float], discs: list[tuple[float, float, float]]) -> bool:
         return all(math.hypot(xy[0] - x, xy[1] - y) >= r for x, y, r in discs)
 
-    def _away_from_sites(self, xy: tuple[float, float], own: tuple[float, float] | None, away: float) -> bool:
-        """Whether ``xy`` keeps ``away`` from every block lying in the world but those of the site ``own``."""
+    def _away_from_sites(
+        self, xy: tuple[float, float], own: tuple[float, float] | None, away: float, worked_only: bool = False
+    ) -> bool:
+        """Whether ``xy`` keeps ``away`` from every block lying in the world but those of the site ``own``.
+
+        With ``worked_only``, only from the blocks a teammate works at (a stand-off point reserved
+        within :data:`WORKED` of them).
+        """
         if away <= 0:
             return True
+        points = reservations.reserved(self) if worked_only else []
         for fp in self.world.ground_truth_obstacles(include_samples=True):
             if self.world.objects[fp.name].kind not in ("block", "sample"):
                 continue
             if own is not None and math.hypot(fp.x - own[0], fp.y - own[1]) < 0.3:
+                continue
+            if worked_only and not any(math.hypot(fp.x - x, fp.y - y) < WORKED for x, y, _ in points):
                 continue
             if math.hypot(xy[0] - fp.x, xy[1] - fp.y) < away:
                 return False
@@ -122,7 +143,8 @@ class WaitAside(DriveToFreeSpace):
         """Whether the robot may wait at ``xy``: clear of robots and reservations, and where its duty wants it.
 
         Guarding: within ``guard_radius`` of the guarded object. Waiting for a
-        step: within :data:`NEAR_SPAN` of its work site. Standing by: ``keep_away`` from every block.
+        step: within :data:`NEAR_SPAN` of its work site. Standing by: ``keep_away`` from every block a
+        teammate works at (a new place, when it has to move, keeps ``keep_away`` from every block).
         """
         if not self._free(xy, self._crowding()):
             return False
@@ -133,7 +155,11 @@ class WaitAside(DriveToFreeSpace):
         if near is not None:
             gap = distance(xy, near)
             return NEAR_SPAN[0] <= gap <= NEAR_SPAN[1]
-        return self._away_from_sites(xy, None, float(self.param("keep_away", 0.0)))  # type: ignore[arg-type]
+        # standing by, a robot stays where it is unless a teammate comes to work at a block near it, or a
+        # robot holding something stands close (an opponent that cannot put its block down holds it for good)
+        if any(distance(xy, holder) < HOLDER_ROOM for holder in self._holders()):
+            return False
+        return self._away_from_sites(xy, None, float(self.param("keep_away", 0.0)), worked_only=True)  # type: ignore[arg-type]
 
     def _ring_place(self, centre: tuple[float, float], radii: tuple[float, ...]) -> tuple[float, float] | None:
         """The free point on rings around ``centre`` nearest to the robot."""
@@ -174,11 +200,32 @@ class WaitAside(DriveToFreeSpace):
             place = self._ring_place(near, NEAR_RING)
             if place is not None:
                 return place
+        from alica.skills.motion import escape_goal
+
         self.placing = True  # every reserved point counts when choosing the place (see _others)
         try:
-            return super()._free_place()
+            away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
+            lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []
+            sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
+            sites += [(x, y, HOLDER_ROOM) for x, y in self._holders()]
+            return escape_goal(
+                self._grid(),
+                self.robot.estimate,
+                clearance=self.robot.spec.radius + float(self.param("clearance", 1.0)),  # type: ignore[arg-type]
+                max_distance=float(self.param("max_distance", 3.0)),  # type: ignore[arg-type]
+                other_robots=self._others(),
+                keep_away=sites,
+            )
         finally:
             self.placing = False
+
+    def _holders(self) -> list[tuple[float, float]]:
+        """Where the other robots that hold something stand: they need room to put it down."""
+        return [
+            (float(r.pose[0]), float(r.pose[1]))
+            for r in self.world.robots.values()
+            if r is not self.robot and r.arm is not None and r.arm.held is not None
+        ]
 
     def _others(self) -> list[tuple[float, float, float]]:
         """The other robots, with the points teammates reserved as robots standing there (for the path too).
