@@ -80,12 +80,14 @@ def reserved(skill: _Skill) -> list[tuple[float, float, float]]:
     for name, robot in sorted(world.robots.items()):
         if robot is me:
             continue
+        point: tuple[object, ...] | None = None
         if wm is None:
             hit = local.get(name)
             point = hit[:2] if hit is not None and hit[2] > now else None
         else:
             value = wm.get(STANDOFF, name)
-            point = value if isinstance(value, (tuple, list)) and len(value) == 2 else None
-        if point is not None and all(math.isfinite(float(v)) for v in point):
-            out.append((float(point[0]), float(point[1]), float(robot.spec.radius)))
+            point = tuple(value) if isinstance(value, (tuple, list)) and len(value) == 2 else None
+        if point is None or not all(isinstance(v, (int, float)) and math.isfinite(v) for v in point):
+            continue
+        out.append((float(point[0]), float(point[1]), float(robot.spec.radius)))  # type: ignore[arg-type]
     return out
