@@ -39,7 +39,10 @@ the WaitPlan, so they keep out of the way of those who work (IMPERA 8.2: "in
 WaitPlan, every agent drives to a free position, so as not to disturb other
 tasks"). It counts nothing for coverage and has the smallest priority, so an
 agent stands by only when no task has room for it, and leaves it for a task
-that frees up just as an idle agent would.
+that frees up just as an idle agent would. When the WaitPlan declares the
+variables ``near`` and ``guard``, the wait states and success states of the
+tasks run it too (see :func:`build_plan`): an agent waits near its next
+step's work site, and guards what its task finished.
 """
 
 from __future__ import annotations

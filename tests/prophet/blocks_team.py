@@ -91,14 +91,15 @@ class BlockSkills:
             if fail:
                 self.fail.remove(skill)
             self.runs.append((context.agent, skill, dict(params)))
-            ticks = None if skill == "Idle" else (1 if skill == "DriveToFreeSpace" else self.ticks)
+            # waiting never ends by itself (the WaitPlan's WaitAside, Idle); a drive to free space takes a tick
+            ticks = None if skill in ("Idle", "WaitAside") else (1 if skill == "DriveToFreeSpace" else self.ticks)
             return BlockSkill(name, skill, params, context, ticks, fail)
 
         return make
 
     def mapping(self) -> dict[str, Any]:
         """Skill name -> factory, for :class:`SimulatedTeam`."""
-        names = ("MoveToPosition", "DriveToFreeSpace", "Idle", "Pickup", "Putdown", "Stack", "Unstack")
+        names = ("MoveToPosition", "DriveToFreeSpace", "WaitAside", "Idle", "Pickup", "Putdown", "Stack", "Unstack")
         return {n: self.factory(n) for n in names}
 
 
