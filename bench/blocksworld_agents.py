@@ -12,9 +12,10 @@ are added. With opponents it is higher, because the team has to replan.
 
 Several block counts run in one go (``--blocks 8,12``); the plot of each
 shows, beside the curves measured now, the curve recorded before issue 19
-(``bench/blocksworld_before.tsv``: the mean simulated times without
-opponents at commit 5405f13, seeds 0-9, measured with
-``bench/blocksworld_timeline.py``).
+(``bench/blocksworld_before.tsv``: the mean simulated times at commit
+5405f13, seeds 0-9: without opponents measured with
+``bench/blocksworld_timeline.py``, with 2 opponents (8 blocks) with this
+script at that commit).
 
 Run: ``.venv/bin/python bench/blocksworld_agents.py [--agents 1-5] [--opponents 2] [--blocks 8,12] [--seeds 10] [--time-limit 600] [--jobs 2]``
 """
@@ -193,18 +194,19 @@ def _report(
     print(f"\nwrote blocksworld_agents_b{blocks}.tsv, blocksworld_runs_b{blocks}.tsv (every run) and the plot to {OUT}")
 
 
-#: The mean simulated times recorded before issue 19 (no opponents): blocks, agents, seconds.
+#: The mean simulated times recorded before issue 19: blocks, opponents, agents, seconds.
 BEFORE = Path(__file__).resolve().parent / "blocksworld_before.tsv"
 
 
-def _before(blocks: int) -> dict[int, float]:
+def _before(blocks: int) -> dict[int, dict[int, float]]:
+    """Opponents -> agents -> the mean simulated time recorded before, for ``blocks``."""
     if not BEFORE.exists():
         return {}
-    out = {}
+    out: dict[int, dict[int, float]] = {}
     for line in BEFORE.read_text(encoding="utf-8").splitlines()[1:]:
-        b, a, sim = line.split("\t")[:3]
+        b, o, a, sim = line.split("\t")[:4]
         if int(b) == blocks:
-            out[int(a)] = float(sim)
+            out.setdefault(int(o), {})[int(a)] = float(sim)
     return out
 
 
@@ -222,10 +224,11 @@ def _plot(rows: list[dict[str, object]], path: Path, args: argparse.Namespace, b
         low = [float(r["sim_mean"]) - float(r["sim_min"]) for r in mine]  # type: ignore[arg-type]
         high = [float(r["sim_max"]) - float(r["sim_mean"]) for r in mine]  # type: ignore[arg-type]
         ax.errorbar(xs, ys, yerr=[low, high], fmt=style, capsize=3, label=f"{opponents} opponents")
-    before = _before(blocks)
-    if before:
-        xs = sorted(before)
-        ax.plot(xs, [before[a] for a in xs], ":", color="grey", marker="x", label="0 opponents, before (5405f13)")
+    for opponents, curve in sorted(_before(blocks).items()):
+        xs = sorted(curve)
+        colour = "grey" if opponents == 0 else "peru"
+        label = f"{opponents} opponents, before (5405f13)"
+        ax.plot(xs, [curve[a] for a in xs], ":", color=colour, marker="x", label=label)
     ax.set_xticks(_range(args.agents))
     ax.set_xlabel("agents")
     ax.set_ylabel("execution time (simulated s)")
