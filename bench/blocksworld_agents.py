@@ -94,8 +94,17 @@ def main() -> int:
         default=1,
         help="runs at once, each in its own process (default 1; wall times are then shared-machine figures)",
     )
+    parser.add_argument(
+        "--replot", action="store_true", help="draw the plots again from the tables written before (no runs)"
+    )
     args = parser.parse_args()
     counts = [int(b) for b in str(args.blocks).split(",")]
+    if args.replot:
+        for blocks in counts:
+            rows = _read_table(OUT / f"blocksworld_agents_b{blocks}.tsv")
+            args.agents = f"{min(int(r['agents']) for r in rows)}-{max(int(r['agents']) for r in rows)}"  # type: ignore[call-overload]
+            _plot(rows, OUT / f"blocksworld_agents_b{blocks}.png", args, blocks)
+        return 0
     cells = [(opponents, agents) for opponents in (0, args.opponents) for agents in _range(args.agents)]
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         futures = {
@@ -192,6 +201,21 @@ def _report(
             )
     _plot(rows, OUT / f"blocksworld_agents_b{blocks}.png", args, blocks)
     print(f"\nwrote blocksworld_agents_b{blocks}.tsv, blocksworld_runs_b{blocks}.tsv (every run) and the plot to {OUT}")
+
+
+def _read_table(path: Path) -> list[dict[str, object]]:
+    """The rows of a table this script wrote."""
+    lines = path.read_text(encoding="utf-8").splitlines()
+    keys = lines[0].split("\t")
+    rows: list[dict[str, object]] = []
+    for line in lines[1:]:
+        row: dict[str, object] = dict(zip(keys, line.split("\t"), strict=True))
+        for key in ("agents", "opponents"):
+            row[key] = int(str(row[key]))
+        for key in ("sim_mean", "sim_min", "sim_max"):
+            row[key] = float(str(row[key]))
+        rows.append(row)
+    return rows
 
 
 #: The mean simulated times recorded before issue 19: blocks, opponents, agents, seconds.

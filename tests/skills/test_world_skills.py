@@ -310,3 +310,37 @@ def test_drivable_goal_is_the_nearest_valid_point_within_the_tolerance():
     assert point is not None and checker.valid_xy(*point)
     assert 0.0 < math.dist(point, goal) <= 0.3 and point[0] > goal[0]
     assert drivable_goal(checker, (0.0, 0.0), 0.3) is None  # the rock's centre: nothing within the tolerance
+
+
+def _cross_the_path(blocks_world, leave_after):
+    """r2 steps onto r1's path once r1 drives, and leaves after ``leave_after`` s (None: stays)."""
+    blocks_world.robots["r1"].set_pose(-2.0, -1.2, 0.0)
+    other = blocks_world.robots["r2"]
+    stepped = []
+
+    def cross(world, behaviour):
+        if not stepped and getattr(behaviour, "follower", None) is not None and world.now() > 0.5:
+            stepped.append(world.now())
+            other.set_pose(0.0, -1.2, math.pi / 2)
+        elif stepped and leave_after is not None and world.now() - stepped[0] > leave_after and other.pose[1] < 0:
+            other.set_pose(0.0, 2.0, math.pi / 2)
+
+    return cross, stepped
+
+
+def test_move_to_position_lets_a_robot_on_its_path_pass(blocks_world, skill_run):
+    cross, stepped = _cross_the_path(blocks_world, leave_after=1.0)
+    run = skill_run("MoveToPosition", blocks_world, "r1", {"goal": [2.0, -1.2]}, on_tick=cross)
+    assert stepped and run.ok, (run.reason, run.trace[-4:])
+    feedback = [str(t["feedback"]) for t in run.trace]
+    assert any("letting it pass" in f for f in feedback)
+    assert not any("path blocked" in f for f in feedback)  # it waited instead of planning a detour
+
+
+def test_move_to_position_plans_around_a_robot_that_stays_on_its_path(blocks_world, skill_run):
+    cross, stepped = _cross_the_path(blocks_world, leave_after=None)
+    run = skill_run("MoveToPosition", blocks_world, "r1", {"goal": [2.0, -1.2]}, on_tick=cross)
+    assert stepped and run.ok, (run.reason, run.trace[-4:])
+    feedback = [str(t["feedback"]) for t in run.trace]
+    assert any("letting it pass" in f for f in feedback)
+    assert any("path blocked by another robot: replanning" in f for f in feedback)
