@@ -306,13 +306,7 @@ class ArmSkill(WorldSkill):
                     )
                 return self.running("waiting: every side of the work site is taken by other robots")
             self.blocked_since = None
-            self.mover = MoveToPosition(
-                f"{self.name}/approach",
-                {"goal": goal, "tolerance": self.approach_tolerance(), "timeout": 60.0},
-                self.context,
-            )
-            self.mover.setup(context=self.context)
-            self._reserve(goal)
+            self.mover = self._approach_to(goal)
         if self.mover.status != Status.SUCCESS:
             self.mover.tick_once()
             if self.mover.status == Status.FAILURE:
@@ -390,15 +384,20 @@ class ArmSkill(WorldSkill):
             return False
         self.goal_moves += 1
         mover.stop(Status.INVALID)
-        self.mover = MoveToPosition(
+        self.mover = self._approach_to(goal)
+        self.mover.tick_once()
+        return True
+
+    def _approach_to(self, goal: tuple[float, float]) -> MoveToPosition:
+        """The drive to the stand-off point ``goal``, which is reserved for this robot from now on."""
+        mover = MoveToPosition(
             f"{self.name}/approach",
             {"goal": goal, "tolerance": self.approach_tolerance(), "timeout": 60.0},
             self.context,
         )
-        self.mover.setup(context=self.context)
+        mover.setup(context=self.context)
         self._reserve(goal)
-        self.mover.tick_once()
-        return True
+        return mover
 
     def _side_tried(self, xy: tuple[float, float]) -> bool:
         """Whether the arm found no plan from a stand-off point this close to ``xy`` already."""
