@@ -296,3 +296,15 @@ def test_without_the_variables_the_wait_plan_runs_only_for_standing_by(blocks):
     plan, _, places = build_plan("Gen", tasks, standby="DriveToFreePosition", standby_variables=())
     with_children = {s.name for s in plan.states if s.children}
     assert with_children == {STANDBY} | {name for name, p in places.items() if p.kind.value == "run"}
+
+
+def test_agents_standing_by_guard_what_no_step_touches(blocks):
+    from alica.prophet.tasks import STANDBY
+
+    roleset = next(iter(blocks.rolesets.values()))
+    plan = [PlanStep("Unstack", ("r", "c", "a")), PlanStep("Putdown", ("r", "c"))]  # b stays where it is
+    created = create_tasks("Gen", plan, blocks, SUSSMAN, "r", roleset, "Default", standby="DriveToFreePosition")
+    (standby,) = created.plan.state(STANDBY).children
+    assert {b.variable: b.value for b in standby.bindings} == {"guard": "b"}
+    # the robot never counts as an object to guard
+    assert "r" not in {b.value for b in standby.bindings}
