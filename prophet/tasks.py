@@ -560,6 +560,7 @@ def create_tasks(
     if not plan_steps:
         raise PlannerError("an empty plan makes no tasks: the goal already holds")
     team = _robots(robots)
+    init = tuple(init)  # read twice: by the parallelisation and for the objects to guard
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _parallelise(steps, init, team)
     wait_plan = library.plans.get(standby) if standby is not None else None

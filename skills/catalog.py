@@ -103,6 +103,15 @@ def _composite(registry: SkillRegistry) -> None:
     )
 
 
+def _free_space_params(keep_away: str) -> tuple[ParamSpec, ...]:
+    """``clearance``, ``max_distance`` and ``keep_away`` (documented as given) of the skills that look for free space."""
+    return (
+        _p("clearance", "float", "distance in metres to keep from obstacles, robots and work sites", default=1.0),
+        _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
+        _p("keep_away", "float", keep_away, default=0.0),
+    )
+
+
 def _navigation(registry: SkillRegistry) -> None:
     registry.declare(
         "DriveTo",
@@ -121,27 +130,15 @@ def _navigation(registry: SkillRegistry) -> None:
     )
     registry.declare(
         "DriveToFreeSpace",
-        _p("clearance", "float", "distance in metres to keep from obstacles, robots and work sites", default=1.0),
-        _p("max_distance", "float", "farthest the robot may drive to find such a place", default=3.0),
-        _p(
-            "keep_away",
-            "float",
-            "distance in metres to keep from every block or sample lying in the world (0: none)",
-            default=0.0,
-        ),
+        *_free_space_params("distance in metres to keep from every block or sample lying in the world (0: none)"),
         doc="drive to the nearest position with the given clearance, e.g. out of a corner or out of the way",
         capabilities=("base",),
         implementation="alica.skills.navigation:DriveToFreeSpace",
     )
     registry.declare(
         "WaitAside",
-        _p("clearance", "float", "distance in metres to keep from obstacles and robots", default=1.0),
-        _p("max_distance", "float", "farthest the robot may drive to find a place to wait", default=3.0),
-        _p(
-            "keep_away",
-            "float",
-            "distance in metres to keep from every block or sample lying in the world but the work site's (0: none)",
-            default=0.0,
+        *_free_space_params(
+            "distance in metres to keep from every block or sample lying in the world but the work site's (0: none)"
         ),
         _p("near", "object", "the work site of the robot's next step: wait on a ring around it", required=False),
         _p(

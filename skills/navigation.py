@@ -438,18 +438,16 @@ class MoveToPosition(WorldSkill):
                 self._remember_bump()
             return self._stuck(now)
         blocked = self._blocked()
-        if blocked == "robot" and now - (self.yield_since if self.yield_since is not None else now) < ROBOT_YIELD:
+        since = now if self.yield_since is None else self.yield_since
+        if blocked == "robot" and now - since < ROBOT_YIELD:
             # another robot crosses the path: wait for it to pass (a replan would route around a moving robot)
-            if self.yield_since is None:
-                self.yield_since = now
+            self.yield_since = since
             robot.stop()
             self.speed = 0.0
             self.follower.reset_stuck()  # an intended pause, not a lack of progress
             return self.running("another robot is on the path: letting it pass")
-        if not blocked:
-            self.yield_since = None
+        self.yield_since = None
         if blocked:
-            self.yield_since = None
             # robots move on: traffic costs time (the timeout bounds it), only obstacles count toward giving up
             if blocked == "robot":
                 self.robot_replans += 1
@@ -593,6 +591,18 @@ class MoveToPosition(WorldSkill):
             self.robot.stop()
 
 
+def lying_sites(world: RobotWorld) -> list[tuple[float, float]]:
+    """Where the movable objects lying in the world (blocks, samples; held ones are left out) are: the work sites.
+
+    They come from the world's known layout (the blocks world, where the waiting skills use them).
+    """
+    return [
+        (fp.x, fp.y)
+        for fp in world.ground_truth_obstacles(include_samples=True)
+        if world.objects[fp.name].kind in ("block", "sample")
+    ]
+
+
 class DriveToFreeSpace(MoveToPosition):
     """Drive to the nearest place with ``clearance`` metres of free space within ``max_distance``.
 
@@ -623,19 +633,28 @@ class DriveToFreeSpace(MoveToPosition):
 
         clearance = float(self.param("clearance", 1.0))  # type: ignore[arg-type]
         reach = float(self.param("max_distance", 3.0))  # type: ignore[arg-type]
-        away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
-        grid = self._grid()
-        # the work sites are the movable objects lying in the world (the blocks world's known layout)
-        lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []  # held objects are left out
-        sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
         return escape_goal(
-            grid,
+            self._grid(),
             self.robot.estimate,
             clearance=self.robot.spec.radius + clearance,
             max_distance=reach,
             other_robots=self._others(),
-            keep_away=sites,
+            keep_away=self._keep_away_sites(),
         )
+
+    def _keep_away_sites(self) -> list[tuple[float, float, float]]:
+        """Points ``(x, y, distance)`` the free place keeps away from: the work sites, ``keep_away`` each."""
+        away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
+        return [(x, y, away) for x, y in lying_sites(self.world)] if away > 0 else []
+
+    def _drive_to(self, spot: tuple[float, float]) -> None:
+        """Make ``spot`` the place to drive to, and plan the way there."""
+        self.spot = spot
+        self.params["goal"] = spot
+        self.goal = spot
+        self.target = drivable_goal(self._checker(), spot, self.tolerance)
+        self.wait_until = 0.0
+        self._plan(self.target or spot)
 
     def update(self) -> Status:
         """Fail when there is no free place, else drive there; a place another robot took is given up for another."""
@@ -648,12 +667,7 @@ class DriveToFreeSpace(MoveToPosition):
             spot = self._free_place()
             if spot is not None and spot != self.spot and self.moved_goal < MAX_REPLANS:
                 self.moved_goal += 1
-                self.spot = spot
-                self.params["goal"] = spot
-                self.goal = spot
-                self.target = drivable_goal(self._checker(), spot, self.tolerance)
-                self.wait_until = 0.0
-                self._plan(self.target or spot)
+                self._drive_to(spot)
                 return self.running(f"another robot took the free place: driving to ({spot[0]:.2f}, {spot[1]:.2f})")
         return status
 

@@ -41,7 +41,7 @@ from py_trees.common import Status
 
 from alica.skills import reservations
 from alica.skills.handling import inside_field
-from alica.skills.navigation import DriveToFreeSpace, drivable_goal
+from alica.skills.navigation import DriveToFreeSpace, lying_sites
 from alica.skills.world_skill import distance
 
 #: Radii (m) of the rings around a step's work site where a robot waits for its turn.
@@ -94,7 +94,7 @@ class WaitAside(DriveToFreeSpace):
         value = self.param(name)
         if not isinstance(value, str):
             return None
-        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+        here = self._here()
         radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
         found: list[tuple[float, tuple[float, float]]] = []
         for label in value.split():
@@ -118,106 +118,86 @@ class WaitAside(DriveToFreeSpace):
         return all(math.hypot(xy[0] - x, xy[1] - y) >= r for x, y, r in discs)
 
     def _away_from_sites(
-        self, xy: tuple[float, float], own: tuple[float, float] | None, away: float, worked_only: bool = False
+        self, xy: tuple[float, float], sites: list[tuple[float, float]], away: float, own: tuple[float, float] | None
     ) -> bool:
-        """Whether ``xy`` keeps ``away`` from every block lying in the world but those of the site ``own``.
+        """Whether ``xy`` keeps ``away`` from every one of ``sites`` but those of the site ``own``."""
+        return all(
+            math.hypot(xy[0] - x, xy[1] - y) >= away
+            for x, y in sites
+            if own is None or math.hypot(x - own[0], y - own[1]) >= 0.3
+        )
 
-        With ``worked_only``, only from the blocks a teammate works at (a stand-off point reserved
-        within :data:`WORKED` of them).
-        """
-        if away <= 0:
-            return True
-        points = reservations.reserved(self) if worked_only else []
-        for fp in self.world.ground_truth_obstacles(include_samples=True):
-            if self.world.objects[fp.name].kind not in ("block", "sample"):
-                continue
-            if own is not None and math.hypot(fp.x - own[0], fp.y - own[1]) < 0.3:
-                continue
-            if worked_only and not any(math.hypot(fp.x - x, fp.y - y) < WORKED for x, y, _ in points):
-                continue
-            if math.hypot(xy[0] - fp.x, xy[1] - fp.y) < away:
-                return False
-        return True
+    def _worked_sites(self) -> list[tuple[float, float]]:
+        """The blocks a teammate works at: a stand-off point reserved within :data:`WORKED` of them."""
+        points = reservations.reserved(self)
+        return [
+            (x, y)
+            for x, y in lying_sites(self.world)
+            if any(math.hypot(x - px, y - py) < WORKED for px, py, _ in points)
+        ]
 
-    def _acceptable(self, xy: tuple[float, float]) -> bool:
+    def _acceptable(
+        self, xy: tuple[float, float], guard: tuple[float, float] | None, near: tuple[float, float] | None
+    ) -> bool:
         """Whether the robot may wait at ``xy``: clear of robots and reservations, and where its duty wants it.
 
-        Guarding: within ``guard_radius`` of the guarded object. Waiting for a
-        step: within :data:`NEAR_SPAN` of its work site. Standing by: ``keep_away`` from every block a
-        teammate works at (a new place, when it has to move, keeps ``keep_away`` from every block).
+        Guarding (``guard``, where the guarded object lies): within ``guard_radius`` of it. Waiting for
+        a step (``near``, its work site): within :data:`NEAR_SPAN` of it. Standing by: ``keep_away``
+        from every block a teammate works at (a new place, when it has to move, keeps ``keep_away``
+        from every block).
         """
         if not self._free(xy, self._crowding()):
             return False
-        guard = self._site("guard")
         if guard is not None:
             return distance(xy, guard) <= float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
-        near = self._site("near")
         if near is not None:
-            gap = distance(xy, near)
-            return NEAR_SPAN[0] <= gap <= NEAR_SPAN[1]
+            return NEAR_SPAN[0] <= distance(xy, near) <= NEAR_SPAN[1]
         # standing by, a robot stays where it is unless a teammate comes to work at a block near it, or a
         # robot holding something stands close (an opponent that cannot put its block down holds it for good)
         if any(distance(xy, holder) < HOLDER_ROOM for holder in self._holders()):
             return False
-        return self._away_from_sites(xy, None, float(self.param("keep_away", 0.0)), worked_only=True)  # type: ignore[arg-type]
+        away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
+        return away <= 0 or self._away_from_sites(xy, self._worked_sites(), away, None)
+
+    def _here(self) -> tuple[float, float]:
+        return float(self.robot.estimate[0]), float(self.robot.estimate[1])
 
     def _ring_place(self, centre: tuple[float, float], radii: tuple[float, ...]) -> tuple[float, float] | None:
         """The free point on rings around ``centre`` nearest to the robot."""
-        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
+        here = self._here()
         discs = self._crowding()
         checker = self._checker()
+        sites = lying_sites(self.world)
+        margin = self.robot.spec.radius + ROOM
         away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
+        angles = [2.0 * math.pi * k / RING_POINTS for k in range(RING_POINTS)]
+        points = [(centre[0] + r * math.cos(a), centre[1] + r * math.sin(a)) for r in radii for a in angles]
+        candidates = [
+            p for p in points if checker.valid_xy(*p) and self._free(p, discs) and inside_field(self.world, p, margin)
+        ]
         for keep in (away, 0.5 * away, 0.0):  # a crowded field: crowd the other stacks a little rather than not wait
-            best: tuple[float, tuple[float, float]] | None = None
-            for radius in radii:
-                for k in range(RING_POINTS):
-                    a = 2.0 * math.pi * k / RING_POINTS
-                    p = (centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a))
-                    if not checker.valid_xy(*p) or not self._free(p, discs):
-                        continue
-                    if not inside_field(self.world, p, self.robot.spec.radius + ROOM):
-                        continue
-                    if not self._away_from_sites(p, centre, keep):
-                        continue
-                    d = distance(p, here)
-                    if best is None or d < best[0]:
-                        best = (d, p)
-            if best is not None:
-                return best[1]
+            kept = [p for p in candidates if self._away_from_sites(p, sites, keep, centre)]
+            if kept:
+                return min(kept, key=lambda p: distance(p, here))
         return None
 
     def _free_place(self) -> tuple[float, float] | None:
-        here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
-        if self._acceptable(here):
-            return here
-        guard = self._site("guard")
-        if guard is not None:
-            place = self._ring_place(guard, GUARD_RING)
+        guard, near = self._site("guard"), self._site("near")
+        if self._acceptable(self._here(), guard, near):
+            return self._here()
+        for centre, ring in ((guard, GUARD_RING), (near, NEAR_RING)):
+            place = self._ring_place(centre, ring) if centre is not None else None
             if place is not None:
                 return place
-        near = self._site("near")
-        if near is not None:
-            place = self._ring_place(near, NEAR_RING)
-            if place is not None:
-                return place
-        from alica.skills.motion import escape_goal
-
         self.placing = True  # every reserved point counts when choosing the place (see _others)
         try:
-            away = float(self.param("keep_away", 0.0))  # type: ignore[arg-type]
-            lying = self.world.ground_truth_obstacles(include_samples=True) if away > 0 else []
-            sites = [(fp.x, fp.y, away) for fp in lying if self.world.objects[fp.name].kind in ("block", "sample")]
-            sites += [(x, y, HOLDER_ROOM) for x, y in self._holders()]
-            return escape_goal(
-                self._grid(),
-                self.robot.estimate,
-                clearance=self.robot.spec.radius + float(self.param("clearance", 1.0)),  # type: ignore[arg-type]
-                max_distance=float(self.param("max_distance", 3.0)),  # type: ignore[arg-type]
-                other_robots=self._others(),
-                keep_away=sites,
-            )
+            return super()._free_place()
         finally:
             self.placing = False
+
+    def _keep_away_sites(self) -> list[tuple[float, float, float]]:
+        """The work sites, ``keep_away`` each, and the robots that hold something, :data:`HOLDER_ROOM` each."""
+        return super()._keep_away_sites() + [(x, y, HOLDER_ROOM) for x, y in self._holders()]
 
     def _holders(self) -> list[tuple[float, float]]:
         """Where the other robots that hold something stand: they need room to put it down."""
@@ -232,7 +212,7 @@ class WaitAside(DriveToFreeSpace):
 
         For the path, a reserved point the robot stands on is left out: it is driving away from it.
         """
-        x, y = float(self.robot.estimate[0]), float(self.robot.estimate[1])
+        x, y = self._here()
         mine = self.robot.spec.radius
         return super()._others() + [
             (rx, ry, rr)
@@ -249,8 +229,7 @@ class WaitAside(DriveToFreeSpace):
             if now < self.next_check:
                 return self.running("waiting aside")
             self.next_check = now + CHECK_PERIOD
-            here = (float(self.robot.estimate[0]), float(self.robot.estimate[1]))
-            if self._acceptable(here):
+            if self._acceptable(self._here(), self._site("guard"), self._site("near")):
                 return self.running("waiting aside")
             self._move_on("a teammate needs this place")
             return self.running("making way for a teammate")
@@ -272,17 +251,14 @@ class WaitAside(DriveToFreeSpace):
 
     def _move_on(self, why: str) -> None:
         """Choose a new place and drive there."""
-        self.spot = self._free_place()
+        spot = self._free_place()
+        self.spot = spot
         self.waiting = False
-        if self.spot is None:
+        if spot is None:
             return
-        self.params["goal"] = self.spot
-        self.goal = self.spot
         self.started = self.now()
         self.replans = 0
         self.moved_goal = 0
-        self.target = drivable_goal(self._checker(), self.spot, self.tolerance)
-        self.wait_until = 0.0
         self.escaping = False
         self.reason = why
-        self._plan(self.target or self.spot)
+        self._drive_to(spot)
