@@ -248,9 +248,27 @@ def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple
 BLOCKS_PREDICATES = ("on", "ontable", "clear", "holding", "handempty")
 
 
+#: Metres a block (at rest) or a robot moves before the perception writes its ``pos`` again.
+BLOCK_MOVED, ROBOT_MOVED = 0.05, 0.5
+
+
+def blocks_places(world: RobotWorld) -> dict[str, tuple[float, float, float]]:
+    """Where the blocks no robot holds and the robots are: name -> ``(x, y, tolerance)`` (see :class:`FactPerception`)."""
+    held = {r.arm.held.name for r in world.robots.values() if r.arm is not None and r.arm.held is not None}
+    out: dict[str, tuple[float, float, float]] = {}
+    for name, obj in world.objects.items():
+        if obj.kind == "block" and name not in held:
+            x, y = (float(v) for v in obj.position()[:2])
+            out[name] = (x, y, BLOCK_MOVED)
+    for name, robot in world.robots.items():
+        x, y, _ = robot.pose
+        out[name] = (float(x), float(y), ROBOT_MOVED)
+    return out
+
+
 def blocks_perception(every: float = 0.2) -> FactPerception:
-    """The blocks world's team perception: :func:`blocks_facts` every ``every`` simulated seconds."""
-    return FactPerception(blocks_facts, every=every, predicates=BLOCKS_PREDICATES)
+    """The blocks world's team perception: :func:`blocks_facts` and :func:`blocks_places` every ``every`` simulated seconds."""
+    return FactPerception(blocks_facts, every=every, predicates=BLOCKS_PREDICATES, places=blocks_places)
 
 
 def sample_names(count: int) -> list[str]:

@@ -6,8 +6,10 @@ base function ``Pos``, ``MaximalDist`` holds iff the Euclidean distance of
 ``p1`` and ``p2`` is greater than ``d`` and ``MinimalDist`` iff it is smaller.
 Both are false when either position is unknown. An argument that is a point
 itself (a pair ``(x, y)``, a mapping or an object with ``x``, ``y``; a solved
-point variable, say) is taken as its own position; ``dist`` takes object names
-(through ``Pos``) as well as points. The paper's Eq. 1 spreads
+point variable, say) is taken as its own position; ``dist`` and ``closeness``
+take object names (through ``Pos``) as well as points. Where ``Pos`` has no
+value, the skills' own ``pos`` (what navigation, the arm skills and the blocks
+world's perception write) is read. The paper's Eq. 1 spreads
 frontier points apart with
 ``forall f1, f2 in Frontier: MaximalDist(f1, f2, eps) or f1 = f2``.
 """
@@ -71,10 +73,13 @@ def is_point(value: object) -> bool:
 
 
 def position(belief: BeliefBase, a: object) -> object | None:
-    """Where ``a`` is: ``a`` itself when it is a point, else ``Pos(a)`` from the belief base (None when unknown)."""
+    """Where ``a`` is: ``a`` itself when it is a point, else ``Pos(a)`` or, without it, ``pos(a)`` (None when unknown)."""
     if is_point(a):
         return a
-    return belief.lookup("Pos", (a,))
+    if a is None:
+        return None
+    found = belief.lookup("Pos", (a,))
+    return found if found is not None else belief.lookup("pos", (a,))
 
 
 def _position_distance(belief: BeliefBase, a: object, b: object) -> float | None:
@@ -92,6 +97,32 @@ def place_dist(belief: BeliefBase, a: object, b: object) -> float:
         unknown = a if position(belief, a) is None else b
         raise ValueError(f"{unknown!r} is neither a point nor an object with a known Pos")
     return distance
+
+
+def closeness(belief: BeliefBase, a: object, b: object) -> float:
+    """``1 / (1 + dist(a, b))``: 1 where ``a`` and ``b`` are at the same place, towards 0 farther apart.
+
+    0 when either position is unknown, so that a utility summand built on it
+    stays defined (and in [0, 1]) before perception has placed everything.
+    """
+    distance = _position_distance(belief, a, b)
+    return 0.0 if distance is None else 1.0 / (1.0 + distance)
+
+
+def choose(key: object, *cases: object) -> object:
+    """``choose(k, k1, v1, k2, v2, ..., default)``: the ``v`` of the first ``k_i`` equal to ``k``, else ``default``.
+
+    Raises:
+        ValueError: no default (an odd number of arguments after ``key``).
+    """
+    if len(cases) % 2 == 0:
+        raise ValueError(
+            f"choose takes a key, pairs of case and value, and a default; got {len(cases) + 1} arguments (add a default)"
+        )
+    for i in range(0, len(cases) - 1, 2):
+        if cases[i] == key:
+            return cases[i + 1]
+    return cases[-1]
 
 
 def maximal_dist(belief: BeliefBase, a: object, b: object, d: float) -> bool:
@@ -156,7 +187,7 @@ def default_registry() -> Registry:
 
     Returns:
         A registry with ``sqrt``, ``abs``, ``min``, ``max``, ``dist``,
-        ``floor``, ``ceil``, ``round``, ``count``, ``having``, ``MaximalDist`` and
+        ``closeness``, ``choose``, ``floor``, ``ceil``, ``round``, ``count``, ``having``, ``MaximalDist`` and
         ``MinimalDist``; callers may add to it freely.
     """
     registry = Registry()
@@ -167,6 +198,17 @@ def default_registry() -> Registry:
     registry.register("max", _max, (1, None), kind=fn, doc=_max.__doc__ or "")
     registry.register(
         "dist", place_dist, 2, kind=fn, needs_belief=True, doc="Euclidean distance of two points (or objects' Pos)"
+    )
+    registry.register(
+        "closeness",
+        closeness,
+        2,
+        kind=fn,
+        needs_belief=True,
+        doc="closeness(a, b): 1 / (1 + dist(a, b)), 0 when a position is unknown",
+    )
+    registry.register(
+        "choose", choose, (2, None), kind=fn, doc="choose(k, k1, v1, ..., default): the v of the first k_i equal to k"
     )
     registry.register("floor", math.floor, 1, kind=fn, doc="largest integer <= x")
     registry.register("ceil", math.ceil, 1, kind=fn, doc="smallest integer >= x")

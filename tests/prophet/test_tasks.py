@@ -97,11 +97,14 @@ def test_cardinalities_and_utility(blocks):
     u = created.plan.utility
     n = 3
     wt, wp, ws = 1 / n, 1 / (n + 1) ** 2, 1 / (n + 1) ** 3
-    total = wt + wp + ws
+    wd = ws / (n + 1)  # the proximity summand: below one agent's similarity
+    total = wt + wp + ws + wd
     assert u.weight_sum == pytest.approx(1.0)
     assert u.priority_weight == pytest.approx(wp / total) and u.similarity_weight == pytest.approx(ws / total)
     assert u.summands[0].weight == pytest.approx(wt / total) and u.threshold == pytest.approx(ws / total)
+    assert u.summands[1].name == "Proximity" and u.summands[1].weight == pytest.approx(wd / total)
     assert generic_utility(1).weight_sum == pytest.approx(1.0)
+    assert [s.name for s in generic_utility(1).summands] == ["Coverage"]  # no work sites, no proximity
 
 
 def test_steps_wait_for_their_preconditions(blocks):
@@ -308,3 +311,34 @@ def test_agents_standing_by_guard_what_no_step_touches(blocks):
     assert {b.variable: b.value for b in standby.bindings} == {"guard": "b"}
     # the robot never counts as an object to guard
     assert "r" not in {b.value for b in standby.bindings}
+
+
+def _nearest_first(blocks, places, robots=("r1", "r2", "r3")):
+    """The generated Sussman plan allocated to three robots placed at ``places`` (blocks and robots)."""
+    from alica.allocation import AllocationProblem, allocate
+    from alica.lang import FactBase, evaluate
+
+    created, roleset = _created(blocks)
+    role = next(r.name for r in created.roleset.roles if roleset.priority(r.name, "Default") > 0)
+    belief = FactBase(values={("pos", name): xy for name, xy in places.items()})
+
+    def summand(plan, term, agent, ep):
+        return evaluate(term.expression, belief, {"self": agent, "task": ep.task, "entry": ep.name})
+
+    problem = AllocationProblem(robots, dict.fromkeys(robots, role), created.roleset, (created.plan,), summand=summand)
+    result = allocate(problem)
+    assert result.assignment is not None
+    return {agent: ep.rsplit("_", 1)[1] for agent, ep in result.assignment.entries}
+
+
+def test_a_task_goes_to_the_robot_nearest_where_it_starts(blocks):
+    # T0 starts at c (Unstack(c, a)), T1 at b (Pickup(b)), T2 at a (Pickup(a))
+    blocks_at = {"c": (0.0, 0.0), "a": (0.0, 0.0), "b": (6.0, 0.0)}
+    near = _nearest_first(blocks, {**blocks_at, "r1": (6.5, 0.0), "r2": (0.5, 0.0), "r3": (-0.5, 0.2)})
+    assert near["r1"] == "T1"  # the robot beside b picks b up
+    swapped = _nearest_first(blocks, {**blocks_at, "r1": (0.5, 0.0), "r2": (6.5, 0.0), "r3": (-0.5, 0.2)})
+    assert swapped["r2"] == "T1"
+    # positions unknown: every closeness is 0, and the tie rule gives the tasks in agent order
+    assert _nearest_first(blocks, {}) == {"r1": "T0", "r2": "T1", "r3": "T2"}
+    # proximity never puts a later task first: a lone robot beside b still takes T0, which T1 and T2 wait for
+    assert _nearest_first(blocks, {**blocks_at, "r1": (6.5, 0.0)}, robots=("r1",)) == {"r1": "T0"}

@@ -66,3 +66,34 @@ def test_declared_predicates_are_kept_in_line_even_before_they_are_seen():
 def test_every_must_be_positive():
     with pytest.raises(ValueError, match="positive number of seconds"):
         FactPerception(lambda world: (), every=0)
+
+
+def test_places_are_written_when_missing_or_moved_beyond_their_tolerance():
+    team = _Team(["r1", "r2"])
+    team.world.places = {"b": (1.0, 2.0, 0.05), "r1": (0.0, 0.0, 0.5)}
+    perception = FactPerception(lambda world: (), every=0.2, places=lambda world: world.places)
+    perception(team)
+    for engine in team.engines:
+        assert engine.world_model.get("pos", "b") == (1.0, 2.0) and engine.world_model.get("pos", "r1") == (0.0, 0.0)
+    wm = team.engines[0].world_model
+    # r1 drove 0.3 m (within its 0.5 m), b was moved 0.2 m (beyond its 0.05 m): only b is written again
+    team.t, team.world.places = 0.2, {"b": (1.2, 2.0, 0.05), "r1": (0.3, 0.0, 0.5)}
+    perception(team)
+    assert wm.get("pos", "b") == (1.2, 2.0) and wm.get("pos", "r1") == (0.0, 0.0)
+    team.t, team.world.places["r1"] = 0.4, (0.6, 0.0, 0.5)
+    perception(team)
+    assert wm.get("pos", "r1") == (0.6, 0.0)
+
+
+def test_the_blocks_world_perception_places_the_blocks_lying_and_the_robots():
+    from alica.worldsim.scenarios import blocks_places, blocksworld
+
+    world = blocksworld([["a", "b"], ["c"]], agents=2, seed=0)
+    try:
+        places = blocks_places(world)
+        assert {"a", "b", "c", "r1", "r2"} <= set(places)
+        a, c = world.objects["a"].position(), world.objects["c"].position()
+        assert places["a"][:2] == pytest.approx((a[0], a[1])) and places["c"][:2] == pytest.approx((c[0], c[1]))
+        assert places["r1"][:2] == pytest.approx(world.robots["r1"].pose[:2])
+    finally:
+        world.close()
