@@ -226,6 +226,29 @@ class ProblemRuntime:
             return (plans[self.model.alternative_plan],)  # type: ignore[index]
         return ()
 
+    def bindings(self) -> dict[str, object]:
+        """While the team waits, the WaitPlan guards the finished part of the goal, when it declares ``guard``.
+
+        ``guard`` is bound to the objects of the goal's positive literals that
+        hold now, space-separated; each waiting agent guards the nearest one
+        nobody guards yet (IMPERA 8.2: "the opponents often were not able to
+        act, because the stack was blocked by an agent"). Nothing to bind in
+        the other phases: the generated plan binds its own states' WaitPlans.
+        """
+        name = self.model.wait_plan
+        if self.phase() != "wait" or not name:
+            return {}
+        wait_plan = self.host.library.plans.get(name)
+        if wait_plan is None or all(v.name != "guard" for v in wait_plan.variables):
+            return {}
+        believed = {Fact(f.predicate, tuple(str(a) for a in f.args)) for f in self.host.world.facts()}
+        try:
+            goal = goal_literals(self.problem)
+        except PlannerError:
+            return {}
+        finished = sorted({str(a) for positive, fact in goal if positive and fact in believed for a in fact.args})
+        return {"guard": " ".join(finished)} if finished else {}
+
     def outcome(self) -> ChildStatus | None:
         """The child's status when it no longer depends on a running plan."""
         phase = self.phase()

@@ -248,6 +248,12 @@ class ChildRuntime(Protocol):
     def wanted(self) -> tuple[Plan, ...]:
         """The plans the child may run now, in preference order (none when it is finished)."""
 
+    def bindings(self) -> Mapping[str, object]:
+        """Values for the wanted plans' variables, on top of the child's own bindings (say, what a WaitPlan guards).
+
+        Read when the child starts a plan; a runtime that wants other values bumps its :attr:`revision`.
+        """
+
     def outcome(self) -> ChildStatus | None:
         """The child's status when it no longer depends on a running plan (``None``: it does)."""
 

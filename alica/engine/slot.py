@@ -203,7 +203,8 @@ class Slot:
         if not usable:
             self._wait(now, "no plan whose pre-condition holds" if candidates else "no plan left")
             return
-        node = engine.allocator.start(self, usable, self.env, now)
+        env = self.env if self.runtime is None else {**self.env, **self.runtime.bindings()}
+        node = engine.allocator.start(self, usable, env, now)
         if node is None:
             self._wait(now, self.reason)
             return

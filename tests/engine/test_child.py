@@ -97,6 +97,9 @@ class ToyRuntime:
     def wanted(self) -> tuple[Plan, ...]:
         return (self.plan,) if self.plan is not None else (self.host.library.plans["Park"],)
 
+    def bindings(self) -> dict[str, object]:
+        return {}
+
     def outcome(self) -> ChildStatus | None:
         return None
 

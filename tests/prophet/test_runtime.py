@@ -332,6 +332,9 @@ def test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_wa
         "robots outside the team hold, or nobody sees, b" in e["reason"] for e in events(rec, "planner", what="waiting")
     )
     assert events(rec, "problem", phase="failed") == []
+    # while the team waits, its WaitPlan guards the part of the goal that holds (e on the table)
+    waits = [params for _, skill, params in skills.runs if skill == "WaitAside"]
+    assert waits[-1].get("guard") == "e"
     sim.set_facts(
         [(False, "holding", ("o1", "b")), (True, "ontable", ("b",)), (True, "clear", ("b",))]
     )  # it puts b down
