@@ -417,19 +417,19 @@ def work_site(step: Step) -> str | None:
     return None
 
 
-def finished_object(step: Step, later: Sequence[Step]) -> str | None:
-    """The object ``step`` leaves where the plan wants it: its first object, when no later step touches it.
+def placed_object(step: Step) -> str | None:
+    """The object ``step`` leaves in the world: its first object, ``None`` when the robot holds something after it.
 
-    ``None`` when the step leaves the robot holding something, or a later
-    step touches one of its objects (say, stacks onto the block it placed).
+    ``Stack(x, y)`` and ``Putdown(x)``: ``x``; ``Pickup(x)`` and ``Unstack(x, y)``: none (``holding(r, x)``).
+    Whether the plan is done with it or a later step stacks onto it or takes it
+    again, opponents must leave it alone: a guard keeps them off a finished
+    part of the goal, off a tower still growing, and off a block put down for
+    a later step.
     """
     if not step.bindings or any(
         positive and step.robot in args and set(args) - {step.robot} for positive, (_, args) in step.effect
     ):
         return None  # the robot holds something of the step after it (holding(r, x))
-    touched = _objects(step)
-    if any(touched & _objects(other) for other in later):
-        return None
     return step.bindings[0][1]
 
 
@@ -453,8 +453,9 @@ def build_plan(
     an agent that waits for its next step runs the WaitPlan with ``near`` bound
     to the step's work site (:func:`work_site`); when it declares ``guard``,
     an agent whose task is done runs it with ``guard`` bound to what its last
-    step finished (:func:`finished_object`), so that it can keep opponents
-    off that part of the goal; the agents standing by get ``guard`` bound to
+    step placed (:func:`placed_object`), so that it can keep opponents
+    off that stack (a finished part of the goal, a tower still growing, or a
+    block put down for a later step); the agents standing by get ``guard`` bound to
     the objects of ``settled`` (those of the world) that no step touches,
     space-separated (each guards the nearest one no one else guards).
 
@@ -505,7 +506,7 @@ def build_plan(
             )
         last = task[-1]
         done_children = (
-            (_standby_ref(standby, waits, guard=finished_object(last, by_index[last.index + 1 :])),)
+            (_standby_ref(standby, waits, guard=placed_object(last)),)
             if standby is not None and "guard" in waits
             else ()
         )

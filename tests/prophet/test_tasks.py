@@ -284,9 +284,9 @@ def test_waiting_agents_run_the_wait_plan_near_their_next_step_and_guard_what_th
     done = {s.name: bound[s.name] for s in plan.states if (p := created.place(s.name)) and p.kind is StepKind.DONE}
     last = created.place(plan.entry_points[len(created.tasks) - 1].state).task
     assert done[f"T{last}_Done"] == {"guard": "a"}
-    # Putdown(c) is followed by Stack(b, c): c is not finished, its robot guards nothing
+    # Putdown(c) is followed by Stack(b, c): its robot guards c, so that opponents leave it for that step
     first = [s.label for s in created.tasks[0]]
-    assert first == ["Unstack(c, a)", "Putdown(c)"] and done["T0_Done"] == {}
+    assert first == ["Unstack(c, a)", "Putdown(c)"] and done["T0_Done"] == {"guard": "c"}
     # every block is touched by the plan: the agents standing by have nothing to guard
     (standby,) = plan.state(STANDBY).children
     assert standby.bindings == ()
