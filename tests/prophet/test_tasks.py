@@ -342,3 +342,28 @@ def test_a_task_goes_to_the_robot_nearest_where_it_starts(blocks):
     assert _nearest_first(blocks, {}) == {"r1": "T0", "r2": "T1", "r3": "T2"}
     # proximity never puts a later task first: a lone robot beside b still takes T0, which T1 and T2 wait for
     assert _nearest_first(blocks, {**blocks_at, "r1": (6.5, 0.0)}, robots=("r1",)) == {"r1": "T0"}
+
+
+_XY = st.tuples(st.floats(-3, 3), st.floats(-3, 3))
+
+
+@given(
+    places=st.fixed_dictionaries({name: _XY for name in ("a", "b", "c", "r1", "r2", "r3")}),
+    team=st.integers(1, 3),
+)
+def test_proximity_only_decides_who_takes_which_task_never_which_tasks(blocks, places, team):
+    import itertools
+    import math
+
+    robots = ("r1", "r2", "r3")[:team]
+    chosen = _nearest_first(blocks, places, robots)
+    # the same tasks as without positions: the earlier tasks first, one robot each
+    assert sorted(chosen.values()) == sorted(_nearest_first(blocks, {}, robots).values())
+    # and among the robots, the way of giving them out with the most closeness to where they start
+    sites = {"T0": "c", "T1": "b", "T2": "a"}
+
+    def closeness(assignment):
+        return sum(1 / (1 + math.dist(places[r], places[sites[t]])) for r, t in assignment.items())
+
+    best = max(closeness(dict(zip(robots, p, strict=True))) for p in itertools.permutations(chosen.values()))
+    assert closeness(chosen) >= best - 1e-6
