@@ -348,7 +348,7 @@ _XY = st.tuples(st.floats(-3, 3), st.floats(-3, 3))
 
 
 @given(
-    places=st.fixed_dictionaries({name: _XY for name in ("a", "b", "c", "r1", "r2", "r3")}),
+    places=st.fixed_dictionaries(dict.fromkeys(("a", "b", "c", "r1", "r2", "r3"), _XY)),
     team=st.integers(1, 3),
 )
 def test_proximity_only_decides_who_takes_which_task_never_which_tasks(blocks, places, team):
