@@ -93,7 +93,9 @@ class _BlockReader(Cursor):
             if word.kind != NAME or word.text not in allowed:
                 hint = suggestion(word.text, allowed) or "expected one of: " + ", ".join(allowed)
                 raise self.error(word, f"unknown keyword {word.shown()} in {what}", hint)
-            section: Callable[[Token, dict[str, Any]], None] = getattr(self, "_" + keyword.text.replace("-", "_") + "_section")
+            section: Callable[[Token, dict[str, Any]], None] = getattr(
+                self, "_" + keyword.text.replace("-", "_") + "_section"
+            )
             section(word, fields)
         place = {"line": keyword.line, "column": keyword.column}
         if keyword.text == "domain":
