@@ -110,7 +110,7 @@ class TypedParam:
     """A parameter bound by a quantifier or aggregation: ``?x : xPos``."""
 
     name: str
-    type: str
+    type: Name
     line: int = field(default=0, compare=False, repr=False, kw_only=True)
     column: int = field(default=0, compare=False, repr=False, kw_only=True)
 

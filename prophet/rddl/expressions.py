@@ -22,6 +22,7 @@ from alica.prophet.rddl.ast import (
     Expr,
     If,
     IntConst,
+    Name,
     Neg,
     Not,
     Param,
@@ -222,7 +223,11 @@ class Cursor:
                 raise self.error(var, f"expected a parameter '?name', found {var.shown()}")
             self.expect(":", f"after '{var.text}'")
             type_ = self.name("a type")
-            params.append(TypedParam(var.text, type_.text, line=var.line, column=var.column))
+            params.append(
+                TypedParam(
+                    var.text, Name(type_.text, line=type_.line, column=type_.column), line=var.line, column=var.column
+                )
+            )
             if not self.accept(","):
                 break
         self.expect("}", "to close the parameter list")

@@ -237,7 +237,7 @@ def _expr(expr: Expr) -> tuple[str, int]:
         case If(cond=cond, then=then, else_=else_):
             return f"if ({write_expr(cond)}) then {write_expr(then)} else {write_expr(else_)}", 0
         case Aggregate(op=op, params=params, body=body):
-            bound = ", ".join(f"{p.name} : {p.type}" for p in params)
+            bound = ", ".join(f"{p.name} : {p.type.text}" for p in params)
             return f"{op}_{{{bound}}} [{write_expr(body)}]", 0
     raise TypeError(f"not an RDDL expression: {expr!r}")  # pragma: no cover
 
