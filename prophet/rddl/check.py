@@ -78,6 +78,10 @@ class _Scope:
             )
 
 
+def _count(number: int) -> str:
+    return f"{number} argument" + ("" if number == 1 else "s")
+
+
 def _scope(file: str, domain: Domain | None) -> _Scope:
     scope = _Scope(file, domain)
     if domain is None:
@@ -131,9 +135,7 @@ def check_domain(domain: Domain, file: str = "<string>") -> None:
                 raise scope.error(head, f"'{cpf.name}' is a {target.kind}, only state fluents are primed", "drop the '")
             raise scope.error(head, f"the cpf of the state fluent '{cpf.name}' needs a prime", f"write {cpf.name}'")
         if len(cpf.params) != len(target.params):
-            raise scope.error(
-                head, f"'{cpf.name}' takes {len(target.params)} parameters, the cpf has {len(cpf.params)}"
-            )
+            raise scope.error(head, f"'{cpf.name}' takes {_count(len(target.params))}, the cpf has {len(cpf.params)}")
         bound: dict[str, str] = {}
         for param, type_ in zip(cpf.params, target.params):
             if param.name in bound:
@@ -164,7 +166,7 @@ def _expr(scope: _Scope, expr: Expr, bound: dict[str, str], where: str, *, argum
                 hint = suggestion(name, [*scope.pvariables, *(scope.objects or ())]) or "declare it in 'pvariables'"
                 raise scope.error(expr, f"undeclared {what} '{name}' in {where}", hint)
             if len(args) != len(target.params):
-                raise scope.error(expr, f"'{name}' takes {len(target.params)} arguments, {len(args)} given in {where}")
+                raise scope.error(expr, f"'{name}' takes {_count(len(target.params))}, {len(args)} given in {where}")
             for arg in args:
                 _expr(scope, arg, bound, where, argument=True)
         case Aggregate(params=params, body=body):
@@ -214,7 +216,7 @@ def _values(scope: _Scope, items: tuple[Assignment, ...], kinds: tuple[str, ...]
             hint = suggestion(item.name, candidates) or f"'{section}' sets {wanted}s only"
             raise scope.error(item, f"'{item.name}' in '{section}': {found}, expected a {wanted}", hint)
         if len(item.args) != len(target.params):
-            raise scope.error(item, f"'{item.name}' takes {len(target.params)} arguments, {len(item.args)} given")
+            raise scope.error(item, f"'{item.name}' takes {_count(len(target.params))}, {len(item.args)} given")
         for arg, type_ in zip(item.args, target.params):
             scope.argument(arg, type_.text, f"'{item.name}'")
 

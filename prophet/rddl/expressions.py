@@ -68,7 +68,7 @@ _NOT_LEVEL = 4
 
 def suggestion(word: str, options: list[str] | tuple[str, ...] | frozenset[str]) -> str:
     """A ``did you mean`` hint for ``word`` among ``options`` (empty when nothing is close)."""
-    close = get_close_matches(word, sorted(options), n=1, cutoff=0.6)
+    close = get_close_matches(word, sorted(options), n=1, cutoff=0.5)
     return f"did you mean '{close[0]}'?" if close else ""
 
 
