@@ -57,10 +57,14 @@ class Param:
 
 @dataclass(frozen=True, slots=True)
 class Apply:
-    """A pvariable application ``f(?x, a)``, a 0-ary ``f``, or an object name used as an argument."""
+    """A pvariable application ``f(?x, a)``, a 0-ary ``f``, or an object name used as an argument.
+
+    ``primed`` marks the next-state value of a state fluent (``f'(?x)``, as observation cpfs use it).
+    """
 
     name: str
     args: tuple[Expr, ...] = ()
+    primed: bool = False
     line: int = field(default=0, compare=False, repr=False, kw_only=True)
     column: int = field(default=0, compare=False, repr=False, kw_only=True)
 

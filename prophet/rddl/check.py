@@ -157,8 +157,10 @@ def _expr(scope: _Scope, expr: Expr, bound: dict[str, str], where: str, *, argum
                     f"parameter '{name}' is not bound in {where}",
                     "bind it in the pvariable's parameters or with a quantifier such as sum_{" + name + " : type}",
                 )
-        case Apply(name=name, args=args):
+        case Apply(name=name, args=args, primed=primed):
             target = scope.pvariables.get(name)
+            if primed and (target is None or target.kind != "state-fluent"):
+                raise scope.error(expr, f"'{name}' is no state fluent and has no next value in {where}", "drop the '")
             if target is None:
                 if argument and not args and (scope.objects is None or name in scope.objects):
                     return

@@ -30,7 +30,7 @@ from alica.prophet.rddl.ast import (
     TypedParam,
 )
 from alica.prophet.rddl.errors import RddlError
-from alica.prophet.rddl.lexer import ENUM, EOF, INT, NAME, REAL, SYMBOL, VAR, Token
+from alica.prophet.rddl.lexer import ENUM, EOF, INT, NAME, PRIMED, REAL, SYMBOL, VAR, Token
 from alica.source import SourceSpan
 
 AGGREGATES = ("sum", "prod", "forall", "exists")
@@ -181,6 +181,8 @@ class Cursor:
             return EnumValue(token.text, **place)
         if token.kind == VAR:
             return Param(token.text, **place)
+        if token.kind == PRIMED:
+            return Apply(token.text, self.args() if self.peek().is_symbol("(") else (), True, **place)
         if token.kind != NAME:
             raise self.error(token, f"expected an expression, found {token.shown()}")
         if token.text in {"true", "false"}:

@@ -217,8 +217,9 @@ def _expr(expr: Expr) -> tuple[str, int]:
             return _real(value), (_NEG if value < 0 or repr(value).startswith("-") else _ATOM)
         case EnumValue(name=name) | Param(name=name):
             return name, _ATOM
-        case Apply(name=name, args=args):
-            return (f"{name}({', '.join(write_expr(a) for a in args)})" if args else name), _ATOM
+        case Apply(name=name, args=args, primed=primed):
+            head = name + ("'" if primed else "")
+            return (f"{head}({', '.join(write_expr(a) for a in args)})" if args else head), _ATOM
         case Distribution(name=name, args=args):
             return f"{name}({', '.join(write_expr(a) for a in args)})", _ATOM
         case Neg(operand=operand):

@@ -138,9 +138,9 @@ domain full {
     };
     cpfs {
         heat(?r) = Normal(WEIGHT(?r), 1.5) + DiracDelta(2);
-        seen(?c) = Bernoulli(0.8) & lit(?c);
+        seen(?c) = Bernoulli(0.8) & lit'(?c);
         lit'(?c) = if (flip(?c) <=> lit(?c)) then false else exists_{?d : cell} [ADJ(?c, ?d) => lit(?d)];
-        count' = prod_{?c : cell} [if (lit(?c)) then 2 else 1] / -SIZE;
+        count' = prod_{?c : cell} [if (lit(?c)) then 2 else 1] * -SIZE;
         mode' = if (mode == @low ^ count ~= 0) then @mid else mode;
     };
     reward = sum_{?c : cell} [lit(?c) * WEIGHT(?c)] - 2 * count + -1;
@@ -203,11 +203,11 @@ def test_every_construct_reads() -> None:
         Distribution("Normal", (Apply("WEIGHT", (p("?r"),)), RealConst(1.5))),
         Distribution("DiracDelta", (IntConst(2),)),
     )
-    # The product reaches to the right: the division is inside it.
+    # The product reaches to the right: the multiplication is inside it.
     assert domain.cpfs[3].expr == Aggregate(
         "prod",
         (TypedParam("?c", Name("cell")),),
-        Binary("/", If(Apply("lit", (p("?c"),)), IntConst(2), IntConst(1)), Neg(Apply("SIZE"))),
+        Binary("*", If(Apply("lit", (p("?c"),)), IntConst(2), IntConst(1)), Neg(Apply("SIZE"))),
     )
     assert len(domain.action_preconditions) == 1 and len(domain.state_invariants) == 2
     assert len(domain.state_action_constraints) == 1
