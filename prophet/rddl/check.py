@@ -93,12 +93,11 @@ def _scope(file: str, domain: Domain | None) -> _Scope:
             scope.enums[decl.name] = decl.values
         else:
             scope.types[decl.name] = decl.parent
-    for decl in domain.pvariables:
-        if decl.name in scope.pvariables:
-            raise scope.error(
-                Name(decl.name, line=decl.line, column=decl.column), f"pvariable '{decl.name}' declared twice"
-            )
-        scope.pvariables[decl.name] = decl
+    for pvariable in domain.pvariables:
+        if pvariable.name in scope.pvariables:
+            place = Name(pvariable.name, line=pvariable.line, column=pvariable.column)
+            raise scope.error(place, f"pvariable '{pvariable.name}' declared twice")
+        scope.pvariables[pvariable.name] = pvariable
     return scope
 
 

@@ -168,7 +168,6 @@ class Cursor:
     def primary(self) -> Expr:
         """A constant, parameter, pvariable, bracketed expression, ``if``, aggregation or distribution."""
         token = self.advance()
-        place = {"line": token.line, "column": token.column}
         if token.is_symbol("(") or token.is_symbol("["):
             inner = self.expr()
             self.expect(
@@ -176,17 +175,23 @@ class Cursor:
             )
             return inner
         if token.kind in {INT, REAL}:
-            return _number(token, negative=False, **place)
+            return _number(token, negative=False, line=token.line, column=token.column)
         if token.kind == ENUM:
-            return EnumValue(token.text, **place)
+            return EnumValue(token.text, line=token.line, column=token.column)
         if token.kind == VAR:
-            return Param(token.text, **place)
+            return Param(token.text, line=token.line, column=token.column)
         if token.kind == PRIMED:
-            return Apply(token.text, self.args() if self.peek().is_symbol("(") else (), True, **place)
+            return Apply(
+                token.text,
+                self.args() if self.peek().is_symbol("(") else (),
+                True,
+                line=token.line,
+                column=token.column,
+            )
         if token.kind != NAME:
             raise self.error(token, f"expected an expression, found {token.shown()}")
         if token.text in {"true", "false"}:
-            return BoolConst(token.text == "true", **place)
+            return BoolConst(token.text == "true", line=token.line, column=token.column)
         if token.text == "if":
             self.expect("(", "after 'if'")
             cond = self.expr()
@@ -194,15 +199,17 @@ class Cursor:
             self._keyword("then")
             then = self.expr()
             self._keyword("else")
-            return If(cond, then, self.expr(), **place)
+            return If(cond, then, self.expr(), line=token.line, column=token.column)
         word = token.text[:-1]
         if token.text.endswith("_") and word in AGGREGATES and self.peek().is_symbol("{"):
-            return Aggregate(word, self.typed_params(), self.expr(), **place)
+            return Aggregate(word, self.typed_params(), self.expr(), line=token.line, column=token.column)
         if token.text in DISTRIBUTIONS and self.peek().is_symbol("("):
-            return Distribution(token.text, self.args(), **place)
+            return Distribution(token.text, self.args(), line=token.line, column=token.column)
         if token.text in KEYWORDS:
             raise self.error(token, f"expected an expression, found the keyword '{token.text}'")
-        return Apply(token.text, self.args() if self.peek().is_symbol("(") else (), **place)
+        return Apply(
+            token.text, self.args() if self.peek().is_symbol("(") else (), line=token.line, column=token.column
+        )
 
     def args(self) -> tuple[Expr, ...]:
         """``(e1, e2, ...)``."""
@@ -242,15 +249,14 @@ class Cursor:
             self.advance()
             return _number(self.advance(), negative=True, line=token.line, column=token.column)
         self.advance()
-        place = {"line": token.line, "column": token.column}
         if token.kind in {INT, REAL}:
-            return _number(token, negative=False, **place)
+            return _number(token, negative=False, line=token.line, column=token.column)
         if token.kind == ENUM:
-            return EnumValue(token.text, **place)
+            return EnumValue(token.text, line=token.line, column=token.column)
         if token.kind == NAME and token.text in {"true", "false"}:
-            return BoolConst(token.text == "true", **place)
+            return BoolConst(token.text == "true", line=token.line, column=token.column)
         if token.kind == NAME and token.text not in KEYWORDS:
-            return Apply(token.text, **place)
+            return Apply(token.text, line=token.line, column=token.column)
         raise self.error(token, f"expected a value (a number, true, false, @value or an object), found {token.shown()}")
 
     def _keyword(self, word: str) -> None:

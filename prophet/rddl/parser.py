@@ -97,14 +97,13 @@ class _BlockReader(Cursor):
                 self, "_" + keyword.text.replace("-", "_") + "_section"
             )
             section(word, fields)
-        place = {"line": keyword.line, "column": keyword.column}
         if keyword.text == "domain":
-            return Domain(name.text, **fields, **place)
+            return Domain(name.text, **fields, line=keyword.line, column=keyword.column)
         if "domain" not in fields:
             raise self.error(name, f"{what} '{name.text}' names no domain", "add 'domain = NAME;'")
         if keyword.text == "non-fluents":
-            return NonFluents(name.text, **fields, **place)
-        return Instance(name.text, **fields, **place)
+            return NonFluents(name.text, **fields, line=keyword.line, column=keyword.column)
+        return Instance(name.text, **fields, line=keyword.line, column=keyword.column)
 
     def _once(self, word: Token, fields: dict[str, Any], key: str, value: object) -> None:
         if key in fields:
@@ -140,16 +139,15 @@ class _BlockReader(Cursor):
     def _type(self) -> TypeDecl:
         name = self.new_name("a type")
         self.expect(":", f"after the type '{name.text}'")
-        place = {"line": name.line, "column": name.column}
         if self.accept("{"):
             values = [self._enum_value()]
             while self.accept(","):
                 values.append(self._enum_value())
             self.expect("}", "to close the enum values")
-            decl = TypeDecl(name.text, None, tuple(values), **place)
+            decl = TypeDecl(name.text, None, tuple(values), line=name.line, column=name.column)
         else:
             parent = self.name("a super type ('object' or a type)")
-            decl = TypeDecl(name.text, _name(parent), **place)
+            decl = TypeDecl(name.text, _name(parent), line=name.line, column=name.column)
         self.expect(";", f"the type '{name.text}'")
         return decl
 
@@ -243,12 +241,12 @@ class _BlockReader(Cursor):
                     if not self.accept(","):
                         break
                 self.expect(")", "to close the arguments")
-            place = {"line": (negated or name).line, "column": (negated or name).column}
-            value: Any = BoolConst(negated is None, **place)
+            first = negated or name
+            value: Any = BoolConst(negated is None, line=first.line, column=first.column)
             if negated is None and self.accept("="):
                 value = self.constant()
             self.expect(";", f"the value of '{name.text}'")
-            items.append(Assignment(name.text, tuple(args), value, **place))
+            items.append(Assignment(name.text, tuple(args), value, line=first.line, column=first.column))
         return tuple(items)
 
     def _non_fluents_section(self, word: Token, fields: dict[str, Any]) -> None:
