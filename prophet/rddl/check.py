@@ -170,6 +170,11 @@ def _expr(scope: _Scope, expr: Expr, bound: dict[str, str], where: str, *, argum
                 raise scope.error(expr, f"'{name}' takes {_count(len(target.params))}, {len(args)} given in {where}")
             for arg in args:
                 _expr(scope, arg, bound, where, argument=True)
+        case EnumValue(name=name):
+            values = [v for vs in scope.enums.values() for v in vs]
+            if name not in values:
+                hint = suggestion(name, values) or "declare it in an enum type: 'name : {@a, @b};'"
+                raise scope.error(expr, f"unknown enum value '{name}' in {where}", hint)
         case Aggregate(params=params, body=body):
             inner = dict(bound)
             for param in params:

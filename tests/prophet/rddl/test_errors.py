@@ -108,6 +108,18 @@ def test_the_sample_texts_are_valid() -> None:
             "<string>:7:36: error: unknown type 'boolean'",
         ),
         ("state-fluent", "state-fluents", "<string>:7:22: error: unknown pvariable kind 'state-fluents'"),
+        ("| at(?r);", "| at(?r) ^ @on;", "<string>:11:37: error: unknown enum value '@on' in the cpf of 'at'"),
+        (
+            "at'(?r) = go(?r)",
+            "at'(?r) = go'(?r)",
+            "<string>:11:19: error: 'go' is no state fluent and has no next value",
+        ),
+        (
+            "at(robot) : {state",
+            "at(robot) : {state-fluent, bool};\n        COST : {state",
+            "<string>:8:9: error: pvariable 'COST' declared twice",
+        ),
+        ("robot : object;", "robot : thing;", "<string>:3:17: error: unknown type 'thing'"),
         ("domain d {", "domain det {", "<string>:1:8: error: 'det' is an RDDL keyword and cannot name a domain"),
         ("reward = sum", "reward = 1 $ sum", "<string>:13:16: error: unexpected character '$'"),
         (
