@@ -58,12 +58,14 @@ _LEVELS: tuple[tuple[str, ...], ...] = (
     ("=>",),
     ("|",),
     ("^", "&"),
+    (),  # prefix ~
     ("==", "~=", "<", "<=", ">", ">="),
     ("+", "-"),
     ("*", "/"),
 )
+_OPERATORS = {op: level for level, ops in enumerate(_LEVELS) for op in ops}
 _NOT_LEVEL = 4
-"""``~`` binds tighter than ``^`` (level 3) and looser than the comparisons (level 4)."""
+"""``~`` binds tighter than ``^`` and looser than the comparisons."""
 
 
 def suggestion(word: str, options: list[str] | tuple[str, ...] | frozenset[str]) -> str:
@@ -98,6 +100,10 @@ class Cursor:
     def error(self, token: Token, message: str, hint: str = "") -> RddlError:
         """An :class:`RddlError` at ``token``."""
         return RddlError(message, self.span(token), hint)
+
+    def too_deep(self) -> RddlError:
+        """The error for an expression nested deeper than Python's recursion limit allows to read."""
+        return self.error(self.peek(), "the expression is nested too deeply to read", "split it, or bracket less")
 
     def accept(self, text: str) -> Token | None:
         """The current token if it is the symbol ``text`` (moving past it), else None."""
@@ -134,21 +140,21 @@ class Cursor:
         """An expression."""
         return self._binary(0)
 
-    def _binary(self, level: int) -> Expr:
-        if level == _NOT_LEVEL:
+    def _binary(self, lowest: int) -> Expr:
+        """Precedence climbing: an operand, then operators of level ``lowest`` or tighter (one frame per nesting)."""
+        token = self.peek()
+        if lowest <= _NOT_LEVEL and token.is_symbol("~"):
+            self.advance()
+            left: Expr = Not(self._binary(_NOT_LEVEL), line=token.line, column=token.column)
+        else:
+            left = self.unary()
+        while True:
             token = self.peek()
-            if token.is_symbol("~"):
-                self.advance()
-                return Not(self._binary(_NOT_LEVEL), line=token.line, column=token.column)
-        if level == len(_LEVELS):
-            return self.unary()
-        left = self._binary(level + 1)
-        ops = _LEVELS[level]
-        while self.peek().kind == SYMBOL and self.peek().text in ops:
-            token = self.advance()
-            right = self._binary(level + 1)
-            left = _binary(token, left, right)
-        return left
+            level = _OPERATORS.get(token.text, -1) if token.kind == SYMBOL else -1
+            if level < lowest:
+                return left
+            self.advance()
+            left = _binary(token, left, self._binary(level + 1))
 
     def unary(self) -> Expr:
         """A unary minus or ``~`` applied to a unary expression, or a primary expression."""

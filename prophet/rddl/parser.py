@@ -76,7 +76,10 @@ def parse_blocks(text: str, file: str = "<string>") -> RddlFile:
             raise reader.error(token, f"unknown keyword {token.shown()} at the top level", hint)
         if token.text in found:
             raise reader.error(token, f"a second '{token.text}' block", "put each block in a file of its own")
-        found[token.text] = reader.block(token)
+        try:
+            found[token.text] = reader.block(token)
+        except RecursionError:
+            raise reader.too_deep() from None
     return RddlFile(found.get("domain"), found.get("non-fluents"), found.get("instance"))
 
 

@@ -35,13 +35,16 @@ def parse_rddl(
         RddlError: ``FILE:LINE:COL: error: ... (fix: ...)`` at the first problem.
     """
     blocks = parse_blocks(text, filename)
-    if blocks.domain is not None:
-        check_domain(blocks.domain, filename)
-    known_domain = blocks.domain or domain
-    if blocks.non_fluents is not None:
-        check_non_fluents(blocks.non_fluents, known_domain, filename)
-    if blocks.instance is not None:
-        check_instance(blocks.instance, known_domain, blocks.non_fluents or non_fluents, filename)
+    try:
+        if blocks.domain is not None:
+            check_domain(blocks.domain, filename)
+        known_domain = blocks.domain or domain
+        if blocks.non_fluents is not None:
+            check_non_fluents(blocks.non_fluents, known_domain, filename)
+        if blocks.instance is not None:
+            check_instance(blocks.instance, known_domain, blocks.non_fluents or non_fluents, filename)
+    except RecursionError:  # pragma: no cover - the reader gives up first
+        raise RddlError(f"{filename}: an expression is nested too deeply to check", None, "split it") from None
     return blocks
 
 
@@ -87,7 +90,10 @@ def parse_expr(text: str, filename: str = "<string>") -> Expr:
         RddlError: the text is no single expression.
     """
     cursor = Cursor(tokenize(text, filename), filename)
-    expr = cursor.expr()
+    try:
+        expr = cursor.expr()
+    except RecursionError:
+        raise cursor.too_deep() from None
     token = cursor.peek()
     if token.kind != EOF:
         raise cursor.error(token, f"unexpected {token.shown()} after the expression", "remove it or add an operator")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from alica.prophet.rddl import Domain, RddlError, parse_expr, parse_rddl, read_rddl
+from alica.prophet.rddl import Domain, RddlError, parse_expr, parse_rddl, read_rddl, write_expr
 
 BASE = """domain d {
     types {
@@ -229,6 +229,17 @@ def test_expression_errors() -> None:
         parse_expr("if (a) then")
     with pytest.raises(RddlError, match=r"^<string>:1:7: error: expected a parameter '\?name', found 't'"):
         parse_expr("sum_{ t : u } [1]")
+
+
+def test_deep_nesting_raises_rddl_error() -> None:
+    deep = "(" * 5000 + "a" + ")" * 5000
+    with pytest.raises(RddlError, match=r"^<string>:1:\d+: error: the expression is nested too deeply to read"):
+        parse_expr(deep)
+    with pytest.raises(RddlError, match=r"^<string>:13:\d+: error: the expression is nested too deeply to read"):
+        parse_rddl(BASE.replace("reward = sum", f"reward = {deep} + sum"))
+    assert parse_expr("(" * 150 + "a" + ")" * 150) == parse_expr("a")
+    chain = "".join(f"if (c{i}) then {i} else " for i in range(150)) + "0"
+    assert write_expr(parse_expr(chain)).count("else if") == 149
 
 
 def test_read_rddl_gives_the_file_in_the_place(tmp_path: Path) -> None:
