@@ -10,21 +10,32 @@ from hypothesis import strategies as st
 
 from alica.prophet.rddl import (
     KEYWORDS,
+    PVARIABLE_KINDS,
     Aggregate,
     Apply,
+    Assignment,
     Binary,
     BoolConst,
+    Constant,
+    Cpf,
     Distribution,
+    Domain,
     EnumValue,
     Expr,
     If,
+    Instance,
     IntConst,
     Name,
     Neg,
+    NonFluents,
     Not,
+    ObjectsDecl,
     Param,
+    PVariable,
     RddlError,
+    RddlFile,
     RealConst,
+    TypeDecl,
     TypedParam,
     parse_expr,
     parse_rddl,
@@ -35,6 +46,7 @@ from alica.prophet.rddl import (
     write_non_fluents,
     write_rddl,
 )
+from alica.prophet.rddl.parser import parse_blocks
 from tests.prophet.rddl.test_parse import FULL
 
 DATA = Path(__file__).parent / "data"
@@ -133,3 +145,106 @@ def test_damaged_text_raises_only_rddl_error(expr: Expr, position: int, cut: int
         parse_rddl(damaged)
     except RddlError as error:
         assert str(error).startswith("<string>:")
+
+
+CONSTANTS: st.SearchStrategy[Constant] = st.one_of(
+    st.builds(BoolConst, st.booleans()),
+    st.builds(IntConst, st.integers(-1000, 1000)),
+    st.builds(RealConst, st.floats(-1e6, 1e6, allow_nan=False)),
+    WORDS.map(lambda w: EnumValue("@" + w)),
+    WORDS.map(Apply),
+)
+NAMES = WORDS.map(Name)
+
+
+@st.composite
+def domains(draw: st.DrawFn) -> Domain:
+    """A random domain; its expressions name anything (read back unchecked)."""
+    types = tuple(
+        draw(
+            st.lists(
+                st.one_of(
+                    st.builds(TypeDecl, WORDS, NAMES),
+                    st.builds(
+                        TypeDecl, WORDS, st.none(), st.lists(WORDS.map(lambda w: "@" + w), min_size=1).map(tuple)
+                    ),
+                ),
+                max_size=3,
+            )
+        )
+    )
+    pvariables = []
+    for index in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from(PVARIABLE_KINDS))
+        level = draw(st.none() | st.integers(1, 3)) if kind == "interm-fluent" else None
+        pvariables.append(
+            PVariable(
+                f"p{index}",
+                tuple(draw(st.lists(NAMES, max_size=3))),
+                kind,
+                draw(st.sampled_from(["bool", "int", "real"]).map(Name) | NAMES),
+                draw(st.none() | CONSTANTS),
+                level,
+            )
+        )
+    cpfs = tuple(
+        Cpf(p.name, p.kind == "state-fluent", tuple(Param(f"?x{i}") for i in range(len(p.params))), draw(EXPRESSIONS))
+        for p in pvariables
+        if draw(st.booleans())
+    )
+    small = st.lists(EXPRESSIONS, max_size=2).map(tuple)
+    return Domain(
+        draw(WORDS),
+        tuple(draw(st.lists(WORDS, max_size=3))),
+        types,
+        tuple(pvariables),
+        cpfs,
+        draw(st.none() | EXPRESSIONS),
+        draw(small),
+        draw(small),
+        draw(small),
+    )
+
+
+ASSIGNMENTS = st.lists(
+    st.builds(
+        Assignment, WORDS, st.lists(NAMES | WORDS.map(lambda w: Name("@" + w)), max_size=3).map(tuple), CONSTANTS
+    ),
+    max_size=4,
+).map(tuple)
+OBJECTS = st.lists(st.builds(ObjectsDecl, NAMES, st.lists(NAMES, min_size=1, max_size=3).map(tuple)), max_size=3).map(
+    tuple
+)
+
+
+@given(
+    domains(),
+    st.builds(NonFluents, WORDS, NAMES, OBJECTS, ASSIGNMENTS),
+    st.builds(
+        Instance,
+        WORDS,
+        NAMES,
+        st.none() | NAMES,
+        OBJECTS,
+        ASSIGNMENTS,
+        st.none() | st.integers(1, 50),
+        st.none() | st.integers(1, 500),
+        st.none() | st.floats(0, 1),
+    ),
+)
+def test_generated_blocks_round_trip(domain: Domain, non_fluents: NonFluents, instance: Instance) -> None:
+    blocks = RddlFile(domain, non_fluents, instance)
+    text = write_rddl(blocks)
+    assert parse_blocks(text) == blocks, text
+
+
+PAPER_DOMAIN = (DATA / "multi_ros_robot_mdp.rddl").read_text(encoding="utf-8")
+
+
+@given(st.integers(0, len(PAPER_DOMAIN)), st.integers(0, 12), st.text("(){}[];,:=~-^|<>?@_' xr1\n", max_size=4))
+def test_damaged_paper_domain_raises_only_rddl_error(position: int, cut: int, junk: str) -> None:
+    damaged = PAPER_DOMAIN[:position] + junk + PAPER_DOMAIN[position + cut :]
+    try:
+        parse_rddl(damaged, "paper.rddl")
+    except RddlError as error:
+        assert str(error).startswith("paper.rddl:")
