@@ -129,6 +129,8 @@ def check_domain(domain: Domain, file: str = "<string>") -> None:
         if target is None:
             hint = suggestion(cpf.name, list(scope.pvariables)) or "declare it in 'pvariables'"
             raise scope.error(head, f"cpf of the undeclared pvariable '{cpf.name}'", hint)
+        if target.kind in {"non-fluent", "action-fluent"}:
+            raise scope.error(head, f"the {target.kind} '{cpf.name}' takes no cpf", "remove the cpf")
         if cpf.primed != (target.kind == "state-fluent"):
             if cpf.primed:
                 raise scope.error(head, f"'{cpf.name}' is a {target.kind}, only state fluents are primed", "drop the '")

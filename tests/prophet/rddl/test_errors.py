@@ -95,6 +95,7 @@ def test_the_sample_texts_are_valid() -> None:
         ),
         ("at'(?r)", "ta'(?r)", "<string>:11:9: error: cpf of the undeclared pvariable 'ta'"),
         ("at'(?r)", "at'(?r, ?s)", "<string>:11:9: error: 'at' takes 1 argument, the cpf has 2"),
+        ("at'(?r)", "go(?r)", "<string>:11:9: error: the action-fluent 'go' takes no cpf (fix: remove the cpf)"),
         ("at'(?r)", "at(?r)", "<string>:11:9: error: the cpf of the state fluent 'at' needs a prime"),
         ("COST(?r)]", "COST(?r, ?r)]", "<string>:13:41: error: 'COST' takes 1 argument, 2 given in the reward"),
         ("COST(?r)]", "COSTS(?r)]", "<string>:13:41: error: undeclared pvariable 'COSTS' in the reward"),
