@@ -15,7 +15,7 @@ import numpy as np
 from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import RobotWorld
 from alica.worldsim.objects import SAMPLE_KINDS
-from alica.worldsim.perception import FactPerception
+from alica.worldsim.perception import FactPerception, Place
 from alica.worldsim.world import World
 
 __all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "random_stacks", "sample_names"]
@@ -252,10 +252,10 @@ BLOCKS_PREDICATES = ("on", "ontable", "clear", "holding", "handempty")
 BLOCK_MOVED, ROBOT_MOVED = 0.05, 0.5
 
 
-def blocks_places(world: RobotWorld) -> dict[str, tuple[float, float, float]]:
+def blocks_places(world: RobotWorld) -> dict[str, Place]:
     """Where the blocks no robot holds and the robots are: name -> ``(x, y, tolerance)`` (see :class:`FactPerception`)."""
     held = {r.arm.held.name for r in world.robots.values() if r.arm is not None and r.arm.held is not None}
-    out: dict[str, tuple[float, float, float]] = {}
+    out: dict[str, Place] = {}
     for name, obj in world.objects.items():
         if obj.kind == "block" and name not in held:
             x, y = (float(v) for v in obj.position()[:2])
