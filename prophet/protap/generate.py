@@ -65,7 +65,7 @@ def random_spec(
         robots: the number of robots ``r1..``.
         width: the number of columns.
         height: the number of rows.
-        goals: the number of goals ``g1..`` (at most ``width * height``).
+        goals: the number of goals ``g1..`` (1 to ``width * height``).
         seed: the seed of the ``random.Random`` that places everything.
         manipulation_actions: the number of manipulation actions (the paper: 2).
         user_actions: the number of user-defined actions after them (the paper: 1).
@@ -151,8 +151,9 @@ def spec_from_facts(
         return float(prob_goto[robot]) if isinstance(prob_goto, Mapping) else float(prob_goto)
 
     def cell(value: object) -> Cell:
-        x, y = value  # type: ignore[misc]
-        return (int(x), int(y))
+        if not isinstance(value, Sequence) or len(value) != 2:
+            raise ValueError(f"a cell is an (x, y) pair, not {value!r}")
+        return (int(value[0]), int(value[1]))
 
     return ProblemSpec(
         robots=tuple(Robot(rddl_name(robot, "robot"), cell(at), probability(robot)) for robot, at in pairs),
@@ -230,10 +231,10 @@ def instance_text(spec: ProblemSpec) -> str:
         objects("action", (action.name for action in spec.actions)),
         objects("xPos", xs),
         objects("yPos", ys),
+        objects("goal", (goal.name for goal in spec.goals)),
+        "    };",
+        "    non-fluents {",
     ]
-    if spec.goals:
-        lines.append(objects("goal", (goal.name for goal in spec.goals)))
-    lines += ["    };", "    non-fluents {"]
     lines += [f"        PROB_GOTO({robot.name}) = {_number(robot.prob_goto)};" for robot in spec.robots]
     lines += [
         f"        DO_COST({robot.name}, {action.name}) = {_number(spec.do_costs[r][a])};"

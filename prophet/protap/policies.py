@@ -69,9 +69,7 @@ class Evaluation:
     std: float
 
 
-def run_episode(
-    model: ProtapModel, policy: Policy, rng: random.Random, horizon: int | None = None
-) -> float:
+def run_episode(model: ProtapModel, policy: Policy, rng: random.Random, horizon: int | None = None) -> float:
     """The total discounted reward of one episode of ``policy`` from the initial state.
 
     Args:

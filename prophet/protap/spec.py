@@ -166,6 +166,8 @@ class ProblemSpec:
             out.append("no robots")
         if not self.actions:
             out.append("no actions")
+        if not self.goals:
+            out.append("no goals (RDDL wants an object of every type)")
         names = self.object_names()
         out.extend(f"{name!r} is no valid RDDL object name" for name in names if not is_object_name(name))
         seen: set[str] = set()

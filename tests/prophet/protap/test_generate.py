@@ -23,6 +23,8 @@ from alica.prophet.protap import (
 )
 from tests.prophet.protap.rddl_facts import read_facts
 
+_ONE_GOAL = (Goal("g1", "a1", (0, 0)),)
+
 
 def test_appendix_c_with_its_typos_fixed() -> None:
     facts = read_facts(instance_text(appendix_c_spec()))
@@ -128,7 +130,10 @@ def test_spec_from_world_model_facts() -> None:
         user_actions=["report", "wave"],
         prob_goto={"scout-1": 0.8, "Carrier 2": 1.0},
     )
-    assert [(r.name, r.cell, r.prob_goto) for r in spec.robots] == [("scout_1", (0, 0), 0.8), ("Carrier_2", (4, 4), 1.0)]
+    assert [(r.name, r.cell, r.prob_goto) for r in spec.robots] == [
+        ("scout_1", (0, 0), 0.8),
+        ("Carrier_2", (4, 4), 1.0),
+    ]
     assert spec.actions == (Action("drill"), Action("report", USER_DEFINED), Action("wave", USER_DEFINED))
     assert spec.goals == (Goal("rock_7", "drill", (2, 3), 50.0), Goal("base", "report", (0, 4), 100.0))
     assert spec.max_nondef_actions == 2
@@ -140,14 +145,16 @@ def test_spec_from_facts_refuses_what_rddl_cannot_say() -> None:
     with pytest.raises(ValueError, match="outside the grid"):
         spec_from_facts({"r1": (5, 0)}, [{"name": "g", "action": "a", "cell": (0, 0)}], width=5, height=5)
     with pytest.raises(ValueError, match="used twice"):
-        spec_from_facts({"r-1": (0, 0), "r 1": (1, 1)}, [], width=2, height=2, user_actions=["a"])
+        spec_from_facts(
+            {"r-1": (0, 0), "r 1": (1, 1)}, [{"name": "g", "action": "a", "cell": (0, 0)}], width=2, height=2
+        )
 
 
 @pytest.mark.parametrize("name", ["done", "if", "Bernoulli", "sum", "det", "x__1", "1r", "r_", "a-b", "", "goto"])
 def test_keywords_and_bad_names_are_refused(name: str) -> None:
     assert not is_object_name(name)
     with pytest.raises(ValueError, match="valid RDDL object name"):
-        ProblemSpec(robots=(Robot(name, (0, 0)),), actions=(Action("a1"),), goals=(), width=1, height=1)
+        ProblemSpec(robots=(Robot(name, (0, 0)),), actions=(Action("a1"),), goals=_ONE_GOAL, width=1, height=1)
 
 
 @pytest.mark.parametrize(
@@ -160,7 +167,12 @@ def test_rddl_name_makes_valid_names(text: str, name: str) -> None:
 
 def test_names_must_be_distinct_across_types() -> None:
     with pytest.raises(ValueError, match="'x1' used twice"):
-        ProblemSpec(robots=(Robot("x1", (0, 0)),), actions=(Action("a1"),), goals=(), width=1, height=1)
+        ProblemSpec(robots=(Robot("x1", (0, 0)),), actions=(Action("a1"),), goals=_ONE_GOAL, width=1, height=1)
+
+
+def test_a_problem_needs_robots_actions_and_goals() -> None:
+    with pytest.raises(ValueError, match="no robots; no actions; no goals"):
+        ProblemSpec(robots=(), actions=(), goals=(), width=1, height=1)
 
 
 def test_write_problem_writes_the_domain_and_the_instance(tmp_path) -> None:  # type: ignore[no-untyped-def]

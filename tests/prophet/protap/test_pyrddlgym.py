@@ -87,7 +87,9 @@ def _mixed(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
     return greedy(model, state, rng) if rng.random() < 0.5 else random_policy(model, state, rng)
 
 
-def _episodes(env: Any, model: ProtapModel, episodes: int, seed: int) -> Iterator[tuple[State, JointAction, float, State]]:
+def _episodes(
+    env: Any, model: ProtapModel, episodes: int, seed: int
+) -> Iterator[tuple[State, JointAction, float, State]]:
     rng = random.Random(seed)
     for episode in range(episodes):
         obs, _ = env.reset(seed=seed + episode)
