@@ -16,7 +16,7 @@ from alica.prophet.protap.generate import (
     spec_from_facts,
     write_problem,
 )
-from alica.prophet.protap.model import NOOP, JointAction, ProtapModel, State
+from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
 from alica.prophet.protap.policies import Evaluation, Policy, evaluate, greedy, random_policy
 from alica.prophet.protap.spec import (
     MANIPULATION,
@@ -31,6 +31,7 @@ from alica.prophet.protap.spec import (
 )
 
 __all__ = [
+    "IDLE",
     "MANIPULATION",
     "NOOP",
     "USER_DEFINED",
@@ -43,6 +44,7 @@ __all__ = [
     "ProblemSpec",
     "ProtapModel",
     "Robot",
+    "RobotAction",
     "State",
     "appendix_c_spec",
     "domain_text",

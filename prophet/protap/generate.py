@@ -7,7 +7,7 @@ problem with its typos fixed). :func:`instance_text` writes the instance and
 :func:`write_problem` writes it next to the domain.
 
 >>> spec = random_spec(robots=2, width=5, height=5, goals=3, seed=0)
->>> "max-nondef-actions = 2;" in instance_text(spec)
+>>> "max-nondef-actions = 4;" in instance_text(spec)
 True
 """
 
@@ -75,7 +75,7 @@ def random_spec(
         discount: the discount factor.
 
     Returns:
-        The spec, its concurrency bound the number of robots.
+        The spec, its concurrency bound 2 x the number of robots.
 
     Raises:
         ValueError: for more goals than cells or an invalid spec.

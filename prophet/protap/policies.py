@@ -2,8 +2,8 @@
 
 A policy maps ``(model, state, rng)`` to a joint action. :func:`greedy` sends
 every robot to the nearest open goal no other robot takes and does the goal's
-action there; :func:`random_policy` picks each robot's action uniformly among
-those the domain allows. :func:`evaluate` runs episodes and returns the mean
+action there (a goto or a do per step, never both); :func:`random_policy`
+draws each robot's goto and do independently among those the domain allows. :func:`evaluate` runs episodes and returns the mean
 and standard deviation of the total (discounted) reward.
 
 >>> from alica.prophet.protap.generate import appendix_c_spec
@@ -20,7 +20,7 @@ import statistics
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from alica.prophet.protap.model import NOOP, JointAction, ProtapModel, State
+from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
 
 Policy = Callable[[ProtapModel, State, random.Random], JointAction]
 
@@ -32,7 +32,10 @@ def greedy(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
     pair first (ties: lower robot, then lower goal number), then the closest
     pair among the rest, and so on. A robot at its goal's cell does the goal's
     action, one elsewhere goes to the goal's cell, one without a goal waits.
-    ``rng`` is not used (the policy is deterministic).
+    It is the simple "go, then do" policy of the project's reference figures:
+    a robot that does at a goal does not set off to the next one in the same
+    step, though the domain would allow it. ``rng`` is not used (the policy
+    is deterministic).
     """
     spec = model.spec
     pairs = sorted(
@@ -41,7 +44,7 @@ def greedy(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
         for g, goal in enumerate(spec.goals)
         if not state.done >> g & 1
     )
-    joint = [NOOP] * len(spec.robots)
+    joint: list[RobotAction] = [IDLE] * len(spec.robots)
     busy: set[int] = set()
     taken: set[int] = set()
     for _, robot, g in pairs:
@@ -51,13 +54,19 @@ def greedy(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
         taken.add(g)
         goal = spec.goals[g]
         target = model.index(goal.cell)
-        joint[robot] = model.do(goal.action) if state.cells[robot] == target else 1 + target
+        joint[robot] = (NOOP, model.do(goal.action)) if state.cells[robot] == target else (1 + target, NOOP)
     return tuple(joint)
 
 
 def random_policy(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
-    """Each robot takes an action drawn uniformly from :meth:`ProtapModel.available` (no-op included)."""
-    return tuple(rng.choice(model.available(state, robot)) for robot in range(len(state.cells)))
+    """Each robot draws a goto and a do independently and uniformly, ``NOOP`` included.
+
+    The goto among :meth:`ProtapModel.goto_choices` (no goto or any other
+    cell), the do among :meth:`ProtapModel.do_choices` (no do or any action):
+    every pair of :meth:`ProtapModel.available` is equally likely.
+    """
+    dos = model.do_choices()
+    return tuple((rng.choice(model.goto_choices(state, robot)), rng.choice(dos)) for robot in range(len(state.cells)))
 
 
 @dataclass(frozen=True, slots=True)

@@ -130,7 +130,8 @@ class ProblemSpec:
         do_costs: ``DO_COST``, one row per robot, one column per action.
         goto_unit: ``GOTO_COST`` is this times the Euclidean distance, rounded
             to hundredths as in the paper.
-        max_nondef_actions: the concurrency bound (the number of robots).
+        max_nondef_actions: the concurrency bound, by default 2 x the number
+            of robots (each robot takes at most one goto and one do per step).
         horizon: the number of steps.
         discount: the discount factor.
         name: the instance name; the non-fluents block is ``nf_`` + name.
@@ -152,7 +153,7 @@ class ProblemSpec:
         if not self.do_costs:
             object.__setattr__(self, "do_costs", tuple(tuple(1.0 for _ in self.actions) for _ in self.robots))
         if self.max_nondef_actions == 0:
-            object.__setattr__(self, "max_nondef_actions", len(self.robots))
+            object.__setattr__(self, "max_nondef_actions", 2 * len(self.robots))
         problems = self.problems()
         if problems:
             raise ValueError("invalid ProTaP problem: " + "; ".join(problems))

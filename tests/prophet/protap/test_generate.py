@@ -71,11 +71,11 @@ def test_appendix_c_with_its_typos_fixed() -> None:
     }
     # r0 -> r1, r1 -> r2, x0 -> x1.
     assert facts.init == {("robotAt", ("r1", "x4", "y1")): "true", ("robotAt", ("r2", "x1", "y2")): "true"}
-    # max-nondef-actions (the paper misspelt it max-nondet-actions) is the number of robots.
+    # max-nondef-actions (the paper misspelt it max-nondet-actions, with the same 4) is 2 x the robots.
     assert facts.settings == {
         "domain": "multi_ros_robot_mdp",
         "non-fluents": "nf_multi_ros_robot_inst_mdp__1",
-        "max-nondef-actions": "2",
+        "max-nondef-actions": "4",
         "horizon": "10",
         "discount": "1.0",
     }
@@ -95,7 +95,7 @@ def test_random_spec_is_deterministic_for_a_seed() -> None:
 def test_random_spec_places_goals_on_distinct_cells() -> None:
     spec = random_spec(robots=3, width=3, height=3, goals=9, seed=1)
     assert sorted(goal.cell for goal in spec.goals) == [(x, y) for x in range(3) for y in range(3)]
-    assert spec.max_nondef_actions == 3
+    assert spec.max_nondef_actions == 6
     with pytest.raises(ValueError, match="distinct cells"):
         random_spec(robots=1, width=2, height=2, goals=5)
 
@@ -104,7 +104,7 @@ def test_instance_facts_of_a_random_spec() -> None:
     spec = random_spec(robots=3, width=4, height=2, goals=2, seed=7, prob_goto=0.75, horizon=12, discount=0.9)
     facts = read_facts(instance_text(spec))
     assert facts.objects["xPos"] == ["x1", "x2", "x3", "x4"] and facts.objects["yPos"] == ["y1", "y2"]
-    assert facts.settings["max-nondef-actions"] == "3"
+    assert facts.settings["max-nondef-actions"] == "6"
     assert facts.settings["horizon"] == "12" and facts.settings["discount"] == "0.9"
     assert {v for k, v in facts.non_fluents.items() if k[0] == "PROB_GOTO"} == {"0.75"}
     goals = {k[1] for k in facts.non_fluents if k[0] == "GOAL"}
@@ -136,7 +136,7 @@ def test_spec_from_world_model_facts() -> None:
     ]
     assert spec.actions == (Action("drill"), Action("report", USER_DEFINED), Action("wave", USER_DEFINED))
     assert spec.goals == (Goal("rock_7", "drill", (2, 3), 50.0), Goal("base", "report", (0, 4), 100.0))
-    assert spec.max_nondef_actions == 2
+    assert spec.max_nondef_actions == 4
     facts = read_facts(instance_text(spec))
     assert ("GOAL", ("rock_7", "drill", "x3", "y4")) in facts.non_fluents
 

@@ -52,7 +52,8 @@ def test_generated_specs_are_valid(made) -> None:  # type: ignore[no-untyped-def
     names = made.object_names()
     assert all(is_object_name(name) for name in names)
     assert len(set(names)) == len(names)
-    assert made.max_nondef_actions == len(made.robots)
+    assert made.max_nondef_actions == 2 * len(made.robots)
+    assert read_facts(instance_text(made)).settings["max-nondef-actions"] == str(2 * len(made.robots))
 
 
 @settings(max_examples=30, deadline=None)
@@ -78,7 +79,7 @@ def test_simulated_states_stay_on_the_grid(made, seed: int) -> None:  # type: ig
     state = sim.initial
     for _ in range(20):
         joint = random_policy(sim, state, rng)
-        assert sim.violations(state, sim.pairs(joint)) == []
+        assert sim.violations(state, sim.fluents(joint)) == []
         nxt, reward = sim.step(state, joint, rng)
         assert reward == pytest.approx(sim.reward(state, joint))
         assert all(0 <= cell < sim.n_cells for cell in nxt.cells)

@@ -18,6 +18,7 @@ import pytest
 from alica.prophet.protap import (
     NOOP,
     JointAction,
+    Policy,
     ProblemSpec,
     ProtapModel,
     State,
@@ -53,10 +54,10 @@ def _env(spec: ProblemSpec, folder: Path) -> Any:
         return pyRDDLGym.make(str(domain), str(instance), enforce_action_constraints=True)
 
 
-def _gym_action(model: ProtapModel, joint: JointAction) -> dict[str, bool]:
+def _gym_fluents(model: ProtapModel, fluents: list[tuple[int, int]]) -> dict[str, bool]:
     spec = model.spec
     action: dict[str, bool] = {}
-    for robot, code in model.pairs(joint):
+    for robot, code in fluents:
         name = spec.robots[robot].name
         if code <= model.n_cells:
             x, y = model.cell(code - 1)
@@ -64,6 +65,10 @@ def _gym_action(model: ProtapModel, joint: JointAction) -> dict[str, bool]:
         else:
             action[f"do___{name}__{spec.actions[code - model.n_cells - 1].name}"] = True
     return action
+
+
+def _gym_action(model: ProtapModel, joint: JointAction) -> dict[str, bool]:
+    return _gym_fluents(model, model.fluents(joint))
 
 
 def _state(model: ProtapModel, obs: dict[str, Any]) -> State:
@@ -82,9 +87,25 @@ def _state(model: ProtapModel, obs: dict[str, Any]) -> State:
     return State(tuple(cells), done)
 
 
+def _chained(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
+    """Greedy, but a robot that does at a goal also sets off to the nearest other open goal's cell."""
+    joint = list(greedy(model, state, rng))
+    for robot, (_, do) in enumerate(joint):
+        here = state.cells[robot]
+        targets = sorted(
+            (model.spec.goto_cost(model.cell(here), goal.cell), model.index(goal.cell))
+            for g, goal in enumerate(model.spec.goals)
+            if not model.is_done(state, g) and model.index(goal.cell) != here
+        )
+        if do and targets:
+            joint[robot] = (1 + targets[0][1], do)
+    return tuple(joint)
+
+
 def _mixed(model: ProtapModel, state: State, rng: random.Random) -> JointAction:
-    """Greedy half of the time (goals get done), random otherwise (every kind of action)."""
-    return greedy(model, state, rng) if rng.random() < 0.5 else random_policy(model, state, rng)
+    """Greedy, greedy that goes on while it does, or random (a goto and a do per robot): every kind of action."""
+    policy = rng.choice((greedy, _chained, random_policy))
+    return policy(model, state, rng)
 
 
 def _episodes(
@@ -115,7 +136,7 @@ def test_pyrddlgym_parses_grounds_and_simulates_every_generated_problem(name: st
     steps = list(_episodes(env, model, episodes=5, seed=1))
     assert len(steps) == 5 * spec.horizon
     for state, joint, _, after in steps:
-        assert model.violations(state, model.pairs(joint)) == []
+        assert model.violations(state, model.fluents(joint)) == []
         assert after.done & state.done == state.done  # goals stay done
 
 
@@ -126,17 +147,31 @@ def test_simulator_agrees_with_pyrddlgym_step_by_step(name: str, tmp_path: Path)
     model = ProtapModel(spec)
     count = 0
     done_steps = 0
+    go_on_steps = 0
     for state, joint, reward, after in _episodes(env, model, episodes=800 // spec.horizon, seed=2):
         mine, my_reward = model.step(state, joint, random.Random(0))
-        assert mine == after, (state, [model.describe(r, c) for r, c in enumerate(joint)])
+        assert mine == after, (state, [model.describe_action(r, a) for r, a in enumerate(joint)])
         assert my_reward == pytest.approx(reward, abs=1e-9)
         count += 1
         done_steps += mine.done != state.done
+        # A robot completes a goal at its start cell and moves on in the same step.
+        go_on_steps += any(
+            goto
+            and do
+            and not model.is_done(state, g)
+            and model.index(goal.cell) == state.cells[r]
+            and model.do(goal.action) == do
+            for r, (goto, do) in enumerate(joint)
+            for g, goal in enumerate(spec.goals)
+        )
     assert count >= 790
     assert done_steps > 0  # the runs complete goals, not only move
+    if len(spec.goals) > 1:
+        assert go_on_steps > 0  # ... also with a goto and a do of one robot in one step
 
 
-def test_the_stochastic_gotos_agree_in_distribution(tmp_path: Path) -> None:
+@pytest.mark.parametrize("policy", [greedy, _chained], ids=["greedy", "do-and-go-on"])
+def test_the_stochastic_gotos_agree_in_distribution(policy: Policy, tmp_path: Path) -> None:
     spec = appendix_c_spec()
     env = _env(spec, tmp_path)
     model = ProtapModel(spec)
@@ -146,10 +181,10 @@ def test_the_stochastic_gotos_agree_in_distribution(tmp_path: Path) -> None:
         obs, _ = env.reset(seed=episode)
         total = 0.0
         for _ in range(spec.horizon):
-            obs, reward, *_ = env.step(_gym_action(model, greedy(model, _state(model, obs), rng)))
+            obs, reward, *_ = env.step(_gym_action(model, policy(model, _state(model, obs), rng)))
             total += float(reward)
         totals.append(total)
-    mine = evaluate(model, greedy, episodes=3000, seed=0)
+    mine = evaluate(model, policy, episodes=3000, seed=0)
     error = (statistics.variance(totals) / len(totals) + mine.std**2 / 3000) ** 0.5
     assert abs(statistics.fmean(totals) - mine.mean) < 4 * error
 
@@ -160,20 +195,65 @@ def test_pyrddlgym_refuses_what_the_limits_checker_reports(tmp_path: Path) -> No
     model = ProtapModel(spec)
     state = model.initial
     broken = [
-        [(0, model.goto((3, 1))), (0, model.do("a1"))],  # two actions of one robot
         [(0, model.goto((3, 1))), (0, model.goto((2, 1)))],  # two gotos of one robot
+        [(1, model.do("a1")), (1, model.do("a3"))],  # two dos of one robot
         [(1, model.goto((0, 1)))],  # goto to the robot's own cell
     ]
-    for pairs in broken:
-        assert model.violations(state, pairs)
-        joint = [NOOP, NOOP]
-        action: dict[str, bool] = {}
-        for robot, code in pairs:
-            joint[robot] = code
-            action.update(_gym_action(model, tuple(joint)))
+    for fluents in broken:
+        assert model.violations(state, fluents)
         env.reset(seed=0)
         with pytest.raises(ValueError, match="not satisfied"):
-            env.step(action)
+            env.step(_gym_fluents(model, fluents))
+    # A goto and a do of one robot, for both robots (4 = max-nondef-actions): allowed.
+    allowed = [(0, model.goto((3, 1))), (0, model.do("a2")), (1, model.goto((0, 0))), (1, model.do("a3"))]
+    assert model.violations(state, allowed) == []
+    env.reset(seed=0)
+    env.step(_gym_fluents(model, allowed))
+
+
+def _random_fluents(model: ProtapModel, state: State, rng: random.Random) -> list[tuple[int, int]]:
+    """0 to 2 gotos (now and then to the robot's own cell) and 0 to 2 dos per robot."""
+    fluents = []
+    for robot in range(len(state.cells)):
+        for _ in range(rng.choice((0, 1, 1, 2))):
+            cell = state.cells[robot] if rng.random() < 0.15 else rng.randrange(model.n_cells)
+            fluents.append((robot, 1 + cell))
+        fluents.extend((robot, rng.choice(model.do_choices()[1:])) for _ in range(rng.choice((0, 1, 1, 2))))
+    return fluents
+
+
+@pytest.mark.parametrize("bound", [None, 3])
+def test_pyrddlgym_refuses_exactly_what_the_limits_checker_reports(bound: int | None, tmp_path: Path) -> None:
+    spec = _deterministic(appendix_c_spec())
+    if bound is not None:
+        spec = dataclasses.replace(spec, max_nondef_actions=bound)
+    env = _env(spec, tmp_path)
+    model = ProtapModel(spec)
+    rng = random.Random(7)
+    refused = allowed = 0
+    for _ in range(300):
+        obs, _ = env.reset(seed=0)
+        for _ in range(rng.randrange(3)):  # from later states too (greedy stays within a bound of 2 or more)
+            obs, *_ = env.step(_gym_action(model, greedy(model, _state(model, obs), rng)))
+        state = _state(model, obs)
+        fluents = _random_fluents(model, state, rng)
+        reported = model.violations(state, fluents)
+        try:
+            obs, reward, *_ = env.step(_gym_fluents(model, fluents))
+        except ValueError:
+            assert reported, [model.describe(r, c) for r, c in fluents]
+            refused += 1
+            continue
+        assert not reported, reported
+        allowed += 1
+        # What pyRDDLGym takes is a joint action of the simulator, with the same outcome.
+        joint = [[NOOP, NOOP] for _ in spec.robots]
+        for robot, code in fluents:
+            joint[robot][0 if model.is_goto(code) else 1] = code
+        mine, my_reward = model.step(state, tuple((goto, do) for goto, do in joint), random.Random(0))
+        assert mine == _state(model, obs)
+        assert my_reward == pytest.approx(float(reward), abs=1e-9)
+    assert refused > 50 and allowed > 50
 
 
 def test_pyrddlgym_rejects_a_robot_in_no_cell(tmp_path: Path) -> None:
