@@ -1,4 +1,4 @@
-"""ProTaP: the paper's RDDL domain (fixed), problem generation (Algorithm 2) and a fast simulator.
+"""ProTaP: the paper's RDDL domain (fixed), problem generation (Algorithm 2), a fast simulator and a planner.
 
 >>> spec = random_spec(robots=2, width=5, height=5, goals=3, seed=0)
 >>> model = ProtapModel(spec)
@@ -16,7 +16,9 @@ from alica.prophet.protap.generate import (
     spec_from_facts,
     write_problem,
 )
+from alica.prophet.protap.heuristic import Determinisation
 from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
+from alica.prophet.protap.planner import Budget, PlannerPolicy, ProtapPlanner
 from alica.prophet.protap.policies import Evaluation, Policy, evaluate, greedy, random_policy
 from alica.prophet.protap.spec import (
     MANIPULATION,
@@ -36,13 +38,17 @@ __all__ = [
     "NOOP",
     "USER_DEFINED",
     "Action",
+    "Budget",
     "Cell",
+    "Determinisation",
     "Evaluation",
     "Goal",
     "JointAction",
+    "PlannerPolicy",
     "Policy",
     "ProblemSpec",
     "ProtapModel",
+    "ProtapPlanner",
     "Robot",
     "RobotAction",
     "State",

@@ -55,6 +55,14 @@ class Determinisation:
             self._done_by[cell][code - self._offset] |= 1 << g
         cells = [model.cell(index) for index in range(model.n_cells)]
         self._dist = [[spec.goto_cost(a, b) for b in cells] for a in cells]
+        # matching keys: the distance in hundredths, then the robot, then the goal, packed in one int
+        self._goal_bits = max(1, len(spec.goals).bit_length())
+        self._robot_bits = max(1, self._robots.bit_length())
+        shift = self._goal_bits + self._robot_bits
+        self._keys = [
+            [round(self._dist[cell][goal_cell] * 100) << shift | g for g, goal_cell in enumerate(self._goal_cell)]
+            for cell in range(model.n_cells)
+        ]
         self._values: dict[tuple[State, int], float] = {}
 
     def open_goals(self, state: State) -> int:
@@ -127,28 +135,33 @@ class Determinisation:
         targets = open_ & ~claimed
         free = [robot for robot in range(self._robots) if 2 * robot >= k]
         if targets and free:
-            pairs = []
-            g = 0
-            rest = targets
-            while rest:
-                if rest & 1:
-                    goal_cell = self._goal_cell[g]
-                    pairs.extend((self._dist[cells[robot]][goal_cell], robot, g) for robot in free)
-                rest >>= 1
-                g += 1
+            goal_bits = self._goal_bits
+            goal_mask = (1 << goal_bits) - 1
+            robot_mask = (1 << self._robot_bits) - 1
+            goals = [g for g in range(targets.bit_length()) if targets >> g & 1]
+            pairs: list[int] = []
+            for robot in free:
+                keys = self._keys[cells[robot]]
+                tag = robot << goal_bits
+                pairs.extend(keys[g] | tag for g in goals)
             pairs.sort()
-            busy: set[int] = set()
+            assigned = 0
+            wanted = min(len(free), len(goals))
+            busy = 0
             taken = 0
-            for _, robot, g in pairs:
-                if robot in busy or taken >> g & 1:
+            for key in pairs:
+                g = key & goal_mask
+                robot = key >> goal_bits & robot_mask
+                if busy >> robot & 1 or taken >> g & 1:
                     continue
-                busy.add(robot)
+                busy |= 1 << robot
                 taken |= 1 << g
                 goal_cell = self._goal_cell[g]
                 if goal_cell != cells[robot] and used < bound:
                     joint[robot][0] = goal_cell + 1
                     used += 1
-                if len(busy) == len(free):
+                assigned += 1
+                if assigned == wanted:
                     break
         return tuple((goto, do) for goto, do in joint)
 
@@ -211,4 +224,3 @@ class Determinisation:
     def clear(self) -> None:
         """Forget the cached values."""
         self._values.clear()
-

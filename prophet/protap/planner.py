@@ -26,8 +26,8 @@ trial with the best of these values. The trial's return is backed up
 
 :meth:`ProtapPlanner.plan_step` is anytime: it runs trials until its
 :class:`Budget` (trials or seconds) is spent and returns the joint action of
-the best choices, completed by the heuristic where the tree stops; with no
-trial at all, the heuristic's joint action.
+the most visited choices (ties: the higher value), completed by the heuristic
+where the tree stops; with no trial at all, the heuristic's joint action.
 
 >>> import random
 >>> from alica.prophet.protap.generate import appendix_c_spec
@@ -107,7 +107,7 @@ class ProtapPlanner:
         self,
         model: ProtapModel,
         *,
-        exploration: float = 0.05,
+        exploration: float = 0.1,
         virtual_visits: float = 5.0,
         max_nodes: int = 200_000,
     ) -> None:
@@ -250,7 +250,7 @@ class ProtapPlanner:
             if node is None:
                 break
             q, n = node.q, node.n
-            index = max(range(len(q)), key=lambda i: (q[i], n[i], -i))
+            index = max(range(len(q)), key=lambda i: (n[i], q[i], -i))
             prefix.append(node.choices[index])
             node = node.sub[index]
         return self.heuristic.complete(state, tuple(prefix))
