@@ -266,7 +266,8 @@ class ProtapPlanner:
 
         Args:
             state: the observed state.
-            budget: trials and/or seconds; a zero budget returns the heuristic's joint action.
+            budget: trials and/or seconds; a zero budget returns the heuristic's joint
+                action, and so does a state with every goal done (no search needed).
             rng: the source of the sampled outcomes (the only randomness).
             steps_to_go: the steps left in the episode, this one included (default: the horizon).
 
@@ -275,8 +276,9 @@ class ProtapPlanner:
         """
         horizon = self.model.spec.horizon
         steps = horizon if steps_to_go is None else steps_to_go
-        if steps <= 0:
-            return self.heuristic.complete(state)
+        if steps <= 0 or not self.heuristic.open_goals(state):
+            self.last_trials = 0
+            return self.heuristic.complete(state)  # nothing left to decide: every slot is NOOP
         if steps == horizon or len(self._tree) > self.max_nodes:
             self.reset()
         deadline = None if budget.seconds is None else time.perf_counter() + budget.seconds

@@ -61,7 +61,7 @@ def test_every_returned_action_is_allowed(spec: ProblemSpec, trials: int, seed: 
     for steps in range(spec.horizon, 0, -1):
         joint = search.plan_step(state, Budget(trials=trials), rng, steps)
         _assert_allowed(model, state, joint)
-        assert search.last_trials == trials
+        assert search.last_trials == (trials if search.heuristic.open_goals(state) else 0)
         state = model.step(state, joint, rng)[0]
 
 
