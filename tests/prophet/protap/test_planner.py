@@ -92,6 +92,19 @@ def test_every_choice_of_the_tree_is_allowed(spec: ProblemSpec, seed: int) -> No
         state = model.step(state, pairs, rng)[0]
 
 
+def test_a_tight_bound_limits_the_choices_and_still_completes_goals() -> None:
+    spec = dataclasses.replace(random_spec(robots=3, width=5, height=5, goals=3, seed=4), max_nondef_actions=2)
+    model = ProtapModel(spec)
+    search = ProtapPlanner(model)
+    rng = random.Random(1)
+    state = model.initial
+    for steps in range(spec.horizon, 0, -1):
+        joint = search.plan_step(state, Budget(trials=200), rng, steps)
+        _assert_allowed(model, state, joint)
+        state = model.step(state, joint, rng)[0]
+    assert state.done == 0b111
+
+
 def _episodes(model: ProtapModel, trials: int, seed: int) -> list[tuple[tuple[int, int], ...]]:
     policy = PlannerPolicy(ProtapPlanner(model), Budget(trials=trials))
     rng = random.Random(seed)
