@@ -5,12 +5,13 @@ goals), (b) 4 robots on 8x8 with 6 goals and (c) 8 robots on 12x12 with 12
 goals (both placed by ``random_spec`` with ``--seed``). Every policy runs the
 same ``--episodes`` episodes (one seeded ``random.Random`` each, as
 :func:`evaluate` does); the planner replans every step from the observed
-state with ``--time-per-step`` seconds (a state with every goal done needs no
-search; its time and trials per step are over the steps that searched).
-Constraint breaks count the limits
-:meth:`ProtapModel.violations` reports over every joint action chosen (must
-be 0). The second table gives the planner's reward on (a) and (b) as the
-time per step grows.
+state with ``--time-per-step`` seconds, its search drawing from a random
+source of its own, so that the episodes' draws go to the outcomes alone. A
+state with every goal done needs no search; the planner's time and trials
+per step are over the steps that searched. Constraint breaks count the
+limits :meth:`ProtapModel.violations` reports over every joint action chosen
+(must be 0). The second table gives the planner's reward on (a) and (b) as
+the time per step grows.
 
 Run: ``.venv/bin/python bench/protap.py [--episodes 20] [--time-per-step 0.5] [--seed 0] [--quick]``
 (``--quick``: 3 episodes, 0.1 s per step, two budgets in the second table.)
@@ -75,9 +76,9 @@ def _instances(seed: int) -> dict[str, ProblemSpec]:
     }
 
 
-def _planner_policy(model: ProtapModel, seconds: float) -> _Recorder:
+def _planner_policy(model: ProtapModel, seconds: float, seed: int) -> _Recorder:
     planner = ProtapPlanner(model)
-    return _Recorder(PlannerPolicy(planner, Budget(seconds=seconds)), planner)
+    return _Recorder(PlannerPolicy(planner, Budget(seconds=seconds), rng=random.Random(seed)), planner)
 
 
 def main() -> None:
@@ -100,7 +101,7 @@ def main() -> None:
     for name, spec in instances.items():
         model = ProtapModel(spec)
         runs = {
-            "planner": _planner_policy(model, per_step),
+            "planner": _planner_policy(model, per_step, args.seed),
             "greedy": _Recorder(greedy),
             "random": _Recorder(random_policy),
         }
@@ -120,7 +121,7 @@ def main() -> None:
         model = ProtapModel(spec)
         cells = []
         for seconds in budgets:
-            recorder = _planner_policy(model, seconds)
+            recorder = _planner_policy(model, seconds, args.seed)
             result = evaluate(model, recorder, episodes=episodes, seed=args.seed)
             trials = statistics.median(recorder.trials) if recorder.trials else 0
             cells.append(f"{result.mean:.1f} +- {result.std:.1f} ({trials:,.0f} trials)")

@@ -266,7 +266,9 @@ class ProtapPlanner:
 
         Args:
             state: the observed state.
-            budget: trials and/or seconds; a zero budget returns the heuristic's joint
+            budget: trials and/or seconds (a trial starts only when the time left
+                exceeds the longest trial of the call so far, so the call
+                overruns its seconds little); a zero budget returns the heuristic's joint
                 action, and so does a state with every goal done (no search needed).
             rng: the source of the sampled outcomes (the only randomness).
             steps_to_go: the steps left in the episode, this one included (default: the horizon).
@@ -281,12 +283,18 @@ class ProtapPlanner:
             return self.heuristic.complete(state)  # nothing left to decide: every slot is NOOP
         if steps == horizon or len(self._tree) > self.max_nodes:
             self.reset()
-        deadline = None if budget.seconds is None else time.perf_counter() + budget.seconds
+        clock = time.perf_counter
+        deadline = None if budget.seconds is None else clock() + budget.seconds
         limit = budget.trials
         trials = 0
-        while (limit is None or trials < limit) and (deadline is None or time.perf_counter() < deadline):
+        longest = 0.0  # the longest trial of this call: one starts only if it fits in the time left
+        while limit is None or trials < limit:
+            start = clock()
+            if deadline is not None and start + longest >= deadline:
+                break
             self._trial(state, steps, rng)
             trials += 1
+            longest = max(longest, clock() - start)
         self.last_trials = trials
         return self._best(state, steps)
 
@@ -303,12 +311,23 @@ class PlannerPolicy:
         planner: the planner.
         budget: the search budget of every step.
         horizon: the steps per episode (default: the spec's horizon).
+        rng: the source of the search's sampled outcomes; by default the
+            ``rng`` of each call (the episode's). A separate seeded one leaves
+            the episode's draws to the outcomes, so episodes of different
+            budgets and policies meet the same goto failures.
     """
 
-    def __init__(self, planner: ProtapPlanner, budget: Budget, horizon: int | None = None) -> None:
+    def __init__(
+        self,
+        planner: ProtapPlanner,
+        budget: Budget,
+        horizon: int | None = None,
+        rng: random.Random | None = None,
+    ) -> None:
         self.planner = planner
         self.budget = budget
         self.horizon = planner.model.spec.horizon if horizon is None else horizon
+        self.rng = rng
         self._step = 0
 
     def reset(self) -> None:
@@ -319,4 +338,4 @@ class PlannerPolicy:
         """The planner's joint action for ``state`` (``model`` must be the planner's)."""
         steps = self.horizon - self._step % self.horizon
         self._step += 1
-        return self.planner.plan_step(state, self.budget, rng, steps)
+        return self.planner.plan_step(state, self.budget, rng if self.rng is None else self.rng, steps)
