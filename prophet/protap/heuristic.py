@@ -73,6 +73,10 @@ class Determinisation:
         """The bit mask of the goals that ``do`` (a do code, not ``NOOP``) of ``robot`` completes in ``state``."""
         return self._done_by[state.cells[robot]][do - self._offset] & ~state.done
 
+    def distance(self, start: int, target: int) -> float:
+        """``GOTO_COST`` between two cell indices."""
+        return self._dist[start][target]
+
     def goals_at(self, cell: int) -> int:
         """The bit mask of the goals at a cell index."""
         return self._cell_goals[cell]

@@ -96,6 +96,9 @@ class ProtapPlanner:
         exploration: the UCB1 constant, relative to the size of the node's best value.
         virtual_visits: how many visits the heuristic value of a new choice counts for.
         max_nodes: the tree is cleared when it holds more state nodes than this.
+        max_targets: a goto slot offers the gotos to at most this many open
+            goal cells, the nearest (and the heuristic's choice besides);
+            ``None``: all. It keeps large teams' nodes small.
 
     Attributes:
         model: the simulator.
@@ -110,12 +113,14 @@ class ProtapPlanner:
         exploration: float = 0.1,
         virtual_visits: float = 5.0,
         max_nodes: int = 200_000,
+        max_targets: int | None = 8,
     ) -> None:
         self.model = model
         self.heuristic = Determinisation(model)
         self.exploration = exploration
         self.virtual_visits = virtual_visits
         self.max_nodes = max_nodes
+        self.max_targets = max_targets
         self.last_trials = 0
         self._slots = 2 * len(model.spec.robots)
         self._goal_do = [model.do(goal.action) for goal in model.spec.goals]
@@ -129,7 +134,7 @@ class ProtapPlanner:
         self.heuristic.clear()
 
     # -- the factored decisions ----------------------------------------------
-    def choices(self, state: State, slot: int, used: int, doing: int) -> tuple[int, ...]:
+    def choices(self, state: State, slot: int, used: int, doing: int, prefix: tuple[int, ...] = ()) -> tuple[int, ...]:
         """The codes slot ``slot`` may take in ``state``, ``NOOP`` first.
 
         Args:
@@ -137,11 +142,13 @@ class ProtapPlanner:
             slot: ``2 * robot`` for the robot's goto, ``2 * robot + 1`` for its do.
             used: how many fluents the earlier slots of the step set true.
             doing: the bit mask of the goals the earlier slots' dos complete.
+            prefix: the codes of the earlier slots (only read with ``max_targets``).
 
         Returns:
             Only ``NOOP`` once ``max-nondef-actions`` fluents are used; else
             ``NOOP`` and a goto to each cell of an open goal but the robot's
-            own, or ``NOOP`` and each do that completes an open goal at the
+            own (with ``max_targets``: the nearest ones, and the heuristic's
+            target), or ``NOOP`` and each do that completes an open goal at the
             robot's cell that no earlier do completes.
         """
         if used >= self.heuristic.bound:
@@ -151,7 +158,16 @@ class ProtapPlanner:
         here = state.cells[robot]
         open_ = det.open_goals(state) & ~doing
         if slot & 1 == 0:
-            return (NOOP, *(cell + 1 for cell in det.goal_cells(open_) if cell != here))
+            targets = [cell for cell in det.goal_cells(open_) if cell != here]
+            limit = self.max_targets
+            if limit is not None and len(targets) > limit:
+                targets.sort(key=lambda cell: (det.distance(here, cell), cell))
+                kept = targets[:limit]
+                default = det.complete(state, prefix)[robot][0] - 1
+                if default >= 0 and default not in kept:
+                    kept.append(default)
+                targets = kept
+            return (NOOP, *(cell + 1 for cell in targets))
         return self._do_codes(open_ & det.goals_at(here))
 
     def _do_codes(self, goals: int) -> tuple[int, ...]:
@@ -215,7 +231,7 @@ class ProtapPlanner:
             parent: _Node = node
             for slot in range(slots):
                 if node is None:
-                    choices = self.choices(state, slot, used, doing)
+                    choices = self.choices(state, slot, used, doing, tuple(prefix))
                     node = self._expand(state, steps, tuple(prefix), choices)
                     parent.sub[chain[-1][1]] = node
                 index = self._select(node)

@@ -52,10 +52,10 @@ def _assert_allowed(model: ProtapModel, state: State, joint: tuple[tuple[int, in
 
 
 @settings(max_examples=40, deadline=None)
-@given(_small_specs(), st.sampled_from([0, 1, 3, 20, 60]), st.integers(0, 1000))
-def test_every_returned_action_is_allowed(spec: ProblemSpec, trials: int, seed: int) -> None:
+@given(_small_specs(), st.sampled_from([0, 1, 3, 20, 60]), st.integers(0, 1000), st.sampled_from([None, 1, 2]))
+def test_every_returned_action_is_allowed(spec: ProblemSpec, trials: int, seed: int, targets: int | None) -> None:
     model = ProtapModel(spec)
-    search = ProtapPlanner(model)
+    search = ProtapPlanner(model, max_targets=targets)
     rng = random.Random(seed)
     state = model.initial
     for steps in range(spec.horizon, 0, -1):
@@ -66,11 +66,11 @@ def test_every_returned_action_is_allowed(spec: ProblemSpec, trials: int, seed: 
 
 
 @settings(max_examples=25, deadline=None)
-@given(_small_specs(), st.integers(0, 1000))
-def test_every_choice_of_the_tree_is_allowed(spec: ProblemSpec, seed: int) -> None:
+@given(_small_specs(), st.integers(0, 1000), st.sampled_from([None, 1]))
+def test_every_choice_of_the_tree_is_allowed(spec: ProblemSpec, seed: int, targets: int | None) -> None:
     """Not only the returned actions: every joint action a trial builds is allowed (checked via the choices)."""
     model = ProtapModel(spec)
-    search = ProtapPlanner(model)
+    search = ProtapPlanner(model, max_targets=targets)
     rng = random.Random(seed)
     state = model.initial
     for _ in range(3):
@@ -78,7 +78,7 @@ def test_every_choice_of_the_tree_is_allowed(spec: ProblemSpec, seed: int) -> No
         doing = 0
         joint: list[int] = []
         for slot in range(2 * len(spec.robots)):
-            choices = search.choices(state, slot, used, doing)
+            choices = search.choices(state, slot, used, doing, tuple(joint))
             assert choices[0] == 0
             code = rng.choice(choices)
             joint.append(code)
