@@ -1,0 +1,357 @@
+"""The built-in anytime planner for ProTaP: UCT over factored joint actions, initialised from a determinisation.
+
+The search is a THTS-style UCT (Keller and Helmert) whose tree never lists
+joint actions. A step of the tree is a chain of decision nodes, one per
+*slot*: robot 0's goto, robot 0's do, robot 1's goto, ... Each slot offers
+only a few choices (:meth:`ProtapPlanner.choices`): no goto or a goto to the
+cell of an open goal (another cell is never better: a goto reaches any cell in
+one step at the Euclidean distance), no do or a do that completes an open goal
+at the robot's cell (another do changes nothing and costs). Once
+``max-nondef-actions`` fluents are chosen, every later slot offers only
+``NOOP``. So every joint action of the tree is allowed by construction, and a
+step costs ``2 x robots`` small decisions instead of one among
+``(cells x actions) ^ robots``.
+
+A trial walks down from the root state: in each slot it picks a choice by
+UCB1, then samples the outcome of the joint action with the model's
+probabilities, and goes on in the next state (the number of steps to go is
+part of a state's key, so the values are finite-horizon) until it meets a
+state it has not seen, or the horizon. A new decision node values each of its
+choices by completing the joint action with the "do, then go" policy and
+adding the value of the most likely next state in the determinisation
+(:class:`~alica.prophet.protap.heuristic.Determinisation`), counted as
+``virtual_visits`` visits (PROST's IDS initialisation); a new state ends the
+trial with the best of these values. The trial's return is backed up
+(Monte-Carlo averages) along every slot of every step it took.
+
+:meth:`ProtapPlanner.plan_step` is anytime: it runs trials until its
+:class:`Budget` (trials or seconds) is spent and returns the joint action of
+the most visited choices (ties: the higher value), completed by the heuristic
+where the tree stops; with no trial at all, the heuristic's joint action.
+
+>>> import random
+>>> from alica.prophet.protap.generate import appendix_c_spec
+>>> from alica.prophet.protap.policies import evaluate
+>>> model = ProtapModel(appendix_c_spec())
+>>> planner = ProtapPlanner(model)
+>>> joint = planner.plan_step(model.initial, Budget(trials=200), random.Random(0))
+>>> model.violations(model.initial, model.fluents(joint))
+[]
+>>> evaluate(model, PlannerPolicy(planner, Budget(trials=100)), episodes=2, seed=0).mean > 2000
+True
+"""
+
+from __future__ import annotations
+
+import math
+import random
+import time
+from dataclasses import dataclass
+
+from alica.prophet.protap.heuristic import Determinisation
+from alica.prophet.protap.model import NOOP, JointAction, ProtapModel, State
+
+
+@dataclass(frozen=True, slots=True)
+class Budget:
+    """How long :meth:`ProtapPlanner.plan_step` searches: a number of trials, wall-clock seconds, or both.
+
+    The search stops at whichever limit comes first. A trial budget makes the
+    planner deterministic for a seed (tests use it); a time budget suits a
+    robot team (the bench uses it).
+
+    Attributes:
+        trials: the most trials (``None``: no limit).
+        seconds: the most wall-clock seconds (``None``: no limit).
+    """
+
+    trials: int | None = None
+    seconds: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.trials is None and self.seconds is None:
+            raise ValueError("a budget needs trials or seconds")
+        if (self.trials is not None and self.trials < 0) or (self.seconds is not None and self.seconds < 0):
+            raise ValueError("a budget is not negative")
+
+
+class _Node:
+    """A decision node: the choices of one slot with their visit counts and mean returns."""
+
+    __slots__ = ("choices", "n", "q", "sub", "total")
+
+    def __init__(self, choices: tuple[int, ...], values: list[float], visits: float) -> None:
+        self.choices = choices
+        self.q = values
+        self.n = [visits] * len(choices)
+        self.total = visits * len(choices)
+        self.sub: list[_Node | None] = [None] * len(choices)
+
+
+class ProtapPlanner:
+    """An anytime UCT planner for one ProTaP model, over factored joint actions.
+
+    Args:
+        model: the simulator (its spec's horizon and ``max-nondef-actions`` are used).
+        exploration: the UCB1 constant, relative to the size of the node's best value.
+        virtual_visits: how many visits the heuristic value of a new choice counts for.
+        max_nodes: the tree is cleared when it holds more state nodes than this.
+        max_targets: a goto slot offers the gotos to at most this many open
+            goal cells, the nearest (and the heuristic's choice besides);
+            ``None``: all. It keeps large teams' nodes small.
+
+    Attributes:
+        model: the simulator.
+        heuristic: the determinisation that values new nodes.
+        last_trials: the number of trials of the last :meth:`plan_step`.
+    """
+
+    def __init__(
+        self,
+        model: ProtapModel,
+        *,
+        exploration: float = 0.1,
+        virtual_visits: float = 5.0,
+        max_nodes: int = 200_000,
+        max_targets: int | None = 8,
+    ) -> None:
+        self.model = model
+        self.heuristic = Determinisation(model)
+        self.exploration = exploration
+        self.virtual_visits = virtual_visits
+        self.max_nodes = max_nodes
+        self.max_targets = max_targets
+        self.last_trials = 0
+        self._slots = 2 * len(model.spec.robots)
+        self._goal_do = [model.do(goal.action) for goal in model.spec.goals]
+        self._tree: dict[tuple[State, int], _Node] = {}
+        self._joint_values: dict[tuple[State, int, JointAction], float] = {}
+
+    def reset(self) -> None:
+        """Forget the search tree and the cached values (a new episode, say)."""
+        self._tree.clear()
+        self._joint_values.clear()
+        self.heuristic.clear()
+
+    # -- the factored decisions ----------------------------------------------
+    def choices(self, state: State, slot: int, used: int, doing: int, prefix: tuple[int, ...] = ()) -> tuple[int, ...]:
+        """The codes slot ``slot`` may take in ``state``, ``NOOP`` first.
+
+        Args:
+            state: the state of the step.
+            slot: ``2 * robot`` for the robot's goto, ``2 * robot + 1`` for its do.
+            used: how many fluents the earlier slots of the step set true.
+            doing: the bit mask of the goals the earlier slots' dos complete.
+            prefix: the codes of the earlier slots (only read with ``max_targets``).
+
+        Returns:
+            Only ``NOOP`` once ``max-nondef-actions`` fluents are used; else
+            ``NOOP`` and a goto to each cell of an open goal but the robot's
+            own (with ``max_targets``: the nearest ones, and the heuristic's
+            target), or ``NOOP`` and each do that completes an open goal at the
+            robot's cell that no earlier do completes.
+        """
+        if used >= self.heuristic.bound:
+            return (NOOP,)
+        det = self.heuristic
+        robot = slot >> 1
+        here = state.cells[robot]
+        open_ = det.open_goals(state) & ~doing
+        if slot & 1 == 0:
+            targets = [cell for cell in det.goal_cells(open_) if cell != here]
+            limit = self.max_targets
+            if limit is not None and len(targets) > limit:
+                targets.sort(key=lambda cell: (det.distance(here, cell), cell))
+                kept = targets[:limit]
+                default = det.complete(state, prefix)[robot][0] - 1
+                if default >= 0 and default not in kept:
+                    kept.append(default)
+                targets = kept
+            return (NOOP, *(cell + 1 for cell in targets))
+        return self._do_codes(open_ & det.goals_at(here))
+
+    def _do_codes(self, goals: int) -> tuple[int, ...]:
+        codes = [NOOP]
+        g = 0
+        while goals:
+            if goals & 1:
+                code = self._goal_do[g]
+                if code not in codes:
+                    codes.append(code)
+            goals >>= 1
+            g += 1
+        return tuple(codes)
+
+    def _expand(self, state: State, steps: int, prefix: tuple[int, ...], choices: tuple[int, ...]) -> _Node:
+        values = []
+        cache = self._joint_values
+        for code in choices:
+            joint = self.heuristic.complete(state, (*prefix, code))
+            key = (state, steps, joint)
+            value = cache.get(key)
+            if value is None:
+                value = self.heuristic.action_value(state, steps, joint)
+                cache[key] = value
+            values.append(value)
+        return _Node(choices, values, self.virtual_visits)
+
+    def _select(self, node: _Node) -> int:
+        choices = node.choices
+        if len(choices) == 1:
+            return 0
+        q, n = node.q, node.n
+        scale = self.exploration * max(1.0, abs(max(q)))
+        log_total = math.log(node.total)
+        best, best_score = 0, -math.inf
+        for i in range(len(choices)):
+            score = q[i] + scale * math.sqrt(log_total / n[i])
+            if score > best_score:
+                best, best_score = i, score
+        return best
+
+    # -- trials ----------------------------------------------------------------
+    def _trial(self, state: State, steps: int, rng: random.Random) -> None:
+        tree = self._tree
+        det = self.heuristic
+        model = self.model
+        slots = self._slots
+        path: list[tuple[list[tuple[_Node, int]], float]] = []
+        leaf = 0.0
+        while steps > 0:
+            node: _Node | None = tree.get((state, steps))
+            if node is None:
+                root = self._expand(state, steps, (), self.choices(state, 0, 0, 0))
+                tree[(state, steps)] = root
+                leaf = max(root.q)
+                break
+            chain: list[tuple[_Node, int]] = []
+            prefix: list[int] = []
+            used = 0
+            doing = 0
+            parent: _Node = node
+            for slot in range(slots):
+                if node is None:
+                    choices = self.choices(state, slot, used, doing, tuple(prefix))
+                    node = self._expand(state, steps, tuple(prefix), choices)
+                    parent.sub[chain[-1][1]] = node
+                index = self._select(node)
+                chain.append((node, index))
+                code = node.choices[index]
+                prefix.append(code)
+                if code:
+                    used += 1
+                    if slot & 1:
+                        doing |= det.completes(state, slot >> 1, code)
+                parent = node
+                node = node.sub[index]
+            joint = tuple(zip(prefix[0::2], prefix[1::2], strict=True))
+            next_state, reward = model.step(state, joint, rng)
+            path.append((chain, reward))
+            state = next_state
+            steps -= 1
+        discount = model.spec.discount
+        value = leaf
+        for chain, reward in reversed(path):
+            value = reward + discount * value
+            for node_, index in chain:
+                node_.total += 1
+                count = node_.n[index] + 1
+                node_.n[index] = count
+                node_.q[index] += (value - node_.q[index]) / count
+
+    def _best(self, state: State, steps: int) -> JointAction:
+        node = self._tree.get((state, steps))
+        prefix: list[int] = []
+        for _ in range(self._slots):
+            if node is None:
+                break
+            q, n = node.q, node.n
+            index = max(range(len(q)), key=lambda i: (n[i], q[i], -i))
+            prefix.append(node.choices[index])
+            node = node.sub[index]
+        return self.heuristic.complete(state, tuple(prefix))
+
+    def plan_step(
+        self, state: State, budget: Budget, rng: random.Random, steps_to_go: int | None = None
+    ) -> JointAction:
+        """Search from ``state`` until ``budget`` is spent and return the best joint action found.
+
+        The tree of earlier calls is kept (a state met again keeps its
+        statistics) and cleared at the start of an episode (``steps_to_go``
+        equal to the horizon) or when it outgrows ``max_nodes``.
+
+        Args:
+            state: the observed state.
+            budget: trials and/or seconds (a trial starts only when the time left
+                exceeds the longest trial of the call so far, so the call
+                overruns its seconds little); a zero budget returns the heuristic's joint
+                action, and so does a state with every goal done (no search needed).
+            rng: the source of the sampled outcomes (the only randomness).
+            steps_to_go: the steps left in the episode, this one included (default: the horizon).
+
+        Returns:
+            One ``(goto, do)`` pair per robot, within every limit of the domain.
+        """
+        horizon = self.model.spec.horizon
+        steps = horizon if steps_to_go is None else steps_to_go
+        if steps <= 0 or not self.heuristic.open_goals(state):
+            self.last_trials = 0
+            return self.heuristic.complete(state)  # nothing left to decide: every slot is NOOP
+        if steps == horizon or len(self._tree) > self.max_nodes:
+            self.reset()
+        clock = time.perf_counter
+        deadline = None if budget.seconds is None else clock() + budget.seconds
+        limit = budget.trials
+        trials = 0
+        longest = 0.0  # the longest trial of this call: one starts only if it fits in the time left
+        while limit is None or trials < limit:
+            start = clock()
+            if deadline is not None and start + longest >= deadline:
+                break
+            self._trial(state, steps, rng)
+            trials += 1
+            longest = max(longest, clock() - start)
+        self.last_trials = trials
+        return self._best(state, steps)
+
+
+class PlannerPolicy:
+    """A :data:`~alica.prophet.protap.policies.Policy` that replans every step with a :class:`ProtapPlanner`.
+
+    It counts its calls to know the steps to go: episodes are taken to last
+    ``horizon`` steps each, one call per step, as in
+    :func:`~alica.prophet.protap.policies.evaluate` (call :meth:`reset` to
+    start an episode early).
+
+    Args:
+        planner: the planner.
+        budget: the search budget of every step.
+        horizon: the steps per episode (default: the spec's horizon).
+        rng: the source of the search's sampled outcomes; by default the
+            ``rng`` of each call (the episode's). A separate seeded one leaves
+            the episode's draws to the outcomes, so episodes of different
+            budgets and policies meet the same goto failures.
+    """
+
+    def __init__(
+        self,
+        planner: ProtapPlanner,
+        budget: Budget,
+        horizon: int | None = None,
+        rng: random.Random | None = None,
+    ) -> None:
+        self.planner = planner
+        self.budget = budget
+        self.horizon = planner.model.spec.horizon if horizon is None else horizon
+        self.rng = rng
+        self._step = 0
+
+    def reset(self) -> None:
+        """Start a new episode at the next call."""
+        self._step = 0
+
+    def __call__(self, model: ProtapModel, state: State, rng: random.Random) -> JointAction:
+        """The planner's joint action for ``state`` (``model`` must be the planner's)."""
+        steps = self.horizon - self._step % self.horizon
+        self._step += 1
+        return self.planner.plan_step(state, self.budget, rng if self.rng is None else self.rng, steps)
