@@ -23,46 +23,20 @@ from __future__ import annotations
 import argparse
 import random
 import statistics
-import time
-from dataclasses import dataclass, field
 
 from alica.prophet.protap import (
     Budget,
-    JointAction,
     PlannerPolicy,
-    Policy,
     ProblemSpec,
     ProtapModel,
     ProtapPlanner,
-    State,
+    Recorder,
     appendix_c_spec,
     evaluate,
     greedy,
     random_policy,
     random_spec,
 )
-
-
-@dataclass
-class _Recorder:
-    """Wraps a policy: counts the limits its joint actions break, times each step, keeps the planner's trials."""
-
-    policy: Policy
-    planner: ProtapPlanner | None = None
-    breaks: int = 0
-    seconds: list[float] = field(default_factory=list)
-    trials: list[int] = field(default_factory=list)
-
-    def __call__(self, model: ProtapModel, state: State, rng: random.Random) -> JointAction:
-        start = time.perf_counter()
-        joint = self.policy(model, state, rng)
-        elapsed = time.perf_counter() - start
-        if self.planner is None or self.planner.last_trials:
-            self.seconds.append(elapsed)  # the planner's steps that searched (not those with every goal done)
-        if self.planner is not None and self.planner.last_trials:
-            self.trials.append(self.planner.last_trials)
-        self.breaks += len(model.violations(state, model.fluents(joint)))
-        return joint
 
 
 def _median(values: list[float]) -> float:
@@ -77,9 +51,9 @@ def _instances(seed: int) -> dict[str, ProblemSpec]:
     }
 
 
-def _planner_policy(model: ProtapModel, seconds: float, seed: int) -> _Recorder:
+def _planner_policy(model: ProtapModel, seconds: float, seed: int) -> Recorder:
     planner = ProtapPlanner(model)
-    return _Recorder(PlannerPolicy(planner, Budget(seconds=seconds), rng=random.Random(seed)), planner)
+    return Recorder(PlannerPolicy(planner, Budget(seconds=seconds), rng=random.Random(seed)), planner)
 
 
 def main() -> None:
@@ -103,8 +77,8 @@ def main() -> None:
         model = ProtapModel(spec)
         runs = {
             "planner": _planner_policy(model, per_step, args.seed),
-            "greedy": _Recorder(greedy),
-            "random": _Recorder(random_policy),
+            "greedy": Recorder(greedy),
+            "random": Recorder(random_policy),
         }
         for label, recorder in runs.items():
             result = evaluate(model, recorder, episodes=episodes, seed=args.seed)

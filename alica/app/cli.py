@@ -293,6 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
     from alica.app.cli_agent import add_parser as add_agent_parser
     from alica.app.cli_demo import add_parser as add_demo_parser
     from alica.app.cli_plan import add_parser as add_plan_parser
+    from alica.app.cli_protap import add_parser as add_protap_parser
     from alica.app.cli_run import add_parser as add_run_parser
     from alica.app.cli_skill import add_parser as add_skill_parser
     from alica.app.cli_solve import add_parser as add_solve_parser
@@ -303,6 +304,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_plan_parser(sub)
     add_solve_parser(sub)
     add_demo_parser(sub)
+    add_protap_parser(sub)
     return parser
 
 

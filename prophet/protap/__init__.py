@@ -19,7 +19,7 @@ from alica.prophet.protap.generate import (
 from alica.prophet.protap.heuristic import Determinisation
 from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
 from alica.prophet.protap.planner import Budget, PlannerPolicy, ProtapPlanner
-from alica.prophet.protap.policies import Evaluation, Policy, evaluate, greedy, random_policy
+from alica.prophet.protap.policies import Evaluation, Policy, Recorder, evaluate, greedy, random_policy
 from alica.prophet.protap.spec import (
     MANIPULATION,
     USER_DEFINED,
@@ -49,6 +49,7 @@ __all__ = [
     "ProblemSpec",
     "ProtapModel",
     "ProtapPlanner",
+    "Recorder",
     "Robot",
     "RobotAction",
     "State",

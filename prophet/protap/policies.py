@@ -17,8 +17,10 @@ from __future__ import annotations
 
 import random
 import statistics
+import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
 
@@ -119,3 +121,38 @@ def evaluate(
     totals = tuple(run_episode(model, policy, rng, horizon) for _ in range(episodes))
     std = statistics.stdev(totals) if len(totals) > 1 else 0.0
     return Evaluation(totals, statistics.fmean(totals), std)
+
+
+@dataclass
+class Recorder:
+    """Wraps a policy: counts the limits its joint actions break, times each step, keeps a planner's trials.
+
+    Args:
+        policy: the policy to run.
+        planner: the planner behind ``policy``, if any: only its steps that
+            searched (``last_trials`` > 0) are timed, and their trials kept.
+
+    Attributes:
+        breaks: limits broken (:meth:`ProtapModel.violations`) over every joint action chosen.
+        seconds: the time of each step timed.
+        trials: the planner's trials of each step that searched.
+    """
+
+    policy: Policy
+    planner: Any = None
+    breaks: int = 0
+    seconds: list[float] = field(default_factory=list)
+    trials: list[int] = field(default_factory=list)
+
+    def __call__(self, model: ProtapModel, state: State, rng: random.Random) -> JointAction:
+        """The wrapped policy's joint action, counted and timed."""
+        start = time.perf_counter()
+        joint = self.policy(model, state, rng)
+        elapsed = time.perf_counter() - start
+        searched = getattr(self.planner, "last_trials", 0) if self.planner is not None else None
+        if searched is None or searched:
+            self.seconds.append(elapsed)
+        if searched:
+            self.trials.append(int(searched))
+        self.breaks += len(model.violations(state, model.fluents(joint)))
+        return joint
