@@ -26,6 +26,9 @@
    ``w_s = x/(n+1)^3`` for task coverage, priorities and similarity; ``x``
    cancels when the weights are normalised to sum to 1, and the threshold is
    the normalised ``w_s``: the team switches only for a gain of more than that.
+   When tasks start at a work site, a ``Proximity`` summand (weight
+   ``w_s / (n + 1)``) prefers the robots nearest to where their tasks start
+   (see :func:`generic_utility`).
 
 The generated plan: one entry point per task, and per task a chain of
 states, each waiting until its step's precondition holds in the world model
