@@ -34,6 +34,7 @@ class Determinisation:
     Attributes:
         model: the simulator.
         bound: the spec's ``max-nondef-actions``; :meth:`complete` never sets more fluents true.
+        goal_do: per goal, the code of the ``do`` that completes it.
     """
 
     def __init__(self, model: ProtapModel) -> None:
@@ -44,17 +45,13 @@ class Determinisation:
         self._success = [robot.prob_goto >= 0.5 for robot in spec.robots]
         self._offset = model.n_cells + 1
         self._goal_cell = [model.index(goal.cell) for goal in spec.goals]
-        self._goal_do = [model.do(goal.action) for goal in spec.goals]
+        self.goal_do = [model.do(goal.action) for goal in spec.goals]
         self._all = (1 << len(spec.goals)) - 1
         self._cell_goals = [0] * model.n_cells
         for g, cell in enumerate(self._goal_cell):
             self._cell_goals[cell] |= 1 << g
-        # the goals a do completes: _done_by[cell][code - offset]
-        self._done_by = [[0] * len(spec.actions) for _ in range(model.n_cells)]
-        for g, (cell, code) in enumerate(zip(self._goal_cell, self._goal_do, strict=True)):
-            self._done_by[cell][code - self._offset] |= 1 << g
-        cells = [model.cell(index) for index in range(model.n_cells)]
-        self._dist = [[spec.goto_cost(a, b) for b in cells] for a in cells]
+        self._done_by = model.goal_mask  # the goals a do completes: _done_by[cell][code - offset]
+        self._dist = model.goto_cost
         # matching keys: the distance in hundredths, then the robot, then the goal, packed in one int
         self._goal_bits = max(1, len(spec.goals).bit_length())
         self._robot_bits = max(1, self._robots.bit_length())
@@ -132,7 +129,7 @@ class Determinisation:
             here = self._cell_goals[cells[robot]] & open_
             if here and used < bound:
                 g = (here & -here).bit_length() - 1
-                code = self._goal_do[g]
+                code = self.goal_do[g]
                 joint[robot][1] = code
                 used += 1
                 open_ &= ~self._done_by[cells[robot]][code - self._offset]

@@ -74,17 +74,20 @@ class ProtapModel:
         spec: the problem.
         n_cells: the number of grid cells.
         initial: the initial state (the robots' start cells, no goal done).
+        goto_cost: ``goto_cost[a][b]``, the ``GOTO_COST`` from cell index ``a`` to ``b`` (read only).
+        goal_mask: ``goal_mask[cell][action]``, the bit mask of the goals a ``do`` of that
+            action (by position) completes at that cell index (read only).
     """
 
     __slots__ = (
         "_available",
         "_do_choices",
         "_do_cost",
-        "_goal_mask",
         "_goto_choices",
-        "_goto_cost",
         "_prob",
         "_utility",
+        "goal_mask",
+        "goto_cost",
         "initial",
         "n_cells",
         "spec",
@@ -94,12 +97,12 @@ class ProtapModel:
         self.spec = spec
         self.n_cells = spec.width * spec.height
         cells = [self.cell(index) for index in range(self.n_cells)]
-        self._goto_cost = [[spec.goto_cost(a, b) for b in cells] for a in cells]
+        self.goto_cost = [[spec.goto_cost(a, b) for b in cells] for a in cells]
         self._do_cost = [list(row) for row in spec.do_costs]
         self._prob = [robot.prob_goto for robot in spec.robots]
-        self._goal_mask = [[0] * len(spec.actions) for _ in cells]
+        self.goal_mask = [[0] * len(spec.actions) for _ in cells]
         for g, goal in enumerate(spec.goals):
-            self._goal_mask[self.index(goal.cell)][spec.action_index(goal.action)] |= 1 << g
+            self.goal_mask[self.index(goal.cell)][spec.action_index(goal.action)] |= 1 << g
         utilities = [goal.utility for goal in spec.goals]
         self._utility: list[float] | None = None
         if len(utilities) <= 16:
@@ -213,7 +216,7 @@ class ProtapModel:
         offset = self.n_cells + 1
         for robot, (goto, do) in enumerate(joint):
             if goto:
-                cost += self._goto_cost[state.cells[robot]][goto - 1]
+                cost += self.goto_cost[state.cells[robot]][goto - 1]
             if do:
                 cost += self._do_cost[robot][do - offset]
         return self.utility(state) - cost
@@ -238,7 +241,7 @@ class ProtapModel:
         done = state.done
         cost = 0.0
         offset = self.n_cells + 1
-        goto_cost, do_cost, goal_mask, prob = self._goto_cost, self._do_cost, self._goal_mask, self._prob
+        goto_cost, do_cost, goal_mask, prob = self.goto_cost, self._do_cost, self.goal_mask, self._prob
         for robot, (goto, do) in enumerate(joint):
             if goto:
                 cost += goto_cost[old[robot]][goto - 1]
@@ -248,9 +251,7 @@ class ProtapModel:
                 action = do - offset
                 cost += do_cost[robot][action]
                 done |= goal_mask[old[robot]][action]
-        table = self._utility
-        utility = table[state.done] if table is not None else self._sum_utility(state.done)
-        return State(tuple(cells), done), utility - cost
+        return State(tuple(cells), done), self.utility(state) - cost
 
     # -- limits ------------------------------------------------------------
     def violations(self, state: State, actions: Iterable[tuple[int, int]]) -> list[str]:

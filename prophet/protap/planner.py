@@ -123,7 +123,6 @@ class ProtapPlanner:
         self.max_targets = max_targets
         self.last_trials = 0
         self._slots = 2 * len(model.spec.robots)
-        self._goal_do = [model.do(goal.action) for goal in model.spec.goals]
         self._tree: dict[tuple[State, int], _Node] = {}
         self._joint_values: dict[tuple[State, int, JointAction], float] = {}
 
@@ -172,10 +171,11 @@ class ProtapPlanner:
 
     def _do_codes(self, goals: int) -> tuple[int, ...]:
         codes = [NOOP]
+        goal_do = self.heuristic.goal_do
         g = 0
         while goals:
             if goals & 1:
-                code = self._goal_do[g]
+                code = goal_do[g]
                 if code not in codes:
                     codes.append(code)
             goals >>= 1

@@ -63,8 +63,9 @@ _LEVELS: tuple[tuple[str, ...], ...] = (
     ("+", "-"),
     ("*", "/"),
 )
-_OPERATORS = {op: level for level, ops in enumerate(_LEVELS) for op in ops}
-_NOT_LEVEL = 4
+OPERATORS = {op: level for level, ops in enumerate(_LEVELS) for op in ops}
+"""Binary operator -> binding level (0 binds loosest); the parser and the writer share it."""
+NOT_LEVEL = 4
 """``~`` binds tighter than ``^`` and looser than the comparisons."""
 
 
@@ -143,14 +144,14 @@ class Cursor:
     def _binary(self, lowest: int) -> Expr:
         """Precedence climbing: an operand, then operators of level ``lowest`` or tighter (one frame per nesting)."""
         token = self.peek()
-        if lowest <= _NOT_LEVEL and token.is_symbol("~"):
+        if lowest <= NOT_LEVEL and token.is_symbol("~"):
             self.advance()
-            left: Expr = Not(self._binary(_NOT_LEVEL), line=token.line, column=token.column)
+            left: Expr = Not(self._binary(NOT_LEVEL), line=token.line, column=token.column)
         else:
             left = self.unary()
         while True:
             token = self.peek()
-            level = _OPERATORS.get(token.text, -1) if token.kind == SYMBOL else -1
+            level = OPERATORS.get(token.text, -1) if token.kind == SYMBOL else -1
             if level < lowest:
                 return left
             self.advance()

@@ -34,26 +34,13 @@ from alica.prophet.rddl.ast import (
     RealConst,
     TypeDecl,
 )
+from alica.prophet.rddl.expressions import NOT_LEVEL, OPERATORS
 
 _INDENT = "    "
-_PRECEDENCE = {
-    "<=>": 1,
-    "=>": 2,
-    "|": 3,
-    "^": 4,
-    "&": 4,
-    "==": 6,
-    "~=": 6,
-    "<": 6,
-    "<=": 6,
-    ">": 6,
-    ">=": 6,
-    "+": 7,
-    "-": 7,
-    "*": 8,
-    "/": 8,
-}
-_NOT, _NEG, _ATOM = 5, 9, 10
+# the parser's binding levels, shifted by one; unary minus and atoms bind tighter than every operator
+_PRECEDENCE = {op: level + 1 for op, level in OPERATORS.items()}
+_NOT, _NEG = NOT_LEVEL + 1, max(_PRECEDENCE.values()) + 1
+_ATOM = _NEG + 1
 
 
 def write_expr(expr: Expr) -> str:

@@ -1,14 +1,12 @@
 """pyRDDLGym, an independent RDDL implementation, reads and grounds what write_rddl prints.
 
 pyRDDLGym is a test-only checker (the ``test`` extra); the tests skip, saying
-why, when it cannot be imported.
+why, when it cannot be imported (as those of the ProTaP domain do).
 """
 
 from __future__ import annotations
 
-import importlib
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 
@@ -17,19 +15,12 @@ from tests.prophet.rddl.test_parse import FULL
 
 DATA = Path(__file__).parent / "data"
 pytestmark = pytest.mark.optional
-
-
-def _pyrddlgym() -> ModuleType:
-    try:
-        return importlib.import_module("pyRDDLGym")
-    except ImportError as error:  # pragma: no cover - depends on the environment
-        reason = f"pyRDDLGym cannot be imported ({error}); install the 'test' extra to run this check"
-        print(reason)
-        pytest.skip(reason)
+gym = pytest.importorskip(
+    "pyRDDLGym", reason="pyRDDLGym cannot be imported; install the 'test' extra to run this check"
+)
 
 
 def test_pyrddlgym_grounds_the_written_paper_files(tmp_path: Path) -> None:
-    gym = _pyrddlgym()
     domain = read_rddl(DATA / "multi_ros_robot_mdp.rddl").domain
     assert domain is not None
     blocks = read_rddl(DATA / "multi_ros_robot_inst_mdp__1.rddl", domain=domain)
@@ -50,7 +41,6 @@ def test_pyrddlgym_grounds_the_written_paper_files(tmp_path: Path) -> None:
 
 
 def test_pyrddlgym_reads_the_written_constructs(tmp_path: Path) -> None:
-    gym = _pyrddlgym()
     # pyRDDLGym takes neither sub types of object types nor objects declared in an instance: leave them out here.
     text = (
         FULL.replace("room : cell;", "room : object;")
