@@ -26,11 +26,12 @@ Example::
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from alica.errors import PlannerError
 from alica.model import PlanLibrary, PlanningProblem
 from alica.prophet.pddl import Domain, Problem
+from alica.prophet.pddl.model import And
 from alica.prophet.planner import (
     DEFAULT_MEMORY_MB,
     Done,
@@ -120,7 +121,9 @@ class ProblemPlanning:
         Raises:
             PlannerError: the plan is not valid (the message names the planner and the reason).
         """
-        check = validate_plan((self.domain, self.pddl), plan)
+        # a stepwise planner's plan is the next step of a policy: its actions must apply, the goal need not hold after it
+        pddl = replace(self.pddl, goal=And(())) if self.planner.stepwise else self.pddl
+        check = validate_plan((self.domain, pddl), plan)
         if not check.valid:
             raise PlannerError(f"planner '{self.planner.name}' returned an invalid plan: {check.reason}")
         names = {name.lower(): name for name, _ in self.world.objects}

@@ -250,6 +250,11 @@ class Planner(ABC):
     features: frozenset[Feature] = frozenset({Feature.STRIPS})
     takes_limits: bool = False
     """Whether :meth:`_search` takes ``limits`` (and checks them while it grounds and searches)."""
+    stepwise: bool = False
+    """Whether its plan is only the next step of a policy (ProTaP): each step is meant for the robot it
+    names, and once the step is over the runtime plans the next one from the world as it is then."""
+    reads_positions: bool = False
+    """Whether its constructor takes ``positions`` (object -> position in metres, the world model's ``pos``)."""
 
     def missing(self, needed: Iterable[Feature]) -> frozenset[Feature]:
         """The needed features this planner lacks."""

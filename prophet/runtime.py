@@ -65,6 +65,7 @@ from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
 from alica.prophet.pddl.writer import write_domain, write_problem
 from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
 from alica.prophet.planner import Done, PlanStatus, Progress
+from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
 from alica.prophet.tasks import (
     STEP_DONE,
@@ -401,6 +402,7 @@ class ProblemRuntime:
                     host.roleset,
                     share.entry_task,
                     standby=self.model.wait_plan,
+                    per_robot=self._stepwise(),
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
@@ -575,7 +577,9 @@ class ProblemRuntime:
                     self.next_update = now + self.model.update_time
                     return
                 problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
-            options = {"progress_every": 100} if problem.planner == "builtin" else {}
+            options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
+            if _planner_trait(problem.planner, "reads_positions"):
+                options.update(positions=self._positions(), seed=generation)
             planning = plan_problem(problem, host.library, world, options=options)
             team = [a for a in self.slot.members() if a != me]
             if self.magic is not None and problem.planner == "builtin" and team:
@@ -812,6 +816,21 @@ class ProblemRuntime:
             self.predicates = predicate_types(self.model, self.host.library)
         return self.predicates
 
+    def _stepwise(self) -> bool:
+        """Whether the problem's planner plans one step at a time (ProTaP), each step pinned to its robots."""
+        return _planner_trait(self.model.planner, "stepwise")
+
+    def _positions(self) -> dict[str, tuple[float, ...]]:
+        """Object -> its position from the world model's ``pos`` values (for planners that read positions)."""
+        out: dict[str, tuple[float, ...]] = {}
+        for name, args, value in self.host.world.values():
+            if name == "pos" and len(args) == 1 and isinstance(value, (tuple, list)) and len(value) >= 2:
+                try:
+                    out[str(args[0])] = tuple(float(v) for v in value)
+                except (TypeError, ValueError):
+                    continue
+        return out
+
     def _executing(self) -> bool:
         """Whether an agent runs a step of the shared plan (a better plan then no longer replaces it)."""
         node, created = self.slot.node, self.created
@@ -889,9 +908,18 @@ class ProblemRuntime:
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         order = [[step.index for step in steps] for steps in created.tasks]
         members = self.slot.members()
+        stepwise = self._stepwise()
+        if stepwise:
+            target = ()  # a step of a policy is not meant to reach the goal: only its actions must still fit
         reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(
             progress, order, created.allowed, members
         )
+        if reason is None and stepwise and all(p.done for p in progress):
+            # the step is over: the next one is planned from the world as it is now (goal holds: the child succeeds)
+            if not holds(reachable, set(world.facts)):
+                self.search = None
+                self._start_search(now, "the step is done: planning the next one")
+            return
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):  # the rest of the goal is reached
                 self._wait_for_world(now, world, self._next_generation(), _rest_holds(world))
@@ -905,6 +933,14 @@ class ProblemRuntime:
             self._replan(now, f"the plan is stuck: {reason}")
         else:
             self._replan(now, f"the world changed under the plan: {reason}")
+
+
+def _planner_trait(name: str, trait: str) -> bool:
+    """A class attribute of the planner called ``name`` (``False`` for an unknown planner: planning fails later)."""
+    try:
+        return bool(getattr(planner_class(name), trait, False))
+    except PlannerError:
+        return False
 
 
 def _rest_holds(world: PlanningWorld) -> str:

@@ -294,6 +294,14 @@ def _parallelise(
     return tasks, allowed
 
 
+def _by_robot(steps: Sequence[Step]) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
+    """One task per robot, its steps in plan order, pinned to it (tasks in the order of their first step)."""
+    tasks: dict[str, list[Step]] = {}
+    for step in steps:
+        tasks.setdefault(step.robot, []).append(step)
+    return list(tasks.values()), [(robot,) for robot in tasks]
+
+
 def _own_facts(
     robot: str,
     team: tuple[str, ...],
@@ -563,6 +571,8 @@ def create_tasks(
     roleset: RoleSet,
     entry_task: str,
     standby: str | None = None,
+    *,
+    per_robot: bool = False,
 ) -> CreatedTasks:
     """Turn a single-agent plan into tasks, a multi-agent plan and role-task priorities (the module docstring says how).
 
@@ -576,6 +586,8 @@ def create_tasks(
         roleset: the team's role set.
         entry_task: the task through which the team runs the planning problem.
         standby: the planning problem's WaitPlan, run by the agents no task needs (none: they idle).
+        per_robot: instead of Algorithms 2-3, one task per robot the plan names, with that robot's
+            steps in plan order, pinned to it: the plan of a stepwise planner (ProTaP) says who does what.
 
     Raises:
         PlannerError: the plan is empty or names unknown skills.
@@ -585,7 +597,7 @@ def create_tasks(
     team = _robots(robots)
     init = tuple(init)  # read twice: by the parallelisation and for the objects to guard
     steps = steps_of(plan_steps, library, team)
-    tasks, allowed = _parallelise(steps, init, team)
+    tasks, allowed = _by_robot(steps) if per_robot else _parallelise(steps, init, team)
     wait_plan = library.plans.get(standby) if standby is not None else None
     variables = tuple(v.name for v in wait_plan.variables) if wait_plan is not None else ()
     members = set(team)

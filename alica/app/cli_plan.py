@@ -63,9 +63,10 @@ def add_parser(sub: Any) -> None:
     )
     p.add_argument(
         "--planner",
-        default="builtin",
+        default=None,
         choices=sorted(PLANNERS),
-        help="the back-end (default builtin; fd needs: pip install 'alica-teams[fd]')",
+        help="the back-end (default: a plan file's problem's own planner, else builtin; fd needs: "
+        "pip install 'alica-teams[fd]')",
     )
     p.add_argument(
         "--time-limit",
@@ -133,11 +134,14 @@ def cmd_plan(args: argparse.Namespace) -> int:
     """Run ``alica plan``; returns the exit code."""
     start = time.monotonic()
     limits = Limits(args.time_limit, args.memory_limit)
+    if args.planner is None and Path(args.domain).suffix.lower() not in PLAN_FILE_SUFFIXES:
+        args.planner = "builtin"
     try:
         return _plan(args, limits)
     except LimitReached as exc:  # while reading or before the planner ran: reported as the planner's own limits are
-        result = PlanResult(exc.status, None, args.planner, None, time.monotonic() - start, 0, str(exc))
-        return _report(args, args.planner, result, lambda plan: plan.cost)
+        planner = args.planner or "builtin"
+        result = PlanResult(exc.status, None, planner, None, time.monotonic() - start, 0, str(exc))
+        return _report(args, planner, result, lambda plan: plan.cost)
 
 
 def _plan(args: argparse.Namespace, limits: Limits) -> int:
@@ -277,6 +281,7 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
         )
     world = read_world(problem, library, (), ())
     planning = plan_problem(problem, library, world, planner=args.planner)
+    args.planner = planning.planner.name
     result = planning.solve(anytime=args.anytime, limits=limits)  # PlannerError: an invalid plan
 
     def tasks() -> dict[str, Any]:
@@ -296,6 +301,7 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
             roleset,
             "Default",
             standby=problem.wait_plan,
+            per_robot=planning.planner.stepwise,
         )
         if args.emit_plan:
             out = Path(args.emit_plan)
@@ -374,3 +380,7 @@ def _print_text(result: PlanResult, cost: float | None) -> None:
     print(f"; final cost: {_number(cost)} after {result.time_s:.3f} s ({result.status.value})")
     print(f"; expansions: {result.expansions}")
     print(f"; planner: {result.planner}")
+    from alica.prophet.planners import planner_class
+
+    if planner_class(result.planner).stepwise:
+        print("; the next step only: this planner plans one step at a time (a team plans the next when it is over)")

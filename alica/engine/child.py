@@ -171,6 +171,9 @@ class WorldFacts(Protocol):
     def objects(self, type_name: str) -> tuple[object, ...]:
         """The objects of a type."""
 
+    def values(self) -> list[tuple[str, tuple[object, ...], object]]:
+        """The function values (not truth values) as ``(name, args, value)``: ``pos(x)``, say."""
+
     def assert_fact(self, predicate: str, *args: object) -> object:
         """Make a fact hold, for the whole team."""
 

@@ -52,6 +52,9 @@ class _World:
     def objects(self, type_name: str) -> tuple[object, ...]:
         return tuple(self._model.objects(type_name))
 
+    def values(self) -> list[tuple[str, tuple[object, ...], object]]:
+        return list(self._model.values())
+
     def assert_fact(self, predicate: str, *args: object) -> object:
         return self._model.assert_fact(predicate, *args)
 

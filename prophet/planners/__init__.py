@@ -1,4 +1,4 @@
-"""The planner back-ends by name: the builtin search and Fast Downward.
+"""The planner back-ends by name: the builtin search, Fast Downward and ProTaP (stepwise, for teams).
 
 ``PLANNERS`` maps a name to ``"module:Class"``; :func:`get_planner` imports the
 back-end only when it is asked for, so an optional back-end that is not
@@ -21,6 +21,7 @@ from alica.prophet.planner import Planner
 PLANNERS: dict[str, str] = {
     "builtin": "alica.prophet.search.planner:BuiltinPlanner",
     "fd": "alica.prophet.planners.fd:FastDownward",
+    "protap": "alica.prophet.protap.step_planner:ProtapStepPlanner",
 }
 """Every back-end: name -> ``"module:Class"`` of a :class:`~alica.prophet.planner.Planner` subclass."""
 

@@ -299,6 +299,21 @@ class ProtapPlanner:
             return self.heuristic.complete(state)  # nothing left to decide: every slot is NOOP
         if steps == horizon or len(self._tree) > self.max_nodes:
             self.reset()
+        self.last_trials = self.search(state, budget, rng, steps)
+        return self.best(state, steps)
+
+    def search(self, state: State, budget: Budget, rng: random.Random, steps_to_go: int | None = None) -> int:
+        """Run trials from ``state`` until ``budget`` is spent, keeping the tree; the number of trials run.
+
+        :meth:`plan_step` is this and :meth:`best`; a caller that searches in
+        slices (a team's planner, a budget per engine tick) calls it again and
+        again on the same state and asks :meth:`best` at the end.
+        """
+        steps = self.model.spec.horizon if steps_to_go is None else steps_to_go
+        if steps <= 0 or not self.heuristic.open_goals(state):
+            return 0
+        if len(self._tree) > self.max_nodes:
+            self.reset()
         clock = time.perf_counter
         deadline = None if budget.seconds is None else clock() + budget.seconds
         limit = budget.trials
@@ -311,7 +326,13 @@ class ProtapPlanner:
             self._trial(state, steps, rng)
             trials += 1
             longest = max(longest, clock() - start)
-        self.last_trials = trials
+        return trials
+
+    def best(self, state: State, steps_to_go: int | None = None) -> JointAction:
+        """The joint action of the most visited choices from ``state`` (the heuristic's where the tree stops)."""
+        steps = self.model.spec.horizon if steps_to_go is None else steps_to_go
+        if steps <= 0 or not self.heuristic.open_goals(state):
+            return self.heuristic.complete(state)
         return self._best(state, steps)
 
 

@@ -130,6 +130,10 @@ class ProblemSpec:
         do_costs: ``DO_COST``, one row per robot, one column per action.
         goto_unit: ``GOTO_COST`` is this times the Euclidean distance, rounded
             to hundredths as in the paper.
+        costs: ``GOTO_COST`` given outright instead, ``costs[a][b]`` from the
+            cell of index ``a`` to that of ``b`` (index ``y * width + x``): the
+            distances between a team's places in metres, say, when the cells
+            are places rather than a grid (``()``: from ``goto_unit``).
         max_nondef_actions: the concurrency bound, by default 2 x the number
             of robots (each robot takes at most one goto and one do per step).
         horizon: the number of steps.
@@ -144,6 +148,7 @@ class ProblemSpec:
     height: int
     do_costs: tuple[tuple[float, ...], ...] = ()
     goto_unit: float = 1.0
+    costs: tuple[tuple[float, ...], ...] = ()
     max_nondef_actions: int = 0
     horizon: int = 10
     discount: float = 1.0
@@ -202,6 +207,11 @@ class ProblemSpec:
             out.append("do_costs holds a value that is not finite")
         if not (math.isfinite(self.goto_unit) and self.goto_unit >= 0):
             out.append(f"goto_unit {self.goto_unit} is not a finite number >= 0")
+        cells = self.width * self.height
+        if self.costs and (len(self.costs) != cells or any(len(row) != cells for row in self.costs)):
+            out.append(f"costs is not one row and one column per cell ({cells})")
+        elif not all(math.isfinite(cost) and cost >= 0 for row in self.costs for cost in row):
+            out.append("costs holds a value that is negative or not finite")
         if self.max_nondef_actions < 1:
             out.append(f"max_nondef_actions {self.max_nondef_actions} < 1")
         if self.horizon < 1:
@@ -235,7 +245,9 @@ class ProblemSpec:
         ]
 
     def goto_cost(self, start: Cell, target: Cell) -> float:
-        """``GOTO_COST``: ``goto_unit`` times the Euclidean distance, rounded to hundredths."""
+        """``GOTO_COST``: from :attr:`costs` when given, else ``goto_unit`` times the Euclidean distance, rounded to hundredths."""
+        if self.costs:
+            return self.costs[start[1] * self.width + start[0]][target[1] * self.width + target[0]]
         return round(self.goto_unit * math.hypot(start[0] - target[0], start[1] - target[1]), 2)
 
     def action_index(self, name: str) -> int:

@@ -14,6 +14,7 @@ def test_names() -> None:
     assert PLANNERS == {
         "builtin": "alica.prophet.search.planner:BuiltinPlanner",
         "fd": "alica.prophet.planners.fd:FastDownward",
+        "protap": "alica.prophet.protap.step_planner:ProtapStepPlanner",
     }
 
 
