@@ -111,3 +111,30 @@ def test_the_same_seed_gives_the_same_run():
         sim.run(until_done=True, max_time=120)
         runs.append(skills.runs)
     assert runs[0] == runs[1]
+
+
+def test_alica_plan_prints_the_next_step_of_a_plan_file_problem_with_the_problem_s_own_planner(capsys):
+    from alica.app.cli import main
+
+    survey = str(PLANS / "examples" / "protap_survey.yaml")
+    assert main(["plan", survey, "--world", "at(r1, base) and at(r2, s3)"]) == 0
+    out = capsys.readouterr().out
+    assert "; planner: protap" in out and "; the next step only" in out
+    assert "(scansite r2 s3)" in out  # r2 stands at s3, whose scan is a goal: it scans in this step
+
+
+def test_alica_run_with_stand_ins_reaches_the_goal(capsys):
+    from alica.app.cli import main
+
+    survey = str(PLANS / "examples" / "protap_survey.yaml")
+    argv = [
+        "run",
+        survey,
+        "--agents",
+        "r1:Surveyor,r2:Surveyor",
+        "--stand-ins",
+        "--fact",
+        "at(r1, base) and at(r2, base)@0",
+    ]
+    assert main([*argv, "--max-time", "120"]) == 0
+    assert "SurveyMission: success" in capsys.readouterr().out
