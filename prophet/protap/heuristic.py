@@ -60,7 +60,9 @@ class Determinisation:
             [round(self._dist[cell][goal_cell] * 100) << shift | g for g, goal_cell in enumerate(self._goal_cell)]
             for cell in range(model.n_cells)
         ]
-        self._values: dict[tuple[State, int], float] = {}
+        # keys are plain tuples of ints, never State: the cyclic garbage collector stops tracking those,
+        # while every State (a named tuple) would stay tracked and make each full collection slower
+        self._values: dict[tuple[tuple[int, ...], int, int], float] = {}
 
     def open_goals(self, state: State) -> int:
         """The bit mask of the goals not done in ``state``."""
@@ -187,13 +189,13 @@ class Determinisation:
             steps: the number of steps to go (0 gives 0).
         """
         values = self._values
-        key = (state, steps)
+        key = (state.cells, state.done, steps)
         known = values.get(key)
         if known is not None:
             return known
         model = self.model
         discount = model.spec.discount
-        trail: list[tuple[tuple[State, int], float]] = []
+        trail: list[tuple[tuple[tuple[int, ...], int, int], float]] = []
         total = 0.0
         while steps > 0:
             known = values.get(key)
@@ -209,7 +211,7 @@ class Determinisation:
             trail.append((key, model.reward(state, joint)))
             state = self.step(state, joint)
             steps -= 1
-            key = (state, steps)
+            key = (state.cells, state.done, steps)
         for known_key, reward in reversed(trail):
             total = reward + discount * total
             values[known_key] = total

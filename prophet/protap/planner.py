@@ -75,6 +75,10 @@ class Budget:
             raise ValueError("a budget is not negative")
 
 
+class _OutOfTime(Exception):
+    """The search's deadline came while a trial expanded a node (the trial is dropped)."""
+
+
 class _Node:
     """A decision node: the choices of one slot with their visit counts and mean returns."""
 
@@ -123,8 +127,11 @@ class ProtapPlanner:
         self.max_targets = max_targets
         self.last_trials = 0
         self._slots = 2 * len(model.spec.robots)
-        self._tree: dict[tuple[State, int], _Node] = {}
-        self._joint_values: dict[tuple[State, int, JointAction], float] = {}
+        # keys are plain tuples of ints, never State (see Determinisation._values): the garbage collector
+        # untracks them, which keeps its full collections short while the tree grows
+        self._tree: dict[tuple[tuple[int, ...], int, int], _Node] = {}
+        self._joint_values: dict[tuple[tuple[int, ...], int, int, JointAction], float] = {}
+        self._deadline: float | None = None
 
     def reset(self) -> None:
         """Forget the search tree and the cached values (a new episode, say)."""
@@ -185,9 +192,12 @@ class ProtapPlanner:
     def _expand(self, state: State, steps: int, prefix: tuple[int, ...], choices: tuple[int, ...]) -> _Node:
         values = []
         cache = self._joint_values
+        deadline = self._deadline
         for code in choices:
+            if deadline is not None and time.perf_counter() >= deadline:
+                raise _OutOfTime
             joint = self.heuristic.complete(state, (*prefix, code))
-            key = (state, steps, joint)
+            key = (state.cells, state.done, steps, joint)
             value = cache.get(key)
             if value is None:
                 value = self.heuristic.action_value(state, steps, joint)
@@ -218,10 +228,10 @@ class ProtapPlanner:
         path: list[tuple[list[tuple[_Node, int]], float]] = []
         leaf = 0.0
         while steps > 0:
-            node: _Node | None = tree.get((state, steps))
+            node: _Node | None = tree.get((state.cells, state.done, steps))
             if node is None:
                 root = self._expand(state, steps, (), self.choices(state, 0, 0, 0))
-                tree[(state, steps)] = root
+                tree[(state.cells, state.done, steps)] = root
                 leaf = max(root.q)
                 break
             chain: list[tuple[_Node, int]] = []
@@ -260,7 +270,7 @@ class ProtapPlanner:
                 node_.q[index] += (value - node_.q[index]) / count
 
     def _best(self, state: State, steps: int) -> JointAction:
-        node = self._tree.get((state, steps))
+        node = self._tree.get((state.cells, state.done, steps))
         prefix: list[int] = []
         for _ in range(self._slots):
             if node is None:
@@ -282,9 +292,9 @@ class ProtapPlanner:
 
         Args:
             state: the observed state.
-            budget: trials and/or seconds (a trial starts only when the time left
-                exceeds the longest trial of the call so far, so the call
-                overruns its seconds little); a zero budget returns the heuristic's joint
+            budget: trials and/or seconds (the deadline is checked before every
+                node a trial expands, and a trial it cuts short is dropped, so
+                the call overruns its seconds by one heuristic value at most); a zero budget returns the heuristic's joint
                 action, and so does a state with every goal done (no search needed).
             rng: the source of the sampled outcomes (the only randomness).
             steps_to_go: the steps left in the episode, this one included (default: the horizon).
@@ -297,8 +307,11 @@ class ProtapPlanner:
         if steps <= 0 or not self.heuristic.open_goals(state):
             self.last_trials = 0
             return self.heuristic.complete(state)  # nothing left to decide: every slot is NOOP
+        start = time.perf_counter()
         if steps == horizon or len(self._tree) > self.max_nodes:
-            self.reset()
+            self.reset()  # freeing a large tree takes a while: it counts against the step's seconds
+            if budget.seconds is not None:
+                budget = Budget(budget.trials, max(0.0, budget.seconds - (time.perf_counter() - start)))
         self.last_trials = self.search(state, budget, rng, steps)
         return self.best(state, steps)
 
@@ -318,14 +331,17 @@ class ProtapPlanner:
         deadline = None if budget.seconds is None else clock() + budget.seconds
         limit = budget.trials
         trials = 0
-        longest = 0.0  # the longest trial of this call: one starts only if it fits in the time left
-        while limit is None or trials < limit:
-            start = clock()
-            if deadline is not None and start + longest >= deadline:
-                break
-            self._trial(state, steps, rng)
-            trials += 1
-            longest = max(longest, clock() - start)
+        self._deadline = deadline
+        try:
+            while limit is None or trials < limit:
+                if deadline is not None and clock() >= deadline:
+                    break
+                self._trial(state, steps, rng)
+                trials += 1
+        except _OutOfTime:
+            pass  # the deadline came in the middle of a trial's expansion: that trial is dropped, the tree stays valid
+        finally:
+            self._deadline = None
         return trials
 
     def best(self, state: State, steps_to_go: int | None = None) -> JointAction:
