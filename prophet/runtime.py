@@ -179,6 +179,8 @@ class ProblemRuntime:
         self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
         self.step_failures_any: dict[str, int] = {}
         self.steps_done = 0
+        self.step_over: float | None = None
+        """When a stepwise plan's step was seen over while its effects had not all arrived yet."""
         self.team_wait_until: float | None = None
         """While no plan exists without robots outside the team: when the leader stops waiting for them."""
         self.overrides = dict(host.override(self.model.name))
@@ -816,6 +818,27 @@ class ProblemRuntime:
             self.predicates = predicate_types(self.model, self.host.library)
         return self.predicates
 
+    def _next_step(self, now: float, created: CreatedTasks, goal: Sequence[Literal]) -> None:
+        """A stepwise plan's step is over: plan the next one from the world as it is now (nothing when the goal holds).
+
+        The step's effects are awaited first (a teammate's finished step may be known before the facts its
+        runtime wrote arrive), for at most two UpdateTimes: planning from a world that lags behind would
+        repeat a step that is done.
+        """
+        self._mark_done()  # this agent's own last step first
+        believed = {Fact(f.predicate, tuple(str(a) for a in f.args)) for f in self.host.world.facts()}
+        if holds(goal, believed):
+            return  # the child succeeds with the generated plan (child_status)
+        effects = [literal for task in created.tasks for step in task for literal in step.effect]
+        if not holds(effects, believed):
+            if self.step_over is None:
+                self.step_over = now
+            if now - self.step_over < 2 * self.model.update_time:
+                return
+        self.step_over = None
+        self.search = None
+        self._start_search(now, "the step is done: planning the next one")
+
     def _stepwise(self) -> bool:
         """Whether the problem's planner plans one step at a time (ProTaP), each step pinned to its robots."""
         return _planner_trait(self.model.planner, "stepwise")
@@ -915,10 +938,7 @@ class ProblemRuntime:
             progress, order, created.allowed, members
         )
         if reason is None and stepwise and all(p.done for p in progress):
-            # the step is over: the next one is planned from the world as it is now (goal holds: the child succeeds)
-            if not holds(reachable, set(world.facts)):
-                self.search = None
-                self._start_search(now, "the step is done: planning the next one")
+            self._next_step(now, created, reachable)
             return
         if reason is None and all(p.done for p in progress):
             if reachable != goal and holds(reachable, set(world.facts)):  # the rest of the goal is reached

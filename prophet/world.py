@@ -173,7 +173,8 @@ def read_world(
         # an object of a left-out relation that facts of the team still mention is planned for: a robot
         # that crashed standing at a sample (at(r, s)) leaves it on the ground (onground(s)); one an
         # opponent holds is mentioned by nothing else (clear(b) and ontable(b) went with the grasp)
-        outside -= mentioned
+        # and a place the problem declares is never held: a robot that crashed standing at it leaves it there
+        outside -= mentioned | set(fixed)
         # a goal object no fact mentions (a block falling, out of sight) is not planned for until it is seen again
         outside.update(
             str(a)

@@ -138,3 +138,16 @@ def test_alica_run_with_stand_ins_reaches_the_goal(capsys):
     ]
     assert main([*argv, "--max-time", "120"]) == 0
     assert "SurveyMission: success" in capsys.readouterr().out
+
+
+def test_the_leader_crashes_and_the_other_robot_finishes_the_survey_alone():
+    skills = BlockSkills()
+    sim, _ = survey_team(skills)
+    sim.crash("r1", at=1.0)  # while r1 drives to its first site
+    summary = sim.run(until_done=True, max_time=120)
+    assert summary["success"], summary
+    assert goal_holds(sim, "r2")
+    later = made_plans(sim, "r2")[1:]
+    assert later and all(step.robot == "r2" for created in later for task in created.tasks for step in task)
+    # the site the crashed robot stood at is still surveyed: a declared place is never held by a robot outside
+    assert any(step.label == "TakeSample(s1)" for created in later for task in created.tasks for step in task)
