@@ -250,7 +250,9 @@ def _run_lunar(args: argparse.Namespace) -> int:
     from alica.app.skill_options import skill_registry
     from alica.prophet.protap import Budget, PlannerPolicy, ProtapModel, ProtapPlanner, Recorder
     from alica.prophet.protap.dispatch import StepRecord
+    from alica.skills.motion import configure_ompl
 
+    configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
     for name, default in _WORLD_DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, default)
@@ -265,12 +267,11 @@ def _run_lunar(args: argparse.Namespace) -> int:
     recorder = Recorder(
         PlannerPolicy(planner, Budget(seconds=args.time_per_step), rng=random.Random(args.seed)), planner
     )
-    if not args.json:
-        print(
-            f"ProTaP in the lunar world: {args.robots} robot(s) on {width}x{height} ({args.cell_size:g} m cells) with "
-            f"{args.goals} goal(s), seed {args.seed}, {episodes} episode(s) of {args.steps} steps, "
-            f"{args.time_per_step:g} s planning per step"
-        )
+    header = (
+        f"ProTaP in the lunar world: {args.robots} robot(s) on {width}x{height} ({args.cell_size:g} m cells) with "
+        f"{args.goals} goal(s), seed {args.seed}, {episodes} episode(s) of {args.steps} steps, "
+        f"{args.time_per_step:g} s planning per step"
+    )
     trace: list[dict[str, Any]] = []
     totals: list[float] = []
     goals_done = failures = 0
@@ -281,6 +282,8 @@ def _run_lunar(args: argparse.Namespace) -> int:
         def record(step: StepRecord, episode: int = episode) -> None:
             trace.append(_step_trace(model, episode, step))
             if not args.json:
+                if len(trace) == 1:  # after the checks and the world's building, which may refuse the input
+                    print(header)
                 _print_step(model, episode, episodes, step)
 
         run = run_lunar_episode(
