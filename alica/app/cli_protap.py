@@ -162,7 +162,7 @@ def add_parser(sub: Any) -> None:
         default=None,
         metavar="ROBOT@STEP",
         help="fault injection: crash ROBOT when its goto of step STEP (1 = the first) starts, and power it up "
-        "again when the step ends (repeatable)",
+        "again when the step ends; nothing happens if it has no goto in that step (repeatable)",
     )
     r.set_defaults(run=cmd_run)
 
@@ -250,9 +250,7 @@ def _run_lunar(args: argparse.Namespace) -> int:
     from alica.app.skill_options import skill_registry
     from alica.prophet.protap import Budget, PlannerPolicy, ProtapModel, ProtapPlanner, Recorder
     from alica.prophet.protap.dispatch import StepRecord
-    from alica.skills.motion import configure_ompl
 
-    configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
     for name, default in _WORLD_DEFAULTS.items():
         if getattr(args, name) is None:
             setattr(args, name, default)

@@ -473,6 +473,10 @@ def run_lunar_episode(
         rng: handed to ``choose_step``.
         on_step: called with each :class:`~alica.prophet.protap.dispatch.StepRecord` when its step ended.
 
+    OMPL's random generator is seeded with ``seed`` if nothing in the process
+    planned before (see :func:`alica.skills.motion.configure_ompl`): a run
+    from a fresh process is the same for a seed.
+
     Raises:
         AlicaError: a bad ``--uda-skill``, a field that cannot be built, a fault
             naming no robot, or a skill that cannot run.
@@ -483,7 +487,10 @@ def run_lunar_episode(
             raise AlicaError(
                 f"--fail-goto {fault.robot}@{fault.step}: no robot named {fault.robot} ({', '.join(sorted(names))})"
             )
+    from alica.skills.motion import configure_ompl
+
     skill = uda_skill(registry, uda, layout)
+    configure_ompl(seed)  # OMPL's generator is per process: seed it before any planner exists (the first call wins)
     started = time.perf_counter()
     with build_world(model.spec, layout, seed=seed, rocks=rocks) as world:
         executor = LunarExecutor(

@@ -1,4 +1,8 @@
-"""The ProTaP grid in metres and the lunar executor, below the command line (alica.app.protap_world)."""
+"""The ProTaP grid in metres and the lunar executor, below the command line (alica.app.protap_world).
+
+Here rather than in an earlier folder: OMPL has one random generator per process, seeded by the first
+planner that asks, and the demos' tests (tests/demos) compare simulated times of seeded runs.
+"""
 
 from __future__ import annotations
 
