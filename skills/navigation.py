@@ -24,6 +24,9 @@ Which grid depends on what the robot knows (:func:`planning_grid`):
   in a test or by ``alica skill run``) the world's layout is known: the grid
   is rasterised from the world's obstacles (tables, rocks, blocks) and a path
   is checked exactly with FCL against the rocks' meshes and the tables.
+  Samples are left out (work sites the manipulation skills drive up to); a
+  robot that bumps into one remembers the spot and plans around it for the
+  rest of the drive, as in map mode.
 
 In both modes the other robots are the world's robot poses (``_others``): a
 stand-in for the positions robots broadcast in a real team.
@@ -346,14 +349,16 @@ class MoveToPosition(WorldSkill):
         return checker
 
     def _remember_bump(self) -> None:
-        """Map mode: remember an obstacle just ahead of where the robot drove when it bumped.
+        """Remember an obstacle just ahead of where the robot drove when it bumped.
 
-        What the map does not show (a sample lying on the ground, a rock below
-        the lidar) stops the robot; a robot's bumper tells it, and the robot
-        plans around the spot and escapes away from it for the rest of this
-        drive. Bumps into another robot are not remembered (robots move).
+        What the grid does not show stops the robot: in map mode a sample
+        lying on the ground or a rock below the lidar, in known-map mode a
+        sample (the known layout leaves samples out: they are work sites the
+        manipulation skills drive up to). A robot's bumper tells it, and the
+        robot plans around the spot and escapes away from it for the rest of
+        this drive. Bumps into another robot are not remembered (robots move).
         """
-        if not self.map_mode() or abs(self.speed) < 1e-3:
+        if abs(self.speed) < 1e-3:
             return
         x, y, yaw = self.robot.estimate
         heading = yaw if self.speed > 0 else yaw + math.pi

@@ -99,6 +99,138 @@ def checked_params(spec: Any, params: Mapping[str, object]) -> dict[str, object]
     return out
 
 
+class SkillSession:
+    """One skill built from a registry for one robot of a world, ticked by its caller.
+
+    The part of :func:`run_skill` that runs a skill: build the behaviour from
+    the registry's implementation with the robot's world model, tick it, keep
+    the trace of its status and feedback, stop it, and say what happened. A
+    caller drives the time: :func:`run_skill` steps the world between the
+    ticks of one session, :func:`alica.skills.together.run_together` between
+    the ticks of several sessions on different robots.
+
+    Args:
+        name: the skill.
+        world: the world it acts in.
+        robot: the robot that runs it.
+        params: the skill's parameters (defaults are filled in).
+        registry: where the skill is declared and implemented.
+        world_model: the robot's world model (a new one on the world's clock when omitted).
+        seed: seeds the skill's ``random.Random`` (with the robot's name).
+        scratch: the robot's scratch space, shared with the skills run before and after it.
+
+    Attributes:
+        name: the skill.
+        robot: the robot.
+        world_model: the robot's world model.
+        behaviour: the py_trees behaviour (set up, not yet ticked).
+        started: the simulated time the session was made.
+        ticks: the ticks so far.
+        status: ``running``, then ``success``, ``failure`` or ``timeout`` (stopped before it ended).
+        trace: ``{"t", "status", "feedback"}`` whenever the feedback or status changed.
+
+    Raises:
+        SkillError: bad parameters, no such robot, or no implementation.
+        UnknownSkillError: no skill of that name.
+    """
+
+    def __init__(
+        self,
+        name: str,
+        world: World,
+        robot: str,
+        params: Mapping[str, object] | None,
+        registry: SkillRegistry,
+        *,
+        world_model: WorldModelLike | None = None,
+        seed: int = 0,
+        scratch: dict[str, object] | None = None,
+    ) -> None:
+        from alica.engine.behaviours import SkillContext
+        from alica.worldmodel import WorldModel
+
+        spec = registry.get(name)
+        values = checked_params(spec, params or {})
+        if robot not in world.robots:
+            raise SkillError(f"the world has no robot named '{robot}' (robots: {', '.join(sorted(world.robots))})")
+        factory = registry.load(name)
+        self.name = name
+        self.robot = robot
+        self.world = world
+        self.world_model: WorldModelLike = (
+            world_model if world_model is not None else WorldModel(robot, clock=world.clock)
+        )
+        belief: Any = self.world_model  # alone, the world model is the skill's whole belief base
+        context = SkillContext(
+            robot, world.now, self.world_model, belief, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}"
+        )
+        if scratch is not None:
+            context.scratch = scratch  # shared with the skills run before and after: a pipeline, step by step
+        self.behaviour: Behaviour = factory(name, values, context)
+        self.behaviour.setup(context=context)
+        self.started = world.now()
+        self.ticks = 0
+        self.status = "running"
+        self.trace: list[dict[str, object]] = []
+        self._last: tuple[str, str] | None = None
+
+    @property
+    def running(self) -> bool:
+        """Whether the skill has not ended yet."""
+        return self.status == "running"
+
+    def tick(self) -> bool:
+        """Tick the behaviour once; returns whether it has ended (succeeded or failed)."""
+        from py_trees.common import Status
+
+        behaviour = self.behaviour
+        behaviour.tick_once()
+        self.ticks += 1
+        seen = (behaviour.status.value, behaviour.feedback_message)
+        if seen != self._last:
+            self.trace.append(
+                {"t": round(self.world.now() - self.started, 4), "status": seen[0].lower(), "feedback": seen[1]}
+            )
+            self._last = seen
+        if behaviour.status == Status.SUCCESS:
+            self.status = "success"
+        elif behaviour.status == Status.FAILURE:
+            self.status = "failure"
+        return not self.running
+
+    def stop(self) -> None:
+        """Stop a running skill (py_trees runs its ``terminate``); it counts as ``timeout``."""
+        from py_trees.common import Status
+
+        if self.running:
+            self.behaviour.stop(Status.INVALID)
+            self.status = "timeout"
+
+    def result(self, timeout: float | None = None) -> SkillRun:
+        """What happened: the status, the skill's last feedback, the time taken and the world model's facts.
+
+        Args:
+            timeout: the time bound the session was stopped at, to say so when the skill said nothing.
+        """
+        reason = self.behaviour.feedback_message
+        if not reason and self.status == "timeout":
+            reason = "still running" + (f" after {timeout:.0f} s" if timeout is not None else "")
+        wm = self.world_model
+        facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
+        written = {Fact(key, args): value for key, args, value in wm.values()}
+        return SkillRun(
+            self.name,
+            self.robot,
+            self.status,
+            reason,
+            round(self.world.now() - self.started, 4),
+            self.ticks,
+            list(self.trace),
+            facts,
+            written,
+        )
+
+
 def run_skill(
     name: str,
     world: World,
@@ -124,64 +256,40 @@ def run_skill(
     ``skills`` (as ``--skills`` does on the command line, e.g.
     ``skills=["my_skills"]``). Pass one ``scratch`` dict to several calls to
     run a pipeline of skills step by step: each finds what the one before
-    left in the agent's scratch space (``context.scratch``).
+    left in the agent's scratch space (``context.scratch``). Several skills on
+    different robots at once: :func:`alica.skills.together.run_together`.
 
     Raises:
         SkillError: bad parameters, no such robot, or no implementation.
         UnknownSkillError: no skill of that name.
         SkillPluginError: a module of ``skills`` cannot be loaded.
     """
-    from py_trees.common import Status
-
-    from alica.engine.behaviours import SkillContext
-    from alica.worldmodel import WorldModel
-
-    if registry is not None and skills:
-        raise SkillError("run_skill takes a registry or plug-in modules (skills=...), not both")
-    modules = [skills] if isinstance(skills, str) else list(skills)
-    registry = registry if registry is not None else default_registry(modules)
-    spec = registry.get(name)
-    values = checked_params(spec, params or {})
-    if robot not in world.robots:
-        raise SkillError(f"the world has no robot named '{robot}' (robots: {', '.join(sorted(world.robots))})")
-    factory = registry.load(name)
-    wm = world_model if world_model is not None else WorldModel(robot, clock=world.clock)
-    belief: Any = wm  # alone, the world model is the skill's whole belief base
-    context = SkillContext(robot, world.now, wm, belief, random.Random(f"{seed}:{robot}"), world, None, f"skill/{name}")
-    if scratch is not None:
-        context.scratch = scratch  # shared with the skills run before and after: a pipeline, step by step
-    behaviour = factory(name, values, context)
-    behaviour.setup(context=context)
-    start = world.now()
+    registry = resolve_registry(registry, skills, "run_skill")
+    session = SkillSession(name, world, robot, params, registry, world_model=world_model, seed=seed, scratch=scratch)
     period = 1.0 / rate
-    trace: list[dict[str, object]] = []
-    ticks = 0
-    last: tuple[str, str] | None = None
-    status = "timeout"
     while True:
         if on_tick is not None:
-            on_tick(world, behaviour)
-        behaviour.tick_once()
-        ticks += 1
-        now = world.now()
-        seen = (behaviour.status.value, behaviour.feedback_message)
-        if seen != last:
-            trace.append({"t": round(now - start, 4), "status": seen[0].lower(), "feedback": seen[1]})
-            last = seen
-        if behaviour.status == Status.SUCCESS:
-            status = "success"
+            on_tick(world, session.behaviour)
+        if session.tick():
             break
-        if behaviour.status == Status.FAILURE:
-            status = "failure"
-            break
-        if now - start >= timeout:
-            behaviour.stop(Status.INVALID)
+        if world.now() - session.started >= timeout:
+            session.stop()
             break
         world.step(period)
-    reason = behaviour.feedback_message or ("" if status != "timeout" else f"still running after {timeout:.0f} s")
-    facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
-    written = {Fact(key, args): value for key, args, value in wm.values()}
-    return SkillRun(name, robot, status, reason, round(world.now() - start, 4), ticks, trace, facts, written)
+    return session.result(timeout)
+
+
+def resolve_registry(registry: SkillRegistry | None, skills: Iterable[str] | str, caller: str) -> SkillRegistry:
+    """``registry``, or the installed plug-ins with the plug-in modules ``skills`` (one of the two, not both).
+
+    Raises:
+        SkillError: both are given.
+        SkillPluginError: a module of ``skills`` cannot be loaded.
+    """
+    if registry is not None and skills:
+        raise SkillError(f"{caller} takes a registry or plug-in modules (skills=...), not both")
+    modules = [skills] if isinstance(skills, str) else list(skills)
+    return registry if registry is not None else default_registry(modules)
 
 
 # -- scoring maps against the ground truth (tests and benches) --------------------------

@@ -1,6 +1,8 @@
-"""Ready-made worlds: the blocks world (IMPERA Section 8.2) and the lunar field (Sections 2 and 6).
+"""Ready-made worlds: the blocks world (IMPERA Section 8.2), the lunar field (Sections 2 and 6) and lunar sites.
 
-Both are deterministic functions of their arguments.
+:func:`lunar_sites` is the lunar ground with robots and sample containers
+where the caller puts them (a dispatcher's grid, say), and a few rocks kept
+clear of given places. All are deterministic functions of their arguments.
 """
 
 from __future__ import annotations
@@ -9,6 +11,7 @@ import logging
 import math
 import random
 import string
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -16,9 +19,10 @@ from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import RobotWorld
 from alica.worldsim.objects import SAMPLE_KINDS
 from alica.worldsim.perception import FactPerception, Place
+from alica.worldsim.robots import ROBOT_KINDS
 from alica.worldsim.world import World
 
-__all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "random_stacks", "sample_names"]
+__all__ = ["block_names", "blocks_facts", "blocksworld", "lunar", "lunar_sites", "random_stacks", "sample_names"]
 
 logger = logging.getLogger(__name__)
 
@@ -346,4 +350,95 @@ def lunar(
     for name, angle in (("scout", 0.0), ("stummel", 2.0 * math.pi / 3.0), ("amparo", -2.0 * math.pi / 3.0)):
         world.add_robot(name, name, (1.5 * math.cos(angle), 1.5 * math.sin(angle), angle))
     world.step(0.1)  # let the samples settle
+    return world
+
+
+#: Free room (m) kept between a rock of :func:`lunar_sites` and a robot's footprint, a sample, another rock.
+SITE_ROOM = {"robot": 0.5, "sample": 0.8, "rock": 0.3, "border": 0.5}
+
+
+def lunar_sites(
+    seed: int = 0,
+    *,
+    bounds: Sequence[float],
+    robots: Sequence[tuple[str, str, Sequence[float]]] = (),
+    samples: Sequence[tuple[str, str, Sequence[float]]] = (),
+    rocks: int = 0,
+    keep_clear: Sequence[tuple[float, float, float]] = (),
+    rock_radius: tuple[float, float] = (0.2, 0.45),
+    time_step: float = 1.0 / 240.0,
+    gui: bool = False,
+) -> World:
+    """A lunar field with robots and sample containers at given places and a few seeded rocks.
+
+    The generic half of a scenario: positions in, world out. The caller (a
+    dispatcher laying a grid over the field, say) decides where robots and
+    samples go; this function adds the ground and the bodies, and places
+    ``rocks`` rocks at random (seeded) where they keep clear of every disc of
+    ``keep_clear``, of the robots and samples, of each other and of the
+    field's border (by :data:`SITE_ROOM`).
+
+    Args:
+        seed: seeds the world and the rocks' layout.
+        bounds: the field ``(xmin, ymin, xmax, ymax)`` in metres.
+        robots: ``(name, kind, (x, y, yaw))`` per robot (kinds of
+            :data:`~alica.worldsim.robots.ROBOT_KINDS`).
+        samples: ``(name, kind, (x, y))`` per sample container (kinds of
+            :data:`~alica.worldsim.objects.SAMPLE_KINDS`).
+        rocks: how many rocks.
+        keep_clear: ``(x, y, radius)`` discs no rock may touch (where robots
+            will drive and stand, say).
+        rock_radius: the smallest and largest rock radius in metres.
+        time_step: the physics step.
+        gui: show the pybullet window (when a display is available).
+
+    Raises:
+        WorldError: a negative rock count, a bad radius range, rocks that do
+            not fit, or a robot or sample off the field or overlapping another
+            body (the message says which).
+    """
+    if rocks < 0:
+        raise WorldError(f"lunar_sites: rocks must be >= 0, got {rocks}")
+    low, high = (float(v) for v in rock_radius)
+    if not 0.0 < low <= high:
+        raise WorldError(
+            f"lunar_sites: rock_radius is (smallest, largest) with 0 < smallest <= largest, got {rock_radius}"
+        )
+    world = World(seed, gui=gui, time_step=time_step, bounds=bounds)
+    try:
+        xmin, ymin, xmax, ymax = world.bounds
+        taken: list[tuple[float, float, float]] = [(float(x), float(y), float(radius)) for x, y, radius in keep_clear]
+        for _, kind, pose in robots:
+            radius = ROBOT_KINDS[kind].radius if kind in ROBOT_KINDS else 0.5
+            taken.append((float(pose[0]), float(pose[1]), radius + SITE_ROOM["robot"]))
+        taken.extend((float(position[0]), float(position[1]), SITE_ROOM["sample"]) for _, _, position in samples)
+        layout = np.random.default_rng([int(seed), 11])
+        placed = 0
+        attempts = 0
+        border = SITE_ROOM["border"]
+        while placed < rocks:
+            attempts += 1
+            if attempts > 500 * rocks:
+                raise WorldError(
+                    f"lunar_sites: could only place {placed} of {rocks} rocks clear of the robots, the samples and "
+                    f"the places to keep clear; ask for fewer rocks or a larger field"
+                )
+            r = float(layout.uniform(low, high))
+            if xmax - xmin <= 2.0 * (r + border) or ymax - ymin <= 2.0 * (r + border):
+                continue
+            x = float(layout.uniform(xmin + r + border, xmax - r - border))
+            y = float(layout.uniform(ymin + r + border, ymax - r - border))
+            if any(math.hypot(x - cx, y - cy) < r + cr for cx, cy, cr in taken):
+                continue
+            placed += 1
+            world.add_rock(f"rock{placed}", (x, y), r, seed=int(layout.integers(2**31)))
+            taken.append((x, y, r + SITE_ROOM["rock"]))
+        for name, kind, position in samples:
+            world.add_sample(name, kind, (float(position[0]), float(position[1])))
+        for name, kind, pose in robots:
+            world.add_robot(kind, name, tuple(float(v) for v in pose))
+        world.step(0.1)  # let the samples settle
+    except BaseException:
+        world.close()
+        raise
     return world

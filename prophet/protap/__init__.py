@@ -1,4 +1,4 @@
-"""ProTaP: the paper's RDDL domain (fixed), problem generation (Algorithm 2), a fast simulator and a planner.
+"""ProTaP: the paper's RDDL domain (fixed), problem generation (Algorithm 2), a fast simulator, a planner, a dispatcher.
 
 >>> spec = random_spec(robots=2, width=5, height=5, goals=3, seed=0)
 >>> model = ProtapModel(spec)
@@ -8,6 +8,19 @@ True
 
 from __future__ import annotations
 
+from alica.prophet.protap.dispatch import (
+    ActionCall,
+    Activity,
+    Episode,
+    Executor,
+    ModelExecutor,
+    RobotCalls,
+    RobotOutcome,
+    StepRecord,
+    calls,
+    observe,
+    run_dispatched,
+)
 from alica.prophet.protap.generate import (
     appendix_c_spec,
     domain_text,
@@ -38,12 +51,17 @@ __all__ = [
     "NOOP",
     "USER_DEFINED",
     "Action",
+    "ActionCall",
+    "Activity",
     "Budget",
     "Cell",
     "Determinisation",
+    "Episode",
     "Evaluation",
+    "Executor",
     "Goal",
     "JointAction",
+    "ModelExecutor",
     "PlannerPolicy",
     "Policy",
     "ProblemSpec",
@@ -52,16 +70,22 @@ __all__ = [
     "Recorder",
     "Robot",
     "RobotAction",
+    "RobotCalls",
+    "RobotOutcome",
     "State",
+    "StepRecord",
     "appendix_c_spec",
+    "calls",
     "domain_text",
     "evaluate",
     "greedy",
     "instance_text",
     "is_object_name",
+    "observe",
     "random_policy",
     "random_spec",
     "rddl_name",
+    "run_dispatched",
     "spec_from_facts",
     "write_problem",
 ]

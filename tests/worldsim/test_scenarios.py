@@ -1,4 +1,4 @@
-"""The blocks world and the lunar field: defaults that run, IPC facts, layout rules, errors."""
+"""The blocks world, the lunar field and lunar sites: defaults that run, IPC facts, layout rules, errors."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from alica.worldsim.errors import WorldError
 from alica.worldsim.objects import SAMPLE_KINDS
-from alica.worldsim.scenarios import blocks_facts, blocksworld, lunar, sample_names
+from alica.worldsim.scenarios import blocks_facts, blocksworld, lunar, lunar_sites, sample_names
 
 
 def test_blocksworld_defaults() -> None:
@@ -118,3 +118,47 @@ def test_lunar_errors() -> None:
         lunar(size=5.0)
     with pytest.raises(WorldError, match="could only place"):
         lunar(rocks=500, size=12.0)
+
+
+def _sites(**overrides: object):
+    arguments: dict[str, object] = {
+        "bounds": (-6.0, -6.0, 6.0, 6.0),
+        "robots": [("r1", "stummel", (-3.0, -2.0, 0.0)), ("r2", "stummel", (2.0, 3.0, math.pi))],
+        "samples": [("g1", SAMPLE_KINDS[0], (-3.0, -3.0)), ("g2", SAMPLE_KINDS[1], (3.0, 3.0))],
+        "rocks": 6,
+        "keep_clear": [(x, y, 1.6) for x in (-3.0, 0.0, 3.0) for y in (-3.0, 0.0, 3.0)],
+    }
+    arguments.update(overrides)
+    return lunar_sites(1, **arguments)  # type: ignore[arg-type]
+
+
+def test_lunar_sites_put_robots_and_samples_where_asked_and_rocks_clear_of_them() -> None:
+    with _sites() as w:
+        assert w.bounds == (-6.0, -6.0, 6.0, 6.0)
+        assert {n: r.spec.kind for n, r in w.robots.items()} == {"r1": "stummel", "r2": "stummel"}
+        assert w.robots["r1"].pose == pytest.approx((-3.0, -2.0, 0.0))
+        assert np.allclose(w.objects["g2"].position()[:2], (3.0, 3.0), atol=0.01)
+        rocks = [o for o in w.objects.values() if o.kind == "rock"]
+        assert len(rocks) == 6
+        for rock in rocks:
+            x, y = rock.position()[:2]
+            assert all(math.hypot(x - cx, y - cy) >= 1.6 + rock.radius - 1e-9 for cx in (-3, 0, 3) for cy in (-3, 0, 3))
+            assert all(
+                math.hypot(x - r.pose[0], y - r.pose[1]) > r.spec.radius + rock.radius for r in w.robots.values()
+            )
+        layout = sorted(tuple(np.round(o.position()[:2], 6)) for o in rocks)
+    with _sites() as again:
+        assert (
+            sorted(tuple(np.round(o.position()[:2], 6)) for o in again.objects.values() if o.kind == "rock") == layout
+        )
+
+
+def test_lunar_sites_errors() -> None:
+    with pytest.raises(WorldError, match="could only place"):
+        _sites(rocks=40, keep_clear=[(0.0, 0.0, 5.5)])
+    with pytest.raises(WorldError, match="rocks must be >= 0"):
+        _sites(rocks=-1)
+    with pytest.raises(WorldError, match="off the field"):
+        _sites(robots=[("r1", "stummel", (9.0, 0.0, 0.0))], rocks=0)
+    with pytest.raises(WorldError, match="overlap"):
+        _sites(robots=[("r1", "stummel", (0.0, 0.0, 0.0)), ("r2", "stummel", (0.2, 0.0, 0.0))], rocks=0)
