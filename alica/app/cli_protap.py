@@ -44,24 +44,24 @@ def _count(text: str) -> int:
     return int(text)
 
 
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not value >= 0:
-        raise argparse.ArgumentTypeError(f"expected 0 or more seconds, got {text!r}")
-    return value
+def _number(what: str, *, zero: bool) -> Any:
+    """An argparse type: a number of ``what`` (``"seconds"``, ``"metres"``) above 0, or from 0 with ``zero``."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number of {what}, got {text!r}") from None
+        if not (value >= 0 if zero else value > 0) or value == float("inf"):
+            bound = "0 or more" if zero else "more than 0"
+            raise argparse.ArgumentTypeError(f"expected {bound} {what}, got {text!r}")
+        return value
+
+    return parse
 
 
-def _metres(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a length in metres, got {text!r}") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"expected a length above 0 m, got {text!r}")
-    return value
+_seconds = _number("seconds", zero=True)
+_metres = _number("metres", zero=False)
 
 
 def _whole(text: str) -> int:
