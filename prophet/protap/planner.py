@@ -48,7 +48,7 @@ import random
 import time
 from dataclasses import dataclass
 
-from alica.prophet.protap.heuristic import Determinisation
+from alica.prophet.protap.heuristic import Determinisation, cache_key
 from alica.prophet.protap.model import NOOP, JointAction, ProtapModel, State
 
 
@@ -127,10 +127,9 @@ class ProtapPlanner:
         self.max_targets = max_targets
         self.last_trials = 0
         self._slots = 2 * len(model.spec.robots)
-        # keys are plain tuples of ints, never State (see Determinisation._values): the garbage collector
-        # untracks them, which keeps its full collections short while the tree grows
-        self._tree: dict[tuple[tuple[int, ...], int, int], _Node] = {}
-        self._joint_values: dict[tuple[tuple[int, ...], int, int, JointAction], float] = {}
+        # keyed by cache_key (bytes), never by State: see there why
+        self._tree: dict[bytes, _Node] = {}
+        self._joint_values: dict[bytes, float] = {}
         self._deadline: float | None = None
 
     def reset(self) -> None:
@@ -197,7 +196,7 @@ class ProtapPlanner:
             if deadline is not None and time.perf_counter() >= deadline:
                 raise _OutOfTime
             joint = self.heuristic.complete(state, (*prefix, code))
-            key = (state.cells, state.done, steps, joint)
+            key = cache_key(state, steps, joint)
             value = cache.get(key)
             if value is None:
                 value = self.heuristic.action_value(state, steps, joint)
@@ -228,10 +227,11 @@ class ProtapPlanner:
         path: list[tuple[list[tuple[_Node, int]], float]] = []
         leaf = 0.0
         while steps > 0:
-            node: _Node | None = tree.get((state.cells, state.done, steps))
+            key = cache_key(state, steps)
+            node: _Node | None = tree.get(key)
             if node is None:
                 root = self._expand(state, steps, (), self.choices(state, 0, 0, 0))
-                tree[(state.cells, state.done, steps)] = root
+                tree[key] = root
                 leaf = max(root.q)
                 break
             chain: list[tuple[_Node, int]] = []
@@ -270,7 +270,7 @@ class ProtapPlanner:
                 node_.q[index] += (value - node_.q[index]) / count
 
     def _best(self, state: State, steps: int) -> JointAction:
-        node = self._tree.get((state.cells, state.done, steps))
+        node = self._tree.get(cache_key(state, steps))
         prefix: list[int] = []
         for _ in range(self._slots):
             if node is None:
