@@ -290,6 +290,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_skills_option(p)
     p.set_defaults(run=_cmd_list_skills)
 
+    from alica.app.center.cli import add_parser as add_center_parser
     from alica.app.cli_agent import add_parser as add_agent_parser
     from alica.app.cli_demo import add_parser as add_demo_parser
     from alica.app.cli_plan import add_parser as add_plan_parser
@@ -305,6 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_solve_parser(sub)
     add_demo_parser(sub)
     add_protap_parser(sub)
+    add_center_parser(sub)
     return parser
 
 

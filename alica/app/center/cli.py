@@ -1,0 +1,60 @@
+"""``alica center``: serve the control center's page for a trace replay or a plan file."""
+
+from __future__ import annotations
+
+import argparse
+import secrets
+from typing import Any
+
+from alica.errors import AlicaError
+
+
+def _cmd_center(args: argparse.Namespace) -> int:
+    from alica.app.center.server import plan_app, replay_app, serve
+
+    token = args.token or secrets.token_urlsafe(24)
+    if args.trace is not None:
+        from alica.app.center.replay import Replay
+        from alica.app.center.trace_file import load_trace
+
+        app = replay_app(Replay(load_trace(args.trace)), token)
+    else:
+        app = plan_app(args.plan, *plan_views(args.plan), token)
+    serve(app, args.host, args.port, token)
+    return 0
+
+
+def plan_views(path: str) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
+    """The plan trees (data and SVG) of a plan file's top-level plans.
+
+    Raises:
+        PlanFormatError: the plan file does not load.
+        AlicaError: it defines nothing to draw.
+    """
+    from alica.app.center.plan_view import plan_svg, plan_tree
+    from alica.app.cli import _load, _roots
+
+    library, entry = _load(path)
+    roots = _roots(library, entry, None)
+    if not roots:
+        raise AlicaError(f"{path} defines no plan, planning problem or behaviour to draw")
+    return {r: plan_tree(library, r) for r in roots}, {r: plan_svg(library, r) for r in roots}
+
+
+def add_parser(sub: Any) -> None:
+    """Register ``alica center``."""
+    p = sub.add_parser(
+        "center",
+        help="serve the control center: replay a trace or draw a plan file in a web page",
+        description="Serve the control center's web page on HOST:PORT and print the one line to open, "
+        "http://HOST:PORT/?token=TOKEN. Every request needs the token. --trace replays a recorded trace "
+        "(time slider, play at 1x-10x, next fault or replan, agents, event log, map of poses); --plan draws "
+        "the plan tree of a plan file. Stop it with Ctrl-C.",
+    )
+    what = p.add_mutually_exclusive_group(required=True)
+    what.add_argument("--trace", metavar="FILE", help="a trace (JSON Lines) to replay")
+    what.add_argument("--plan", metavar="FILE", help="a plan file (YAML or XML) to draw")
+    p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
+    p.add_argument("--port", type=int, default=8765, help="port (default 8765; 0 picks a free one)")
+    p.add_argument("--token", help="the access token (default: a new random one)")
+    p.set_defaults(run=_cmd_center)

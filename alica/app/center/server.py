@@ -1,0 +1,182 @@
+"""The control center's web server: a Starlette app behind a Jupyter-style token.
+
+Every request (page, API, static file) must carry the token: as the query
+parameter ``token=``, as the cookie the first visit sets, or as an
+``Authorization: Bearer`` header. Without it the answer is 403.
+"""
+
+from __future__ import annotations
+
+import hmac
+import socket
+import sys
+from importlib import resources
+from typing import Any, TextIO
+
+from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
+from starlette.requests import Request
+from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
+from starlette.routing import Route
+
+from alica.app.center.replay import FAULT_KINDS, REPLAN_KINDS, Replay
+
+COOKIE = "alica_center_token"
+
+
+class TokenGate(BaseHTTPMiddleware):
+    """Refuses (403) every request that does not carry the token; sets the cookie on a good first visit."""
+
+    def __init__(self, app: Any, token: str) -> None:
+        super().__init__(app)
+        self.token = token
+
+    def _given(self, request: Request) -> tuple[str | None, bool]:
+        query = request.query_params.get("token")
+        if query is not None:
+            return query, True
+        auth = request.headers.get("authorization", "")
+        if auth.lower().startswith("bearer "):
+            return auth[7:].strip(), False
+        return request.cookies.get(COOKIE), False
+
+    async def dispatch(self, request: Request, call_next: RequestResponseEndpoint) -> Response:
+        given, from_query = self._given(request)
+        if given is None or not hmac.compare_digest(given.encode(), self.token.encode()):
+            return PlainTextResponse("403: this page needs the token printed by 'alica center'\n", status_code=403)
+        response = await call_next(request)
+        if from_query:
+            response.set_cookie(COOKIE, self.token, httponly=True, samesite="strict")
+        return response
+
+
+def _static(name: str) -> str:
+    return resources.files("alica.app.center").joinpath("static", name).read_text(encoding="utf-8")
+
+
+STATIC_TYPES = {".js": "text/javascript", ".css": "text/css", ".html": "text/html"}
+
+
+async def _static_file(request: Request) -> Response:
+    name = request.path_params["name"]
+    suffix = name[name.rfind(".") :] if "." in name else ""
+    if "/" in name or suffix not in STATIC_TYPES:
+        return PlainTextResponse("not found\n", status_code=404)
+    try:
+        text = _static(name)
+    except (FileNotFoundError, OSError):
+        return PlainTextResponse("not found\n", status_code=404)
+    return Response(text, media_type=STATIC_TYPES[suffix])
+
+
+def _number(request: Request, name: str) -> float | None:
+    raw = request.query_params.get(name)
+    if raw in (None, ""):
+        return None
+    try:
+        return float(raw)
+    except ValueError:
+        raise ValueError(f"'{name}' must be a number, not {raw!r}") from None
+
+
+def replay_app(replay: Replay, token: str) -> Starlette:
+    """The app of a trace replay: the page and ``/api/meta``, ``/api/events``, ``/api/state``, ``/api/next``."""
+
+    async def page(request: Request) -> Response:
+        return HTMLResponse(_static("replay.html"))
+
+    async def meta(request: Request) -> Response:
+        return JSONResponse(replay.meta())
+
+    async def events(request: Request) -> Response:
+        try:
+            start, end = _number(request, "start"), _number(request, "end")
+        except ValueError as exc:
+            return JSONResponse({"error": str(exc)}, status_code=400)
+        raw = request.query_params.get("kinds")
+        kinds = {k for k in raw.split(",") if k} if raw else None
+        return JSONResponse({"events": replay.window(start, end, kinds)})
+
+    async def state(request: Request) -> Response:
+        try:
+            t = _number(request, "t")
+        except ValueError as exc:
+            return JSONResponse({"error": str(exc)}, status_code=400)
+        return JSONResponse(replay.state(replay.meta()["end"] if t is None else t))
+
+    async def next_event(request: Request) -> Response:
+        kind = request.query_params.get("kind", "")
+        kinds = {"fault": FAULT_KINDS, "replan": REPLAN_KINDS}.get(kind)
+        if kinds is None:
+            return JSONResponse({"error": "kind must be 'fault' or 'replan'"}, status_code=400)
+        try:
+            after = _number(request, "after")
+        except ValueError as exc:
+            return JSONResponse({"error": str(exc)}, status_code=400)
+        return JSONResponse({"kind": kind, "t": replay.next_time(-1e300 if after is None else after, kinds)})
+
+    routes = [
+        Route("/", page),
+        Route("/api/meta", meta),
+        Route("/api/events", events),
+        Route("/api/state", state),
+        Route("/api/next", next_event),
+        Route("/static/{name}", _static_file),
+    ]
+    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+
+
+def plan_app(file: str, trees: dict[str, dict[str, Any]], svgs: dict[str, str], token: str) -> Starlette:
+    """The app of the plan-file view: the page, ``/api/plan`` (the trees as JSON) and ``/api/plan.svg``."""
+
+    async def page(request: Request) -> Response:
+        return HTMLResponse(_static("plan.html"))
+
+    async def plan(request: Request) -> Response:
+        return JSONResponse({"file": file, "roots": list(trees), "trees": trees})
+
+    async def plan_svg(request: Request) -> Response:
+        root = request.query_params.get("root") or next(iter(svgs))
+        if root not in svgs:
+            return PlainTextResponse(f"no plan tree '{root}' in {file}\n", status_code=404)
+        return Response(svgs[root], media_type="image/svg+xml")
+
+    routes = [
+        Route("/", page),
+        Route("/api/plan", plan),
+        Route("/api/plan.svg", plan_svg),
+        Route("/static/{name}", _static_file),
+    ]
+    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+
+
+def bind(host: str, port: int) -> socket.socket:
+    """A listening socket on ``host:port``; port 0 picks a free port.
+
+    Raises:
+        OSError: the address cannot be bound.
+    """
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    sock.listen(128)
+    return sock
+
+
+def address(host: str, sock: socket.socket, token: str) -> str:
+    """The one line to open: ``http://HOST:PORT/?token=TOKEN`` with the port really bound."""
+    port = sock.getsockname()[1]
+    shown = f"[{host}]" if ":" in host else host
+    return f"http://{shown}:{port}/?token={token}"
+
+
+def serve(app: Starlette, host: str, port: int, token: str, out: TextIO = sys.stdout) -> None:
+    """Bind, print the address line, and serve until interrupted."""
+    import uvicorn
+
+    sock = bind(host, port)
+    print(address(host, sock, token), file=out, flush=True)
+    config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off")
+    uvicorn.Server(config).run(sockets=[sock])
