@@ -62,8 +62,8 @@ def _node(library: PlanLibrary, name: str, shown: set[str]) -> dict[str, Any]:
 
 # -- drawing ---------------------------------------------------------------
 
-PAD, GAP, R, HEAD = 12, 16, 22, 22
-STATE_W = 120
+PAD, GAP, R, HEAD = 12.0, 16.0, 22.0, 22.0
+STATE_W = 120.0
 
 
 def plan_svg(library: PlanLibrary, root: str) -> str:

@@ -8,10 +8,10 @@ from typing import Any
 from alica.app.center.trace_file import Trace
 
 FAULT_KINDS = frozenset({"fault", "failure"})
-"""Events the "next fault" button jumps to."""
+"""Events the "next fault" button jumps to: injected faults (crash, recover, partition) and plan failures."""
 
 REPLAN_KINDS = frozenset({"replan"})
-"""Events the "next replan" button jumps to (also ``planner`` events that say a new plan was shared)."""
+"""Events the "next replan" button jumps to: the leader plans again after a failed step or a changed team."""
 
 
 class Replay:
@@ -65,7 +65,7 @@ class Replay:
         """The time of the first event of ``kinds`` strictly after ``after``, or ``None``."""
         for i in range(bisect.bisect_right(self.times, after), len(self.events)):
             e = self.events[i]
-            if e["event"] in kinds or (kinds is REPLAN_KINDS and _is_new_plan(e)):
+            if e["event"] in kinds:
                 return self.times[i]
         return None
 
@@ -114,7 +114,3 @@ def _enter(who: dict[str, Any], event: dict[str, Any]) -> None:
     last = who["key"] or ""
     if key.count("/") >= last.count("/") or not last.startswith(key):
         who["key"], who["plan"] = key, event.get("plan", who["plan"])
-
-
-def _is_new_plan(event: dict[str, Any]) -> bool:
-    return event["event"] == "planner" and event.get("what") in ("shared", "plan", "found")

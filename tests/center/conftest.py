@@ -1,0 +1,57 @@
+"""Traces for the control center's tests: one recorded by ``alica run``, one written by hand with replans and poses."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from alica.app.cli import main
+from alica.io import plans_dir
+
+TOKEN = "test-token"
+
+
+@pytest.fixture(scope="session")
+def recorded_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The formation example run by three robots, r2 crashing at 1 s."""
+    path = tmp_path_factory.mktemp("center") / "formation.jsonl"
+    code = main(
+        [
+            "run",
+            str(plans_dir() / "examples" / "formation.yaml"),
+            "--agents",
+            "r1:Robot,r2:Robot,r3:Robot",
+            "--stand-ins",
+            "--crash",
+            "r2@1",
+            "--max-time",
+            "5",
+            "--trace",
+            str(path),
+        ]
+    )
+    assert code in (0, 1)
+    assert path.stat().st_size > 0
+    return path
+
+
+@pytest.fixture()
+def written_trace(tmp_path: Path) -> Path:
+    """A header line, allocations, a transition, two replans, a crash and poses."""
+    events = [
+        {"event": "trace", "format": "alica-trace", "version": 2, "agents": ["a", "b"], "roles": {"a": "Scout"}},
+        {"t": 0.0, "agent": "a", "event": "allocation", "key": "Top", "plan": "Top", "entries": {"a": "Go", "b": "Go"}},
+        {"t": 0.0, "agent": "b", "event": "allocation", "key": "Top", "plan": "Top", "entries": {"a": "Go", "b": "Go"}},
+        {"t": 0.5, "agent": "a", "event": "pose", "x": 0.0, "y": 0.0, "yaw": 0.0},
+        {"t": 1.0, "agent": "a", "event": "transition", "key": "Top", "plan": "Top", "source": "S1", "target": "S2"},
+        {"t": 1.5, "agent": "a", "event": "pose", "x": 1.0, "y": 2.0, "yaw": 0.5},
+        {"t": 2.0, "agent": "a", "event": "replan", "key": "Top/S2/P", "reason": "a step failed"},
+        {"t": 3.0, "agent": "-", "event": "fault", "fault": "crash", "agent_name": "b"},
+        {"t": 3.0, "agent": "b", "event": "fault", "fault": "crash"},
+        {"t": 4.0, "agent": "a", "event": "replan", "key": "Top/S2/P", "reason": "b lost"},
+    ]
+    path = tmp_path / "written.jsonl"
+    path.write_text("".join(json.dumps(e) + "\n" for e in events), encoding="utf-8")
+    return path

@@ -1,0 +1,186 @@
+"""The control center's server: the token, the replay API, the plan view, and the start-up line."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+import urllib.request
+from pathlib import Path
+
+import pytest
+from starlette.testclient import TestClient
+
+from alica.app.center.cli import plan_views
+from alica.app.center.replay import Replay
+from alica.app.center.server import COOKIE, plan_app, replay_app
+from alica.app.center.trace_file import load_trace
+from alica.io import plans_dir
+
+from .conftest import TOKEN
+
+
+def _client(trace: Path) -> TestClient:
+    return TestClient(replay_app(Replay(load_trace(trace)), TOKEN))
+
+
+@pytest.mark.parametrize("path", ["/", "/api/meta", "/api/state?t=0", "/api/events", "/static/replay.js"])
+def test_every_request_without_the_token_is_refused(written_trace: Path, path: str) -> None:
+    client = _client(written_trace)
+    assert client.get(path).status_code == 403
+    assert client.get(path + ("&" if "?" in path else "?") + "token=wrong").status_code == 403
+    assert client.get(path, headers={"Authorization": "Bearer wrong"}).status_code == 403
+
+
+def test_the_token_opens_the_page_and_sets_a_cookie_for_the_rest(written_trace: Path) -> None:
+    client = _client(written_trace)
+    page = client.get(f"/?token={TOKEN}")
+    assert page.status_code == 200
+    assert "alica control center" in page.text
+    assert client.cookies.get(COOKIE) == TOKEN
+    assert client.get("/api/meta").status_code == 200  # the cookie alone
+    assert client.get("/static/replay.js").status_code == 200
+    assert client.get("/static/style.css").status_code == 200
+
+
+def test_a_bearer_header_is_enough(written_trace: Path) -> None:
+    client = _client(written_trace)
+    response = client.get("/api/meta", headers={"Authorization": f"Bearer {TOKEN}"})
+    assert response.status_code == 200
+
+
+def test_meta_and_state_of_a_recorded_run(recorded_trace: Path) -> None:
+    client = _client(recorded_trace)
+    client.cookies.set(COOKIE, TOKEN)
+    meta = client.get("/api/meta").json()
+    assert meta["agents"] == ["r1", "r2", "r3"]
+    assert meta["kinds"]["allocation"] >= 3
+    assert meta["kinds"]["fault"] >= 1
+    assert meta["poses"] is False
+    assert meta["duration"] > 0
+    start = client.get(f"/api/state?t={meta['start']}").json()["agents"]
+    assert start["r1"]["plan"] == "Formation"
+    assert start["r1"]["task"] is not None
+    assert all(a["alive"] for a in start.values())
+    end = client.get(f"/api/state?t={meta['end']}").json()["agents"]
+    assert end["r2"]["alive"] is False
+    assert end["r1"]["alive"] is True
+    fault = client.get("/api/next?kind=fault&after=0").json()["t"]
+    assert fault == pytest.approx(1.0, abs=0.2)
+
+
+def test_state_follows_transitions_crashes_and_header_roles(written_trace: Path) -> None:
+    client = _client(written_trace)
+    client.cookies.set(COOKIE, TOKEN)
+    before = client.get("/api/state?t=0.9").json()["agents"]
+    assert before["a"] == {
+        "role": "Scout",
+        "task": "Go",
+        "alive": True,
+        "plan": "Top",
+        "state": None,
+        "key": "Top",
+        "behaviour": None,
+        "pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},
+    }
+    after = client.get("/api/state?t=3.5").json()["agents"]
+    assert after["a"]["state"] == "S2"
+    assert after["a"]["pose"] == {"x": 1.0, "y": 2.0, "yaw": 0.5}
+    assert after["b"]["alive"] is False
+    assert client.get("/api/meta").json()["poses"] is True
+
+
+def test_next_replan_jumps_from_replan_to_replan(written_trace: Path) -> None:
+    client = _client(written_trace)
+    client.cookies.set(COOKIE, TOKEN)
+    assert client.get("/api/next?kind=replan&after=0").json()["t"] == 2.0
+    assert client.get("/api/next?kind=replan&after=2.0").json()["t"] == 4.0
+    assert client.get("/api/next?kind=replan&after=4.0").json()["t"] is None
+    assert client.get("/api/next?kind=fault&after=0").json()["t"] == 3.0
+    assert client.get("/api/next?kind=nonsense").status_code == 400
+    assert client.get("/api/next?kind=replan&after=soon").status_code == 400
+
+
+def test_events_by_window_and_kind(written_trace: Path) -> None:
+    client = _client(written_trace)
+    client.cookies.set(COOKIE, TOKEN)
+    everything = client.get("/api/events").json()["events"]
+    assert len(everything) == 9
+    window = client.get("/api/events?start=1&end=3&kinds=replan,fault").json()["events"]
+    assert [(e["t"], e["event"]) for e in window] == [(2.0, "replan"), (3.0, "fault"), (3.0, "fault")]
+
+
+@pytest.mark.parametrize(
+    ("file", "root", "expected"),
+    [
+        ("examples/formation.yaml", "Formation", ["plan", "state"]),
+        ("blocksworld/mission.yaml", None, ["plan", "state", "problem"]),
+    ],
+)
+def test_the_plan_view_draws_a_plan_file(file: str, root: str | None, expected: list[str]) -> None:
+    path = str(plans_dir() / file)
+    trees, svgs = plan_views(path)
+    if root is not None:
+        assert list(trees) == [root]
+    client = TestClient(plan_app(path, trees, svgs, TOKEN))
+    assert client.get("/api/plan").status_code == 403
+    client.cookies.set(COOKIE, TOKEN)
+    assert "plan file" in client.get("/").text
+    data = client.get("/api/plan").json()
+    assert data["roots"] == list(trees)
+    tree = data["trees"][data["roots"][0]]
+    assert tree["kind"] == "plan"
+    assert tree["states"]
+    response = client.get("/api/plan.svg")
+    assert response.headers["content-type"].startswith("image/svg+xml")
+    text = response.text
+    assert text.startswith("<svg")
+    for kind in expected:
+        assert f'class="{kind}"' in text
+    for state in tree["states"]:
+        assert f'data-state="{state["name"]}"' in text
+    assert client.get("/api/plan.svg?root=Nothing").status_code == 404
+
+
+def test_the_start_up_line_names_the_real_port_and_the_page_loads(recorded_trace: Path) -> None:
+    process = subprocess.Popen(
+        [sys.executable, "-m", "alica.app.cli", "center", "--trace", str(recorded_trace), "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        line = process.stdout.readline().strip()
+        match = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]{20,})", line)
+        assert match, line
+        assert int(match.group(1)) > 0
+        with urllib.request.urlopen(line, timeout=10) as response:
+            assert response.status == 200
+            assert "alica control center" in response.read().decode()
+        with pytest.raises(urllib.error.HTTPError) as refused:
+            urllib.request.urlopen(f"http://127.0.0.1:{match.group(1)}/api/meta", timeout=10)
+        assert refused.value.code == 403
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+
+
+def test_a_blocks_world_demo_trace_replays(tmp_path: Path) -> None:
+    from alica.app.cli import main
+
+    assert main(["demo", "blocksworld", "--agents", "2", "--blocks", "3", "--seed", "1", "--out", str(tmp_path)]) == 0
+    client = _client(tmp_path / "trace.jsonl")
+    client.cookies.set(COOKIE, TOKEN)
+    meta = client.get("/api/meta").json()
+    assert meta["agents"] == ["r1", "r2"]
+    assert meta["kinds"]["planner"] >= 1
+    agents = client.get(f"/api/state?t={meta['end']}").json()["agents"]
+    assert {a["plan"] for a in agents.values()} <= {
+        *(e["plan"] for e in client.get("/api/events?kinds=allocation,transition").json()["events"])
+    }
+    assert all(a["plan"] for a in agents.values())
