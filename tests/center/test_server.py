@@ -184,3 +184,17 @@ def test_a_blocks_world_demo_trace_replays(tmp_path: Path) -> None:
         *(e["plan"] for e in client.get("/api/events?kinds=allocation,transition").json()["events"])
     }
     assert all(a["plan"] for a in agents.values())
+
+
+def test_the_page_files_are_package_data() -> None:
+    import fnmatch
+    import tomllib
+
+    root = Path(__file__).resolve().parents[2]
+    config = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["tool"]["setuptools"]
+    globs = config["package-data"]["alica.app.center"]
+    static = root / "alica" / "app" / "center" / "static"
+    files = [p.relative_to(static.parent).as_posix() for p in static.iterdir()]
+    assert {"static/replay.html", "static/replay.js", "static/plan.html", "static/style.css"} <= set(files)
+    for name in files:
+        assert any(fnmatch.fnmatch(name, g) for g in globs), f"{name} is not in the wheel's package data"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import secrets
+import sys
 from typing import Any
 
 from alica.errors import AlicaError
@@ -15,9 +16,14 @@ def _cmd_center(args: argparse.Namespace) -> int:
     token = args.token or secrets.token_urlsafe(24)
     if args.trace is not None:
         from alica.app.center.replay import Replay
-        from alica.app.center.trace_file import load_trace
+        from alica.app.center.trace_file import TraceFormatError, load_trace
 
-        app = replay_app(Replay(load_trace(args.trace)), token)
+        try:
+            trace = load_trace(args.trace)
+        except TraceFormatError as exc:  # already FILE:LINE: error: ..., as a compiler says it
+            print(exc, file=sys.stderr)
+            return 1
+        app = replay_app(Replay(trace), token)
     else:
         app = plan_app(args.plan, *plan_views(args.plan), token)
     serve(app, args.host, args.port, token)

@@ -16,6 +16,19 @@ from typing import Any
 from alica.errors import AlicaError
 
 
+class TraceFormatError(AlicaError, ValueError):
+    """A line of a trace file that cannot be read; the message is ``FILE:LINE: error: ...``.
+
+    Attributes:
+        file: the trace file.
+        line: the line number, from 1.
+    """
+
+    def __init__(self, file: str, line: int, message: str) -> None:
+        self.file, self.line = file, line
+        super().__init__(f"{file}:{line}: error: {message}")
+
+
 @dataclass(slots=True)
 class Trace:
     """The events of a trace, in file order, and its header if it has one."""
@@ -29,8 +42,8 @@ def load_trace(path: str | Path) -> Trace:
     """Read a trace file.
 
     Raises:
-        AlicaError: the file is missing or unreadable, or a line is not a JSON
-            object with a numeric ``t`` and a string ``event`` (``FILE:LINE: error: ...``).
+        AlicaError: the file is missing or unreadable.
+        TraceFormatError: a line is not a JSON object with a numeric ``t`` and a string ``event``.
     """
     name = str(path)
     try:
@@ -47,17 +60,17 @@ def load_trace(path: str | Path) -> Trace:
         try:
             record = json.loads(line)
         except json.JSONDecodeError as exc:
-            raise AlicaError(f"{name}:{number}: error: not JSON ({exc.msg} at column {exc.colno})") from None
+            raise TraceFormatError(name, number, f"not JSON ({exc.msg} at column {exc.colno})") from None
         if not isinstance(record, dict):
-            raise AlicaError(f"{name}:{number}: error: a trace line must be a JSON object")
+            raise TraceFormatError(name, number, "a trace line must be a JSON object")
         if record.get("event") == "trace" and not events and not meta:
             meta = record
             continue
         if not isinstance(record.get("event"), str):
-            raise AlicaError(f"{name}:{number}: error: the line has no 'event' name")
+            raise TraceFormatError(name, number, "the line has no 'event' name")
         t = record.get("t")
         if isinstance(t, bool) or not isinstance(t, int | float):
-            raise AlicaError(f"{name}:{number}: error: the line has no numeric time 't'")
+            raise TraceFormatError(name, number, "the line has no numeric time 't'")
         events.append(record)
     events.sort(key=lambda e: float(e["t"]))  # stable: file order within one time
     return Trace(name, events, meta)
