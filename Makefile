@@ -5,9 +5,18 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DOCS_STAMP := $(VENV)/.installed-docs
 
-.PHONY: demo test check docs setup clean
+.PHONY: demo test check docs setup clean browser
 
-setup: $(STAMP)
+setup: $(STAMP) browser
+
+# Debian's chromium for the control center's browser tests (tests/center/test_browser.py),
+# installed once where we may (root with apt-get); a quick check when it is there already.
+# Elsewhere the browser tests are skipped and say why.
+browser:
+	@[ -x /usr/bin/chromium ] || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    DEBIAN_FRONTEND=noninteractive apt-get install -y -q chromium >/dev/null || echo "note: could not install chromium; the browser tests will be skipped"; \
+	  else echo "note: no /usr/bin/chromium and no root to install it (apt-get install chromium); the browser tests will be skipped"; fi; }
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -26,7 +35,7 @@ demo: $(STAMP)
 	$(BIN)/alica demo lunar --seed 1 --crash scout@20 --loss 0.1 --out build/lunar
 	$(BIN)/alica demo blocksworld --agents 3 --blocks 5 --seed 1 --out build/blocks
 
-test: $(STAMP)
+test: $(STAMP) browser
 	$(BIN)/python tools/quality.py
 	$(BIN)/python -m pytest
 

@@ -1,0 +1,116 @@
+"""The replay page in a real browser: headless Chromium (Debian's ``chromium``) driven by Playwright.
+
+Skipped, with the reason printed, where Playwright or the browser is not installed
+(``make setup`` installs both where it can). Screenshots go to ``build/center/``.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from alica.io import plans_dir
+
+CHROMIUM = "/usr/bin/chromium"
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
+SHOTS = Path(__file__).resolve().parents[2] / "build" / "center"
+
+pytestmark = pytest.mark.optional
+
+
+def _browser_or_skip() -> None:
+    pytest.importorskip("playwright.sync_api", reason="the playwright package is not installed")
+    if shutil.which(CHROMIUM) is None:
+        pytest.skip(f"no browser at {CHROMIUM}: install Debian's chromium package (apt-get install chromium)")
+
+
+def _serve(*args: str) -> Iterator[str]:
+    process = subprocess.Popen(
+        [sys.executable, "-m", "alica.app.cli", "center", *args, "--port", "0"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert process.stdout is not None
+        line = process.stdout.readline().strip()
+        assert re.fullmatch(r"http://127\.0\.0\.1:\d+/\?token=\S+", line), line
+        yield line
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+
+
+@pytest.fixture()
+def replay_url(recorded_trace: Path) -> Iterator[str]:
+    _browser_or_skip()
+    yield from _serve("--trace", str(recorded_trace))
+
+
+@pytest.fixture()
+def plan_url() -> Iterator[str]:
+    _browser_or_skip()
+    yield from _serve("--plan", str(plans_dir() / "blocksworld" / "mission.yaml"))
+
+
+def test_the_replay_page_shows_the_agents_and_follows_the_slider(replay_url: str) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 800})
+            page.goto(replay_url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            rows = page.locator("#agents-body tr")
+            assert rows.count() == 3
+            assert page.locator('#agents-body tr[data-agent="r1"] td').nth(4).inner_text() == "Formation"
+            assert page.locator("#map-body").inner_text().strip() == "no poses in this trace"
+            end = float(page.locator("#slider").get_attribute("max") or "0")
+            assert end > 0
+            page.click("#next-fault")
+            page.wait_for_function("parseFloat(document.getElementById('slider').value) > 0", timeout=10_000)
+            fault_at = float(page.locator("#slider").input_value())
+            assert fault_at == pytest.approx(1.0, abs=0.2)
+            page.wait_for_selector('#agents-body tr.dead[data-agent="r2"]', timeout=10_000)
+            page.fill("#filter", "fault")
+            page.wait_for_function("document.getElementById('log-body').rows.length >= 1", timeout=10_000)
+            assert all("fault" in t for t in page.locator("#log-body tr").all_inner_texts())
+            page.screenshot(path=str(SHOTS / "replay.png"), full_page=True)
+        finally:
+            browser.close()
+
+
+def test_the_plan_view_draws_the_tree(plan_url: str) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1400, "height": 900})
+            page.goto(plan_url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            assert page.locator("#tree svg g.plan").count() >= 1
+            assert page.locator("#tree svg g.state").count() >= 2
+            page.screenshot(path=str(SHOTS / "plan.png"), full_page=True)
+        finally:
+            browser.close()
