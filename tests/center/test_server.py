@@ -43,6 +43,14 @@ def test_the_token_opens_the_page_and_sets_a_cookie_for_the_rest(written_trace: 
     assert client.get("/static/style.css").status_code == 200
 
 
+def test_a_websocket_without_the_token_is_closed_unaccepted(written_trace: Path) -> None:
+    from starlette.websockets import WebSocketDisconnect
+
+    with pytest.raises(WebSocketDisconnect) as closed, _client(written_trace).websocket_connect("/ws"):
+        pass
+    assert closed.value.code == 1008
+
+
 def test_a_bearer_header_is_enough(written_trace: Path) -> None:
     client = _client(written_trace)
     response = client.get("/api/meta", headers={"Authorization": f"Bearer {TOKEN}"})
@@ -73,16 +81,17 @@ def test_state_follows_transitions_crashes_and_header_roles(written_trace: Path)
     client = _client(written_trace)
     client.cookies.set(COOKIE, TOKEN)
     before = client.get("/api/state?t=0.9").json()["agents"]
-    assert before["a"] == {
-        "role": "Scout",
-        "task": "Go",
-        "alive": True,
-        "plan": "Top",
-        "state": None,
-        "key": "Top",
-        "behaviour": None,
-        "pose": {"x": 0.0, "y": 0.0, "yaw": 0.0},
-    }
+    a = before["a"]
+    assert (a["role"], a["task"], a["alive"], a["plan"], a["state"], a["key"]) == (
+        "Scout",
+        "Go",
+        True,
+        "Top",
+        None,
+        "Top",
+    )
+    assert a["pose"] == {"x": 0.0, "y": 0.0, "yaw": 0.0}
+    assert before["b"]["role"] is None
     after = client.get("/api/state?t=3.5").json()["agents"]
     assert after["a"]["state"] == "S2"
     assert after["a"]["pose"] == {"x": 1.0, "y": 2.0, "yaw": 0.5}
@@ -198,3 +207,33 @@ def test_the_page_files_are_package_data() -> None:
     assert {"static/replay.html", "static/replay.js", "static/plan.html", "static/style.css"} <= set(files)
     for name in files:
         assert any(fnmatch.fnmatch(name, g) for g in globs), f"{name} is not in the wheel's package data"
+
+
+def test_a_transition_above_leaves_the_plans_below_and_a_recovery_starts_afresh() -> None:
+    from alica.app.center.trace_file import Trace
+
+    def allocation(t: float, key: str, plan: str, task: str) -> dict[str, object]:
+        return {"t": t, "agent": "a", "event": "allocation", "key": key, "plan": plan, "entries": {"a": task}}
+
+    events = [
+        allocation(0.0, "Top", "Top", "Lead"),
+        {"t": 1.0, "agent": "a", "event": "transition", "key": "Top", "plan": "Top", "source": "S1", "target": "S2"},
+        allocation(1.0, "Top/S2/Sub", "Sub", "Carry"),
+        {"t": 2.0, "agent": "a", "event": "transition", "key": "Top/S2/Sub", "plan": "Sub", "target": "Lift"},
+        allocation(2.5, "Top", "Top", "Lead"),  # a reallocation above does not leave Sub
+        {"t": 3.0, "agent": "a", "event": "transition", "key": "Top", "plan": "Top", "source": "S2", "target": "S3"},
+        {"t": 4.0, "agent": "a", "event": "fault", "fault": "crash"},
+        {"t": 5.0, "agent": "a", "event": "fault", "fault": "recover"},
+    ]
+    replay = Replay(Trace("x.jsonl", events))
+
+    def at(t: float) -> tuple[object, ...]:
+        a = replay.state(t)["agents"]["a"]
+        return a["plan"], a["task"], a["state"], a["alive"], [n["plan"] for n in a["plans"]]
+
+    assert at(0.5) == ("Top", "Lead", None, True, ["Top"])
+    assert at(1.5) == ("Sub", "Carry", None, True, ["Top", "Sub"])
+    assert at(2.7) == ("Sub", "Carry", "Lift", True, ["Top", "Sub"])
+    assert at(3.5) == ("Top", "Lead", "S3", True, ["Top"])
+    assert at(4.5) == ("Top", "Lead", "S3", False, ["Top"])
+    assert at(5.5) == (None, None, None, True, [])

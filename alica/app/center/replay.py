@@ -25,6 +25,7 @@ class Replay:
         self.trace = trace
         self.events = trace.events
         self.times = [float(e["t"]) for e in self.events]
+        self._meta = self._describe()
 
     def agents(self) -> list[str]:
         """The agents named in the header or in the events (not the team's own ``-``)."""
@@ -38,6 +39,9 @@ class Replay:
 
     def meta(self) -> dict[str, Any]:
         """Agents, start, end and duration, event kinds with their counts, and whether poses are present."""
+        return self._meta
+
+    def _describe(self) -> dict[str, Any]:
         kinds: dict[str, int] = {}
         for e in self.events:
             kinds[e["event"]] = kinds.get(e["event"], 0) + 1
@@ -70,47 +74,55 @@ class Replay:
         return None
 
     def state(self, t: float) -> dict[str, Any]:
-        """Every agent's role, task, alive, plan and state, and its last pose, from the events up to ``t``."""
+        """Every agent's role, task, alive, plan and state, and its last pose, from the events up to ``t``.
+
+        An agent's plans are the plan nodes it entered (keyed by their path, ``Top/State/Child``):
+        an allocation enters a node (its task is the agent's entry there), a transition sets the
+        node's state and leaves the nodes below it, a recovery starts from nothing. The agent's
+        plan, task and state are those of its deepest node; ``plans`` lists them all, top first.
+        """
         roles = self.trace.meta.get("roles", {})
         agents: dict[str, dict[str, Any]] = {
             a: {
                 "role": roles.get(a) if isinstance(roles, dict) else None,
-                "task": None,
                 "alive": True,
-                "plan": None,
-                "state": None,
-                "key": None,
                 "behaviour": None,
                 "pose": None,
             }
             for a in self.agents()
         }
+        nodes: dict[str, dict[str, dict[str, Any]]] = {a: {} for a in agents}
         for e in self.events[: bisect.bisect_right(self.times, t)]:
             kind = e["event"]
-            who = agents.get(str(e.get("agent")))
-            if kind == "fault" and e.get("fault") in ("crash", "recover") and who is not None:
-                who["alive"] = e["fault"] == "recover"
-            elif who is None:
+            name = str(e.get("agent"))
+            who = agents.get(name)
+            if who is None:
                 continue
+            key = str(e.get("key", ""))
+            if kind == "fault" and e.get("fault") in ("crash", "recover"):
+                who["alive"] = e["fault"] == "recover"
+                if e["fault"] == "recover":
+                    nodes[name].clear()
+                    who["behaviour"] = None
             elif kind == "allocation" and isinstance(e.get("entries"), dict):
-                _enter(who, e)
-                who["task"] = e["entries"].get(e["agent"])
-                who["state"] = None
+                node = nodes[name].get(key)
+                if node is None or e.get("reason") == "initial":
+                    node = nodes[name][key] = {"key": key, "plan": e.get("plan"), "task": None, "state": None}
+                node["plan"] = e.get("plan", node["plan"])
+                node["task"] = e["entries"].get(name)
             elif kind == "transition":
-                _enter(who, e)
-                who["state"] = e.get("target")
+                node = nodes[name].setdefault(key, {"key": key, "plan": e.get("plan"), "task": None, "state": None})
+                node["state"] = e.get("target")
+                for below in [k for k in nodes[name] if k.startswith(key + "/")]:
+                    del nodes[name][below]
             elif kind == "behaviour":
                 who["behaviour"] = f"{e.get('behaviour')} ({e.get('status')})"
             elif kind == "pose":
                 who["pose"] = {k: e[k] for k in ("x", "y", "yaw") if k in e}
             elif kind == "role" and "role" in e:
                 who["role"] = e["role"]
+        for name, who in agents.items():
+            plans = sorted(nodes[name].values(), key=lambda n: n["key"].count("/"))
+            deepest = plans[-1] if plans else {"key": None, "plan": None, "task": None, "state": None}
+            who.update({k: deepest[k] for k in ("key", "plan", "task", "state")}, plans=plans)
         return {"t": t, "agents": agents}
-
-
-def _enter(who: dict[str, Any], event: dict[str, Any]) -> None:
-    """Make the event's plan the agent's current plan when it is as deep as or deeper than the last one."""
-    key = str(event.get("key", ""))
-    last = who["key"] or ""
-    if key.count("/") >= last.count("/") or not last.startswith(key):
-        who["key"], who["plan"] = key, event.get("plan", who["plan"])

@@ -2,7 +2,8 @@
 
 Every request (page, API, static file) must carry the token: as the query
 parameter ``token=``, as the cookie the first visit sets, or as an
-``Authorization: Bearer`` header. Without it the answer is 403.
+``Authorization: Bearer`` header. Without it the answer is 403 (a WebSocket,
+when a later increment adds one, is closed unaccepted).
 """
 
 from __future__ import annotations
@@ -14,41 +15,63 @@ from importlib import resources
 from typing import Any, TextIO
 
 from starlette.applications import Starlette
+from starlette.datastructures import MutableHeaders
 from starlette.middleware import Middleware
-from starlette.middleware.base import BaseHTTPMiddleware, RequestResponseEndpoint
-from starlette.requests import Request
+from starlette.requests import HTTPConnection, Request
 from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
 from starlette.routing import Route
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from alica.app.center.replay import FAULT_KINDS, REPLAN_KINDS, Replay
 
 COOKIE = "alica_center_token"
 
 
-class TokenGate(BaseHTTPMiddleware):
-    """Refuses (403) every request that does not carry the token; sets the cookie on a good first visit."""
+class TokenGate:
+    """ASGI middleware that refuses every HTTP request and WebSocket without the token.
 
-    def __init__(self, app: Any, token: str) -> None:
-        super().__init__(app)
+    An HTTP request without it gets 403; a WebSocket is closed before it is accepted
+    (code 1008, policy violation). A page request with the token in its query gets a
+    cookie with it, so the page's own requests need not carry it.
+    """
+
+    def __init__(self, app: ASGIApp, token: str) -> None:
+        self.app = app
         self.token = token
 
-    def _given(self, request: Request) -> tuple[str | None, bool]:
-        query = request.query_params.get("token")
+    def _given(self, scope: Scope) -> tuple[str | None, bool]:
+        connection = HTTPConnection(scope)
+        query = connection.query_params.get("token")
         if query is not None:
             return query, True
-        auth = request.headers.get("authorization", "")
+        auth = connection.headers.get("authorization", "")
         if auth.lower().startswith("bearer "):
             return auth[7:].strip(), False
-        return request.cookies.get(COOKIE), False
+        return connection.cookies.get(COOKIE), False
 
-    async def dispatch(self, request: Request, call_next: RequestResponseEndpoint) -> Response:
-        given, from_query = self._given(request)
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        given, from_query = self._given(scope)
         if given is None or not hmac.compare_digest(given.encode(), self.token.encode()):
-            return PlainTextResponse("403: this page needs the token printed by 'alica center'\n", status_code=403)
-        response = await call_next(request)
-        if from_query:
-            response.set_cookie(COOKIE, self.token, httponly=True, samesite="strict")
-        return response
+            if scope["type"] == "websocket":
+                await send({"type": "websocket.close", "code": 1008})
+                return
+            refused = PlainTextResponse("403: this page needs the token printed by 'alica center'\n", status_code=403)
+            await refused(scope, receive, send)
+            return
+        if not from_query or scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        cookie = f"{COOKIE}={self.token}; HttpOnly; Path=/; SameSite=strict"
+
+        async def send_with_cookie(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                MutableHeaders(scope=message).append("set-cookie", cookie)
+            await send(message)
+
+        await self.app(scope, receive, send_with_cookie)
 
 
 def _static(name: str) -> str:

@@ -33,6 +33,7 @@
       tr.dataset.agent = name;
       if (!a.alive) { tr.className = "dead"; }
       for (const v of [name, a.role, a.task, a.alive ? "yes" : "no", a.plan, a.state, a.behaviour]) { tr.appendChild(cell(v)); }
+      tr.children[4].title = a.plans.map((p) => p.plan + (p.state ? ": " + p.state : "")).join(" \u203a ");
       body.appendChild(tr);
     }
     showLog(t);
