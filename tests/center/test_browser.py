@@ -65,6 +65,12 @@ def replay_url(recorded_trace: Path) -> Iterator[str]:
 
 
 @pytest.fixture()
+def poses_url(written_trace: Path) -> Iterator[str]:
+    _browser_or_skip()
+    yield from _serve("--trace", str(written_trace))
+
+
+@pytest.fixture()
 def plan_url() -> Iterator[str]:
     _browser_or_skip()
     yield from _serve("--plan", str(plans_dir() / "blocksworld" / "mission.yaml"))
@@ -112,5 +118,25 @@ def test_the_plan_view_draws_the_tree(plan_url: str) -> None:
             assert page.locator("#tree svg g.plan").count() >= 1
             assert page.locator("#tree svg g.state").count() >= 2
             page.screenshot(path=str(SHOTS / "plan.png"), full_page=True)
+        finally:
+            browser.close()
+
+
+def test_the_map_draws_robots_from_pose_events(poses_url: str) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 800})
+            page.goto(poses_url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            assert page.locator("#map-body svg circle.robot").count() == 0  # no pose before t = 0.5
+            page.click("#next-replan")
+            page.wait_for_function("document.getElementById('slider').value === '2'", timeout=10_000)
+            page.wait_for_selector('#map-body svg circle.robot[data-agent="a"]', timeout=10_000)
+            assert page.locator('#agents-body tr[data-agent="a"] td').nth(5).inner_text() == "S2"
+            page.screenshot(path=str(SHOTS / "replay-poses.png"), full_page=True)
         finally:
             browser.close()

@@ -79,7 +79,7 @@
       const last = list[list.length - 1];
       svg += '<polyline points="' + points + '" fill="none" stroke="' + colour + '" stroke-width="' + (w / 300) + '"/>';
       svg += '<circle class="robot" data-agent="' + agent + '" cx="' + last.x + '" cy="' + (-last.y) + '" r="' + (w / 60) + '" fill="' + colour + '"/>';
-      svg += '<text x="' + last.x + '" y="' + (-last.y - w / 40) + '" font-size="' + (w / 40) + '">' + agent + "</text>";
+      svg += '<text x="' + last.x + '" y="' + (-last.y - w / 25) + '" font-size="' + (w / 20) + '">' + agent + "</text>";
     }
     box.innerHTML = svg + "</svg>";
   }
