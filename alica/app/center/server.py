@@ -23,6 +23,7 @@ from starlette.routing import Route
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from alica.app.center.replay import FAULT_KINDS, REPLAN_KINDS, Replay
+from alica.errors import AlicaError
 
 COOKIE = "alica_center_token"
 
@@ -178,13 +179,17 @@ def bind(host: str, port: int) -> socket.socket:
     """A listening socket on ``host:port``; port 0 picks a free port.
 
     Raises:
-        OSError: the address cannot be bound.
+        AlicaError: the address cannot be bound (in use, unknown host, not allowed).
     """
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
     sock = socket.socket(family, socket.SOCK_STREAM)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    sock.bind((host, port))
-    sock.listen(128)
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.bind((host, port))
+        sock.listen(128)
+    except OSError as exc:
+        sock.close()
+        raise AlicaError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
     return sock
 
 

@@ -1,4 +1,4 @@
-"""The control center's trace loader: today's lines, a header line, and clear errors for bad input."""
+"""The trace loader, and clear errors for bad input: a missing trace, a bad line, a bad plan file, a port in use."""
 
 from __future__ import annotations
 
@@ -68,4 +68,20 @@ def test_the_command_reports_a_bad_plan_file(tmp_path: Path, capsys: pytest.Capt
     assert main(["center", "--plan", str(path), "--port", "0"]) == 1
     err = capsys.readouterr().err
     assert "broken.yaml:" in err
+    assert "Traceback" not in err
+
+
+def test_a_port_in_use_is_a_clear_error(capsys: pytest.CaptureFixture[str]) -> None:
+    import socket
+
+    from alica.io import plans_dir
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen(1)
+        port = taken.getsockname()[1]
+        plan = str(plans_dir() / "examples" / "formation.yaml")
+        assert main(["center", "--plan", plan, "--port", str(port)]) == 1
+    err = capsys.readouterr().err
+    assert f"cannot listen on 127.0.0.1:{port}" in err
     assert "Traceback" not in err
