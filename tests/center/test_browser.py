@@ -101,6 +101,14 @@ def test_the_replay_page_shows_the_agents_and_follows_the_slider(replay_url: str
             page.wait_for_function("document.getElementById('log-body').rows.length >= 1", timeout=10_000)
             assert all("fault" in t for t in page.locator("#log-body tr").all_inner_texts())
             page.screenshot(path=str(SHOTS / "replay.png"), full_page=True)
+            page.select_option("#speed", "10")
+            page.click("#play")  # 1 s of the trace left: 0.1 s at 10x
+            page.wait_for_function(
+                "document.getElementById('slider').value === document.getElementById('slider').max"
+                " && document.getElementById('play').textContent === 'play'",
+                timeout=10_000,
+            )
+            assert page.locator("#time").inner_text() == f"t = {end:.3f} s"
         finally:
             browser.close()
 
