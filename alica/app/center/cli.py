@@ -47,6 +47,16 @@ def plan_views(path: str) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
     return {r: plan_tree(library, r) for r in roots}, {r: plan_svg(library, r) for r in roots}
 
 
+def _port(text: str) -> int:
+    try:
+        port = int(text)
+    except ValueError:
+        port = -1
+    if not 0 <= port <= 65535:
+        raise argparse.ArgumentTypeError(f"'{text}' is not a port (0 to 65535; 0 picks a free one)")
+    return port
+
+
 def add_parser(sub: Any) -> None:
     """Register ``alica center``."""
     p = sub.add_parser(
@@ -61,6 +71,6 @@ def add_parser(sub: Any) -> None:
     what.add_argument("--trace", metavar="FILE", help="a trace (JSON Lines) to replay")
     what.add_argument("--plan", metavar="FILE", help="a plan file (YAML or XML) to draw")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
-    p.add_argument("--port", type=int, default=8765, help="port (default 8765; 0 picks a free one)")
+    p.add_argument("--port", type=_port, default=8765, help="port (default 8765; 0 picks a free one)")
     p.add_argument("--token", help="the access token (default: a new random one)")
     p.set_defaults(run=_cmd_center)
