@@ -5,12 +5,17 @@ where the robots were and what the team knew of the field. :class:`WorldTrace`
 samples the simulated world into a trace file (:class:`alica.engine.JsonlTrace`)
 after every tick, in simulated time:
 
-* ``pose`` events, one per robot every ``1 / pose_hz`` seconds (2 Hz by default);
+* ``pose`` events at ``pose_hz`` (2 Hz by default): at the first tick of every
+  period, each robot that moved more than :data:`STILL` metres or radians, or
+  whose agent crashed or came back, since its last pose; a robot that stands
+  still is recorded again every :data:`KEYFRAME_EVERY` seconds all the same;
 * ``object`` events: every object but the terrain once at the start, then, at
   the pose rate, a block or sample that moved more than :data:`MOVED` metres
   (3 cm) from where the trace last put it;
 * ``map`` events every ``map_every`` seconds (5 s) when the team map changed, with
-  the occupancy grid compressed (:func:`alica.engine.trace.encode_cells`).
+  the occupancy grid coarsened to :data:`MAP_RESOLUTION` (a cell is occupied
+  when any of its finer cells is, else free when any is free, else unknown) and
+  compressed (:func:`alica.engine.trace.encode_cells`).
 
 ``docs/trace.md`` documents the fields. :func:`world_header` gives a header's world fields.
 """
@@ -22,14 +27,22 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from alica.engine.trace import MAP_ENCODING, encode_cells
 
 #: Robot poses per simulated second, by default.
 POSE_HZ = 2.0
 #: Metres an object moves before the trace records it again.
 MOVED = 0.03
+#: Metres (and radians of heading) a robot moves before the trace records its pose again.
+STILL = 0.01
+#: Simulated seconds after which the pose of a robot standing still is recorded again.
+KEYFRAME_EVERY = 10.0
 #: Simulated seconds between two looks at the team map.
 MAP_EVERY = 5.0
+#: The coarsest cell side of a traced map in metres: a finer team map is coarsened to it (whole multiples).
+MAP_RESOLUTION = 0.2
 
 Sink = Callable[[dict[str, Any]], None]
 
@@ -43,10 +56,13 @@ def world_header(world: Any, kind: str, *, pose_hz: float = POSE_HZ, map_every: 
         "bounds": list(world.bounds),
         "robots": {name: robot.spec.kind for name, robot in sorted(world.robots.items())},
         "pose_hz": pose_hz,
+        "still_m": STILL,
+        "keyframe_every_s": KEYFRAME_EVERY,
         "moved_m": MOVED,
     }
     if map_every is not None:
         fields["map_every_s"] = map_every
+        fields["map_resolution_m"] = MAP_RESOLUTION
     return fields
 
 
@@ -88,6 +104,7 @@ class WorldTrace:
         self._next_map = 0.0
         self._looked = False
         self._placed: dict[str, tuple[float, float, float]] = {}
+        self._posed: dict[str, tuple[float, float, float, bool, float]] = {}  # x, y, yaw, alive, t
         self._map_digest = ""
 
     def __call__(self, now: float) -> None:
@@ -103,17 +120,28 @@ class WorldTrace:
 
     def _poses(self, t: float) -> None:
         for name, robot in sorted(self.world.robots.items()):
-            x, y, yaw = robot.pose
+            x, y, yaw = (float(v) for v in robot.pose)
+            alive = self.alive is None or bool(self.alive(name))
+            last = self._posed.get(name)
+            if (
+                last is not None
+                and last[3] == alive
+                and t - last[4] < KEYFRAME_EVERY - 1e-9
+                and math.hypot(x - last[0], y - last[1]) <= STILL
+                and abs(math.remainder(yaw - last[2], math.tau)) <= STILL
+            ):
+                continue
+            self._posed[name] = (x, y, yaw, alive, t)
             event: dict[str, Any] = {
                 "t": t,
                 "agent": name,
                 "event": "pose",
-                "x": round(float(x), 3),
-                "y": round(float(y), 3),
-                "yaw": round(float(yaw), 3),
+                "x": round(x, 3),
+                "y": round(y, 3),
+                "yaw": round(yaw, 3),
             }
             if self.alive is not None:
-                event["alive"] = bool(self.alive(name))
+                event["alive"] = alive
             self.sink(event)
 
     def _objects(self, t: float) -> None:
@@ -149,7 +177,7 @@ class WorldTrace:
         grid = self.team_map()
         if grid is None:
             return
-        occupancy = grid.occupancy()
+        occupancy, resolution = coarsened(grid.occupancy(), float(grid.resolution), MAP_RESOLUTION)
         height, width = occupancy.shape
         cells = (occupancy + 1).astype("uint8").tobytes()  # -1 unknown, 0 free, 1 occupied -> 0, 1, 2
         digest = hashlib.blake2b(cells, digest_size=8).hexdigest()
@@ -162,10 +190,33 @@ class WorldTrace:
                 "agent": "-",
                 "event": "map",
                 "origin": [round(float(grid.origin[0]), 3), round(float(grid.origin[1]), 3)],
-                "resolution": float(grid.resolution),
+                "resolution": resolution,
                 "width": int(width),
                 "height": int(height),
                 "encoding": MAP_ENCODING,
                 "cells": encode_cells(cells, int(width), int(height)),
             }
         )
+
+
+def coarsened(occupancy: np.ndarray, resolution: float, target: float) -> tuple[np.ndarray, float]:
+    """``occupancy`` (-1 unknown, 0 free, 1 occupied) in cells of the whole multiple of ``resolution`` nearest ``target``.
+
+    A coarse cell is occupied when any of its cells is, else free when any is, else
+    unknown; the grid is padded with unknown cells on its high sides to whole blocks.
+
+    Returns:
+        The coarse grid and its cell side in metres.
+    """
+    factor = max(1, round(target / resolution))
+    if factor == 1:
+        return occupancy, resolution
+    height, width = occupancy.shape
+    rows, cols = -(-height // factor), -(-width // factor)
+    padded = np.full((rows * factor, cols * factor), -1, dtype=np.int8)
+    padded[:height, :width] = occupancy
+    blocks = padded.reshape(rows, factor, cols, factor)
+    out = np.full((rows, cols), -1, dtype=np.int8)
+    out[(blocks == 0).any(axis=(1, 3))] = 0
+    out[(blocks == 1).any(axis=(1, 3))] = 1
+    return out, resolution * factor

@@ -155,9 +155,8 @@ def test_alica_run_in_the_blocks_world_traces_poses_at_the_rate_asked(tmp_path, 
     read = read_trace(path)
     assert read.meta["world"] == "blocks" and len(read.meta["bounds"]) == 4 and read.meta["pose_hz"] == 4.0
     times = [e["t"] for e in read.of("pose", agent="r1")]
-    slots = [math.floor(t / 0.25 + 1e-6) for t in times]  # one pose in every quarter second, at its first tick
-    assert len(times) >= 8 and slots == list(range(slots[0], slots[0] + len(slots)))
-    assert all(t - slot * 0.25 <= 1 / 30 + 1e-6 for t, slot in zip(times, slots, strict=True))
+    slots = [math.floor(t / 0.25 + 1e-6) for t in times]  # a pose in a quarter second at most, when it moved
+    assert times and len(slots) == len(set(slots))
     assert {e["name"] for e in read.of("object")} >= {"a", "b"}
 
 
