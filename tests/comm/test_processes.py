@@ -55,6 +55,8 @@ def test_a_lunar_team_of_processes_succeeds(capsys, tmp_path):
     trace = events(tmp_path / "run.jsonl")
     assert {e["agent"] for e in trace} >= {"scout", "stummel", "amparo"}
     assert [e["t"] for e in trace] == sorted(e["t"] for e in trace)
+    headers = [e for e in trace if e["event"] == "trace"]  # the run's, first; the agents' own are left out
+    assert headers == [trace[0]] and trace[0]["processes"] and set(trace[0]["agents"]) == {"scout", "stummel", "amparo"}
 
 
 def test_kill_9_takes_an_agent_out_and_its_restart_catches_up(capsys, tmp_path):
