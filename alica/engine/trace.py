@@ -263,7 +263,7 @@ def _event(path: Path, number: int, line: str) -> dict[str, Any]:
             "is this an alica trace?)"
         )
     t = event["t"]
-    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(_seconds(t)):
         raise TraceFormatError(f"{where}: error: t is {t!r}, not a number of seconds (fix: write t as seconds)")
     if not isinstance(event["event"], str) or not isinstance(event["agent"], str):
         raise TraceFormatError(
@@ -271,6 +271,14 @@ def _event(path: Path, number: int, line: str) -> dict[str, Any]:
             "(fix: write them as strings)"
         )
     return event
+
+
+def _seconds(t: float) -> float:
+    """``t`` as a float; infinite for a whole number too large for one."""
+    try:
+        return float(t)
+    except OverflowError:
+        return math.inf
 
 
 def _reason(exc: Exception) -> str:

@@ -70,6 +70,8 @@ def test_a_version_1_trace_is_read_with_a_note_that_poses_and_maps_are_missing(t
         ([json.dumps(EVENTS[0]), "{oops"], r":2: error: not JSON \(Expecting property name"),
         ([json.dumps(EVENTS[0]), "", "[1, 2]"], r":3: error: a JSON list, not an object"),
         ([json.dumps({**EVENTS[0], "t": "soon"})], r":1: error: t is 'soon', not a number"),
+        ([json.dumps({**EVENTS[0], "t": 10**400})], r":1: error: t is 1000.*, not a number"),
+        ([json.dumps(EVENTS[0]).replace("0.5", "NaN")], r":1: error: t is nan, not a number"),
         ([json.dumps({**header(), "format": "rosbag"})], r":1: error: unknown trace format 'rosbag'"),
         (
             [json.dumps({**header(), "version": VERSION + 1})],
@@ -100,7 +102,7 @@ def test_a_missing_file_is_an_error_not_a_traceback(tmp_path):
             st.builds(
                 json.dumps,
                 st.recursive(
-                    st.none() | st.booleans() | st.floats() | st.text(max_size=5),
+                    st.none() | st.booleans() | st.floats() | st.integers(-(10**500), 10**500) | st.text(max_size=5),
                     lambda c: (
                         st.lists(c, max_size=3)
                         | st.dictionaries(st.sampled_from(["t", "agent", "event", "format", "version"]), c, max_size=5)
