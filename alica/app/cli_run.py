@@ -206,7 +206,7 @@ def _trace_header(
 ) -> dict[str, Any]:
     """The header of the run's trace: the plan file, the root plan, every agent's role, the seed, the world."""
     from alica.allocation import AgentSpec, assign_roles
-    from alica.app.trace_world import world_header
+    from alica.app.trace_world import MAP_EVERY, world_header
     from alica.engine import pick_roleset, trace_header
 
     specs = {n: r if isinstance(r, AgentSpec) else AgentSpec(role=r) for n, r in roles.items()}
@@ -217,14 +217,16 @@ def _trace_header(
         seed=args.seed,
         frequency=args.frequency,
         processes=bool(args.processes),
-        **world_header(world, args.world, pose_hz=args.pose_rate),
+        **world_header(
+            world, args.world, pose_hz=args.pose_rate, map_every=MAP_EVERY if args.world == "lunar" else None
+        ),
     )
 
 
 def _run_team(
     args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], wiring: Any, world: Any, perception: Any
 ) -> int:
-    from alica.app.trace_world import WorldTrace
+    from alica.app.trace_world import WorldTrace, team_grid
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
     from alica.prophet import engine_config
@@ -262,7 +264,13 @@ def _run_team(
         perception=perception,
     )
     if trace is not None and world is not None:
-        sample = WorldTrace(trace, world, alive=lambda name: name not in team.crashed, pose_hz=args.pose_rate)
+        sample = WorldTrace(
+            trace,
+            world,
+            alive=lambda name: name not in team.crashed,
+            team_map=(lambda: team_grid(team)) if args.world == "lunar" else None,
+            pose_hz=args.pose_rate,
+        )
         sample(team.now())
         team.after_tick(sample)
     for text in args.crash:

@@ -47,6 +47,17 @@ MAP_RESOLUTION = 0.2
 Sink = Callable[[dict[str, Any]], None]
 
 
+def team_grid(team: Any) -> Any:
+    """The team map (:func:`alica.skills.mapping.team_map`) of the first running agent that has one, else ``None``."""
+    from alica.skills.mapping import team_map
+
+    for engine in team.running() or list(team.engines.values()):
+        grid = team_map(engine.world_model)
+        if grid is not None:
+            return grid
+    return None
+
+
 def world_header(world: Any, kind: str, *, pose_hz: float = POSE_HZ, map_every: float | None = None) -> dict[str, Any]:
     """The header fields (:func:`alica.engine.trace.trace_header`) of a run in ``world`` (``None``: no world)."""
     if world is None:

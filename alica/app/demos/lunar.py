@@ -594,13 +594,9 @@ class _Run:
         return out
 
     def team_map(self) -> Any:
-        from alica.skills.mapping import team_map
+        from alica.app.trace_world import team_grid
 
-        for engine in self.team.running() or list(self.team.engines.values()):
-            grid = team_map(engine.world_model)
-            if grid is not None:
-                return grid
-        return None
+        return team_grid(self.team)
 
     def coverage(self) -> float:
         """The share of the truly free cells the team map knows (ground truth, for scoring)."""
