@@ -68,3 +68,10 @@ class PlannerError(AlicaError, RuntimeError):
 
 class SkillError(AlicaError, RuntimeError):
     """A skill that failed while running."""
+
+
+class TraceFormatError(AlicaError, ValueError):
+    """A trace file that cannot be read: not JSON Lines, another format, or a newer version.
+
+    The message reads ``FILE:LINE: error: what (fix: how)``.
+    """

@@ -177,7 +177,7 @@ def _run(
     from alica.allocation import AgentSpec, assign_roles
     from alica.clock import SystemClock
     from alica.comm.zenoh_transport import ZenohTransport
-    from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset
+    from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset, trace_header
     from alica.engine.realtime import RealTimeLoop
     from alica.engine.runner import describe_agent, root_status
     from alica.lang import literals
@@ -193,7 +193,16 @@ def _run(
     config = engine_config(
         frequency=args.frequency, planner_seconds=0.3 / args.frequency, parallel_planning=args.parallel_planning
     )
-    trace = JsonlTrace(args.trace, line_buffered=True) if args.trace else None  # kept up to a kill -9
+    header = trace_header(
+        plans=[args.plan],
+        root=plan,
+        agents=roster,
+        seed=args.seed,
+        frequency=args.frequency,
+        recorder=args.name,  # this trace holds one agent's events
+        clock="wall",
+    )
+    trace = JsonlTrace(args.trace, header=header, line_buffered=True) if args.trace else None  # kept up to a kill -9
     observers: tuple[Any, ...] = ()
     if trace is not None:
         sink = trace

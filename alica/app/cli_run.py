@@ -84,6 +84,13 @@ def add_parser(sub: Any) -> None:
         help="write a JSON Lines trace of allocations, transitions, repairs, messages and faults",
     )
     p.add_argument("--trace-messages", action="store_true", help="trace every message too (large)")
+    p.add_argument(
+        "--pose-rate",
+        type=float,
+        default=2.0,
+        metavar="HZ",
+        help="with --world and --trace: robot poses per simulated second in the trace (default 2)",
+    )
     p.add_argument("--show-tree", action="store_true", help="print each agent's running plan tree whenever it changes")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument(
@@ -188,22 +195,48 @@ def cmd_run(args: argparse.Namespace) -> int:
         registry, plan_skills(library, plan), world=args.world is not None, stand_ins=args.stand_ins, plan=plan
     )
     if args.processes:
-        return _run_processes(args, plan, list(agents), wiring)
+        header = _trace_header(args, library, plan, roles, None) if args.trace else None
+        return _run_processes(args, plan, list(agents), wiring, header)
     with run_world(args, sorted(agents)) as (world, perception):
         return _run_team(args, library, plan, roles, wiring, world, perception)
+
+
+def _trace_header(
+    args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], world: Any
+) -> dict[str, Any]:
+    """The header of the run's trace: the plan file, the root plan, every agent's role, the seed, the world."""
+    from alica.allocation import AgentSpec, assign_roles
+    from alica.app.trace_world import MAP_EVERY, world_header
+    from alica.engine import pick_roleset, trace_header
+
+    specs = {n: r if isinstance(r, AgentSpec) else AgentSpec(role=r) for n, r in roles.items()}
+    return trace_header(
+        plans=[args.plan],
+        root=plan,
+        agents=assign_roles(specs, pick_roleset(library, (s.role for s in specs.values()), args.roleset)),
+        seed=args.seed,
+        frequency=args.frequency,
+        processes=bool(args.processes),
+        **world_header(
+            world, args.world, pose_hz=args.pose_rate, map_every=MAP_EVERY if args.world == "lunar" else None
+        ),
+    )
 
 
 def _run_team(
     args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], wiring: Any, world: Any, perception: Any
 ) -> int:
+    from alica.app.trace_world import WorldTrace, team_grid
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
     from alica.prophet import engine_config
     from alica.testing import default_fallback
 
+    if not (args.pose_rate > 0 and args.pose_rate < float("inf")):
+        raise AlicaError(f"--pose-rate must be a positive number of poses per second, got {args.pose_rate}")
     reasons = _Reasons()
     observers: list[Any] = [reasons]
-    trace = JsonlTrace(args.trace) if args.trace else None
+    trace = JsonlTrace(args.trace, header=_trace_header(args, library, plan, roles, world)) if args.trace else None
     if trace is not None:
         observers.append(trace)
     changed: set[str] = set()
@@ -230,6 +263,16 @@ def _run_team(
         world=world,
         perception=perception,
     )
+    if trace is not None and world is not None:
+        sample = WorldTrace(
+            trace,
+            world,
+            alive=lambda name: name not in team.crashed,
+            team_map=(lambda: team_grid(team)) if args.world == "lunar" else None,
+            pose_hz=args.pose_rate,
+        )
+        sample(team.now())
+        team.after_tick(sample)
     for text in args.crash:
         who, at, _ = _timed("--crash", text)
         team.crash(who, at=at)
@@ -263,7 +306,9 @@ def _run_team(
     return 0 if summary["success"] else 1
 
 
-def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring: Any) -> int:
+def _run_processes(
+    args: argparse.Namespace, plan: str, names: list[str], wiring: Any, header: dict[str, Any] | None = None
+) -> int:
     """``alica run --processes``: one ``alica agent`` per agent (:mod:`alica.app.processes`)."""
     import tempfile
     from pathlib import Path
@@ -327,7 +372,7 @@ def _run_processes(args: argparse.Namespace, plan: str, names: list[str], wiring
             team.stop()
         summary = team.summary(plan, args.seed)
         if args.trace:
-            team.trace(Path(args.trace))
+            team.trace(Path(args.trace), header)
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
     for agent in summary["agents"].values():
         agent["reason"] = None if agent["status"] == "success" else _process_reason(agent)

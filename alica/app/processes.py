@@ -303,8 +303,11 @@ class ProcessTeam:
 
     # -- results ------------------------------------------------------------------
 
-    def trace(self, path: Path) -> int:
-        """Merge the agents' traces and the faults into one JSON Lines file, by time; returns the events written."""
+    def trace(self, path: Path, header: dict[str, Any] | None = None) -> int:
+        """Merge the agents' traces and the faults into one JSON Lines file, by time; returns the events written.
+
+        ``header`` (:func:`alica.engine.trace_header`) goes first; the agents' own headers are left out.
+        """
         events: list[dict[str, Any]] = [dict(f) for f in self.faults]
         for agent in self.agents.values():
             for incarnation, file in enumerate(agent.traces, 1):
@@ -315,9 +318,13 @@ class ProcessTeam:
                         event = json.loads(line)
                     except json.JSONDecodeError:
                         continue  # the last line of a process killed while writing
+                    if not isinstance(event, dict) or event.get("event") == "trace":
+                        continue  # an agent's own header: the merged trace has one for the run
                     event["incarnation"] = incarnation
                     events.append(event)
         events.sort(key=lambda e: float(e.get("t", 0.0)))
+        if header is not None:
+            events.insert(0, header)
         path.parent.mkdir(parents=True, exist_ok=True)
         with path.open("w", encoding="utf-8") as out:
             for event in events:

@@ -19,7 +19,7 @@ from alica.engine.runner import SimulatedTeam, pick_roleset
 from alica.engine.show import running_tree
 from alica.engine.status import ChildStatus
 from alica.engine.team import Claim, TeamMessage, TeamView
-from alica.engine.trace import JsonlTrace, TraceRecorder
+from alica.engine.trace import JsonlTrace, Trace, TraceRecorder, read_trace, trace_header
 
 __all__ = [
     "AgentEngine",
@@ -40,7 +40,10 @@ __all__ = [
     "SkillFactory",
     "TeamMessage",
     "TeamView",
+    "Trace",
     "TraceRecorder",
     "pick_roleset",
+    "read_trace",
     "running_tree",
+    "trace_header",
 ]

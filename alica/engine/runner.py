@@ -162,6 +162,7 @@ class SimulatedTeam:
         self.ticks = 0
         self._events: list[_Event] = []
         self._order = 0
+        self._after_tick: list[Callable[[float], None]] = []
         for name in self.roles:
             self.engines[name] = self._make_engine(name, self.network.attach(name))
 
@@ -198,6 +199,12 @@ class SimulatedTeam:
                 self.world.step(self.config.period)
         else:
             self.clock.advance(self.config.period)
+        for hook in self._after_tick:
+            hook(self.now())
+
+    def after_tick(self, hook: Callable[[float], None]) -> None:
+        """Call ``hook(now)`` at the end of every :meth:`tick`, once time moved on (to sample the world, say)."""
+        self._after_tick.append(hook)
 
     def tick_agents(self) -> None:
         """Timed events, perception, then one lock-step tick of every running agent; time stands still."""

@@ -55,6 +55,8 @@ def test_a_lunar_team_of_processes_succeeds(capsys, tmp_path):
     trace = events(tmp_path / "run.jsonl")
     assert {e["agent"] for e in trace} >= {"scout", "stummel", "amparo"}
     assert [e["t"] for e in trace] == sorted(e["t"] for e in trace)
+    headers = [e for e in trace if e["event"] == "trace"]  # the run's, first; the agents' own are left out
+    assert headers == [trace[0]] and trace[0]["processes"] and set(trace[0]["agents"]) == {"scout", "stummel", "amparo"}
 
 
 def test_kill_9_takes_an_agent_out_and_its_restart_catches_up(capsys, tmp_path):
@@ -172,3 +174,17 @@ def test_a_planning_team_of_processes_plans_with_magic_across_them(capsys, tmp_p
     assert start["agents"] == ["r1", "r2", "r3"]
     rounds = [e for e in trace if e["event"] == "planner" and e["what"] == "magic done"]
     assert rounds and rounds[0]["status"] == "solved" and all(e["messages"] <= 6 for e in rounds)
+
+
+def test_alica_agent_writes_a_header_naming_itself(capsys, tmp_path):
+    from alica.engine import read_trace
+
+    path = tmp_path / "scout.jsonl"
+    argv = ["--name", "scout", "--agents", "scout", "--max-time", "0.3", "--listen", "tcp/127.0.0.1:0"]
+    main(["agent", LUNAR, "--stand-ins", *argv, "--key-prefix", "trace-header-test", "--trace", str(path)])
+    capsys.readouterr()
+    trace = read_trace(path)
+    assert trace.version == 2 and trace.meta["recorder"] == "scout" and trace.meta["clock"] == "wall"
+    assert trace.meta["agents"] == {"scout": {"role": "Scout", "plan": "LunarMission"}} and trace.meta["plans"] == [
+        LUNAR
+    ]

@@ -211,7 +211,8 @@ def run_demo(
     Raises:
         AlicaError: a bad configuration.
     """
-    from alica.engine import JsonlTrace, SimulatedTeam
+    from alica.app.trace_world import WorldTrace, world_header
+    from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
     from alica.lang.skill_plugins import default_registry
     from alica.prophet import engine_config, latest_plans
@@ -230,7 +231,24 @@ def run_demo(
         extra["gui"] = True
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
-    trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
+    trace = None
+    if out is not None:
+        header = trace_header(
+            plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
+            root="BlocksWorldMission",
+            agents={
+                **{f"r{i + 1}": "Manipulator" for i in range(config.agents)},
+                **{f"o{i + 1}": "Opponent" for i in range(config.opponents)},
+            },
+            roots={f"o{i + 1}": "BlocksWorldOpponent" for i in range(config.opponents)},
+            seed=config.seed,
+            frequency=config.frequency,
+            demo="blocks",
+            start=[list(s) for s in start],
+            goal=[list(s) for s in goal],
+            **world_header(world, "blocks"),
+        )
+        trace = JsonlTrace(out / "trace.jsonl", header=header)
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = engine_config(frequency=config.frequency)
     perception = blocks_perception()
@@ -268,6 +286,12 @@ def run_demo(
     wanted = set(goal_facts(goal))
     if out is not None:
         _picture(world, out / "initial.png")
+    sample = None
+    if trace is not None:
+        sample = WorldTrace(
+            trace, world, alive=lambda name: name not in team.crashed and (rivals is None or name not in rivals.crashed)
+        )
+        sample(world.now())
     wall = time.perf_counter()
     next_report = 0.0
     satisfied = 0
@@ -279,6 +303,8 @@ def run_demo(
                 rivals.tick_agents()
             world.step(settings.period)
             now = world.now()
+            if sample is not None:
+                sample(now)
             facts = perception.facts
             satisfied = len(wanted & facts)
             if on_second is not None and now >= next_report:

@@ -305,7 +305,8 @@ def run_lunar(
     Raises:
         AlicaError: a bad configuration.
     """
-    from alica.engine import JsonlTrace, SimulatedTeam
+    from alica.app.trace_world import MAP_EVERY, WorldTrace, world_header
+    from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
     from alica.lang import literals
     from alica.lang.skill_plugins import default_registry
@@ -318,7 +319,19 @@ def run_lunar(
     library = load_library(MISSION)
     world = lunar(config.seed, rocks=config.rocks, samples=config.samples, size=config.size, **_gui(gui))
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
-    trace = JsonlTrace(out / "trace.jsonl") if out is not None else None
+    trace = None
+    if out is not None:
+        header = trace_header(
+            plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
+            root=PLAN,
+            agents={name: ROLES[name] for name in config.robots},
+            seed=config.seed,
+            frequency=config.frequency,
+            demo="lunar",
+            field={"samples": config.samples, "rocks": config.rocks, "size": config.size},
+            **world_header(world, "lunar", map_every=MAP_EVERY),
+        )
+        trace = JsonlTrace(out / "trace.jsonl", header=header)
     watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
     settings = engine_config(frequency=config.frequency)
     try:
@@ -344,7 +357,11 @@ def run_lunar(
         for cut in config.partitions:
             team.partition([list(g) for g in cut.groups], start=cut.start, end=cut.end)
         team.set_facts(literals("start"), at=0.0)
-        run = _Run(config, team, world, (float(base[0]), float(base[1])))
+        run = _Run(config, team, world, (float(base[0]), float(base[1])), trace)
+        if trace is not None:
+            sample = WorldTrace(trace, world, alive=lambda name: name not in team.crashed, team_map=run.team_map)
+            sample(team.now())
+            team.after_tick(sample)
         wall = time.perf_counter()
         run.loop(on_second, counter)
         wall = time.perf_counter() - wall
@@ -458,8 +475,16 @@ def _mission_knowledge(team: Any, world: Any, base: tuple[float, float]) -> None
 class _Run:
     """The loop of one run: ticks, the operator, faults at a grasp, scoring against the simulated world."""
 
-    def __init__(self, config: LunarConfig, team: Any, world: Any, base: tuple[float, float]) -> None:
+    def __init__(
+        self,
+        config: LunarConfig,
+        team: Any,
+        world: Any,
+        base: tuple[float, float],
+        trace: Callable[[dict[str, Any]], None] | None = None,
+    ) -> None:
         self.config = config
+        self.trace = trace  # where ``found`` events go (the trace file), if anywhere
         self.team = team
         self.world = world
         self.base = base
@@ -511,7 +536,22 @@ class _Run:
     def _operate(self, now: float) -> bool:
         """The operator's second: read, and choose once; True when the run cannot go on."""
         operator = self.operator
+        known = len(operator.order)
         explored = operator.read(self.team)
+        if self.trace is not None:
+            for name in operator.order[known:]:
+                x, y = operator.places.get(name, (math.nan, math.nan))
+                self.trace(
+                    {
+                        "t": round(now, 6),
+                        "agent": "-",
+                        "event": "found",
+                        "name": name,
+                        "kind": operator.found.get(name, ""),
+                        "x": round(x, 3) if math.isfinite(x) else None,
+                        "y": round(y, 3) if math.isfinite(y) else None,
+                    }
+                )
         if operator.chosen:
             return False
         choice = operator.choose(explored)
@@ -554,13 +594,9 @@ class _Run:
         return out
 
     def team_map(self) -> Any:
-        from alica.skills.mapping import team_map
+        from alica.app.trace_world import team_grid
 
-        for engine in self.team.running() or list(self.team.engines.values()):
-            grid = team_map(engine.world_model)
-            if grid is not None:
-                return grid
-        return None
+        return team_grid(self.team)
 
     def coverage(self) -> float:
         """The share of the truly free cells the team map knows (ground truth, for scoring)."""
