@@ -41,7 +41,14 @@ def recorded_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def written_trace(tmp_path: Path) -> Path:
     """A header line, allocations, a transition, two replans, a crash and poses."""
     events = [
-        {"event": "trace", "format": "alica-trace", "version": 2, "agents": ["a", "b"], "roles": {"a": "Scout"}},
+        {
+            "t": 0.0,
+            "agent": "-",
+            "event": "trace",
+            "format": "alica-trace",
+            "version": 2,
+            "agents": {"a": {"role": "Scout", "plan": "Top"}, "b": {"role": "Stummel", "plan": "Top"}},
+        },
         {"t": 0.0, "agent": "a", "event": "allocation", "key": "Top", "plan": "Top", "entries": {"a": "Go", "b": "Go"}},
         {"t": 0.0, "agent": "b", "event": "allocation", "key": "Top", "plan": "Top", "entries": {"a": "Go", "b": "Go"}},
         {"t": 0.5, "agent": "a", "event": "pose", "x": 0.0, "y": 0.0, "yaw": 0.0},

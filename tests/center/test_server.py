@@ -91,7 +91,7 @@ def test_state_follows_transitions_crashes_and_header_roles(written_trace: Path)
         "Top",
     )
     assert a["pose"] == {"x": 0.0, "y": 0.0, "yaw": 0.0}
-    assert before["b"]["role"] is None
+    assert before["b"]["role"] == "Stummel"  # from the header's agents
     after = client.get("/api/state?t=3.5").json()["agents"]
     assert after["a"]["state"] == "S2"
     assert after["a"]["pose"] == {"x": 1.0, "y": 2.0, "yaw": 0.5}

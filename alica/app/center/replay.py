@@ -29,8 +29,7 @@ class Replay:
 
     def agents(self) -> list[str]:
         """The agents named in the header or in the events (not the team's own ``-``)."""
-        named = [str(a) for a in self.trace.meta.get("agents", []) if isinstance(a, str)]
-        seen = dict.fromkeys(named)
+        seen: dict[str, None] = dict.fromkeys(sorted(self.trace.roles))
         for e in self.events:
             agent = e.get("agent")
             if isinstance(agent, str) and agent != "-":
@@ -57,6 +56,7 @@ class Replay:
             "kinds": dict(sorted(kinds.items())),
             "poses": "pose" in kinds,
             "header": self.trace.meta,
+            "notes": self.trace.notes,
         }
 
     def window(self, start: float | None, end: float | None, kinds: set[str] | None) -> list[dict[str, Any]]:
@@ -81,10 +81,10 @@ class Replay:
         node's state and leaves the nodes below it, a recovery starts from nothing. The agent's
         plan, task and state are those of its deepest node; ``plans`` lists them all, top first.
         """
-        roles = self.trace.meta.get("roles", {})
+        roles = self.trace.roles
         agents: dict[str, dict[str, Any]] = {
             a: {
-                "role": roles.get(a) if isinstance(roles, dict) else None,
+                "role": roles.get(a),
                 "alive": True,
                 "behaviour": None,
                 "pose": None,

@@ -1,76 +1,57 @@
-"""Read a trace file (JSON Lines) for the control center.
+"""A trace file for the control center: the shared reader's trace, its events in time order.
 
-One small loader, tolerant of what the next trace format adds: a first header
-line ``{"event": "trace", ...}`` is kept as ``meta`` and not counted as an
-event, and ``pose`` events are kept like any other. It will be replaced by the
-shared trace reader.
+Reading and checking is :func:`alica.engine.trace.read_trace` (every format
+version, ``FILE:LINE: error: ... (fix: ...)`` for bad input, a note for a
+version-1 trace); this module only orders the events by time for the replay.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from alica.errors import AlicaError
+from alica.engine.trace import read_trace
+from alica.errors import TraceFormatError
 
-
-class TraceFormatError(AlicaError, ValueError):
-    """A line of a trace file that cannot be read; the message is ``FILE:LINE: error: ...``.
-
-    Attributes:
-        file: the trace file.
-        line: the line number, from 1.
-    """
-
-    def __init__(self, file: str, line: int, message: str) -> None:
-        self.file, self.line = file, line
-        super().__init__(f"{file}:{line}: error: {message}")
+__all__ = ["Trace", "TraceFormatError", "load_trace"]
 
 
 @dataclass(slots=True)
 class Trace:
-    """The events of a trace, in file order, and its header if it has one."""
+    """A trace as the replay uses it.
+
+    Attributes:
+        path: the file.
+        events: every event after the header, ordered by ``t`` (file order within one time).
+        meta: the header's fields with ``version`` (for a version-1 trace, what the reader told from the events).
+        notes: what the reader wants a person to know (a version-1 trace has no poses or maps).
+    """
 
     path: str
     events: list[dict[str, Any]]
     meta: dict[str, Any] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def roles(self) -> dict[str, str]:
+        """Agent -> role, as the header names them (none for a version-1 trace)."""
+        agents = self.meta.get("agents")
+        if not isinstance(agents, dict):
+            return {}
+        return {
+            str(name): str(info["role"])
+            for name, info in agents.items()
+            if isinstance(info, dict) and isinstance(info.get("role"), str)
+        }
 
 
 def load_trace(path: str | Path) -> Trace:
-    """Read a trace file.
+    """Read a trace file with the shared reader.
 
     Raises:
-        AlicaError: the file is missing or unreadable.
-        TraceFormatError: a line is not a JSON object with a numeric ``t`` and a string ``event``.
+        TraceFormatError: a missing or unreadable file, or a line the reader refuses (``FILE:LINE: error: ...``).
     """
-    name = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise AlicaError(f"trace file {name} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise AlicaError(f"cannot read trace file {name}: {exc}") from None
-    events: list[dict[str, Any]] = []
-    meta: dict[str, Any] = {}
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
-        try:
-            record = json.loads(line)
-        except json.JSONDecodeError as exc:
-            raise TraceFormatError(name, number, f"not JSON ({exc.msg} at column {exc.colno})") from None
-        if not isinstance(record, dict):
-            raise TraceFormatError(name, number, "a trace line must be a JSON object")
-        if record.get("event") == "trace" and not events and not meta:
-            meta = record
-            continue
-        if not isinstance(record.get("event"), str):
-            raise TraceFormatError(name, number, "the line has no 'event' name")
-        t = record.get("t")
-        if isinstance(t, bool) or not isinstance(t, int | float):
-            raise TraceFormatError(name, number, "the line has no numeric time 't'")
-        events.append(record)
-    events.sort(key=lambda e: float(e["t"]))  # stable: file order within one time
-    return Trace(name, events, meta)
+    trace = read_trace(path)
+    events = sorted(trace.events, key=lambda e: float(e["t"]))  # stable: file order within one time
+    return Trace(str(path), events, {**trace.meta, "version": trace.version}, list(trace.notes))
