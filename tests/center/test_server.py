@@ -237,3 +237,20 @@ def test_a_transition_above_leaves_the_plans_below_and_a_recovery_starts_afresh(
     assert at(3.5) == ("Top", "Lead", "S3", True, ["Top"])
     assert at(4.5) == ("Top", "Lead", "S3", False, ["Top"])
     assert at(5.5) == (None, None, None, True, [])
+
+
+def test_a_version_1_trace_is_replayed_with_the_reader_s_note(tmp_path: Path) -> None:
+    import json
+
+    from alica.app.center.replay import Replay
+    from alica.app.center.server import replay_app
+    from alica.app.center.trace_file import load_trace
+
+    path = tmp_path / "old.jsonl"
+    lines = [{"t": 0.0, "agent": "a", "event": "allocation", "key": "Top", "plan": "Top", "entries": {"a": "Go"}}]
+    path.write_text("".join(json.dumps(e) + "\n" for e in lines), encoding="utf-8")
+    client = TestClient(replay_app(Replay(load_trace(path)), "tok"))
+    meta = client.get("/api/meta?token=tok").json()
+    assert meta["header"]["version"] == 1
+    assert meta["notes"] and "pose" in " ".join(meta["notes"])
+    assert meta["agents"] == ["a"]

@@ -114,6 +114,7 @@
     meta = await get("api/meta");
     events = (await get("api/events")).events;
     $("file").textContent = meta.file + " \u2014 " + meta.events + " events, " + meta.duration.toFixed(3) + " s";
+    $("notes").textContent = (meta.notes || []).join(" ");
     $("kinds").textContent = "kinds: " + Object.entries(meta.kinds).map(([k, n]) => k + " (" + n + ")").join(", ");
     const slider = $("slider");
     slider.min = meta.start; slider.max = meta.end; slider.value = meta.start;
