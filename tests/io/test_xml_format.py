@@ -1236,7 +1236,9 @@ PLAN = _optional(
         summands=st.lists(_optional({"name": NAME, "weight": UNIT, "expression": TEXT}), max_size=2),
     ),
     constraints=st.lists(_optional({"name": NAME, "formula": TEXT}, variables=st.lists(IDENT, max_size=2)), max_size=2),
-    signature=_optional({}, parameters=st.lists(TYPED, max_size=2), precondition=TEXT, effect=TEXT, cost=FINITE_NON_NEGATIVE),
+    signature=_optional(
+        {}, parameters=st.lists(TYPED, max_size=2), precondition=TEXT, effect=TEXT, cost=FINITE_NON_NEGATIVE
+    ),
     synchronisations=st.lists(
         _optional(
             {"name": NAME, "transitions": st.lists(NAME, min_size=1, max_size=2)},
