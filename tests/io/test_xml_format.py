@@ -1172,9 +1172,8 @@ IDENT = st.from_regex(r"\??[A-Za-z_][A-Za-z0-9_-]{0,5}", fullmatch=True)
 TYPE = st.from_regex(r"[A-Za-z_][A-Za-z0-9_-]{0,5}", fullmatch=True)
 TEXT = st.text(XML_CHARS, max_size=20)
 UNIT = st.floats(0, 1)
-NON_NEGATIVE = st.floats(min_value=0, allow_nan=False)
-#: A signature's cost must be finite (the builder refuses infinity with a clear error, as it should).
-FINITE_NON_NEGATIVE = st.floats(min_value=0, allow_nan=False, allow_infinity=False)
+#: Finite: the builder refuses infinity in every numeric field with a clear error ("too large"), as it should.
+NON_NEGATIVE = st.floats(min_value=0, allow_nan=False, allow_infinity=False)
 TYPED = IDENT | st.tuples(IDENT, TYPE).map(" - ".join) | st.fixed_dictionaries({"name": IDENT}, optional={"type": TYPE})
 SCALARS = (
     st.none()
@@ -1236,9 +1235,7 @@ PLAN = _optional(
         summands=st.lists(_optional({"name": NAME, "weight": UNIT, "expression": TEXT}), max_size=2),
     ),
     constraints=st.lists(_optional({"name": NAME, "formula": TEXT}, variables=st.lists(IDENT, max_size=2)), max_size=2),
-    signature=_optional(
-        {}, parameters=st.lists(TYPED, max_size=2), precondition=TEXT, effect=TEXT, cost=FINITE_NON_NEGATIVE
-    ),
+    signature=_optional({}, parameters=st.lists(TYPED, max_size=2), precondition=TEXT, effect=TEXT, cost=NON_NEGATIVE),
     synchronisations=st.lists(
         _optional(
             {"name": NAME, "transitions": st.lists(NAME, min_size=1, max_size=2)},
