@@ -179,6 +179,8 @@ class ProblemRuntime:
         self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
         self.step_failures_any: dict[str, int] = {}
         self.steps_done = 0
+        self.stepwise = _planner_trait(element.planner, "stepwise")
+        """Whether the problem's planner plans one step at a time (the operator changes goal and world, not planner)."""
         self.step_over: float | None = None
         """When a stepwise plan's step was seen over while its effects had not all arrived yet."""
         self.team_wait_until: float | None = None
@@ -404,7 +406,7 @@ class ProblemRuntime:
                     host.roleset,
                     share.entry_task,
                     standby=self.model.wait_plan,
-                    per_robot=self._stepwise(),
+                    per_robot=self.stepwise,
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
@@ -839,10 +841,6 @@ class ProblemRuntime:
         self.search = None
         self._start_search(now, "the step is done: planning the next one")
 
-    def _stepwise(self) -> bool:
-        """Whether the problem's planner plans one step at a time (ProTaP), each step pinned to its robots."""
-        return _planner_trait(self.model.planner, "stepwise")
-
     def _positions(self) -> dict[str, tuple[float, ...]]:
         """Object -> its position from the world model's ``pos`` values (for planners that read positions)."""
         out: dict[str, tuple[float, ...]] = {}
@@ -931,7 +929,7 @@ class ProblemRuntime:
         target = tuple(literal for literal in share.goal or goal if literal in reachable)
         order = [[step.index for step in steps] for steps in created.tasks]
         members = self.slot.members()
-        stepwise = self._stepwise()
+        stepwise = self.stepwise
         if stepwise:
             target = ()  # a step of a policy is not meant to reach the goal: only its actions must still fit
         reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(

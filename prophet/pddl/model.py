@@ -153,7 +153,7 @@ class Action:
     @property
     def cost(self) -> int | float | FluentTerm | None:
         """The top-level ``(increase (total-cost) x)`` value (summed if numbers), None without one."""
-        values = [e.value for e in _top_level_effects(self.effect) if isinstance(e, Increase)]
+        values = [e.value for e in top_level_parts(self.effect) if isinstance(e, Increase)]
         if not values:
             return None
         if len(values) == 1:
@@ -163,12 +163,12 @@ class Action:
         return values[0]
 
 
-def _top_level_effects(effect: Effect) -> list[Effect]:
-    """The parts of an effect below top-level ``and``s."""
+def top_level_parts(effect: Effect) -> list[Effect]:
+    """The parts of an effect or a formula below top-level ``and``s."""
     if isinstance(effect, And):
         out: list[Effect] = []
         for part in effect.parts:
-            out.extend(_top_level_effects(part))  # type: ignore[arg-type]
+            out.extend(top_level_parts(part))  # type: ignore[arg-type]
         return out
     return [effect]
 

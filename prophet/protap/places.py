@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 from alica.errors import PlannerError
 from alica.prophet.pddl.model import Action as PddlAction
-from alica.prophet.pddl.model import And, Atom, Domain, Formula, Not, Problem
+from alica.prophet.pddl.model import Atom, Domain, Formula, Not, Problem, top_level_parts
 from alica.prophet.planner import PlanStep
 from alica.prophet.protap.model import NOOP, JointAction, ProtapModel, State
 from alica.prophet.protap.spec import Action, Goal, ProblemSpec, Robot
@@ -54,16 +54,13 @@ Position = tuple[float, float]
 
 def _atoms(formula: Formula | object) -> list[tuple[bool, Atom]]:
     """The literals of a conjunction (other parts, such as cost increases, are left out)."""
-    if isinstance(formula, And):
-        out: list[tuple[bool, Atom]] = []
-        for part in formula.parts:
-            out.extend(_atoms(part))
-        return out
-    if isinstance(formula, Atom):
-        return [(True, formula)]
-    if isinstance(formula, Not) and isinstance(formula.formula, Atom):
-        return [(False, formula.formula)]
-    return []
+    out: list[tuple[bool, Atom]] = []
+    for part in top_level_parts(formula):  # type: ignore[arg-type]
+        if isinstance(part, Atom):
+            out.append((True, part))
+        elif isinstance(part, Not) and isinstance(part.formula, Atom):
+            out.append((False, part.formula))
+    return out
 
 
 @dataclass(frozen=True, slots=True)
