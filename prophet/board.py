@@ -56,6 +56,7 @@ class PlanShare:
         goal: the goal literals the plan reaches when robots outside the team hold
             objects of the goal (the rest of the goal); empty: the whole goal.
         origin: the agent that made the plan (a leader repeating it keeps it).
+        pins: ``(task index, robot)``: tasks the operator pinned to a robot when reviewing the plan.
     """
 
     key: PlanKey
@@ -71,6 +72,7 @@ class PlanShare:
     reason: str = ""
     goal: tuple[Literal, ...] = ()
     origin: str = ""
+    pins: tuple[tuple[int, str], ...] = ()
 
     def plan_name(self, problem: str) -> str:
         """The name of the plan generated from this share: unique to its content.
@@ -82,6 +84,8 @@ class PlanShare:
         same plan.
         """
         content = repr((self.steps, self.world, self.robots, self.entry_task, self.goal, self.key))
+        if self.pins:
+            content += repr(self.pins)
         digest = hashlib.blake2b(content.encode("utf-8"), digest_size=3).hexdigest()
         who = self.origin or self.leader
         return f"{problem}_g{self.generation}v{self.version}_{who}_{digest}"
@@ -94,6 +98,7 @@ class PlanShare:
             and self.world == other.world
             and self.robots == other.robots
             and self.goal == other.goal
+            and self.pins == other.pins
         )
 
     def supersedes(self, other: PlanShare) -> bool:

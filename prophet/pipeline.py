@@ -25,7 +25,7 @@ Example::
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from alica.errors import PlannerError
@@ -45,7 +45,7 @@ from alica.prophet.planner import (
 )
 from alica.prophet.planners import get_planner
 from alica.prophet.problem import to_pddl
-from alica.prophet.validate import validate_plan
+from alica.prophet.validate import ValidationResult, validate_plan
 from alica.prophet.world import PlanningWorld
 
 
@@ -121,14 +121,20 @@ class ProblemPlanning:
         Raises:
             PlannerError: the plan is not valid (the message names the planner and the reason).
         """
-        # a stepwise planner's plan is the next step of a policy: its actions must apply, the goal need not hold after it
-        pddl = replace(self.pddl, goal=And(())) if self.planner.stepwise else self.pddl
-        check = validate_plan((self.domain, pddl), plan)
+        check = self.check(plan.steps)
         if not check.valid:
             raise PlannerError(f"planner '{self.planner.name}' returned an invalid plan: {check.reason}")
         names = {name.lower(): name for name, _ in self.world.objects}
         steps = tuple(PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in plan.steps)
         return ValidPlan(steps, check.cost, plan)
+
+    def check(self, steps: Sequence[PlanStep]) -> ValidationResult:
+        """Validate ``steps`` (a planner's, or an operator's change of them) in the world and for the goal planned for.
+
+        A stepwise planner's plan is the next step of a policy: its actions must apply, the goal need not hold after it.
+        """
+        pddl = replace(self.pddl, goal=And(())) if self.planner.stepwise else self.pddl
+        return validate_plan((self.domain, pddl), steps)
 
     def search(self, *, anytime: bool = True, limits: Limits | None = None) -> Iterator[ProblemEvent]:
         """The planner's search as events, each better plan validated (a caller budgets it between events).

@@ -55,7 +55,7 @@ import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
-from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanKey, RunningPlan, key_text
+from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanDecision, PlanKey, RunningPlan, key_text
 from alica.errors import AlicaError, PlannerError
 from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
@@ -64,9 +64,11 @@ from alica.prophet.magic.leader import MagicLeader
 from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
 from alica.prophet.pddl.writer import write_domain, write_problem
 from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
-from alica.prophet.planner import Done, PlanStatus, Progress
+from alica.prophet.planner import Done, PlanStatus, PlanStep, Progress
+from alica.prophet.planner import Plan as StepPlan
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
+from alica.prophet.review import PROPOSAL_PLAN, apply_pins, proposal_fields, reordered, resolve_pins
 from alica.prophet.tasks import (
     STEP_DONE,
     CreatedTasks,
@@ -132,6 +134,17 @@ class _Search:
     shared_cost: float | None = None
     version: int = 0
     goal: tuple[Literal, ...] = ()
+    planning: ProblemPlanning | None = None
+    """What the search plans (its PDDL): an operator's change of the plan is validated against it."""
+
+
+@dataclass
+class _Proposal:
+    """A plan the leader proposed to the operator (review on), waiting for a decision."""
+
+    search: _Search
+    plan: ValidPlan
+    created: CreatedTasks | None
 
 
 class ProblemRuntime:
@@ -186,6 +199,10 @@ class ProblemRuntime:
         self.team_wait_until: float | None = None
         """While no plan exists without robots outside the team: when the leader stops waiting for them."""
         self.overrides = dict(host.override(self.model.name))
+        self.proposal: _Proposal | None = None
+        """The plan proposed to the operator, while the leader waits for a decision (review on)."""
+        self.decided = len(host.decisions(self.model.name))
+        """How many of the operator's decisions on the problem this runtime has read (older ones are not for it)."""
         now = host.now()
         # a share received lately is current (the leader repeats it every UpdateTime); an older one is stale
         fresh = board.fresh(self.key, now, 2 * self.model.update_time)
@@ -316,9 +333,11 @@ class ProblemRuntime:
                 self._replan(now, "the operator changed the planning problem")
             self._lead(now)
         else:
-            if self.search is not None:
+            if self.search is not None or self.proposal is not None:
                 self.search = None
+                self.proposal = None
                 host.emit("planner", key=key_text(self.key), what="handed over")
+            self.decided = len(host.decisions(self.model.name))  # whoever leads decides on its own proposals
             if self.request is not None and now >= self.next_update:
                 host.publish(self.request)
                 self.next_update = now + self.model.update_time
@@ -393,20 +412,16 @@ class ProblemRuntime:
             self.search = None
             self.pending = None
             host.emit("planner", key=key_text(self.key), what="superseded", generation=search.generation)
+        proposal = self.proposal
+        if proposal is not None and share.leader != host.name and share.generation >= proposal.search.generation:
+            self.proposal = None  # another leader is ahead: its plan wins over the one waiting for the operator
+            host.emit("planner", key=key_text(self.key), what="superseded", generation=proposal.search.generation)
         created = None
         if share.status == PLAN:
             name = share.plan_name(self.model.name)
             try:
-                created = create_tasks(
-                    name,
-                    share.steps,
-                    host.library,
-                    share.world,
-                    share.robots,
-                    host.roleset,
-                    share.entry_task,
-                    standby=self.model.wait_plan,
-                    per_robot=self.stepwise,
+                created = apply_pins(
+                    self._tasks_for(name, share.steps, share.world, share.robots, share.entry_task), share.pins
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
@@ -429,6 +444,22 @@ class ProblemRuntime:
         if share.reason:
             fields["reason"] = share.reason
         host.emit("problem", key=key_text(self.key), phase=self.phase(), **fields)
+
+    def _tasks_for(
+        self, name: str, steps: Sequence[PlanStep], world: Sequence[Fact], robots: Sequence[str], entry_task: str
+    ) -> CreatedTasks:
+        """Task creation for a plan of this problem (every agent makes the same tasks from the same share)."""
+        return create_tasks(
+            name,
+            steps,
+            self.host.library,
+            world,
+            robots,
+            self.host.roleset,
+            entry_task,
+            standby=self.model.wait_plan,
+            per_robot=self.stepwise,
+        )
 
     def _publish_failure(self, now: float, generation: int, reason: str) -> None:
         """Tell the team that planning ``generation`` failed: it runs the AlternativePlan."""
@@ -469,7 +500,9 @@ class ProblemRuntime:
         if requests and share is not None and share.status == PLAN:
             self._replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
             return
-        if self.pending is not None:
+        if self.proposal is not None:
+            self._review(now, self.proposal)
+        elif self.pending is not None:
             if now + 1e-9 < self.pending[0]:
                 return
             reason = self.pending[1]
@@ -550,6 +583,7 @@ class ProblemRuntime:
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         host = self.host
+        self.proposal = None
         if generation is None:
             generation = self._next_generation()
         me = host.name
@@ -594,7 +628,7 @@ class ProblemRuntime:
             host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
-        self.search = _Search(generation, world, events, now, goal=partial if partial != goal else ())
+        self.search = _Search(generation, world, events, now, goal=partial if partial != goal else (), planning=planning)
         extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
         host.emit(
             "planner",
@@ -763,6 +797,9 @@ class ProblemRuntime:
         """Share what the search found; end it when it is done."""
         best = search.best
         if best is not None and search.shared_cost is None:
+            if self.host.review:
+                self._propose(search, best)
+                return
             self._share_plan(now, search, best)
         elif search.shared_cost is not None and self._executing():
             finished = finished or Done(PlanStatus.SOLVED, search.expansions, "execution has begun")
@@ -862,7 +899,9 @@ class ProblemRuntime:
             for _, state in node.believed.values()
         )
 
-    def _share_plan(self, now: float, search: _Search, plan: ValidPlan) -> None:
+    def _share_plan(
+        self, now: float, search: _Search, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
+    ) -> None:
         steps = plan.steps
         self.team_wait_until = None
         search.version += 1
@@ -891,8 +930,91 @@ class ProblemRuntime:
             self._entry_task(),
             goal=search.goal,
             origin=self.host.name,
+            pins=pins,
         )
         self._publish(share, now)
+
+    # -- the operator's review (EngineConfig.review) -------------------------------
+
+    def _propose(self, search: _Search, plan: ValidPlan) -> None:
+        """Stop searching and propose the generation's first valid plan to the operator (the team keeps waiting)."""
+        self.search = None
+        self.team_wait_until = None
+        name = PROPOSAL_PLAN.format(problem=self.model.name, generation=search.generation)
+        error = None
+        try:
+            created: CreatedTasks | None = self._tasks_for(
+                name, plan.steps, search.world.facts, search.world.robots, self._entry_task()
+            )
+        except (PlannerError, AlicaError) as exc:
+            created, error = None, f"the plan cannot be turned into tasks: {exc}"
+        self.proposal = _Proposal(search, plan, created)
+        self._emit_proposal(self.proposal, error)
+
+    def _emit_proposal(
+        self, proposal: _Proposal, error: str | None = None, decision: PlanDecision | None = None
+    ) -> None:
+        search = proposal.search
+        self.host.emit(
+            "proposal",
+            **proposal_fields(
+                key=key_text(self.key),
+                problem=self.model.name,
+                generation=search.generation,
+                leader=self.host.name,
+                cost=proposal.plan.plan.cost,
+                goal=conjunction(search.goal) if search.goal else self.problem.goal.text,
+                steps=proposal.plan.steps,
+                created=proposal.created,
+                error=error,
+                decision=decision.describe() if decision is not None else None,
+            ),
+        )
+
+    def _review(self, now: float, proposal: _Proposal) -> None:
+        """Read the operator's new decisions, in order, until one settles the proposal."""
+        decisions = self.host.decisions(self.model.name)
+        generation = proposal.search.generation
+        while self.decided < len(decisions) and self.proposal is proposal:
+            decided_for, decision = decisions[self.decided]
+            self.decided += 1
+            if decided_for != generation:
+                self.host.emit(
+                    "note",
+                    key=key_text(self.key),
+                    message=f"the operator's '{decision.action}' for generation {decided_for} is ignored: "
+                    f"the plan proposed is of generation {generation}",
+                )
+            elif decision.action == "accept":
+                self._accept(now, proposal, proposal.plan)
+            elif decision.action == "decline":
+                self._replan(now, f"the operator declined the plan of generation {generation}")
+            else:
+                self._modify(now, proposal, decision)
+
+    def _accept(
+        self, now: float, proposal: _Proposal, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
+    ) -> None:
+        self.proposal = None
+        self._share_plan(now, proposal.search, plan, pins)
+
+    def _modify(self, now: float, proposal: _Proposal, decision: PlanDecision) -> None:
+        """Run the plan as the operator changed it if it is valid; else propose it again with the error."""
+        search = proposal.search
+        try:
+            steps = reordered(proposal.plan.steps, decision.order)
+            if search.planning is None:
+                raise PlannerError("the plan was not made by a search this agent can validate against")
+            check = search.planning.check(steps)
+            if not check.valid:
+                raise PlannerError(f"the modified plan is invalid: {check.reason}")
+            name = PROPOSAL_PLAN.format(problem=self.model.name, generation=search.generation)
+            created = self._tasks_for(name, steps, search.world.facts, search.world.robots, self._entry_task())
+            pins = resolve_pins(created, decision.pins, search.world.robots)
+        except (PlannerError, AlicaError) as exc:
+            self._emit_proposal(proposal, str(exc), decision)
+            return
+        self._accept(now, proposal, ValidPlan(steps, check.cost, StepPlan(steps, check.cost)), pins)
 
     # -- execution monitoring --------------------------------------------------
 

@@ -13,7 +13,7 @@
 
 from alica.engine.agent import AgentEngine
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext, SkillFactory
-from alica.engine.child import ChildFactory, ChildHost, ChildKind, ChildRuntime, ChildSlot, RunningPlan
+from alica.engine.child import ChildFactory, ChildHost, ChildKind, ChildRuntime, ChildSlot, PlanDecision, RunningPlan
 from alica.engine.config import EngineConfig
 from alica.engine.runner import SimulatedTeam, pick_roleset
 from alica.engine.show import running_tree
@@ -33,6 +33,7 @@ __all__ = [
     "Claim",
     "EngineConfig",
     "JsonlTrace",
+    "PlanDecision",
     "RunningPlan",
     "SimulatedTeam",
     "SkillBinder",

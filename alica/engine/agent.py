@@ -16,6 +16,7 @@ from alica.clock import Clock
 from alica.comm import QoS, Transport
 from alica.engine.allocate import Allocator
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext
+from alica.engine.child import PlanDecision
 from alica.engine.belief import AgentBelief
 from alica.engine.conditions import Formulas
 from alica.engine.config import EngineConfig
@@ -95,6 +96,8 @@ class AgentEngine:
         self.base_roleset = roleset
         self.generated = GeneratedPlans(roleset)
         self.overrides: dict[str, dict[str, str]] = {}
+        self.decisions: dict[str, list[tuple[int, PlanDecision]]] = {}
+        """Planning problem -> the operator's decisions on its proposed plans, ``(generation, decision)``, in order."""
         self.transport = transport
         self.world_model = world_model
         self.clock = clock
@@ -343,6 +346,27 @@ class AgentEngine:
         if world is not None:
             override["world"] = world
         self.overrides[name] = override
+
+    def decide_plan(self, problem: str, generation: int, decision: PlanDecision) -> None:
+        """The operator decides on the plan of ``generation`` proposed for planning problem ``problem``.
+
+        With review on (``EngineConfig.review``) the problem's leader proposes each plan and
+        waits; it reads the decision on its next update: it runs the plan (accept), plans again
+        (decline), or runs the plan as changed if it is still valid (modify; else it proposes it
+        again with the error). A decision for an older generation is ignored. The decision is
+        kept (also by an agent that is not the leader now: it may lead later).
+
+        Raises:
+            AlicaError: no planning problem has that name.
+            TypeError: ``decision`` is not a :class:`~alica.engine.child.PlanDecision`.
+        """
+        if problem not in self.library.problems:
+            raise AlicaError(
+                f"no planning problem named '{problem}'; problems: {', '.join(sorted(self.library.problems)) or 'none'}"
+            )
+        if not isinstance(decision, PlanDecision):
+            raise TypeError(f"a plan decision is a PlanDecision, not {decision!r}")
+        self.decisions.setdefault(problem, []).append((int(generation), decision))
 
     def belief_for(self, node: PlanNode) -> AgentBelief:
         """The belief base, looking at ``node``'s context."""

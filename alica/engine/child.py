@@ -68,9 +68,10 @@ public interface for child runtimes: an import-linter contract keeps
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, MutableMapping
+from collections.abc import Iterator, Mapping, MutableMapping, Sequence
 from collections.abc import Set as AbstractSet
-from typing import Any, Protocol
+from dataclasses import dataclass, field
+from typing import Any, Literal, Protocol
 
 from alica.engine.status import ChildStatus
 from alica.engine.team import PlanKey, key_text
@@ -85,6 +86,7 @@ __all__ = [
     "ChildRuntime",
     "ChildSlot",
     "ChildStatus",
+    "PlanDecision",
     "PlanKey",
     "RunningPlan",
     "WorldFacts",
@@ -95,6 +97,48 @@ __all__ = [
 
 #: An agent's entry point and state in a plan, as it believes them (``None``: idle).
 Entry = tuple[str | None, str | None]
+
+#: What the operator does with a plan proposed for review.
+DecisionAction = Literal["accept", "decline", "modify"]
+
+
+@dataclass(frozen=True, slots=True)
+class PlanDecision:
+    """The operator's decision on a plan a child runtime proposed for review (``EngineConfig.review``).
+
+    Attributes:
+        action: ``accept`` (run the plan as proposed), ``decline`` (plan again) or ``modify``
+            (run the plan changed by ``order`` and ``pins``, if it is still valid).
+        order: with ``modify``, the proposed plan's step indices to keep, in their new order
+            (dropping and reordering steps); ``None`` keeps the steps as they are.
+        pins: with ``modify``, task -> the only agent that may take it; a task is named by its
+            entry point or by its index (``"0"``) in the plan as modified.
+
+    Raises:
+        ValueError: an unknown action, or an order or pins given with another action than ``modify``.
+    """
+
+    action: DecisionAction
+    order: tuple[int, ...] | None = None
+    pins: Mapping[str, str] = field(default_factory=dict, hash=False)
+
+    def __post_init__(self) -> None:
+        if self.action not in ("accept", "decline", "modify"):
+            raise ValueError(f"a plan decision is 'accept', 'decline' or 'modify', not {self.action!r}")
+        if self.action != "modify" and (self.order is not None or self.pins):
+            raise ValueError(f"only 'modify' changes the order or the pins of a plan, not {self.action!r}")
+        if self.order is not None:
+            object.__setattr__(self, "order", tuple(int(i) for i in self.order))
+        object.__setattr__(self, "pins", {str(task): str(agent) for task, agent in dict(self.pins).items()})
+
+    def describe(self) -> dict[str, object]:
+        """The decision as plain data (for a trace event)."""
+        out: dict[str, object] = {"action": self.action}
+        if self.order is not None:
+            out["order"] = list(self.order)
+        if self.pins:
+            out["pins"] = dict(self.pins)
+        return out
 
 
 class RunningPlan(Protocol):
@@ -212,6 +256,16 @@ class ChildHost(Protocol):
 
     def override(self, element: str) -> Mapping[str, str]:
         """What the operator set for the model element ``element`` (e.g. ``goal``, ``world``)."""
+
+    @property
+    def review(self) -> bool:
+        """Whether the operator reviews every plan a runtime would run before it runs (``EngineConfig.review``)."""
+
+    def decisions(self, element: str) -> Sequence[tuple[int, PlanDecision]]:
+        """The operator's decisions on the plans proposed for the model element ``element``, oldest first.
+
+        Each is ``(generation, decision)``: the generation of the proposal it decides.
+        """
 
     def emit(self, event: str, **fields: Any) -> None:
         """Send a trace event."""

@@ -43,6 +43,10 @@ class EngineConfig:
             child of that type runs (:mod:`alica.engine.child`); e.g.
             ``{PlanningProblem: alica.prophet.PLANNING}``. A plan tree that
             reaches an element of a type not given here cannot run.
+        review: the operator reviews every plan a child runtime generates before the
+            team runs it (a planning problem's leader proposes it and waits for
+            :meth:`AgentEngine.decide_plan <alica.engine.agent.AgentEngine.decide_plan>`;
+            the team runs the WaitPlan meanwhile). Off: plans run at once.
     """
 
     frequency: float = 30.0
@@ -59,6 +63,7 @@ class EngineConfig:
     authority_max: float = 16.0
     authority_growth: float = 2.0
     children: Mapping[type, ChildKind] = field(default_factory=dict, hash=False)
+    review: bool = False
 
     def __post_init__(self) -> None:
         positive = ("frequency", "broadcast_interval", "team_timeout", "cycle_window", "authority_min")

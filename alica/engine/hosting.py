@@ -9,12 +9,13 @@ and routes the messages of each kind's topic to its factory.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, MutableMapping
+from collections.abc import Mapping, MutableMapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from alica.engine.child import (
     ChildFactory,
     ChildRuntime,
+    PlanDecision,
     RunningPlan,
     WorldFacts,
     missing_kind_message,
@@ -106,6 +107,13 @@ class EngineHost:
 
     def override(self, element: str) -> Mapping[str, str]:
         return self._engine.overrides.get(element, _NONE)
+
+    @property
+    def review(self) -> bool:
+        return self._engine.config.review
+
+    def decisions(self, element: str) -> Sequence[tuple[int, PlanDecision]]:
+        return self._engine.decisions.get(element, ())
 
     def emit(self, event: str, **fields: Any) -> None:
         self._engine.emit(event, **fields)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from alica.allocation import AgentSpec, assign_roles
@@ -19,6 +19,7 @@ from alica.comm import Delay, SimNetwork
 from alica.comm.faults import describe_fault
 from alica.engine.agent import AgentEngine, Observer
 from alica.engine.behaviours import SkillBinder, SkillFactory
+from alica.engine.child import PlanDecision
 from alica.engine.config import EngineConfig
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError
@@ -102,6 +103,8 @@ class SimulatedTeam:
             robots sense into their world models.
         step_world: whether :meth:`tick` steps the world (``False`` when a caller
             runs several teams in one world and steps it itself).
+        review: the operator reviews every generated plan before the team runs it
+            (sets ``review`` in the engines' config; see :meth:`decide_plan`).
     """
 
     def __init__(
@@ -125,6 +128,7 @@ class SimulatedTeam:
         world: Any = None,
         perception: Callable[[SimulatedTeam], None] | None = None,
         step_world: bool = True,
+        review: bool = False,
     ) -> None:
         if not agents:
             raise AlicaError("a team needs at least one agent")
@@ -137,6 +141,8 @@ class SimulatedTeam:
         self.plan = plan
         self.seed = seed
         self.config = config or EngineConfig()
+        if review:
+            self.config = replace(self.config, review=True)
         self.roleset = pick_roleset(library, (s.role for s in specs.values()), roleset)
         self.roles = assign_roles(specs, self.roleset)
         self.world = world
@@ -298,6 +304,7 @@ class SimulatedTeam:
         engine = self._make_engine(name, old.transport, listen_first=1.5 * self.config.broadcast_interval)
         # the operator's settings are the robot's configuration, not its memory: the restart keeps them
         engine.overrides = {problem: dict(values) for problem, values in old.overrides.items()}
+        engine.decisions = {problem: list(made) for problem, made in old.decisions.items()}
         self.engines[name] = engine
         self._fault("recover", agent=name)
 
@@ -310,26 +317,62 @@ class SimulatedTeam:
         self.network.partition(groups, start=start, end=end)
         self._fault("partition", groups=groups, start=self.now() if start is None else start, end=end)
 
-    def set_facts(self, facts: Iterable[tuple[bool, str, tuple[object, ...]]], at: float | None = None) -> None:
+    def set_facts(
+        self,
+        facts: Iterable[tuple[bool, str, tuple[object, ...]]],
+        at: float | None = None,
+        *,
+        by_operator: bool = False,
+    ) -> None:
         """The operator sets facts, ``(positive, predicate, args)``, in every running agent's world model.
 
-        With ``at`` in the future, at that time.
+        With ``at`` in the future, at that time. With ``by_operator`` the trace's ``operator`` event
+        is the operator's action (agent ``operator``, ``what`` = ``facts``), as :meth:`set_goal` traces.
         """
         facts = [(bool(p), str(n), tuple(a)) for p, n, a in facts]
         if at is not None and at > self.now():
-            self.at(at, "operator", lambda: self.set_facts(facts))
+            self.at(at, "operator", lambda: self.set_facts(facts, by_operator=by_operator))
             return
         for name, engine in self.engines.items():
             if name in self.crashed:
                 continue
             for positive, pred, args in facts:
                 (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *args)
-        record = {
-            "t": round(self.now(), 6),
-            "agent": "-",
-            "event": "operator",
-            "facts": [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts],
-        }
+        texts = [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts]
+        if by_operator:
+            self._operator("facts", facts=texts)
+            return
+        record = {"t": round(self.now(), 6), "agent": "-", "event": "operator", "facts": texts}
+        for observer in self.observers:
+            observer(record)
+
+    def set_goal(self, problem: str, goal: str) -> None:
+        """The operator sets the goal of planning problem ``problem`` on every agent (crashed ones too): the leader replans.
+
+        Raises:
+            AlicaError: no planning problem has that name.
+        """
+        for engine in self.engines.values():
+            engine.set_problem(problem, goal=goal)
+        self._operator("goal", problem=problem, goal=goal)
+
+    def decide_plan(self, problem: str, generation: int, decision: PlanDecision) -> None:
+        """The operator decides on the plan of ``generation`` proposed for ``problem`` (review on).
+
+        Every agent is told, crashed ones too, so that whoever leads (now or after a
+        restart) knows it; see :meth:`AgentEngine.decide_plan`.
+
+        Raises:
+            AlicaError: no planning problem has that name.
+        """
+        for engine in self.engines.values():
+            engine.decide_plan(problem, generation, decision)
+        details = decision.describe()
+        self._operator(str(details.pop("action")), problem=problem, generation=generation, **details)
+
+    def _operator(self, what: str, **fields: Any) -> None:
+        """An ``operator`` event: what the operator did."""
+        record = {"t": round(self.now(), 6), "agent": "operator", "event": "operator", "what": what, **fields}
         for observer in self.observers:
             observer(record)
 
