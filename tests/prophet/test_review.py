@@ -233,3 +233,26 @@ def test_without_review_the_first_plan_runs_at_once_and_nothing_is_proposed():
     sim, rec = blocks_team(["r1", "r2"], skills)
     summary = sim.run(until_done=True, max_time=60)
     assert summary["success"] and proposals(rec) == []
+
+
+def test_a_stepwise_planner_proposes_every_step_and_each_runs_only_once_accepted():
+    from tests.prophet.protap.test_team import goal_holds as survey_done
+    from tests.prophet.protap.test_team import survey_team
+
+    skills = BlockSkills()
+    sim, rec = survey_team(skills, review=True)
+    accepted: list[int] = []
+    for _ in range(1200):
+        if sim.done():
+            break
+        waiting = [p for p in proposals(rec) if p["generation"] not in accepted]
+        if waiting:
+            # before the operator accepts a step, the team runs no action of it
+            assert len(made_plans(sim.engines["r1"])) == len(accepted)
+            accepted.append(waiting[0]["generation"])
+            sim.decide_plan("SurveySites", waiting[0]["generation"], PlanDecision("accept"))
+        sim.tick()
+    assert sim.done() and survey_done(sim, "r1")
+    assert len(accepted) >= 2  # one proposal per step: drive, then act
+    assert [g for g, _, _ in made_plans(sim.engines["r1"])] == accepted
+    assert all(task["robots"] and len(task["robots"]) == 1 for p in proposals(rec) for task in p["tasks"])

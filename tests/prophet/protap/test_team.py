@@ -21,7 +21,7 @@ POSITIONS = {"base": (0.0, 0.0), "s1": (6.0, 0.0), "s2": (0.0, 6.0), "s3": (6.0,
 GOAL = (("sampled", "s1"), ("sampled", "s2"), ("scanned", "s3"))
 
 
-def survey_team(skills: BlockSkills, agents=("r1", "r2"), seed: int = 0):  # type: ignore[no-untyped-def]
+def survey_team(skills: BlockSkills, agents=("r1", "r2"), seed: int = 0, review: bool = False):  # type: ignore[no-untyped-def]
     library = load_library(PLANS / "examples" / "protap_survey.yaml")
     recorder = TraceRecorder()
     sim = SimulatedTeam(
@@ -32,6 +32,7 @@ def survey_team(skills: BlockSkills, agents=("r1", "r2"), seed: int = 0):  # typ
         config=engine_config(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3),
         skills={name: skills.factory(name) for name in SKILLS},
         observers=[recorder],
+        review=review,
     )
     sim.set_facts([(True, "at", (agent, "base")) for agent in agents])
     for engine in sim.engines.values():
