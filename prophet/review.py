@@ -63,9 +63,7 @@ def _task_index(created: CreatedTasks, task: str) -> int | None:
     return None
 
 
-def resolve_pins(
-    created: CreatedTasks, pins: Mapping[str, str], team: Sequence[str]
-) -> tuple[tuple[int, str], ...]:
+def resolve_pins(created: CreatedTasks, pins: Mapping[str, str], team: Sequence[str]) -> tuple[tuple[int, str], ...]:
     """The operator's pins as ``(task index, robot)``, sorted.
 
     Args:

@@ -40,6 +40,14 @@ in a row not, it replans. A step that fails sends its agent back to the
 WaitPlan and asks the leader to replan (:class:`~alica.prophet.board.ReplanRequest`); so does a
 change of goal or world by the operator (``AgentEngine.set_problem``, read through the host).
 
+With review on (``EngineConfig.review``, read through the host), the leader
+does not share the first plan of a generation: it proposes it to the operator
+(a ``proposal`` trace event) and waits for the operator's
+:class:`~alica.engine.child.PlanDecision` (``AgentEngine.decide_plan``, read
+through the host): accept, decline (plan again) or modify (reorder or drop
+steps, pin tasks to robots; validated before it is shared). See
+:mod:`alica.prophet.review`.
+
 The runtime sees the engine only through the child-runtime seam
 (:mod:`alica.engine.child`): the agent's :class:`~alica.engine.child.ChildHost`,
 its :class:`~alica.engine.child.ChildSlot` and the
@@ -628,7 +636,9 @@ class ProblemRuntime:
             host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
-        self.search = _Search(generation, world, events, now, goal=partial if partial != goal else (), planning=planning)
+        self.search = _Search(
+            generation, world, events, now, goal=partial if partial != goal else (), planning=planning
+        )
         extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
         host.emit(
             "planner",
@@ -899,9 +909,7 @@ class ProblemRuntime:
             for _, state in node.believed.values()
         )
 
-    def _share_plan(
-        self, now: float, search: _Search, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
-    ) -> None:
+    def _share_plan(self, now: float, search: _Search, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()) -> None:
         steps = plan.steps
         self.team_wait_until = None
         search.version += 1
@@ -992,9 +1000,7 @@ class ProblemRuntime:
             else:
                 self._modify(now, proposal, decision)
 
-    def _accept(
-        self, now: float, proposal: _Proposal, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
-    ) -> None:
+    def _accept(self, now: float, proposal: _Proposal, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()) -> None:
         self.proposal = None
         self._share_plan(now, proposal.search, plan, pins)
 

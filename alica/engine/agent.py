@@ -16,8 +16,8 @@ from alica.clock import Clock
 from alica.comm import QoS, Transport
 from alica.engine.allocate import Allocator
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext
-from alica.engine.child import PlanDecision
 from alica.engine.belief import AgentBelief
+from alica.engine.child import PlanDecision
 from alica.engine.conditions import Formulas
 from alica.engine.config import EngineConfig
 from alica.engine.generated import GeneratedPlans

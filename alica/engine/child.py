@@ -37,7 +37,8 @@ Design of the seam:
 * **A narrow host, not the engine.** A runtime sees the engine only through
   :class:`ChildHost`: the agent's name and time, the plan library and role
   set, formulas evaluated in a running plan's context, the world model as
-  :class:`WorldFacts`, trace events, counters, operator settings, team
+  :class:`WorldFacts`, trace events, counters, operator settings and
+  decisions on reviewed plans (:class:`PlanDecision`), team
   messages on the topic its kind owns, and the registration of the plans it
   generates (with their task priorities and pinned entry points, so that
   allocation can use them). It sees its slot as a :class:`ChildSlot` and the
