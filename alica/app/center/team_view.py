@@ -126,6 +126,10 @@ class TeamView:
         recovery starts it from nothing; ``pose``, ``object``, ``found`` and ``map`` events move
         robots and objects and replace the map. A ``map`` event whose cells do not decode is
         left out. Events of other kinds change nothing but the time.
+
+        Traces do not record a plan's initial state: until its first transition a node's
+        state is ``None``, unless a node below it (``KEY/STATE/CHILD``) names it, which
+        :meth:`snapshot` fills in.
         """
         kind = event.get("event")
         t = event.get("t")
@@ -229,6 +233,11 @@ class TeamView:
         agents: dict[str, dict[str, Any]] = {}
         for name, who in self.agents.items():
             plans = sorted((dict(n) for n in self.nodes[name].values()), key=lambda n: n["key"].count("/"))
+            for node in plans:
+                if node["state"] is None:  # no transition yet: a node below names the state it runs in
+                    below = next((n["key"] for n in plans if n["key"].startswith(node["key"] + "/")), None)
+                    if below is not None:
+                        node["state"] = below[len(node["key"]) + 1 :].split("/", 1)[0]
             deepest = plans[-1] if plans else _NO_NODE
             agents[name] = {
                 **who,

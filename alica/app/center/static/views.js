@@ -198,12 +198,19 @@
       let out = '<li class="' + n.kind + (here ? " active" : "") + '" data-key="' + esc(key) + '"><span class="name">' + (n.kind === "problem" ? "problem " : "plan type ") + esc(n.name) + "</span><ul>";
       out += n.children.map((c) => node(c, key, active, claimed)).join("");
       if (here && !names.includes(here.plan)) {
+        // A generated plan: its states are not in the file; the plans it runs below its current state are.
         claimed.add(key);
         out += '<li class="plan generated active" data-key="' + esc(key) + '"><span class="name">' + esc(here.plan) + '</span> <span class="task">generated' +
-          (here.task ? ", task " + esc(here.task) : "") + "</span><ul>" +
-          (here.state ? '<li class="state current"><span class="name">' + esc(here.state) + "</span></li>" : "");
-        for (const p of Object.values(active)) {
-          if (p.key.startsWith(key + "/")) { claimed.add(p.key); out += runtime(p, "inside"); }
+          (here.task ? ", task " + esc(here.task) : "") + "</span><ul>";
+        if (here.state) {
+          out += '<li class="state current" data-state="' + esc(here.state) + '"><span class="name">' + esc(here.state) + "</span><ul>";
+          for (const p of Object.values(active)) {
+            const rest = p.key.startsWith(key + "/") ? p.key.slice(key.length + 1).split("/") : [];
+            if (rest.length !== 2 || claimed.has(p.key)) { continue; }
+            const tree = n.children.find((c) => c.name === p.plan || c.name === rest[1]);
+            out += tree ? node(tree, p.key, active, claimed) : (claimed.add(p.key), runtime(p, "inside"));
+          }
+          out += "</ul></li>";
         }
         out += "</ul></li>";
       }
@@ -214,10 +221,19 @@
     let out = '<li class="plan' + (mine ? " active" : "") + '" data-key="' + esc(key) + '" data-name="' + esc(n.name) + '"><span class="name">' + esc(n.name) + "</span>";
     if (mine && here.task) { out += ' <span class="task">task ' + esc(here.task) + "</span>"; }
     out += "<ul>";
+    // Before the plan's first transition the trace does not say its state: the entry point of the agent's task does.
+    const entry = mine && !here.state ? (n.entry_points || []).find((e) => e.task === here.task) : null;
+    const state = mine ? here.state || (entry ? entry.state : null) : null;
     for (const s of n.states) {
-      const current = mine && here.state === s.name;
+      const current = mine && state === s.name;
       out += '<li class="state ' + esc(s.kind) + (current ? " current" : "") + '" data-state="' + esc(s.name) + '"><span class="name">' + esc(s.name) + "</span>";
-      if (s.children.length) { out += "<ul>" + s.children.map((c) => node(c, key + "/" + s.name + "/" + c.name, active, claimed)).join("") + "</ul>"; }
+      if (s.children.length) {
+        const below = "<ul>" + s.children.map((c) => node(c, key + "/" + s.name + "/" + c.name, active, claimed)).join("") + "</ul>";
+        // what the agent is not in now folds away (a click opens it); the way to where it is stays open
+        const inside = Object.keys(active).some((k) => k.startsWith(key + "/" + s.name + "/"));
+        const leaves = s.children.every((c) => c.kind === "behaviour");
+        out += current || inside || leaves ? below : "<details><summary>" + s.children.length + (s.children.length === 1 ? " child" : " children") + "</summary>" + below + "</details>";
+      }
       out += "</li>";
     }
     return out + "</ul></li>";
