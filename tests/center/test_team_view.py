@@ -91,7 +91,9 @@ def test_objects_move_and_found_samples_are_marked() -> None:
         | {"x": 4.0, "y": 1.0, "z": 0.05, "size": 0.1, "radius": 0.03}
     )
     view.apply({"t": 0.1, "agent": "-", "event": "object", "name": "r", "kind": "rock", "x": 4.2, "y": 1.0, "z": 0.0})
-    view.apply({"t": 2.0, "agent": "-", "event": "object", "name": "s1", "kind": "sample", "x": 3.0, "y": 1.0, "z": 0.3})
+    view.apply(
+        {"t": 2.0, "agent": "-", "event": "object", "name": "s1", "kind": "sample", "x": 3.0, "y": 1.0, "z": 0.3}
+    )
     objects = view.snapshot()["objects"]
     assert objects["s1"] == {
         "x": 3.0,
@@ -102,13 +104,17 @@ def test_objects_move_and_found_samples_are_marked() -> None:
         "size": 0.1,
         "radius": 0.03,
     }
-    view.apply({"t": 3.0, "agent": "-", "event": "found", "name": "red_black_red", "kind": "red-black-red", "x": 3.2, "y": 1.1})
+    view.apply(
+        {"t": 3.0, "agent": "-", "event": "found", "name": "red_black_red", "kind": "red-black-red", "x": 3.2, "y": 1.1}
+    )
     view.apply({"t": 3.5, "agent": "-", "event": "found", "name": "far_one", "kind": "", "x": -4.0, "y": -4.0})
     objects = view.snapshot()["objects"]
     assert (objects["s1"]["found"], objects["s1"]["found_as"]) == ("red-black-red", "red_black_red")
     assert "found" not in objects["r"]  # a rock is no sample, however near
     assert objects["far_one"] == {"x": -4.0, "y": -4.0, "z": 0.0, "kind": "sample", "found": "", "found_as": "far_one"}
-    view.apply({"t": 4.0, "agent": "-", "event": "found", "name": "far_one", "kind": "green-red-green", "x": -4.0, "y": -4.0})
+    view.apply(
+        {"t": 4.0, "agent": "-", "event": "found", "name": "far_one", "kind": "green-red-green", "x": -4.0, "y": -4.0}
+    )
     assert view.snapshot()["objects"]["far_one"]["found"] == "green-red-green"  # its kind, once known
 
 

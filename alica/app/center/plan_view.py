@@ -219,7 +219,8 @@ def trace_trees(meta: dict[str, Any], trace_path: str | Path) -> dict[str, Any]:
         ``plan``, else its ``root``), which agent runs which, and why a file or a root is
         missing (never an exception).
     """
-    agents = meta.get("agents") if isinstance(meta.get("agents"), dict) else {}
+    given_agents = meta.get("agents")
+    agents: dict[str, Any] = given_agents if isinstance(given_agents, dict) else {}
     root = meta.get("root")
     wanted: dict[str, str] = {}
     for name, info in sorted(agents.items()):
