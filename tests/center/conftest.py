@@ -62,3 +62,42 @@ def written_trace(tmp_path: Path) -> Path:
     path = tmp_path / "written.jsonl"
     path.write_text("".join(json.dumps(e) + "\n" for e in events), encoding="utf-8")
     return path
+
+
+@pytest.fixture(scope="session")
+def blocks_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The blocks world demo: two manipulators, four blocks (a generated plan, object events of the blocks)."""
+    folder = tmp_path_factory.mktemp("blocks")
+    code = main(["demo", "blocksworld", "--agents", "2", "--blocks", "4", "--seed", "3", "--out", str(folder)])
+    assert code == 0
+    return folder / "trace.jsonl"
+
+
+@pytest.fixture(scope="session")
+def lunar_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A short lunar demo on a small field: samples found, rocks, and team maps every 5 s (a few seconds of wall time)."""
+    folder = tmp_path_factory.mktemp("lunar")
+    main(
+        [
+            "demo",
+            "lunar",
+            "--robots",
+            "scout,stummel",
+            "--samples",
+            "3",
+            "--rocks",
+            "8",
+            "--size",
+            "12",
+            "--pick",
+            "2",
+            "--time-limit",
+            "12",
+            "--out",
+            str(folder),
+            "--no-progress",
+        ]
+    )  # the mission need not finish in 12 s: the trace is what counts
+    path = folder / "trace.jsonl"
+    assert path.stat().st_size > 0
+    return path

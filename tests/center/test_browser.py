@@ -12,10 +12,14 @@ import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from alica.io import plans_dir
+
+if TYPE_CHECKING:
+    from playwright.sync_api import Page
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = [
@@ -68,6 +72,18 @@ def replay_url(recorded_trace: Path) -> Iterator[str]:
 def poses_url(written_trace: Path) -> Iterator[str]:
     _browser_or_skip()
     yield from _serve("--trace", str(written_trace))
+
+
+@pytest.fixture()
+def blocks_url(blocks_trace: Path) -> Iterator[str]:
+    _browser_or_skip()
+    yield from _serve("--trace", str(blocks_trace))
+
+
+@pytest.fixture()
+def lunar_url(lunar_trace: Path) -> Iterator[str]:
+    _browser_or_skip()
+    yield from _serve("--trace", str(lunar_trace))
 
 
 @pytest.fixture()
@@ -146,5 +162,81 @@ def test_the_map_draws_robots_from_pose_events(poses_url: str) -> None:
             page.wait_for_selector('#map-body svg circle.robot[data-agent="a"]', timeout=10_000)
             assert page.locator('#agents-body tr[data-agent="a"] td').nth(5).inner_text() == "S2"
             page.screenshot(path=str(SHOTS / "replay-poses.png"), full_page=True)
+        finally:
+            browser.close()
+
+
+def _slide_to(page: Page, t: str) -> None:
+    """Move the slider to ``t`` (a number, or ``max``) as a person dragging it would."""
+    page.eval_on_selector(
+        "#slider", "(s, t) => { s.value = t === 'max' ? s.max : t; s.dispatchEvent(new Event('input')); }", t
+    )
+
+
+def test_a_blocks_world_replay_shows_the_blocks_table_and_the_generated_plan(blocks_url: str) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 1000})
+            page.goto(blocks_url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            header = page.locator("#file")
+            assert header.inner_text().startswith("trace.jsonl \u2014 ")  # the file's name, not where it lies
+            assert Path(header.get_attribute("title") or "").is_absolute()
+            assert page.locator("#blocks").is_visible()
+            page.wait_for_selector("#blocks-body svg g.block", timeout=10_000)
+            names = sorted(page.locator("#blocks-body svg g.block text").all_text_contents())
+            assert names == ["a", "b", "c", "d"]
+            page.screenshot(path=str(SHOTS / "replay-blocks.png"), full_page=True)
+            _slide_to(page, "5")  # r1 unstacks a block in the leader's generated plan
+            tree = page.locator('#trees-body .agent-tree[data-agent="r1"]')
+            tree.locator("li.plan.generated.active").wait_for(timeout=10_000)
+            generated = tree.locator("li.plan.generated.active > .name").inner_text()
+            assert generated.startswith("StackBlocks_")
+            current = tree.locator("li.plan.generated.active > ul > li.state.current")
+            assert current.locator("> .name").inner_text() == "T0_S0_Unstack"
+            inside = current.locator('> ul > li.plan.active[data-name="Unstack"]')  # drawn from the plan file
+            assert inside.locator("> ul > li.state.current > .name").inner_text() == "TakeOffStack"  # its entry state
+            top = tree.locator('li.plan.active[data-name="BlocksWorldMission"] > ul > li.state.current > .name')
+            assert top.inner_text() == "Stacking"
+            page.locator("#trees").screenshot(path=str(SHOTS / "plan-tree.png"))
+            _slide_to(page, "max")
+            page.wait_for_function("document.getElementById('time').textContent !== 't = 5.000 s'", timeout=10_000)
+            page.wait_for_selector(
+                '#trees-body .agent-tree[data-agent="r1"] li.plan.active[data-name="BlocksWorldMission"]'
+                ' > ul > li.state.current[data-state="Done"]',
+                timeout=10_000,
+            )
+            assert tree.locator("li.plan.generated").count() == 0  # left when the mission's state changed
+        finally:
+            browser.close()
+
+
+def test_a_lunar_replay_shows_the_team_map_objects_and_found_samples(lunar_url: str) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1280, "height": 1000})
+            page.goto(lunar_url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            assert not page.locator("#blocks").is_visible()
+            assert page.locator("#map-body svg .grid").count() == 0  # no map before the first map event
+            assert page.locator("#map-body svg g.object.rock").count() >= 1
+            _slide_to(page, "max")
+            page.wait_for_selector("#map-body svg .grid rect.occupied", timeout=10_000)
+            assert page.locator("#map-body svg .grid rect.free").count() >= 1
+            found = page.locator("#map-body svg g.object.sample.found text").all_text_contents()
+            assert found and all(re.fullmatch(r"\w+: [a-z]+(-[a-z]+)+", f) for f in found), found
+            assert page.locator("#map-body svg circle.robot").count() >= 2
+            assert page.locator("#map-body svg polyline.track").count() >= 1
+            scout = page.locator('#trees-body .agent-tree[data-agent="scout"]')
+            assert scout.locator('li.plan.active[data-name="ImperaMission"] > ul > li.state.current').count() == 1
+            page.screenshot(path=str(SHOTS / "replay-lunar.png"), full_page=True)
         finally:
             browser.close()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -254,3 +255,89 @@ def test_a_version_1_trace_is_replayed_with_the_reader_s_note(tmp_path: Path) ->
     assert meta["header"]["version"] == 1
     assert meta["notes"] and "pose" in " ".join(meta["notes"])
     assert meta["agents"] == ["a"]
+
+
+def test_the_plan_trees_of_a_demo_trace(blocks_trace: Path) -> None:
+    client = _client(blocks_trace)
+    assert client.get("/api/trees").status_code == 403
+    client.cookies.set(COOKIE, TOKEN)
+    data = client.get("/api/trees").json()
+    assert data["agents"] == {"r1": "BlocksWorldMission", "r2": "BlocksWorldMission"}
+    assert data["notes"] == []
+    tree = data["trees"]["BlocksWorldMission"]
+    assert tree["kind"] == "plan"
+    stacking = next(s for s in tree["states"] if s["name"] == "Stacking")
+    problem = stacking["children"][0]
+    assert (problem["kind"], problem["name"]) == ("problem", "StackBlocks")
+    assert "ref" not in json.dumps(tree)  # every plan spelled out where it is used, so each node can be lit
+    assert client.get("/api/meta").json()["plan_notes"] == []
+
+
+def _with_plans(tmp_path: Path, source: Path, plans: list[str]) -> Path:
+    lines = source.read_text(encoding="utf-8").splitlines(keepends=True)
+    header = json.loads(lines[0])
+    header["plans"] = plans
+    path = tmp_path / "moved.jsonl"
+    path.write_text(json.dumps(header) + "\n" + "".join(lines[1:]), encoding="utf-8")
+    return path
+
+
+def test_a_plan_file_beside_the_trace_is_found(tmp_path: Path, recorded_trace: Path) -> None:
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    text = (plans_dir() / "examples" / "formation.yaml").read_text(encoding="utf-8")
+    (mine / "formation.yaml").write_text(text.replace("imports: [../tasks.yaml]", "imports: [tasks.yaml]"))
+    (mine / "tasks.yaml").write_bytes((plans_dir() / "tasks.yaml").read_bytes())
+    client = _client(_with_plans(tmp_path, recorded_trace, ["mine/formation.yaml"]))
+    client.cookies.set(COOKIE, TOKEN)
+    data = client.get("/api/trees").json()
+    assert data["notes"] == []
+    assert set(data["agents"]) == {"r1", "r2", "r3"}
+    assert data["trees"]["Formation"]["name"] == "Formation"
+
+
+@pytest.mark.parametrize(
+    ("plans", "note"),
+    [
+        (["nowhere/missing.yaml"], r"plan file nowhere/missing\.yaml not found \(looked for"),
+        (["broken.yaml"], r"plan file broken\.yaml does not load: "),
+        ([], r"names no plan files"),
+    ],
+)
+def test_plan_files_that_do_not_load_give_a_note_not_a_traceback(
+    tmp_path: Path, recorded_trace: Path, plans: list[str], note: str
+) -> None:
+    (tmp_path / "broken.yaml").write_text("plans: [this is: not a plan\n", encoding="utf-8")
+    client = _client(_with_plans(tmp_path, recorded_trace, plans))
+    client.cookies.set(COOKIE, TOKEN)
+    meta = client.get("/api/meta")
+    assert meta.status_code == 200
+    assert len(meta.json()["plan_notes"]) == 1
+    assert re.search(note, meta.json()["plan_notes"][0])
+    data = client.get("/api/trees").json()
+    assert (data["trees"], data["agents"]) == ({}, {})
+    assert client.get("/api/state?t=1").status_code == 200  # the replay works without trees
+
+
+def test_state_carries_the_world_objects_and_map(tmp_path: Path) -> None:
+    from alica.engine.trace import MAP_ENCODING, encode_cells
+
+    header = {"t": 0.0, "agent": "-", "event": "trace", "format": "alica-trace", "version": 2, "world": "lunar"}
+    header |= {"bounds": [-2.0, -2.0, 2.0, 2.0], "agents": {"a": {"role": "Scout", "plan": "Top"}}}
+    events = [
+        header,
+        {"t": 0.1, "agent": "-", "event": "object", "name": "s", "kind": "sample", "x": 1.0, "y": 1.0, "z": 0.0},
+        {"t": 0.2, "agent": "-", "event": "found", "name": "red", "kind": "red", "x": 1.1, "y": 1.0},
+        {"t": 5.0, "agent": "-", "event": "map", "origin": [-2.0, -2.0], "resolution": 2.0, "width": 2}
+        | {"height": 2, "encoding": MAP_ENCODING, "cells": encode_cells(bytes([1, 2, 0, 1]), 2, 2)},
+    ]
+    path = tmp_path / "world.jsonl"
+    path.write_text("".join(json.dumps(e) + "\n" for e in events), encoding="utf-8")
+    client = _client(path)
+    client.cookies.set(COOKIE, TOKEN)
+    early = client.get("/api/state?t=1").json()
+    assert (early["world"], early["bounds"], early["map"]) == ("lunar", [-2.0, -2.0, 2.0, 2.0], None)
+    assert early["objects"]["s"]["found"] == "red"
+    late = client.get("/api/state?t=5").json()
+    assert late["map"]["cells"] == "1201"
+    assert late["t"] == 5.0

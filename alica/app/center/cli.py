@@ -64,7 +64,8 @@ def add_parser(sub: Any) -> None:
         help="serve the control center: replay a trace or draw a plan file in a web page",
         description="Serve the control center's web page on HOST:PORT and print the one line to open, "
         "http://HOST:PORT/?token=TOKEN. Every request needs the token. --trace replays a recorded trace "
-        "(time slider, play at 1x-10x, next fault or replan, agents, event log, map of poses); --plan draws "
+        "(time slider, play at 1x-10x, next fault or replan, agents, event log, map of poses, team map and objects, "
+        "blocks table, each agent's plan tree with its current states); --plan draws "
         "the plan tree of a plan file. Stop it with Ctrl-C.",
     )
     what = p.add_mutually_exclusive_group(required=True)

@@ -10,32 +10,44 @@ after that.
 from __future__ import annotations
 
 from html import escape
+from pathlib import Path
 from typing import Any
 
+from alica.errors import AlicaError
+from alica.io import Loader, plans_dir
 from alica.model import Behaviour, Plan, PlanLibrary, PlanningProblem, PlanType, format_cardinality
 
 
-def plan_tree(library: PlanLibrary, root: str) -> dict[str, Any]:
-    """The tree below ``root`` as JSON-ready data."""
-    return _node(library, root, set())
+def plan_tree(library: PlanLibrary, root: str, *, refs: bool = True) -> dict[str, Any]:
+    """The tree below ``root`` as JSON-ready data.
+
+    Args:
+        refs: a plan, plan type or problem seen earlier in the tree is a ``ref`` node after
+            that; without, each is spelled out wherever it is used (a ``ref`` only where it
+            would contain itself), so that every plan node a team can be in has its place.
+    """
+    return _node(library, root, set(), refs)
 
 
-def _node(library: PlanLibrary, name: str, shown: set[str]) -> dict[str, Any]:
+def _node(library: PlanLibrary, name: str, shown: set[str], refs: bool) -> dict[str, Any]:
     element = library.abstract(name)
     if isinstance(element, Behaviour):
         return {"kind": "behaviour", "name": name, "skill": element.skill}
     if name in shown:
         return {"kind": "ref", "name": name}
-    shown.add(name)
+    if refs:
+        shown.add(name)  # one set for the whole tree: seen anywhere before
+    else:
+        shown = shown | {name}  # the plans on the way down: seen above this one
     if isinstance(element, PlanType):
-        return {"kind": "plantype", "name": name, "children": [_node(library, p, shown) for p in element.plans]}
+        return {"kind": "plantype", "name": name, "children": [_node(library, p, shown, refs) for p in element.plans]}
     if isinstance(element, PlanningProblem):
         others = [*element.elements, *(n for n in (element.wait_plan, element.alternative_plan) if n)]
         return {
             "kind": "problem",
             "name": name,
             "goal": element.goal.text,
-            "children": [_node(library, p, shown) for p in dict.fromkeys(others)],
+            "children": [_node(library, p, shown, refs) for p in dict.fromkeys(others)],
         }
     plan: Plan = element
     return {
@@ -49,7 +61,7 @@ def _node(library: PlanLibrary, name: str, shown: set[str]) -> dict[str, Any]:
             {
                 "name": s.name,
                 "kind": s.kind.value,
-                "children": [_node(library, c.name, shown) for c in s.children],
+                "children": [_node(library, c.name, shown, refs) for c in s.children],
             }
             for s in plan.states
         ],
@@ -176,3 +188,83 @@ def _column(node: dict[str, Any], title: str, extra: list[str], fill: str, strok
         f'fill="{fill}" stroke="{stroke}"/>{"".join(parts)}</g>'
     )
     return w, h, body
+
+
+# -- the plan trees of a trace's agents -------------------------------------
+
+SHIPPED = "alica:plans/"
+"""How a header names a plan file shipped with alica (under :func:`alica.io.plans_dir`)."""
+
+
+def plan_candidates(given: str, trace_path: str | Path) -> list[Path]:
+    """Where a header's plan file may be: a shipped one under the shipped plans; else as
+    given (from where the run started), then relative to the trace's folder."""
+    if given.startswith(SHIPPED):
+        try:
+            return [plans_dir() / given[len(SHIPPED) :]]
+        except FileNotFoundError:
+            return []
+    path = Path(given)
+    if path.is_absolute():
+        return [path]
+    return [path, Path(trace_path).parent / path]
+
+
+def trace_trees(meta: dict[str, Any], trace_path: str | Path) -> dict[str, Any]:
+    """Each agent's plan tree, from the plan files a trace's header names.
+
+    Returns:
+        ``{"trees": {ROOT: tree}, "agents": {AGENT: ROOT}, "notes": [...]}``: the trees
+        (:func:`plan_tree` without refs) of the roots the agents run (the header's ``agents``
+        ``plan``, else its ``root``), which agent runs which, and why a file or a root is
+        missing (never an exception).
+    """
+    given_agents = meta.get("agents")
+    agents: dict[str, Any] = given_agents if isinstance(given_agents, dict) else {}
+    root = meta.get("root")
+    wanted: dict[str, str] = {}
+    for name, info in sorted(agents.items()):
+        plan = info.get("plan") if isinstance(info, dict) else None
+        plan = plan if isinstance(plan, str) else root
+        if isinstance(plan, str):
+            wanted[str(name)] = plan
+    files = meta.get("plans")
+    notes: list[str] = []
+    if not isinstance(files, list) or not files:
+        return {"trees": {}, "agents": {}, "notes": ["the trace's header names no plan files: no plan trees"]}
+    libraries: list[PlanLibrary] = []
+    for given in files:
+        library, why = _load_library(str(given), trace_path)
+        if library is None:
+            notes.append(why)
+        else:
+            libraries.append(library)
+    trees: dict[str, dict[str, Any]] = {}
+    shown: dict[str, str] = {}
+    for name, plan in wanted.items():
+        if plan not in trees:
+            for library in libraries:
+                try:
+                    trees[plan] = plan_tree(library, plan, refs=False)
+                    break
+                except KeyError:
+                    continue
+            else:
+                if libraries:
+                    notes.append(f"no plan '{plan}' (agent {name}) in the trace's plan files")
+                continue
+        shown[name] = plan
+    return {"trees": trees, "agents": shown, "notes": notes}
+
+
+def _load_library(given: str, trace_path: str | Path) -> tuple[PlanLibrary | None, str]:
+    candidates = plan_candidates(given, trace_path)
+    tried = [p for p in candidates if p.is_file()]
+    if not tried:
+        where = " or ".join(str(p) for p in candidates) or given
+        return None, f"plan file {given} not found (looked for {where}): no plan tree from it"
+    try:
+        return Loader().load(tried[0]), ""
+    except (AlicaError, OSError, ValueError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        return None, f"plan file {given} does not load: {first}"

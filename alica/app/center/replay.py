@@ -5,7 +5,11 @@ from __future__ import annotations
 import bisect
 from typing import Any
 
+from alica.app.center.team_view import TeamView
 from alica.app.center.trace_file import Trace
+
+CHECKPOINT_EVERY = 200
+"""Events between two checkpoints of the replay's fold: ``state(t)`` folds fewer than this many."""
 
 FAULT_KINDS = frozenset({"fault", "failure"})
 """Events the "next fault" button jumps to: injected faults (crash, recover, partition) and plan failures."""
@@ -19,13 +23,18 @@ class Replay:
 
     Args:
         trace: the loaded trace.
+        checkpoint_every: events between two checkpoints of :meth:`state`'s fold.
     """
 
-    def __init__(self, trace: Trace) -> None:
+    def __init__(self, trace: Trace, checkpoint_every: int = CHECKPOINT_EVERY) -> None:
+        if checkpoint_every < 1:
+            raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
+        self.every = checkpoint_every
         self.trace = trace
         self.events = trace.events
         self.times = [float(e["t"]) for e in self.events]
         self._meta = self._describe()
+        self._checkpoints = self._checkpoint()
 
     def agents(self) -> list[str]:
         """The agents named in the header or in the events (not the team's own ``-``)."""
@@ -74,55 +83,40 @@ class Replay:
         return None
 
     def state(self, t: float) -> dict[str, Any]:
-        """Every agent's role, task, alive, plan and state, and its last pose, from the events up to ``t``.
+        """The team at ``t``: :meth:`TeamView.snapshot` of the events up to ``t`` (without tracks).
 
-        An agent's plans are the plan nodes it entered (keyed by their path, ``Top/State/Child``):
-        an allocation enters a node (its task is the agent's entry there), a transition sets the
-        node's state and leaves the nodes below it, a recovery starts from nothing. The agent's
-        plan, task and state are those of its deepest node; ``plans`` lists them all, top first.
+        Every agent's role, task, alive, plan and state, its last pose, and the objects and
+        the latest map. An agent's plans are the plan nodes it entered (keyed by their path,
+        ``Top/State/Child``): an allocation enters a node (its task is the agent's entry
+        there), a transition sets the node's state and leaves the nodes below it, a recovery
+        starts from nothing. The agent's plan, task and state are those of its deepest node;
+        ``plans`` lists them all, top first.
+
+        The fold starts from the latest checkpoint at or before ``t`` (a copy of the view
+        every ``checkpoint_every`` events), so it folds fewer than that many events.
         """
-        roles = self.trace.roles
-        agents: dict[str, dict[str, Any]] = {
-            a: {
-                "role": roles.get(a),
-                "alive": True,
-                "behaviour": None,
-                "pose": None,
-            }
-            for a in self.agents()
-        }
-        nodes: dict[str, dict[str, dict[str, Any]]] = {a: {} for a in agents}
+        count = bisect.bisect_right(self.times, t)
+        index = min(count // self.every, len(self._checkpoints) - 1)
+        view = self._checkpoints[index].copy()
+        for e in self.events[index * self.every : count]:
+            view.apply(e)
+        return view.snapshot(t=t)
+
+    def full_state(self, t: float) -> dict[str, Any]:
+        """:meth:`state` folded from the first event, without checkpoints (slow; for checking them)."""
+        view = self._fresh_view()
         for e in self.events[: bisect.bisect_right(self.times, t)]:
-            kind = e["event"]
-            name = str(e.get("agent"))
-            who = agents.get(name)
-            if who is None:
-                continue
-            key = str(e.get("key", ""))
-            if kind == "fault" and e.get("fault") in ("crash", "recover"):
-                who["alive"] = e["fault"] == "recover"
-                if e["fault"] == "recover":
-                    nodes[name].clear()
-                    who["behaviour"] = None
-            elif kind == "allocation" and isinstance(e.get("entries"), dict):
-                node = nodes[name].get(key)
-                if node is None or e.get("reason") == "initial":
-                    node = nodes[name][key] = {"key": key, "plan": e.get("plan"), "task": None, "state": None}
-                node["plan"] = e.get("plan", node["plan"])
-                node["task"] = e["entries"].get(name)
-            elif kind == "transition":
-                node = nodes[name].setdefault(key, {"key": key, "plan": e.get("plan"), "task": None, "state": None})
-                node["state"] = e.get("target")
-                for below in [k for k in nodes[name] if k.startswith(key + "/")]:
-                    del nodes[name][below]
-            elif kind == "behaviour":
-                who["behaviour"] = f"{e.get('behaviour')} ({e.get('status')})"
-            elif kind == "pose":
-                who["pose"] = {k: e[k] for k in ("x", "y", "yaw") if k in e}
-            elif kind == "role" and "role" in e:
-                who["role"] = e["role"]
-        for name, who in agents.items():
-            plans = sorted(nodes[name].values(), key=lambda n: n["key"].count("/"))
-            deepest = plans[-1] if plans else {"key": None, "plan": None, "task": None, "state": None}
-            who.update({k: deepest[k] for k in ("key", "plan", "task", "state")}, plans=plans)
-        return {"t": t, "agents": agents}
+            view.apply(e)
+        return view.snapshot(t=t)
+
+    def _fresh_view(self) -> TeamView:
+        return TeamView(self.trace.meta, self.trace.roles, self.agents())
+
+    def _checkpoint(self) -> list[TeamView]:
+        view = self._fresh_view()
+        checkpoints = [view.copy()]
+        for i, e in enumerate(self.events, start=1):
+            view.apply(e)
+            if i % self.every == 0:
+                checkpoints.append(view.copy())
+        return checkpoints

@@ -105,13 +105,19 @@ def _number(request: Request, name: str) -> float | None:
 
 
 def replay_app(replay: Replay, token: str) -> Starlette:
-    """The app of a trace replay: the page and ``/api/meta``, ``/api/events``, ``/api/state``, ``/api/next``."""
+    """The app of a trace replay: the page and ``/api/meta``, ``/api/events``, ``/api/state``, ``/api/next``, ``/api/trees``."""
+    from alica.app.center.plan_view import trace_trees
+
+    trees = trace_trees(replay.trace.meta, replay.trace.path)
 
     async def page(request: Request) -> Response:
         return HTMLResponse(_static("replay.html"))
 
     async def meta(request: Request) -> Response:
-        return JSONResponse(replay.meta())
+        return JSONResponse({**replay.meta(), "plan_notes": trees["notes"]})
+
+    async def plan_trees(request: Request) -> Response:
+        return JSONResponse(trees)
 
     async def events(request: Request) -> Response:
         try:
@@ -146,6 +152,7 @@ def replay_app(replay: Replay, token: str) -> Starlette:
         Route("/api/events", events),
         Route("/api/state", state),
         Route("/api/next", next_event),
+        Route("/api/trees", plan_trees),
         Route("/static/{name}", _static_file),
     ]
     return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])

@@ -1,8 +1,10 @@
-// The replay page: asks the server for the trace's meta, all events and the state at the slider's time.
+// The replay page: asks the server for the trace's meta, all events, the plan trees and the state at the slider's
+// time, and draws them with views.js (window.AlicaViews). This file keeps the slider, play and next-event logic.
 "use strict";
 (function () {
   const $ = (id) => document.getElementById(id);
-  let meta = null, events = [], playing = false, lastFrame = 0, stateAsked = -1;
+  const V = window.AlicaViews;
+  let meta = null, events = [], trees = null, playing = false, lastFrame = 0, stateAsked = -1;
 
   async function get(path) {
     const response = await fetch(path, { credentials: "same-origin" });
@@ -10,15 +12,20 @@
     return response.json();
   }
 
-  function cell(text) { const td = document.createElement("td"); td.textContent = text == null ? "-" : String(text); return td; }
-
-  function fields(e) {
-    const rest = {};
-    for (const k of Object.keys(e)) { if (k !== "t" && k !== "agent" && k !== "event") { rest[k] = e[k]; } }
-    return JSON.stringify(rest);
-  }
-
   function now() { return parseFloat($("slider").value); }
+
+  function baseName(path) { const parts = String(path).split(/[\\/]/); return parts[parts.length - 1]; }
+
+  // The field of the whole trace's poses, so that the map keeps its frame while the slider moves.
+  function extent() {
+    let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+    for (const e of events) {
+      if (e.event === "pose" && typeof e.x === "number" && typeof e.y === "number") {
+        x0 = Math.min(x0, e.x); x1 = Math.max(x1, e.x); y0 = Math.min(y0, e.y); y1 = Math.max(y1, e.y);
+      }
+    }
+    return x0 === Infinity ? null : [x0 - 1, y0 - 1, Math.max(x1, x0 + 1) + 1, Math.max(y1, y0 + 1) + 1];
+  }
 
   async function showState() {
     const t = now();
@@ -26,63 +33,14 @@
     stateAsked = t;
     const state = await get("api/state?t=" + t);
     if (stateAsked !== t) { return; }
-    const body = $("agents-body");
-    body.replaceChildren();
-    for (const [name, a] of Object.entries(state.agents)) {
-      const tr = document.createElement("tr");
-      tr.dataset.agent = name;
-      if (!a.alive) { tr.className = "dead"; }
-      for (const v of [name, a.role, a.task, a.alive ? "yes" : "no", a.plan, a.state, a.behaviour]) { tr.appendChild(cell(v)); }
-      tr.children[4].title = a.plans.map((p) => p.plan + (p.state ? ": " + p.state : "")).join(" \u203a ");
-      body.appendChild(tr);
-    }
+    V.agents($("agents-body"), state);
     showLog(t);
-    showMap(t);
+    V.map($("map-body"), state, V.tracks(events, t), meta);
+    if (state.world === "blocks") { V.blocks($("blocks-body"), state, meta); }
+    V.trees($("trees-body"), state, trees);
   }
 
-  function showLog(t) {
-    const filter = $("filter").value.trim().toLowerCase();
-    const body = $("log-body");
-    body.replaceChildren();
-    let shown = 0;
-    for (const e of events) {
-      if (e.t > t) { break; }
-      const line = e.event + " " + e.agent + " " + fields(e);
-      if (filter && !line.toLowerCase().includes(filter)) { continue; }
-      const tr = document.createElement("tr");
-      tr.className = "past";
-      for (const v of [e.t.toFixed(3), e.agent, e.event, fields(e)]) { tr.appendChild(cell(v)); }
-      body.prepend(tr);
-      shown += 1;
-    }
-    body.dataset.shown = String(shown);
-  }
-
-  function showMap(t) {
-    const box = $("map-body");
-    const poses = events.filter((e) => e.event === "pose" && typeof e.x === "number" && typeof e.y === "number");
-    if (poses.length === 0) {
-      box.innerHTML = '<p class="note">no poses in this trace</p>';
-      return;
-    }
-    let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
-    for (const p of poses) { x0 = Math.min(x0, p.x); x1 = Math.max(x1, p.x); y0 = Math.min(y0, p.y); y1 = Math.max(y1, p.y); }
-    const pad = 1, w = Math.max(x1 - x0, 1) + 2 * pad, h = Math.max(y1 - y0, 1) + 2 * pad;
-    const paths = {};
-    for (const p of poses) { if (p.t <= t) { (paths[p.agent] = paths[p.agent] || []).push(p); } }
-    const colours = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];
-    let svg = '<svg xmlns="http://www.w3.org/2000/svg" viewBox="' + (x0 - pad) + " " + (-(y1 + pad)) + " " + w + " " + h + '">';
-    const agents = meta.agents;
-    for (const [agent, list] of Object.entries(paths)) {
-      const colour = colours[Math.max(agents.indexOf(agent), 0) % colours.length];
-      const points = list.map((p) => p.x + "," + (-p.y)).join(" ");
-      const last = list[list.length - 1];
-      svg += '<polyline points="' + points + '" fill="none" stroke="' + colour + '" stroke-width="' + (w / 300) + '"/>';
-      svg += '<circle class="robot" data-agent="' + agent + '" cx="' + last.x + '" cy="' + (-last.y) + '" r="' + (w / 60) + '" fill="' + colour + '"/>';
-      svg += '<text x="' + last.x + '" y="' + (-last.y - w / 25) + '" font-size="' + (w / 20) + '">' + agent + "</text>";
-    }
-    box.innerHTML = svg + "</svg>";
-  }
+  function showLog(t) { V.log($("log-body"), events, $("filter").value, t); }
 
   async function jump(kind) {
     const answer = await get("api/next?kind=" + kind + "&after=" + now());
@@ -113,9 +71,16 @@
   async function start() {
     meta = await get("api/meta");
     events = (await get("api/events")).events;
-    $("file").textContent = meta.file + " \u2014 " + meta.events + " events, " + meta.duration.toFixed(3) + " s";
-    $("notes").textContent = (meta.notes || []).join(" ");
+    trees = await get("api/trees");
+    meta.extent = extent();
+    const file = $("file");
+    file.textContent = baseName(meta.file) + " \u2014 " + meta.events + " events, " + meta.duration.toFixed(3) + " s";
+    file.title = meta.file;
+    $("notes").textContent = [...(meta.notes || []), ...(meta.plan_notes || [])].join(" ");
     $("kinds").textContent = "kinds: " + Object.entries(meta.kinds).map(([k, n]) => k + " (" + n + ")").join(", ");
+    const world = (meta.header && meta.header.world) || "none";
+    document.body.dataset.world = world;
+    $("blocks").hidden = world !== "blocks";
     const slider = $("slider");
     slider.min = meta.start; slider.max = meta.end; slider.value = meta.start;
     slider.addEventListener("input", () => showState());
