@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from alica.app.center.cli import add_live_options, live_session
 from alica.app.timed import add_fault_options, add_network_options, partition, timed
 from alica.errors import AlicaError
 
@@ -55,6 +56,7 @@ def add_parser(sub: Any) -> None:
     b.add_argument("--out", metavar="DIR", help="write trace.jsonl, initial.png, final.png and plan.yaml here")
     b.add_argument("--json", action="store_true", help="print the summary as JSON")
     b.add_argument("--gui", action="store_true", help="show the pybullet window")
+    add_live_options(b)
     b.add_argument(
         "--no-progress",
         action="store_true",
@@ -116,6 +118,7 @@ def _add_lunar(demos: Any) -> None:
     lunar.add_argument("--out", metavar="DIR", help="write trace.jsonl, map.png and plan.yaml here")
     lunar.add_argument("--json", action="store_true", help="print the summary as JSON")
     lunar.add_argument("--gui", action="store_true", help="show the pybullet window")
+    add_live_options(lunar)
     lunar.add_argument(
         "--no-progress", action="store_true", help="no progress line (none when standard error is not a terminal)"
     )
@@ -185,9 +188,12 @@ def cmd_lunar(args: argparse.Namespace) -> int:
     from alica.app.demos.lunar import run_lunar, summary_lines
 
     config = lunar_config(args)
+    session = live_session(args)
     progress = LunarProgress(sys.stderr) if sys.stderr.isatty() and not args.no_progress else None
     try:
-        result = run_lunar(config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui)
+        result = run_lunar(
+            config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui, live=session
+        )
     finally:
         if progress is not None:
             progress.close()
@@ -195,6 +201,8 @@ def cmd_lunar(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_json()))
     else:
         print("\n".join(summary_lines(result)))
+    if session is not None:
+        session.finish(result.as_json())
     return 0 if result.success else 1
 
 
@@ -287,10 +295,16 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         time_limit=args.time_limit,
     )
     actions = fault_actions(args.crash, args.recover, args.agents)
+    session = live_session(args)
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
     try:
         result = run_demo(
-            config, on_second=progress, actions=actions, out=Path(args.out) if args.out else None, gui=args.gui
+            config,
+            on_second=progress,
+            actions=actions,
+            out=Path(args.out) if args.out else None,
+            gui=args.gui,
+            live=session,
         )
     finally:
         if progress is not None:
@@ -299,6 +313,8 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_json()))
     else:
         _print_summary(result)
+    if session is not None:
+        session.finish(result.as_json())
     return 0 if result.success else 1
 
 

@@ -15,6 +15,7 @@ import re
 import sys
 from typing import Any
 
+from alica.app.center.cli import add_live_options, live_session
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
@@ -91,6 +92,7 @@ def add_parser(sub: Any) -> None:
         metavar="HZ",
         help="with --world and --trace: robot poses per simulated second in the trace (default 2)",
     )
+    add_live_options(p, review=True)
     p.add_argument("--show-tree", action="store_true", help="print each agent's running plan tree whenever it changes")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument(
@@ -180,6 +182,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise AlicaError("--delay and --jitter must be >= 0 and --frequency > 0")
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
+    session = live_session(args)
+    if args.center and (args.processes or args.show_tree):
+        raise AlicaError(
+            "--center runs a simulated team in this process; it does not go with --processes or --show-tree"
+        )
     registry = skill_registry(args)
     library, entry = _load(args.plan, Loader(skills=registry))
     if args.name is None:
@@ -198,7 +205,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         header = _trace_header(args, library, plan, roles, None) if args.trace else None
         return _run_processes(args, plan, list(agents), wiring, header)
     with run_world(args, sorted(agents)) as (world, perception):
-        return _run_team(args, library, plan, roles, wiring, world, perception)
+        return _run_team(args, library, plan, roles, wiring, world, perception, session)
 
 
 def _trace_header(
@@ -224,9 +231,17 @@ def _trace_header(
 
 
 def _run_team(
-    args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], wiring: Any, world: Any, perception: Any
+    args: argparse.Namespace,
+    library: Any,
+    plan: str,
+    roles: dict[str, Any],
+    wiring: Any,
+    world: Any,
+    perception: Any,
+    session: Any = None,
 ) -> int:
-    from alica.app.trace_world import WorldTrace, team_grid
+    from alica.app.center.live import drive
+    from alica.app.trace_world import WorldTrace, team_grid, tee
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
     from alica.prophet import engine_config
@@ -236,9 +251,13 @@ def _run_team(
         raise AlicaError(f"--pose-rate must be a positive number of poses per second, got {args.pose_rate}")
     reasons = _Reasons()
     observers: list[Any] = [reasons]
-    trace = JsonlTrace(args.trace, header=_trace_header(args, library, plan, roles, world)) if args.trace else None
+    header = _trace_header(args, library, plan, roles, world) if args.trace or args.center else None
+    trace = JsonlTrace(args.trace, header=header) if args.trace else None
     if trace is not None:
         observers.append(trace)
+    hub = session.start(header, library) if session is not None and header is not None else None
+    if hub is not None:
+        observers.append(hub)
     changed: set[str] = set()
     if args.show_tree:
         observers.append(
@@ -250,7 +269,7 @@ def _run_team(
         roles,
         seed=args.seed,
         config=engine_config(  # planning problems run with pRoPhEt MAS
-            frequency=args.frequency, parallel_planning=args.parallel_planning
+            frequency=args.frequency, parallel_planning=args.parallel_planning, review=args.review
         ),
         roleset=args.roleset,
         loss=args.loss,
@@ -263,9 +282,10 @@ def _run_team(
         world=world,
         perception=perception,
     )
-    if trace is not None and world is not None:
+    sinks = [s for s in (trace, hub) if s is not None]
+    if sinks and world is not None:
         sample = WorldTrace(
-            trace,
+            tee(sinks),
             world,
             alive=lambda name: name not in team.crashed,
             team_map=(lambda: team_grid(team)) if args.world == "lunar" else None,
@@ -288,10 +308,15 @@ def _run_team(
     try:
         if args.show_tree:
             _run_showing(team, args, changed, running_tree)
+        elif session is not None:
+            drive(team, session, ticks=args.ticks, until_done=args.ticks is None, max_time=args.max_time)
         elif args.ticks is not None:
             team.run(ticks=args.ticks)
         else:
             team.run(until_done=True, max_time=args.max_time)
+    except KeyboardInterrupt:
+        if session is None:
+            raise
     finally:
         if trace is not None:
             trace.close()
@@ -303,6 +328,8 @@ def _run_team(
         print(json.dumps(summary, indent=2, sort_keys=True))
     else:
         _print_summary(summary, args.trace)
+    if session is not None:
+        session.finish(summary)
     return 0 if summary["success"] else 1
 
 

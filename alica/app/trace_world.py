@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import hashlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -45,6 +45,18 @@ MAP_EVERY = 5.0
 MAP_RESOLUTION = 0.2
 
 Sink = Callable[[dict[str, Any]], None]
+
+
+def tee(sinks: Sequence[Sink]) -> Sink:
+    """One sink that hands every event to each of ``sinks`` (the trace file and the control center, say)."""
+    if len(sinks) == 1:
+        return sinks[0]
+
+    def each(event: dict[str, Any]) -> None:
+        for sink in sinks:
+            sink(event)
+
+    return each
 
 
 def team_grid(team: Any) -> Any:

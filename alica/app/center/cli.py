@@ -47,7 +47,8 @@ def plan_views(path: str) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
     return {r: plan_tree(library, r) for r in roots}, {r: plan_svg(library, r) for r in roots}
 
 
-def _port(text: str) -> int:
+def port_number(text: str) -> int:
+    """A TCP port from the command line (0 to 65535; 0 picks a free one)."""
     try:
         port = int(text)
     except ValueError:
@@ -55,6 +56,51 @@ def _port(text: str) -> int:
     if not 0 <= port <= 65535:
         raise argparse.ArgumentTypeError(f"'{text}' is not a port (0 to 65535; 0 picks a free one)")
     return port
+
+
+def add_live_options(parser: Any, review: bool = False) -> None:
+    """The options that serve a run's control center live: ``--center`` and its address, token and speed."""
+    group = parser.add_argument_group("control center (a live view of the run in a web page)")
+    group.add_argument(
+        "--center",
+        action="store_true",
+        help="serve the control center for this run: prints http://HOST:PORT/?token=TOKEN to open; the run goes "
+        "at --speed times the wall clock; after the run the page stays up until Ctrl-C",
+    )
+    group.add_argument("--center-host", default="127.0.0.1", metavar="HOST", help="address to bind (default 127.0.0.1)")
+    group.add_argument(
+        "--center-port", type=port_number, default=8765, metavar="P", help="port (default 8765; 0 picks a free one)"
+    )
+    group.add_argument("--center-token", metavar="T", help="the access token (default: a new random one)")
+    group.add_argument(
+        "--speed",
+        type=float,
+        default=1.0,
+        metavar="X",
+        help="with --center: simulated seconds per wall second (default 1; inf: as fast as possible)",
+    )
+    if review:
+        group.add_argument(
+            "--review",
+            action="store_true",
+            help="with --center: the leader shows each generated plan to the operator, who accepts, declines or "
+            "changes it before the team runs it",
+        )
+
+
+def live_session(args: argparse.Namespace) -> Any:
+    """The run's :class:`~alica.app.center.live.LiveSession` with ``--center``, else ``None``.
+
+    Raises:
+        AlicaError: ``--speed`` or ``--review`` without ``--center``, or a speed that is not positive.
+    """
+    if not args.center:
+        if args.speed != 1.0 or getattr(args, "review", False):
+            raise AlicaError("--speed and --review need --center: they are settings of the control center's live run")
+        return None
+    from alica.app.center.live import LiveSession
+
+    return LiveSession(args.speed, args.center_host, args.center_port, args.center_token)
 
 
 def add_parser(sub: Any) -> None:
@@ -72,6 +118,6 @@ def add_parser(sub: Any) -> None:
     what.add_argument("--trace", metavar="FILE", help="a trace (JSON Lines) to replay")
     what.add_argument("--plan", metavar="FILE", help="a plan file (YAML or XML) to draw")
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
-    p.add_argument("--port", type=_port, default=8765, help="port (default 8765; 0 picks a free one)")
+    p.add_argument("--port", type=port_number, default=8765, help="port (default 8765; 0 picks a free one)")
     p.add_argument("--token", help="the access token (default: a new random one)")
     p.set_defaults(run=_cmd_center)

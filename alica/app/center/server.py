@@ -2,16 +2,22 @@
 
 Every request (page, API, static file) must carry the token: as the query
 parameter ``token=``, as the cookie the first visit sets, or as an
-``Authorization: Bearer`` header. Without it the answer is 403 (a WebSocket,
-when a later increment adds one, is closed unaccepted).
+``Authorization: Bearer`` header. Without it the answer is 403 (a WebSocket is
+closed unaccepted).
 """
 
 from __future__ import annotations
 
+import asyncio
 import hmac
+import json
 import socket
 import sys
+import threading
+import time
+from collections.abc import Callable
 from importlib import resources
+from pathlib import Path
 from typing import Any, TextIO
 
 from starlette.applications import Starlette
@@ -19,11 +25,16 @@ from starlette.datastructures import MutableHeaders
 from starlette.middleware import Middleware
 from starlette.requests import HTTPConnection, Request
 from starlette.responses import HTMLResponse, JSONResponse, PlainTextResponse, Response
-from starlette.routing import Route
+from starlette.routing import Route, WebSocketRoute
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
+from starlette.websockets import WebSocket, WebSocketDisconnect
 
+from alica.app.center import operator
+from alica.app.center.live import LiveHub
 from alica.app.center.replay import FAULT_KINDS, REPLAN_KINDS, Replay
+from alica.engine import PlanDecision
 from alica.errors import AlicaError
+from alica.lang.walk import literals
 
 COOKIE = "alica_center_token"
 
@@ -182,6 +193,167 @@ def plan_app(file: str, trees: dict[str, dict[str, Any]], svgs: dict[str, str], 
     return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
 
 
+HELLO_EVENTS = 2000
+"""The latest events a page gets when it connects to a live team (the rest: ``/api/events?since=``)."""
+
+
+def _update(kind: str, events: list[dict[str, Any]], walls: list[float], count: int, state: str) -> str:
+    """A message to the live page, the state's JSON spliced in as it is (it is shared by every page)."""
+    return (
+        f'{{"type":"{kind}","count":{count},"events":{json.dumps(events)},"walls":{json.dumps(walls)},"state":{state}}}'
+    )
+
+
+def live_app(hub: LiveHub, known: dict[str, dict[str, Any]], token: str) -> Starlette:
+    """The app of a live team: the page, ``/ws`` (events and state as they happen), and the operator's API.
+
+    Args:
+        hub: the running team's events and command queue.
+        known: the planning problems the operator may set goals for (:func:`operator.problems`).
+        token: the access token.
+    """
+
+    from alica.app.center.plan_view import trace_trees
+
+    trees = trace_trees(hub.header, Path.cwd() / "live")  # the run's plan files, as its command line named them
+
+    def meta() -> dict[str, Any]:
+        plans = hub.header.get("plans") or []
+        return {
+            "mode": "live",
+            "file": Path(str(plans[0])).name if plans else "",
+            "header": hub.header,
+            "agents": sorted(hub.header.get("agents") or {}),
+            "problems": known,
+            "status": hub.status,
+            "plan_notes": trees["notes"],
+        }
+
+    async def page(request: Request) -> Response:
+        return HTMLResponse(_static("live.html"))
+
+    async def meta_route(request: Request) -> Response:
+        return JSONResponse(meta())
+
+    async def state(request: Request) -> Response:
+        return Response(hub.snapshot_json(), media_type="application/json")
+
+    async def plan_trees(request: Request) -> Response:
+        return JSONResponse(trees)
+
+    async def events(request: Request) -> Response:
+        try:
+            since = int(request.query_params.get("since", "0"))
+        except ValueError:
+            return JSONResponse({"error": "'since' must be a whole number of events"}, status_code=400)
+        found, walls, count = hub.since(max(since, 0))
+        return JSONResponse({"events": found, "walls": walls, "count": count})
+
+    async def feed(socket: WebSocket) -> None:
+        await socket.accept()
+        listener = hub.listen()
+        closed = asyncio.Event()
+
+        async def read() -> None:  # the page says nothing; this notices when it goes
+            try:
+                while True:
+                    await socket.receive_text()
+            except (WebSocketDisconnect, RuntimeError):
+                closed.set()
+                listener.wake.set()
+
+        reader = asyncio.create_task(read())
+        try:
+            found, walls, count = hub.since(0)
+            start = max(0, len(found) - HELLO_EVENTS)
+            hello = _update("hello", found[start:], walls[start:], count, hub.snapshot_json())
+            await socket.send_text(hello[:-1] + f',"meta":{json.dumps(meta())}}}')
+            while not closed.is_set():
+                await listener.wake.wait()
+                listener.wake.clear()
+                listener.pending = False
+                if closed.is_set():
+                    break
+                found, walls, count = hub.since(count)
+                await socket.send_text(_update("update", found, walls, count, hub.snapshot_json()))
+        except (WebSocketDisconnect, RuntimeError, OSError):
+            pass
+        finally:
+            hub.forget(listener)
+            reader.cancel()
+
+    async def body(request: Request) -> dict[str, Any]:
+        try:
+            data = await request.json()
+        except ValueError:
+            raise AlicaError("the request's body must be a JSON object") from None
+        if not isinstance(data, dict):
+            raise AlicaError("the request's body must be a JSON object")
+        return data
+
+    async def act(command: Callable[[Any], Any]) -> Response:
+        try:
+            result = await asyncio.wrap_future(hub.submit(command))
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=409)
+        return JSONResponse({"ok": True, "result": result})
+
+    async def check(request: Request) -> Response:
+        try:
+            data = await body(request)
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        return JSONResponse(operator.check_goal(known, str(data.get("problem", "")), str(data.get("goal", ""))))
+
+    async def goal(request: Request) -> Response:
+        try:
+            data = await body(request)
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        problem, text = str(data.get("problem", "")), str(data.get("goal", ""))
+        checked = operator.check_goal(known, problem, text)
+        if not checked["ok"]:
+            return JSONResponse(checked, status_code=400)
+        return await act(lambda team: team.set_goal(problem, text))
+
+    async def facts(request: Request) -> Response:
+        try:
+            data = await body(request)
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        text = str(data.get("facts", ""))
+        checked = operator.check_facts(text)
+        if not checked["ok"]:
+            return JSONResponse(checked, status_code=400)
+        return await act(lambda team: team.set_facts(literals(text), by_operator=True))
+
+    async def decide(request: Request) -> Response:
+        try:
+            problem, generation, action, order, pins = operator.decision(await body(request))
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        try:
+            choice = PlanDecision(action, order, pins)  # type: ignore[arg-type]  # checked by operator.decision
+        except ValueError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        return await act(lambda team: team.decide_plan(problem, generation, choice))
+
+    routes = [
+        Route("/", page),
+        Route("/api/meta", meta_route),
+        Route("/api/state", state),
+        Route("/api/events", events),
+        Route("/api/trees", plan_trees),
+        Route("/api/check", check, methods=["POST"]),
+        Route("/api/goal", goal, methods=["POST"]),
+        Route("/api/facts", facts, methods=["POST"]),
+        Route("/api/decide", decide, methods=["POST"]),
+        WebSocketRoute("/ws", feed),
+        Route("/static/{name}", _static_file),
+    ]
+    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+
+
 def bind(host: str, port: int) -> socket.socket:
     """A listening socket on ``host:port``; port 0 picks a free port.
 
@@ -215,3 +387,28 @@ def serve(app: Starlette, host: str, port: int, token: str, out: TextIO = sys.st
     print(address(host, sock, token), file=out, flush=True)
     config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off")
     uvicorn.Server(config).run(sockets=[sock])
+
+
+def serve_in_thread(app: Starlette, host: str, port: int, token: str, out: TextIO = sys.stdout) -> Any:
+    """Bind, serve from a thread of its own, print the address line once the server listens.
+
+    Returns:
+        The ``uvicorn.Server``; set its ``should_exit`` to stop it.
+
+    Raises:
+        AlicaError: the address cannot be bound, or the server did not start within 10 s.
+    """
+    import uvicorn
+
+    sock = bind(host, port)
+    config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio")
+    server = uvicorn.Server(config)
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, name="alica-center", daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 10.0
+    while not server.started:
+        if not thread.is_alive() or time.monotonic() > deadline:
+            raise AlicaError(f"the control center did not start on {host}:{sock.getsockname()[1]}")
+        time.sleep(0.01)  # waiting for the server's own thread to listen (start-up, not simulated time)
+    print(address(host, sock, token), file=out, flush=True)
+    return server

@@ -23,11 +23,14 @@ import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.app.demos.common import StepCounter, plan_yaml_text, planning_leader
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
+
+if TYPE_CHECKING:
+    from alica.app.center.live import LiveSession
 
 Stacks = list[list[str]]
 PROBLEM = "StackBlocks"
@@ -196,6 +199,7 @@ def run_demo(
     actions: Iterable[tuple[float, Callable[[Any], None]]] = (),
     out: Path | None = None,
     gui: bool = False,
+    live: LiveSession | None = None,
 ) -> DemoResult:
     """Run the demo in simulated time.
 
@@ -207,11 +211,12 @@ def run_demo(
         out: a folder for the trace (``trace.jsonl``), pictures (``initial.png``,
             ``final.png``) and the generated plan (``plan.yaml``).
         gui: show the pybullet window.
+        live: the control center of the run (``--center``): it serves the page and paces the run.
 
     Raises:
         AlicaError: a bad configuration.
     """
-    from alica.app.trace_world import WorldTrace, world_header
+    from alica.app.trace_world import WorldTrace, tee, world_header
     from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
     from alica.lang.skill_plugins import default_registry
@@ -231,25 +236,25 @@ def run_demo(
         extra["gui"] = True
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
-    trace = None
-    if out is not None:
-        header = trace_header(
-            plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
-            root="BlocksWorldMission",
-            agents={
-                **{f"r{i + 1}": "Manipulator" for i in range(config.agents)},
-                **{f"o{i + 1}": "Opponent" for i in range(config.opponents)},
-            },
-            roots={f"o{i + 1}": "BlocksWorldOpponent" for i in range(config.opponents)},
-            seed=config.seed,
-            frequency=config.frequency,
-            demo="blocks",
-            start=[list(s) for s in start],
-            goal=[list(s) for s in goal],
-            **world_header(world, "blocks"),
-        )
-        trace = JsonlTrace(out / "trace.jsonl", header=header)
-    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
+    header = trace_header(
+        plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
+        root="BlocksWorldMission",
+        agents={
+            **{f"r{i + 1}": "Manipulator" for i in range(config.agents)},
+            **{f"o{i + 1}": "Opponent" for i in range(config.opponents)},
+        },
+        roots={f"o{i + 1}": "BlocksWorldOpponent" for i in range(config.opponents)},
+        seed=config.seed,
+        frequency=config.frequency,
+        demo="blocks",
+        start=[list(s) for s in start],
+        goal=[list(s) for s in goal],
+        **world_header(world, "blocks"),
+    )
+    trace = JsonlTrace(out / "trace.jsonl", header=header) if out is not None else None
+    hub = live.start(header, library) if live is not None else None
+    sinks = [s for s in (trace, hub) if s is not None]
+    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *sinks]
     settings = engine_config(frequency=config.frequency)
     perception = blocks_perception()
     registry = default_registry()
@@ -287,9 +292,11 @@ def run_demo(
     if out is not None:
         _picture(world, out / "initial.png")
     sample = None
-    if trace is not None:
+    if sinks:
         sample = WorldTrace(
-            trace, world, alive=lambda name: name not in team.crashed and (rivals is None or name not in rivals.crashed)
+            tee(sinks),
+            world,
+            alive=lambda name: name not in team.crashed and (rivals is None or name not in rivals.crashed),
         )
         sample(world.now())
     wall = time.perf_counter()
@@ -305,6 +312,8 @@ def run_demo(
             now = world.now()
             if sample is not None:
                 sample(now)
+            if live is not None:
+                live.pace(team)
             facts = perception.facts
             satisfied = len(wanted & facts)
             if on_second is not None and now >= next_report:

@@ -32,11 +32,14 @@ import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.app.demos.common import StepCounter, plan_yaml_text
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
+
+if TYPE_CHECKING:
+    from alica.app.center.live import LiveSession
 
 MISSION = plans_dir() / "lunar" / "impera.yaml"
 PLAN = "ImperaMission"
@@ -284,6 +287,7 @@ def run_lunar(
     out: Path | None = None,
     gui: bool = False,
     prepare_world: Callable[[Any], None] | None = None,
+    live: LiveSession | None = None,
 ) -> LunarResult:
     """Run the lunar mission once (see the module docstring).
 
@@ -301,11 +305,12 @@ def run_lunar(
         prepare_world: called with the simulated world (:class:`alica.worldsim.World`) once the
             field is built and before the team exists, to change it (add rocks, move a sample...);
             for tests and experiments.
+        live: the control center of the run (``--center``): it serves the page and paces the run.
 
     Raises:
         AlicaError: a bad configuration.
     """
-    from alica.app.trace_world import MAP_EVERY, WorldTrace, world_header
+    from alica.app.trace_world import MAP_EVERY, WorldTrace, tee, world_header
     from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
     from alica.lang import literals
@@ -319,20 +324,20 @@ def run_lunar(
     library = load_library(MISSION)
     world = lunar(config.seed, rocks=config.rocks, samples=config.samples, size=config.size, **_gui(gui))
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
-    trace = None
-    if out is not None:
-        header = trace_header(
-            plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
-            root=PLAN,
-            agents={name: ROLES[name] for name in config.robots},
-            seed=config.seed,
-            frequency=config.frequency,
-            demo="lunar",
-            field={"samples": config.samples, "rocks": config.rocks, "size": config.size},
-            **world_header(world, "lunar", map_every=MAP_EVERY),
-        )
-        trace = JsonlTrace(out / "trace.jsonl", header=header)
-    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *([trace] if trace is not None else [])]
+    header = trace_header(
+        plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
+        root=PLAN,
+        agents={name: ROLES[name] for name in config.robots},
+        seed=config.seed,
+        frequency=config.frequency,
+        demo="lunar",
+        field={"samples": config.samples, "rocks": config.rocks, "size": config.size},
+        **world_header(world, "lunar", map_every=MAP_EVERY),
+    )
+    trace = JsonlTrace(out / "trace.jsonl", header=header) if out is not None else None
+    hub = live.start(header, library) if live is not None else None
+    sinks = [s for s in (trace, hub) if s is not None]
+    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *sinks]
     settings = engine_config(frequency=config.frequency)
     try:
         if prepare_world is not None:
@@ -357,11 +362,13 @@ def run_lunar(
         for cut in config.partitions:
             team.partition([list(g) for g in cut.groups], start=cut.start, end=cut.end)
         team.set_facts(literals("start"), at=0.0)
-        run = _Run(config, team, world, (float(base[0]), float(base[1])), trace)
-        if trace is not None:
-            sample = WorldTrace(trace, world, alive=lambda name: name not in team.crashed, team_map=run.team_map)
+        run = _Run(config, team, world, (float(base[0]), float(base[1])), tee(sinks) if sinks else None)
+        if sinks:
+            sample = WorldTrace(tee(sinks), world, alive=lambda name: name not in team.crashed, team_map=run.team_map)
             sample(team.now())
             team.after_tick(sample)
+        if live is not None:
+            team.after_tick(lambda now: live.pace(team))
         wall = time.perf_counter()
         run.loop(on_second, counter)
         wall = time.perf_counter() - wall

@@ -1,0 +1,260 @@
+"""The control center's live mode: a running simulated team's events, shared with the web server.
+
+The team runs on the main thread in simulated time, paced to the wall clock
+(:func:`drive`); the web server runs in a thread of its own with its event
+loop (:func:`start`). :class:`LiveHub` sits between them:
+
+* it is one of the team's observers: every trace event is copied, stamped
+  with the wall time it happened at, folded into the team's view (the same
+  fold a replay uses, :class:`~alica.app.center.team_view.TeamView`) and
+  handed to the server's listeners;
+* the operator's actions (a goal, facts, a decision on a proposed plan) are
+  callables queued by the server and run by :func:`drive` on the team's
+  thread between two ticks, so the team is never touched from two threads.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import json
+import queue
+import secrets
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, TextIO
+
+from alica.app.center.team_view import TeamView
+from alica.errors import AlicaError
+from alica.model import PlanLibrary
+
+Command = Callable[[Any], Any]
+"""An operator's action: called with the team on the team's thread; what it returns goes back to the page."""
+
+
+@dataclass(eq=False)
+class Listener:
+    """One page's connection: woken (from any thread) when events arrive."""
+
+    loop: asyncio.AbstractEventLoop
+    wake: asyncio.Event = field(default_factory=asyncio.Event)
+    pending: bool = False
+
+
+class LiveHub:
+    """The events of a running team, for the server (see the module docstring).
+
+    Args:
+        header: the run's trace header (:func:`alica.engine.trace_header`): plans, root, agents, world.
+        view: the team's state, folded event by event.
+    """
+
+    def __init__(self, header: dict[str, Any], view: TeamView) -> None:
+        self.header = header
+        self.view = view
+        self.events: list[dict[str, Any]] = []
+        self.walls: list[float] = []
+        """The wall time (``time.time()``) at which each event reached the hub."""
+        self.status: dict[str, Any] = {"running": True, "t": 0.0, "summary": None}
+        self._lock = threading.Lock()
+        self._listeners: set[Listener] = set()
+        self._commands: queue.Queue[tuple[Command, concurrent.futures.Future[Any]]] = queue.Queue()
+        self._snapshot: tuple[int, float, str] = (-1, -1.0, "")
+
+    # -- the team's side -------------------------------------------------
+
+    def __call__(self, event: dict[str, Any]) -> None:
+        """Take one event (an observer of the team, on the team's thread)."""
+        copy = dict(event)
+        with self._lock:
+            self.view.apply(copy)
+            self.events.append(copy)
+            self.walls.append(time.time())
+        self._wake()
+
+    def tick(self, now: float) -> None:
+        """The team's time moved on to ``now``."""
+        with self._lock:
+            self.status["t"] = round(now, 6)
+
+    def finish(self, summary: dict[str, Any]) -> None:
+        """The run is over; the page shows the summary. Later operator actions are refused."""
+        with self._lock:
+            self.status.update(running=False, summary=summary)
+        self._wake(force=True)
+        while True:  # anything queued meanwhile gets its answer
+            try:
+                _, future = self._commands.get_nowait()
+            except queue.Empty:
+                break
+            future.set_exception(AlicaError("the run is over"))
+
+    def run_commands(self, team: Any) -> None:
+        """Run the operator's queued actions on the team (on the team's thread)."""
+        while True:
+            try:
+                command, future = self._commands.get_nowait()
+            except queue.Empty:
+                return
+            try:
+                future.set_result(command(team))
+            except AlicaError as exc:
+                future.set_exception(exc)
+
+    # -- the server's side -----------------------------------------------
+
+    def submit(self, command: Command) -> concurrent.futures.Future[Any]:
+        """Queue an operator's action for the team's thread; the future holds its result or its error."""
+        future: concurrent.futures.Future[Any] = concurrent.futures.Future()
+        with self._lock:
+            running = self.status["running"]
+        if not running:
+            future.set_exception(AlicaError("the run is over: the team takes no more operator actions"))
+        else:
+            self._commands.put((command, future))
+        return future
+
+    def listen(self) -> Listener:
+        """A new listener for the calling event loop."""
+        listener = Listener(asyncio.get_running_loop())
+        with self._lock:
+            self._listeners.add(listener)
+        return listener
+
+    def forget(self, listener: Listener) -> None:
+        """Stop waking ``listener``."""
+        with self._lock:
+            self._listeners.discard(listener)
+
+    def since(self, count: int) -> tuple[list[dict[str, Any]], list[float], int]:
+        """The events after the first ``count``, their wall times, and the number of events now."""
+        with self._lock:
+            return self.events[count:], self.walls[count:], len(self.events)
+
+    def snapshot_json(self) -> str:
+        """The team's state now as JSON (computed once per change, shared by every page)."""
+        with self._lock:
+            count, t = len(self.events), float(self.status["t"])
+            if self._snapshot[:2] != (count, t):
+                state = self.view.snapshot()
+                state["t"] = max(float(state.get("t") or 0.0), t)
+                state["status"] = dict(self.status)
+                self._snapshot = (count, t, json.dumps(state))
+            return self._snapshot[2]
+
+    def _wake(self, force: bool = False) -> None:
+        with self._lock:
+            due = [ear for ear in self._listeners if force or not ear.pending]
+            for ear in due:
+                ear.pending = True
+        for ear in due:
+            try:
+                ear.loop.call_soon_threadsafe(ear.wake.set)
+            except RuntimeError:  # the page's loop is closed: the server is stopping
+                self.forget(ear)
+
+
+class LiveSession:
+    """The control center of one simulated run: a hub, the server in its thread, and the pace of the run.
+
+    Args:
+        speed: simulated seconds per wall second (``inf``: as fast as the machine allows).
+        host: the address to bind.
+        port: the port (0 picks a free one).
+        token: the access token (default: a new random one).
+        out: where the line to open goes.
+    """
+
+    def __init__(
+        self,
+        speed: float = 1.0,
+        host: str = "127.0.0.1",
+        port: int = 8765,
+        token: str | None = None,
+        out: TextIO = sys.stdout,
+    ) -> None:
+        if not speed > 0:
+            raise AlicaError(f"the speed must be a positive number of simulated seconds per wall second, got {speed}")
+        self.speed = speed
+        self.host, self.port = host, port
+        self.token = token or secrets.token_urlsafe(24)
+        self.out = out
+        self.hub: LiveHub | None = None
+        self.server: Any = None
+        self._start: tuple[float, float] | None = None
+
+    def start(self, header: dict[str, Any], library: PlanLibrary) -> LiveHub:
+        """Serve the page for a run with this trace header; the hub returned is the run's observer.
+
+        Raises:
+            AlicaError: the address cannot be bound.
+        """
+        from alica.app.center.operator import problems
+        from alica.app.center.server import live_app, serve_in_thread
+
+        self.hub = LiveHub(header, TeamView(header))
+        self.server = serve_in_thread(
+            live_app(self.hub, problems(library), self.token), self.host, self.port, self.token, self.out
+        )
+        return self.hub
+
+    def pace(self, team: Any) -> None:
+        """After a tick: the operator's actions run, the page learns the time, the wall clock catches up."""
+        assert self.hub is not None, "start() the session first"
+        self.hub.run_commands(team)
+        now = team.now()
+        self.hub.tick(now)
+        wall = time.monotonic()
+        if self._start is None:
+            self._start = (wall, now)
+            return
+        ahead = self._start[0] + (now - self._start[1]) / self.speed - wall
+        if ahead > 0:
+            time.sleep(ahead)  # the wall clock catches up with simulated time (a live run, not a test's wait)
+        elif ahead < -1.0:  # far behind (a slow tick): keep the pace from here instead of rushing
+            self._start = (wall, now)
+
+    def finish(self, summary: dict[str, Any]) -> None:
+        """The run is over: the page shows ``summary``; then serve until Ctrl-C or SIGTERM."""
+        if self.hub is None:
+            return
+        self.hub.finish(summary)
+        print("the run is over; the control center stays up until Ctrl-C", file=sys.stderr, flush=True)
+        stop = threading.Event()
+        previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
+        try:
+            while not stop.wait(0.5):
+                pass
+        except KeyboardInterrupt:
+            pass
+        finally:
+            signal.signal(signal.SIGTERM, previous)
+            self.server.should_exit = True
+
+
+def drive(
+    team: Any,
+    session: LiveSession,
+    *,
+    ticks: int | None = None,
+    max_time: float | None = None,
+    until_done: bool = True,
+) -> None:
+    """Run ``team`` like :meth:`SimulatedTeam.run`, at the session's pace, the operator's actions between ticks."""
+    limit = max_time if max_time is not None else float("inf")
+    count = 0
+    session.pace(team)
+    while True:
+        if ticks is not None and count >= ticks:
+            break
+        if until_done and team.done():
+            break
+        if team.now() >= limit:
+            break
+        team.tick()
+        count += 1
+        session.pace(team)

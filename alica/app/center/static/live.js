@@ -1,0 +1,263 @@
+// The live page: a WebSocket brings a running team's events and state; the operator sets goals and facts,
+// and accepts, declines or changes the plans the leader proposes.
+"use strict";
+(function () {
+  const $ = (id) => document.getElementById(id);
+  const V = window.AlicaViews;
+  const MAX_LOG = 500;
+  let meta = null, state = null, trees = null, count = 0;
+  const events = [], tracks = {}, proposals = {}, edits = {};
+  let running = null, checkSeq = 0;
+  window.alicaLatency = [];  // ms from an event reaching the server's hub to the page showing it (the bench reads it)
+
+  async function call(path, payload) {
+    const response = await fetch(path, {
+      method: payload === undefined ? "GET" : "POST",
+      credentials: "same-origin",
+      headers: { "Content-Type": "application/json" },
+      body: payload === undefined ? undefined : JSON.stringify(payload),
+    });
+    return { status: response.status, body: await response.json() };
+  }
+
+  function el(tag, attrs, text) {
+    const node = document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs || {})) { node.setAttribute(k, v); }
+    if (text !== undefined) { node.textContent = text; }
+    return node;
+  }
+
+  // -- what the events say ---------------------------------------------------
+
+  function take(e) {
+    events.push(e);
+    if (e.event === "pose" && typeof e.x === "number") { (tracks[e.agent] = tracks[e.agent] || []).push([e.t, e.x, e.y]); }
+    if (e.event === "proposal") {
+      proposals[e.problem] = e;
+      edits[e.problem] = { order: e.steps.map((_, i) => i), pins: {} };
+    } else if (e.event === "operator" && ["accept", "decline", "modify"].includes(e.what)) {
+      const open = proposals[e.problem];
+      if (open && open.generation === e.generation) { delete proposals[e.problem]; }
+    } else if (e.event === "planner" && e.what === "plan") {
+      running = e;
+    }
+  }
+
+  function showStatus() {
+    const s = state && state.status;
+    if (!s) { return; }
+    let text = "t = " + Number(state.t || 0).toFixed(2) + " s, ";
+    if (s.running) { text += "running"; }
+    else if (s.summary) { text += "over: " + (s.summary.success ? "success" : "not successful"); }
+    $("status").textContent = text;
+    $("status").dataset.running = s.running ? "yes" : "no";
+  }
+
+  function showLog(fresh) {
+    const filter = $("filter").value.trim().toLowerCase();
+    const body = $("log-body");
+    for (const e of fresh) {
+      const rest = {};
+      for (const k of Object.keys(e)) { if (k !== "t" && k !== "agent" && k !== "event") { rest[k] = e[k]; } }
+      const fields = JSON.stringify(rest);
+      const line = (e.event + " " + e.agent + " " + fields).toLowerCase();
+      const tr = el("tr", { "data-kind": e.event });
+      tr.dataset.line = line;
+      if (filter && !line.includes(filter)) { tr.hidden = true; }
+      for (const v of [Number(e.t).toFixed(3), e.agent, e.event, fields]) { tr.appendChild(el("td", {}, String(v))); }
+      body.prepend(tr);
+    }
+    while (body.children.length > MAX_LOG) { body.removeChild(body.lastChild); }
+  }
+
+  function refilter() {
+    const filter = $("filter").value.trim().toLowerCase();
+    for (const tr of $("log-body").children) { tr.hidden = Boolean(filter) && !tr.dataset.line.includes(filter); }
+  }
+
+  function draw() {
+    showStatus();
+    V.agents($("agents-body"), state);
+    V.map($("map-body"), state, tracks, meta);
+    if (state.world === "blocks") { V.blocks($("blocks-body"), state, meta); }
+    if (trees) { V.trees($("trees-body"), state, trees); }
+    showProposals();
+  }
+
+  // -- the operator ----------------------------------------------------------
+
+  function note(text, bad) {
+    $("operator-note").textContent = text;
+    $("operator-note").className = bad ? "note bad" : "note";
+  }
+
+  async function checkGoal() {
+    const seq = ++checkSeq, text = $("goal").value;
+    const answer = (await call("api/check", { problem: $("problem").value, goal: text })).body;
+    if (seq !== checkSeq) { return; }
+    const box = $("goal-check");
+    $("set-goal").disabled = !answer.ok;
+    if (answer.ok) {
+      box.className = "check ok";
+      box.textContent = "ok: " + answer.literals.join(", ");
+    } else {
+      box.className = "check bad";
+      const col = Math.max(1, answer.column || 1);
+      box.textContent = text + "\n" + " ".repeat(col - 1) + "^ column " + col + ": " + answer.error +
+        (answer.hint ? "\n" + answer.hint : "");
+    }
+    box.dataset.column = answer.ok ? "" : String(answer.column);
+  }
+
+  async function setGoal() {
+    const answer = await call("api/goal", { problem: $("problem").value, goal: $("goal").value });
+    note(answer.body.ok ? "goal set: the leader plans" : "refused: " + answer.body.error, !answer.body.ok);
+  }
+
+  async function setFacts() {
+    const answer = await call("api/facts", { facts: $("facts").value });
+    note(answer.body.ok ? "facts set" : "refused: " + (answer.body.error || "") +
+      (answer.body.column ? " (column " + answer.body.column + ")" : ""), !answer.body.ok);
+  }
+
+  async function decide(problem, action) {
+    const p = proposals[problem], edit = edits[problem];
+    const payload = { problem: problem, generation: p.generation, action: action };
+    if (action === "modify") { payload.order = edit.order; payload.pins = edit.pins; }
+    const answer = await call("api/decide", payload);
+    note(answer.body.ok ? action + " sent for generation " + p.generation : "refused: " + answer.body.error,
+      !answer.body.ok);
+  }
+
+  function move(problem, at, by) {
+    const order = edits[problem].order, to = at + by;
+    if (to < 0 || to >= order.length) { return; }
+    [order[at], order[to]] = [order[to], order[at]];
+    showProposals(true);
+  }
+
+  function stepRow(problem, p, position, index) {
+    const li = el("li", { "data-step": String(index) });
+    const keep = el("input", { type: "checkbox", "aria-label": "keep step " + index });
+    keep.checked = true;
+    keep.addEventListener("change", () => {
+      const order = edits[problem].order;
+      order.splice(order.indexOf(index), 1);
+      showProposals(true);
+    });
+    const up = el("button", { type: "button", class: "up", title: "earlier" }, "\u2191");
+    const down = el("button", { type: "button", class: "down", title: "later" }, "\u2193");
+    up.addEventListener("click", () => move(problem, position, -1));
+    down.addEventListener("click", () => move(problem, position, 1));
+    li.append(keep, " ", el("code", {}, p.steps[index]), " ", up, down);
+    return li;
+  }
+
+  function showProposals(force) {
+    const box = $("proposals");
+    const key = JSON.stringify([proposals, edits]);
+    if (!force && box.dataset.key === key) { return; }
+    box.dataset.key = key;
+    box.replaceChildren();
+    for (const [problem, p] of Object.entries(proposals)) {
+      const edit = edits[problem];
+      const div = el("div", { class: "proposal", "data-problem": problem, "data-generation": String(p.generation) });
+      div.appendChild(el("h3", {}, problem + ": plan " + p.generation + " proposed by " + p.leader +
+        " (cost " + p.cost + ", " + p.steps.length + " steps)"));
+      if (p.error) { div.appendChild(el("p", { class: "note bad" }, "the change was refused: " + p.error)); }
+      const list = el("ol", { class: "steps" });
+      edit.order.forEach((index, position) => list.appendChild(stepRow(problem, p, position, index)));
+      const dropped = p.steps.map((_, i) => i).filter((i) => !edit.order.includes(i));
+      div.appendChild(list);
+      if (dropped.length) {
+        div.appendChild(el("p", { class: "note" }, "dropped: " + dropped.map((i) => p.steps[i]).join(", ")));
+      }
+      const table = el("table", { class: "tasks" });
+      table.appendChild(el("tr", {}, "")).append(el("th", {}, "task"), el("th", {}, "steps"), el("th", {}, "robot"));
+      for (const task of p.tasks || []) {
+        const name = task.entry_point;
+        const tr = el("tr", { "data-task": name });
+        const pick = el("select", { "aria-label": "robot for " + name });
+        pick.appendChild(el("option", { value: "" }, task.robots && task.robots.length ? task.robots.join(" or ") : "any"));
+        for (const agent of meta.agents) { pick.appendChild(el("option", { value: agent }, agent)); }
+        pick.value = edit.pins[name] || "";
+        pick.addEventListener("change", () => {
+          if (pick.value) { edit.pins[name] = pick.value; } else { delete edit.pins[name]; }
+        });
+        const steps = (task.steps || []).map((i) => p.steps[i]).join("; ");
+        tr.append(el("td", {}, name), el("td", {}, steps), el("td", {}));
+        tr.lastChild.appendChild(pick);
+        table.appendChild(tr);
+      }
+      div.appendChild(table);
+      for (const action of ["accept", "decline", "modify"]) {
+        const button = el("button", { type: "button", class: action },
+          { accept: "accept", decline: "decline (plan again)", modify: "run with my changes" }[action]);
+        button.addEventListener("click", () => decide(problem, action));
+        div.appendChild(button);
+      }
+      box.appendChild(div);
+    }
+    const shown = $("running-plan");
+    shown.replaceChildren();
+    if (running) {
+      shown.appendChild(el("p", { class: "running" }, "the team runs plan " + running.generation + "." +
+        running.version + " (cost " + running.cost + ", " + running.steps + " steps) since t = " +
+        Number(running.t).toFixed(2) + " s"));
+    }
+  }
+
+  // -- the connection ----------------------------------------------------------
+
+  function receive(message) {
+    const data = JSON.parse(message.data);
+    if (data.type === "hello") {
+      meta = data.meta;
+      $("file").textContent = meta.file;
+      const pick = $("problem");
+      pick.replaceChildren();
+      for (const [name, p] of Object.entries(meta.problems)) { pick.appendChild(el("option", { value: name }, name)); }
+      const first = Object.values(meta.problems)[0];
+      if (first && !$("goal").value) { $("goal").value = first.goal; }
+      if (first) { checkGoal(); } else { $("goal").disabled = true; }
+    }
+    const fresh = data.events;
+    fresh.forEach(take);
+    count = data.count;
+    state = data.state;
+    draw();
+    showLog(fresh);
+    const walls = data.walls;
+    requestAnimationFrame(() => {
+      const shown = Date.now();
+      for (const w of walls) { window.alicaLatency.push(shown - w * 1000); }
+      if (window.alicaLatency.length > 100000) { window.alicaLatency.splice(0, 50000); }
+      document.body.dataset.count = String(count);
+      document.body.dataset.ready = "yes";
+    });
+  }
+
+  function connect() {
+    const scheme = location.protocol === "https:" ? "wss://" : "ws://";
+    const socket = new WebSocket(scheme + location.host + location.pathname.replace(/[^/]*$/, "") + "ws");
+    socket.addEventListener("message", receive);
+    socket.addEventListener("close", () => {
+      $("status").textContent += " (disconnected)";
+      document.body.dataset.connected = "no";
+    });
+    socket.addEventListener("open", () => { document.body.dataset.connected = "yes"; });
+  }
+
+  async function start() {
+    const answer = await call("api/trees");
+    if (answer.status === 200) { trees = answer.body; }
+    $("goal").addEventListener("input", checkGoal);
+    $("problem").addEventListener("change", checkGoal);
+    $("set-goal").addEventListener("click", setGoal);
+    $("set-facts").addEventListener("click", setFacts);
+    $("filter").addEventListener("input", refilter);
+    connect();
+  }
+
+  start().catch((err) => { document.body.insertAdjacentHTML("afterbegin", '<p class="note bad">' + err + "</p>"); });
+})();
