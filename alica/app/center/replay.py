@@ -41,7 +41,7 @@ class Replay:
         seen: dict[str, None] = dict.fromkeys(sorted(self.trace.roles))
         for e in self.events:
             agent = e.get("agent")
-            if isinstance(agent, str) and agent != "-":
+            if isinstance(agent, str) and agent not in ("-", "operator"):
                 seen.setdefault(agent)
         return list(seen)
 

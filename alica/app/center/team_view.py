@@ -18,6 +18,9 @@ The snapshot::
      "map": None or {"t", "origin": [x, y], "resolution", "width", "height",
                      "cells": "0012...",   # width * height digits, rows from the lowest y, each from the lowest x:
                      "free", "occupied"},  # 0 unknown, 1 free, 2 occupied; and the counts of free and occupied cells
+     "operator": {"proposals": {PROBLEM: {"generation", "leader", "cost", "goal", "steps", "tasks", "error"?, "t"}},
+                  "goals": {PROBLEM: GOAL},   # set by the operator
+                  "running": {PROBLEM: {"generation", "version", "cost", "steps", "leader", "t"}}},
      "tracks"?: {NAME: [[t, x, y], ...]}}  # only with snapshot(since=...) of a view that keeps tracks
 
 Tracks: a view built with ``tracks=True`` keeps each robot's poses as ``[t, x, y]``
@@ -29,6 +32,10 @@ A ``found`` event (the team read a sample) marks the nearest ``sample`` object w
 :data:`FOUND_WITHIN` metres of where the team believes it is (``found``: its kind,
 ``found_as``: the team's name of it); without such an object it becomes an object of
 its own, named by the team's name, of kind ``sample``.
+
+The operator's side comes from ``proposal`` events (a plan waiting for review),
+``operator`` events (a goal; an accept, decline or modify answers the proposal of
+its generation) and the leader's ``planner`` events that share a plan.
 """
 
 from __future__ import annotations
@@ -93,6 +100,12 @@ class TeamView:
         self.objects: dict[str, dict[str, Any]] = {}
         self.map: dict[str, Any] | None = None
         self.tracks: dict[str, list[list[float]]] = {}
+        self.proposals: dict[str, dict[str, Any]] = {}
+        """Planning problem -> the plan its leader proposes and the operator has not decided on (``--review``)."""
+        self.goals: dict[str, str] = {}
+        """Planning problem -> the goal the operator set."""
+        self.running: dict[str, dict[str, Any]] = {}
+        """Planning problem -> the plan the leader shared last (generation, version, cost, steps, leader, t)."""
         for name in (*sorted(self.roles), *agents):
             self._agent(name)
 
@@ -116,6 +129,9 @@ class TeamView:
         other.objects = {n: dict(o) for n, o in self.objects.items()}
         other.map = self.map
         other.tracks = {a: list(points) for a, points in self.tracks.items()}
+        other.proposals = dict(self.proposals)  # the proposals themselves are replaced, never changed
+        other.goals = dict(self.goals)
+        other.running = dict(self.running)
         return other
 
     def apply(self, event: Mapping[str, Any]) -> None:
@@ -144,8 +160,10 @@ class TeamView:
         if kind == "map":
             self._map(event)
             return
+        if kind in ("proposal", "operator") or (kind == "planner" and event.get("what") == "plan"):
+            self._operator(kind, event)
         name = event.get("agent")
-        if not isinstance(name, str) or name == "-" or kind == "trace":
+        if not isinstance(name, str) or name in ("-", "operator") or kind == "trace":
             return
         who = self._agent(name)
         nodes = self.nodes[name]
@@ -223,6 +241,24 @@ class TeamView:
             "occupied": cells.count(2),
         }
 
+    def _operator(self, kind: str, event: Mapping[str, Any]) -> None:
+        """The operator's side: proposals waiting for a decision, goals set, the plans shared."""
+        if kind == "proposal" and isinstance(event.get("problem"), str):
+            fields = ("generation", "leader", "cost", "goal", "steps", "tasks", "error", "t")
+            self.proposals[event["problem"]] = {k: event[k] for k in fields if k in event}
+        elif kind == "operator" and isinstance(event.get("problem"), str):
+            problem = event["problem"]
+            if event.get("what") == "goal" and isinstance(event.get("goal"), str):
+                self.goals[problem] = event["goal"]
+            waiting = self.proposals.get(problem)
+            if event.get("what") in ("accept", "decline", "modify") and waiting is not None:
+                if waiting.get("generation") == event.get("generation"):
+                    del self.proposals[problem]
+        elif kind == "planner":
+            problem = str(event.get("key", "")).rsplit("/", 1)[-1]
+            fields = ("generation", "version", "cost", "steps", "t")
+            self.running[problem] = {**{k: event[k] for k in fields if k in event}, "leader": event.get("agent")}
+
     def snapshot(self, t: float | None = None, since: float | None = None) -> dict[str, Any]:
         """The state as JSON-ready data (the module docstring has its fields).
 
@@ -252,6 +288,7 @@ class TeamView:
             "agents": agents,
             "objects": {n: dict(o) for n, o in self.objects.items()},
             "map": None if self.map is None else dict(self.map),
+            "operator": {"proposals": dict(self.proposals), "goals": dict(self.goals), "running": dict(self.running)},
         }
         if since is not None and self.keep_tracks:
             out["tracks"] = {a: [p for p in points if p[0] > since] for a, points in self.tracks.items()}

@@ -6,8 +6,8 @@
   const V = window.AlicaViews;
   const MAX_LOG = 500;
   let meta = null, state = null, trees = null, count = 0;
-  const events = [], tracks = {}, proposals = {}, edits = {};
-  let running = null, checkSeq = 0;
+  const events = [], tracks = {}, edits = {};
+  let proposals = {}, running = {}, checkSeq = 0;
   window.alicaLatency = [];  // ms from an event reaching the server's hub to the page showing it (the bench reads it)
 
   async function call(path, payload) {
@@ -32,15 +32,7 @@
   function take(e) {
     events.push(e);
     if (e.event === "pose" && typeof e.x === "number") { (tracks[e.agent] = tracks[e.agent] || []).push([e.t, e.x, e.y]); }
-    if (e.event === "proposal") {
-      proposals[e.problem] = e;
-      edits[e.problem] = { order: e.steps.map((_, i) => i), pins: {} };
-    } else if (e.event === "operator" && ["accept", "decline", "modify"].includes(e.what)) {
-      const open = proposals[e.problem];
-      if (open && open.generation === e.generation) { delete proposals[e.problem]; }
-    } else if (e.event === "planner" && e.what === "plan") {
-      running = e;
-    }
+    if (e.event === "proposal") { edits[e.problem] = { order: e.steps.map((_, i) => i), pins: {} }; }
   }
 
   function showStatus() {
@@ -76,6 +68,8 @@
   }
 
   function draw() {
+    proposals = state.operator.proposals;
+    running = state.operator.running;
     showStatus();
     V.agents($("agents-body"), state);
     V.map($("map-body"), state, tracks, meta);
@@ -155,12 +149,12 @@
 
   function showProposals(force) {
     const box = $("proposals");
-    const key = JSON.stringify([proposals, edits]);
+    const key = JSON.stringify([proposals, edits, running]);
     if (!force && box.dataset.key === key) { return; }
     box.dataset.key = key;
     box.replaceChildren();
     for (const [problem, p] of Object.entries(proposals)) {
-      const edit = edits[problem];
+      const edit = edits[problem] || (edits[problem] = { order: p.steps.map((_, i) => i), pins: {} });
       const div = el("div", { class: "proposal", "data-problem": problem, "data-generation": String(p.generation) });
       div.appendChild(el("h3", {}, problem + ": plan " + p.generation + " proposed by " + p.leader +
         " (cost " + p.cost + ", " + p.steps.length + " steps)"));
@@ -200,10 +194,10 @@
     }
     const shown = $("running-plan");
     shown.replaceChildren();
-    if (running) {
-      shown.appendChild(el("p", { class: "running" }, "the team runs plan " + running.generation + "." +
-        running.version + " (cost " + running.cost + ", " + running.steps + " steps) since t = " +
-        Number(running.t).toFixed(2) + " s"));
+    for (const [problem, r] of Object.entries(running)) {
+      shown.appendChild(el("p", { class: "running", "data-problem": problem }, problem + ": the team runs plan " +
+        r.generation + "." + r.version + " of " + r.leader + " (cost " + r.cost + ", " + r.steps + " steps) since t = " +
+        Number(r.t).toFixed(2) + " s"));
     }
   }
 

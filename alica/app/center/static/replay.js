@@ -38,6 +38,7 @@
     V.map($("map-body"), state, V.tracks(events, t), meta);
     if (state.world === "blocks") { V.blocks($("blocks-body"), state, meta); }
     V.trees($("trees-body"), state, trees);
+    V.operator($("operator-body"), state);
   }
 
   function showLog(t) { V.log($("log-body"), events, $("filter").value, t); }

@@ -263,5 +263,28 @@
     tbody.dataset.shown = String(rows.length);
   }
 
-  window.AlicaViews = { agents, tracks, map, blocks, trees, log };
+  // The operator's side at this moment: goals set, plans waiting for review, the plans the team runs.
+  function operator(box, snapshot) {
+    const op = snapshot.operator || { proposals: {}, goals: {}, running: {} };
+    let html = "";
+    for (const [problem, goal] of Object.entries(op.goals)) {
+      html += '<p class="goal">' + esc(problem) + ": the operator's goal <code>" + esc(goal) + "</code></p>";
+    }
+    for (const [problem, p] of Object.entries(op.proposals)) {
+      html += '<div class="proposal" data-problem="' + esc(problem) + '" data-generation="' + p.generation + '">' +
+        "<h3>" + esc(problem) + ": plan " + p.generation + " proposed by " + esc(p.leader) + " (cost " + p.cost +
+        "), waiting for the operator</h3>" + (p.error ? '<p class="note bad">the change was refused: ' +
+        esc(p.error) + "</p>" : "") + "<ol>" + p.steps.map((s) => "<li><code>" + esc(s) + "</code></li>").join("") +
+        "</ol></div>";
+    }
+    for (const [problem, r] of Object.entries(op.running)) {
+      html += '<p class="running" data-problem="' + esc(problem) + '">' + esc(problem) + ": the team runs plan " +
+        r.generation + "." + r.version + " of " + esc(r.leader) + " (cost " + r.cost + ", " + r.steps +
+        " steps) since t = " + num(r.t) + " s</p>";
+    }
+    box.innerHTML = html;
+    box.hidden = html === "";
+  }
+
+  window.AlicaViews = { agents, tracks, map, blocks, trees, log, operator };
 })();
