@@ -139,7 +139,7 @@ class LiveHub:
         """The team's state now as JSON (computed once per change, shared by every page)."""
         with self._lock:
             count, t = len(self.events), float(self.status["t"])
-            if self._snapshot[:2] != (count, t):
+            if self._snapshot[:2] != (count, t) or not self.status["running"]:
                 state = self.view.snapshot()
                 state["t"] = max(float(state.get("t") or 0.0), t)
                 state["status"] = dict(self.status)
