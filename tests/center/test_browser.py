@@ -1,4 +1,4 @@
-"""The replay page in a real browser: headless Chromium (Debian's ``chromium``) driven by Playwright.
+"""The control center's pages (replay, live, plan view) in a real browser: headless Chromium (Debian's ``chromium``) driven by Playwright.
 
 Skipped, with the reason printed, where Playwright or the browser is not installed
 (``make setup`` installs both where it can). Screenshots go to ``build/center/``.
@@ -6,17 +6,20 @@ Skipped, with the reason printed, where Playwright or the browser is not install
 
 from __future__ import annotations
 
+import contextlib
+import json
 import re
 import shutil
 import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
 from alica.io import plans_dir
+from tests.center.live_run import BLOCKS, live_run
 
 if TYPE_CHECKING:
     from playwright.sync_api import Page
@@ -240,3 +243,110 @@ def test_a_lunar_replay_shows_the_team_map_objects_and_found_samples(lunar_url: 
             page.screenshot(path=str(SHOTS / "replay-lunar.png"), full_page=True)
         finally:
             browser.close()
+
+
+@pytest.fixture()
+def live_blocks() -> Iterator[Any]:
+    """A blocks-world team planning under --review, served live."""
+    _browser_or_skip()
+    with live_run(*BLOCKS, "--review", "--speed", "2", "--max-time", "600") as live:
+        yield live
+
+
+def test_the_live_page_shows_the_team_updates_within_a_second_and_the_operator_reviews_its_plans(
+    live_blocks: Any,
+) -> None:
+    from playwright.sync_api import sync_playwright
+
+    SHOTS.mkdir(parents=True, exist_ok=True)
+    with sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.goto(live_blocks.url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            assert page.locator("#file").inner_text() == "mission.yaml"
+            assert page.locator("#agents-body tr").count() == 2
+            assert page.locator('#agents-body tr[data-agent="r2"] td').nth(1).inner_text() == "Manipulator"
+            # the team runs: the page's time moves on within a second
+            shown = page.locator("#status").inner_text()
+            page.wait_for_function(f"document.getElementById('status').textContent !== {shown!r}", timeout=1_000)
+
+            # the leader's first plan waits for the operator; the goal field is checked as typed
+            page.wait_for_selector('.proposal[data-generation="1"]', timeout=30_000)
+            page.fill("#goal", "on(c, a) and")
+            page.wait_for_selector("#goal-check.bad", timeout=5_000)
+            assert "column 13" in page.locator("#goal-check").inner_text()
+            assert page.locator("#set-goal").is_disabled()
+            page.fill("#goal", "on(c, a) and ontable(a)")
+            page.wait_for_selector("#goal-check.ok", timeout=5_000)
+            page.click("#set-goal")
+            # the leader plans for the typed goal and shows the plan as tasks and steps
+            page.wait_for_selector('.proposal[data-generation="2"]', timeout=30_000)
+            proposal = page.locator('.proposal[data-generation="2"]')
+            assert proposal.locator("ol.steps li").count() >= 1
+            assert proposal.locator("table.tasks tr[data-task]").count() >= 1
+            page.screenshot(path=str(SHOTS / "live-operator.png"), full_page=True)
+
+            # decline: the leader plans again
+            proposal.locator("button.decline").click()
+            page.wait_for_selector('.proposal[data-generation="3"]', timeout=30_000)
+            third = page.locator('.proposal[data-generation="3"]')
+            steps = third.locator("ol.steps li").count()
+            if steps > 1:  # dropping the first step breaks the plan: refused with the validator's reason
+                third.locator("ol.steps li").first.locator("input[type=checkbox]").click()
+                assert third.locator("ol.steps li").count() == steps - 1
+                third.locator("button.modify").click()
+                page.wait_for_selector(".proposal .note.bad", timeout=30_000)
+            # accept: the team runs the plan
+            page.locator('.proposal[data-generation="3"] button.accept').click()
+            page.wait_for_selector('#running-plan p.running[data-problem="StackBlocks"]', timeout=30_000)
+            assert page.locator(".proposal").count() == 0
+            # each agent's tree shows the generated plan it runs, its current state highlighted
+            page.wait_for_selector("#trees-body li.plan.generated li.state.current", timeout=30_000)
+            page.fill("#filter", "operator")
+            page.wait_for_function(
+                "[...document.querySelectorAll('#log-body tr')].filter((tr) => !tr.hidden).length >= 3", timeout=10_000
+            )
+            page.fill("#filter", "")
+            page.screenshot(path=str(SHOTS / "live-running.png"), full_page=True)
+        finally:
+            browser.close()
+
+
+@pytest.fixture(scope="module")
+def replan_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A blocks demo with an opponent that makes the team replan (in a process of its own: OMPL's seed is per process)."""
+    folder = tmp_path_factory.mktemp("replan")
+    command = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", "2", "--blocks", "4"]
+    command += ["--opponents", "1", "--seed", "4", "--out", str(folder)]
+    subprocess.run(command, check=True, capture_output=True, timeout=300)
+    return folder / "trace.jsonl"
+
+
+def test_a_replay_of_a_demo_trace_jumps_to_its_replans(replan_trace: Path) -> None:
+    from playwright.sync_api import sync_playwright
+
+    _browser_or_skip()
+    events = [json.loads(line) for line in replan_trace.read_text(encoding="utf-8").splitlines()]
+    replans = [e["t"] for e in events if e.get("event") == "replan"]
+    assert replans, "the demo with an opponent replans"
+    with contextlib.ExitStack() as stack:
+        url = stack.enter_context(contextlib.contextmanager(_serve)("--trace", str(replan_trace)))
+        p = stack.enter_context(sync_playwright())
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        stack.callback(browser.close)
+        page = browser.new_page(viewport={"width": 1400, "height": 1000})
+        page.goto(url, timeout=20_000)
+        page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+        page.click("#next-replan")
+        page.wait_for_function(f"Math.abs(parseFloat(document.getElementById('slider').value) - {replans[0]}) < 1e-6")
+        page.fill("#filter", "replan")
+        page.wait_for_function("document.getElementById('log-body').rows.length >= 1", timeout=10_000)
+        assert "replan" in page.locator("#log-body tr").first.inner_text()
+        page.screenshot(path=str(SHOTS / "replay-replan.png"), full_page=True)
+        if len(replans) > 1:
+            page.click("#next-replan")
+            page.wait_for_function(
+                f"Math.abs(parseFloat(document.getElementById('slider').value) - {replans[1]}) < 1e-6"
+            )

@@ -43,18 +43,30 @@ def test_the_operator_declines_changes_pins_and_accepts_a_plan_then_sets_a_goal(
 
         # a change that breaks the plan is refused with the validator's reason, and nothing runs
         order = list(range(len(second["steps"])))[1:]
-        status, _ = live.request("api/decide", {"problem": "StackBlocks", "generation": 2, "action": "modify", "order": order})
+        status, _ = live.request(
+            "api/decide", {"problem": "StackBlocks", "generation": 2, "action": "modify", "order": order}
+        )
         assert status == 200
         refused = live.until(_proposal(2, error=True))
         assert "invalid" in refused["error"] or "does not hold" in refused["error"]
 
         # the plan with its first task pinned to r2 runs
         task = second["tasks"][0]["entry_point"]
-        body = {"problem": "StackBlocks", "generation": 2, "action": "modify", "order": list(range(len(second["steps"]))), "pins": {task: "r2"}}
+        body = {
+            "problem": "StackBlocks",
+            "generation": 2,
+            "action": "modify",
+            "order": list(range(len(second["steps"]))),
+            "pins": {task: "r2"},
+        }
         assert live.request("api/decide", body)[0] == 200
         shared = live.until(lambda e: e["event"] == "planner" and e.get("what") == "plan" and e["generation"] == 2)
         taken = live.until(
-            lambda e: e["event"] == "allocation" and e["agent"] == "r2" and any(v.endswith("_T0") for v in e["entries"].values())
+            lambda e: (
+                e["event"] == "allocation"
+                and e["agent"] == "r2"
+                and any(v.endswith("_T0") for v in e["entries"].values())
+            )
         )
         assert taken["entries"]["r2"].endswith("_T0")
         running = live.until_state(lambda s: "StackBlocks" in s["operator"]["running"])
@@ -95,7 +107,9 @@ def test_the_live_api_refuses_bad_input_and_requests_without_the_token() -> None
         assert status == 400 and "generation" in answer["error"]
         status, answer = live.request("api/decide", {"problem": "StackBlocks", "generation": 1, "action": "maybe"})
         assert status == 400 and "action" in answer["error"]
-        status, answer = live.request("api/decide", {"problem": "StackBlocks", "generation": 1, "action": "accept", "order": [0]})
+        status, answer = live.request(
+            "api/decide", {"problem": "StackBlocks", "generation": 1, "action": "accept", "order": [0]}
+        )
         assert status == 400 and "modify" in answer["error"]
         status, answer = live.request("api/events?since=x")
         assert status == 400
@@ -105,7 +119,9 @@ def test_the_live_api_refuses_bad_input_and_requests_without_the_token() -> None
 
 
 def test_a_demo_serves_its_run_live_and_the_page_shows_the_end() -> None:
-    with live_run("blocksworld", "--agents", "1", "--blocks", "2", "--seed", "1", "--speed", "50", command="demo") as live:
+    with live_run(
+        "blocksworld", "--agents", "1", "--blocks", "2", "--seed", "1", "--speed", "50", command="demo"
+    ) as live:
         live.connect()
         over = live.until_state(lambda s: not s["status"]["running"], timeout=120)
         assert over["status"]["summary"]["success"] is True

@@ -18,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import json
+import math
 import queue
 import secrets
 import signal
@@ -31,6 +32,9 @@ from typing import Any, TextIO
 from alica.app.center.team_view import TeamView
 from alica.errors import AlicaError
 from alica.model import PlanLibrary
+
+CLOCK_EVERY = 0.2
+"""Wall seconds between two updates that only move the pages' clock on (events are pushed as they come)."""
 
 Command = Callable[[Any], Any]
 """An operator's action: called with the team on the team's thread; what it returns goes back to the page."""
@@ -64,6 +68,7 @@ class LiveHub:
         self._listeners: set[Listener] = set()
         self._commands: queue.Queue[tuple[Command, concurrent.futures.Future[Any]]] = queue.Queue()
         self._snapshot: tuple[int, float, str] = (-1, -1.0, "")
+        self._clock_told = -math.inf
 
     # -- the team's side -------------------------------------------------
 
@@ -77,9 +82,13 @@ class LiveHub:
         self._wake()
 
     def tick(self, now: float) -> None:
-        """The team's time moved on to ``now``."""
+        """The team's time moved on to ``now``; pages hear of it at most :data:`CLOCK_EVERY` wall seconds apart."""
         with self._lock:
             self.status["t"] = round(now, 6)
+        wall = time.monotonic()
+        if wall - self._clock_told >= CLOCK_EVERY:
+            self._clock_told = wall
+            self._wake()
 
     def finish(self, summary: dict[str, Any]) -> None:
         """The run is over; the page shows the summary. Later operator actions are refused."""
