@@ -12,7 +12,8 @@ Needs Playwright and Debian's chromium (``/usr/bin/chromium``, as
    headless chromium. After ``--warmup`` wall seconds the page's
    ``window.alicaLatency`` (ms from an event reaching the server's hub, wall
    clock, to the animation frame after the page drew it) is emptied, and read
-   again ``--window`` wall seconds later: p50, p90, p99 and max, the events per
+   again ``--window`` wall seconds later: p50, p90, p99 and max (and the part
+   until the WebSocket message reached the page: the server's share), the events per
    second the page received, the pushes (WebSocket messages) per second and
    their mean size, the page's time in its WebSocket message handler and in
    each view of ``views.js`` (wrapped by an init script), and chromium's own
@@ -88,11 +89,13 @@ TICK = os.sysconf("SC_CLK_TCK")
 # script of the page runs: views.js assigns window.AlicaViews, live.js reads it once).
 INSTRUMENT = """
 (() => {
-  const bench = window.alicaBench = { frames: 0, bytes: 0, maxBytes: 0, handlerMs: 0, views: {} };
+  const bench = window.alicaBench = { frames: 0, bytes: 0, maxBytes: 0, handlerMs: 0, views: {}, arrival: [] };
   const add = EventTarget.prototype.addEventListener;
   WebSocket.prototype.addEventListener = function (type, fn, options) {
     if (type !== "message") { return add.call(this, type, fn, options); }
     return add.call(this, type, function (event) {
+      const arrived = Date.now(), walls = JSON.parse(event.data).walls || [];
+      for (const w of walls) { window.alicaBench.arrival.push(arrived - w * 1000); }
       const t0 = performance.now();
       try { return fn.call(this, event); } finally {
         const b = window.alicaBench;
@@ -122,7 +125,7 @@ INSTRUMENT = """
 
 RESET = """() => {
   if (window.alicaLatency) { window.alicaLatency.length = 0; }
-  const b = window.alicaBench; b.frames = 0; b.bytes = 0; b.maxBytes = 0; b.handlerMs = 0; b.views = {};
+  const b = window.alicaBench; b.frames = 0; b.bytes = 0; b.maxBytes = 0; b.handlerMs = 0; b.views = {}; b.arrival = [];
 }"""
 
 # A slider jump on the replay page: ms from the input event to the frame after the agents table was redrawn.
@@ -556,6 +559,7 @@ def live_table(run: Live, agents: int) -> None:
         return
     lat = run.latencies
     b = run.bench
+    arrival = [float(v) for v in b.get("arrival", [])]
     frames = max(int(b.get("frames", 0)), 1)
     print("| figure | value |")
     print("| --- | ---: |")
@@ -569,6 +573,10 @@ def live_table(run: Live, agents: int) -> None:
         ("latency p90 (ms)", f"{percentile(lat, 90):.0f}"),
         ("latency p99 (ms)", f"{percentile(lat, 99):.0f}"),
         ("latency max (ms)", f"{max(lat) if lat else float('nan'):.0f}"),
+        (
+            "of which hub -> message at the page (server and socket) p50 / p99 / max (ms)",
+            f"{percentile(arrival, 50):.0f} / {percentile(arrival, 99):.0f} / {max(arrival, default=float('nan')):.0f}",
+        ),
         ("pushes (WebSocket messages) / s", f"{b.get('frames', 0) / run.wall:.1f}"),
         ("events per push (mean)", f"{len(lat) / frames:.1f}"),
         ("push size mean / max (kB)", f"{b.get('bytes', 0) / frames / 1e3:.1f} / {b.get('maxBytes', 0) / 1e3:.1f}"),
