@@ -5,9 +5,11 @@
   const $ = (id) => document.getElementById(id);
   const V = window.AlicaViews;
   const MAX_LOG = 500;
+  const PAINT_MS = 50;  // the page is drawn at most 20 times a second
   let meta = null, state = null, trees = null, count = 0;
   const events = [], tracks = {}, edits = {};
   let proposals = {}, running = {}, checkSeq = 0;
+  let queued = [], queuedWalls = [], painting = false, lastPaint = 0;  // events (and their hub wall times) not drawn yet
   window.alicaLatency = [];  // ms from an event reaching the server's hub to the page showing it (the bench reads it)
 
   async function call(path, payload) {
@@ -67,14 +69,30 @@
     for (const tr of $("log-body").children) { tr.hidden = Boolean(filter) && !tr.dataset.line.includes(filter); }
   }
 
+  // What each view last drew: a view is drawn again only when what it shows changed. Under a flow of message
+  // events most updates change the time alone, and the plan trees cost the most to draw.
+  const drawn = {};
+  function changed(view, what) {
+    const key = JSON.stringify(what);
+    if (drawn[view] === key) { return false; }
+    drawn[view] = key;
+    return true;
+  }
+
   function draw() {
     proposals = state.operator.proposals;
     running = state.operator.running;
     showStatus();
-    V.agents($("agents-body"), state);
-    V.map($("map-body"), state, tracks, meta);
-    if (state.world === "blocks") { V.blocks($("blocks-body"), state, meta); }
-    if (trees) { V.trees($("trees-body"), state, trees); }
+    const plans = {};  // the agents without their poses: what the agents table and the plan trees show
+    for (const [name, a] of Object.entries(state.agents || {})) { plans[name] = Object.assign({}, a, { pose: null }); }
+    const agentsChanged = changed("agents", plans);
+    if (agentsChanged) { V.agents($("agents-body"), state); }
+    const trackCount = Object.values(tracks).reduce((n, list) => n + list.length, 0);
+    if (changed("map", [state.agents, state.objects, state.map, state.bounds, trackCount])) {
+      V.map($("map-body"), state, tracks, meta);
+    }
+    if (state.world === "blocks" && changed("blocks", state.objects)) { V.blocks($("blocks-body"), state, meta); }
+    if (trees && (agentsChanged || !drawn.trees)) { V.trees($("trees-body"), state, trees); drawn.trees = true; }
     showProposals();
   }
 
@@ -215,13 +233,32 @@
       if (first && !$("goal").value) { $("goal").value = first.goal; }
       if (first) { checkGoal(); } else { $("goal").disabled = true; }
     }
-    const fresh = data.events;
-    fresh.forEach(take);
+    data.events.forEach(take);
     count = data.count;
     state = data.state;
+    for (const e of data.events) { queued.push(e); }
+    for (const w of data.walls) { queuedWalls.push(w); }
+    // a hidden tab gets no animation frames: keep what the next drawing needs, not the whole backlog
+    if (queued.length > 2 * MAX_LOG) { queued = queued.slice(queued.length - MAX_LOG); }
+    if (queuedWalls.length > 100000) { queuedWalls.splice(0, 50000); }
+    if (!painting) {
+      painting = true;
+      setTimeout(() => requestAnimationFrame(paint), Math.max(0, lastPaint + PAINT_MS - performance.now()));
+    }
+  }
+
+  // The updates that came since the last drawing are drawn together, at most every PAINT_MS: the server pushes as
+  // often as events come (near 100 times a second for 10 agents under --trace-messages), and the browser's layout
+  // and paint of a page that changes at every frame (the event log above all) took all of its main thread.
+  function paint() {
+    painting = false;
+    lastPaint = performance.now();
+    const fresh = queued.length > MAX_LOG ? queued.slice(queued.length - MAX_LOG) : queued;
+    const walls = queuedWalls;
+    queued = [];
+    queuedWalls = [];
     draw();
     showLog(fresh);
-    const walls = data.walls;
     requestAnimationFrame(() => {
       const shown = Date.now();
       for (const w of walls) { window.alicaLatency.push(shown - w * 1000); }
