@@ -245,22 +245,42 @@
     return JSON.stringify(rest);
   }
 
+  const LOG_ROWS = 500;  // the log draws the newest rows up to the time; a long trace has tens of thousands
+
+  // The index of the first event after time t (events are in time order), by bisection.
+  function after(events, t) {
+    let lo = 0, hi = events.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >> 1;
+      if (events[mid].t > t) { hi = mid; } else { lo = mid + 1; }
+    }
+    return lo;
+  }
+
   function log(tbody, events, filter, t) {
     const text = (filter || "").trim().toLowerCase();
-    const rows = [];
-    for (const e of events) {
-      if (t != null && e.t > t) { break; }
-      const line = e.event + " " + e.agent + " " + fields(e);
-      if (text && !line.toLowerCase().includes(text)) { continue; }
+    const fragment = document.createDocumentFragment();
+    let shown = 0, i = t == null ? events.length : after(events, t);
+    while (i > 0 && shown < LOG_ROWS) {
+      const e = events[--i];
+      const rest = fields(e);
+      if (text && !(e.event + " " + e.agent + " " + rest).toLowerCase().includes(text)) { continue; }
       const tr = document.createElement("tr");
       tr.className = "past";
-      for (const v of [Number(e.t).toFixed(3), e.agent, e.event, fields(e)]) { tr.appendChild(cell(v)); }
-      rows.push(tr);
+      for (const v of [Number(e.t).toFixed(3), e.agent, e.event, rest]) { tr.appendChild(cell(v)); }
+      fragment.appendChild(tr);
+      shown += 1;
     }
-    const fragment = document.createDocumentFragment();
-    for (let i = rows.length - 1; i >= 0; i--) { fragment.appendChild(rows[i]); }
+    if (i > 0) {
+      const tr = document.createElement("tr");
+      tr.className = "more";
+      const td = cell("the newest " + LOG_ROWS + " rows are shown; narrow the filter to see older events");
+      td.colSpan = 4;
+      tr.appendChild(td);
+      fragment.appendChild(tr);
+    }
     tbody.replaceChildren(fragment);
-    tbody.dataset.shown = String(rows.length);
+    tbody.dataset.shown = String(shown);
   }
 
   // The operator's side at this moment: goals set, plans waiting for review, the plans the team runs.
