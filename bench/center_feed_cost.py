@@ -72,7 +72,9 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--seconds", type=float, default=12.0)
     args = parser.parse_args()
-    rows: dict[str, dict[str, list[float]]] = {v: {"cpu": [], "ticks": [], "overruns": [], "events": []} for v in VARIANTS}
+    rows: dict[str, dict[str, list[float]]] = {
+        v: {"cpu": [], "ticks": [], "overruns": [], "events": []} for v in VARIANTS
+    }
     for _ in range(args.repeat):
         for variant in VARIANTS:
             summaries, received = one_run(variant, args.seconds)
@@ -81,7 +83,9 @@ def main() -> None:
                 rows[variant]["ticks"].append(float(summary.get("ticks") or 0))
                 rows[variant]["overruns"].append(float(summary.get("overruns") or 0))
             rows[variant]["events"].append(received)
-    print(f"| feed ({args.repeat} runs x 3 agents, {args.seconds:g} s) | CPU % of a core | ticks | overruns | events at the center |")
+    print(
+        f"| feed ({args.repeat} runs x 3 agents, {args.seconds:g} s) | CPU % of a core | ticks | overruns | events at the center |"
+    )
     print("|---|---|---|---|---|")
     for variant, row in rows.items():
         print(

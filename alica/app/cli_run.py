@@ -450,7 +450,9 @@ class _ProcessCenter:
 
         s = self.session
         self.feed.start = self.team.start
-        hub, self.server, self.loop = start_live(self.feed, self.header, self.library, s.host, s.port, s.token, sys.stdout)
+        hub, self.server, self.loop = start_live(
+            self.feed, self.header, self.library, s.host, s.port, s.token, sys.stdout
+        )
         self.hub = hub
 
     def started(self, count: int, at: float) -> None:

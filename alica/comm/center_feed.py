@@ -31,7 +31,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
-from typing import Any
+from typing import Any, Self
 
 import zenoh
 
@@ -233,7 +233,7 @@ class CenterLink:
         finally:
             self._timer.join(timeout=2.0)
 
-    def __enter__(self) -> CenterLink:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *_: object) -> None:
