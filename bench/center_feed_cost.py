@@ -12,6 +12,9 @@ seconds at 30 Hz, in three variants, interleaved run by run:
 * ``on, center``: a :class:`alica.comm.center_feed.CenterLink` (what ``alica
   center --team`` opens) is connected from the start, so events are published.
 
+Then it times :meth:`CenterFeed.__call__` alone in this process (a typical
+``allocation`` event, 100,000 calls), with no subscriber and with one.
+
 Per variant it prints the median over runs and agents of each agent's CPU
 (percent of one core while ticking, the agent's own summary), its ticks, its
 overruns (ticks that started late), and the events the center received.
@@ -67,6 +70,44 @@ def one_run(variant: str, seconds: float) -> tuple[list[dict[str, Any]], int]:
         return [agent.summaries[-1] for agent in team.agents.values() if agent.summaries], received[0]
 
 
+def per_event(listened: bool, calls: int = 100_000) -> float:
+    """Microseconds one event costs the feed, with or without a center subscribed."""
+    import zenoh
+
+    from alica.comm.center_feed import CenterFeed
+    from alica.comm.zenoh_transport import ZenohTransport, free_endpoints, zenoh_config
+
+    endpoint = free_endpoints(1)
+    transport = ZenohTransport("a1", listen=endpoint, team="bench")
+    center = zenoh.open(zenoh_config(tuple(endpoint), (), "client", 2.0, None)) if listened else None
+    try:
+        if center is not None:
+            center.declare_subscriber("bench/center/events/*", lambda _sample: None)
+        feed = CenterFeed(transport, {"event": "trace"}, time.time())
+        deadline = time.monotonic() + 5.0
+        while listened and not feed.listened and time.monotonic() < deadline:
+            time.sleep(0.01)  # the subscriber's declaration reaches the agent
+        event = {
+            "t": 1.234567,
+            "agent": "a1",
+            "event": "allocation",
+            "key": "LunarMission/Explore/Explore",
+            "plan": "Explore",
+            "entries": {"scout": "GetMap", "stummel": "Explore"},
+            "reason": "utility",
+        }
+        began = time.perf_counter()
+        for _ in range(calls):
+            feed(event)
+        spent = (time.perf_counter() - began) / calls * 1e6
+        feed.close()
+        return spent
+    finally:
+        if center is not None:
+            center.close()
+        transport.close()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
@@ -93,6 +134,8 @@ def main() -> None:
             f"| {statistics.median(row['ticks']):.0f} | {statistics.median(row['overruns']):.0f} "
             f"| {statistics.median(row['events']):.0f} |"
         )
+    print()
+    print(f"one event: {per_event(False):.1f} us with no center, {per_event(True):.1f} us with one subscribed")
 
 
 if __name__ == "__main__":

@@ -441,6 +441,7 @@ class _ProcessCenter:
         assert header is not None
         self.session, self.team, self.header, self.library = session, team, header, library
         self.feed = TeamFeed([agent.listen for agent in team.agents.values()], "alica")
+        team.on_fault = self.feed.put  # kill -9, restarts and partitions are this process's doing
         self.server: Any = None
         self.loop: Any = None
 

@@ -39,7 +39,7 @@ def _plan_shared(e: dict[str, Any]) -> bool:
 
 
 def test_a_team_of_processes_is_shown_live_until_it_ends() -> None:
-    with live_run(*TEAM, "--processes", "--max-time", "40") as live:
+    with live_run(*TEAM, "--processes", "--crash", "r2@2.5", "--recover", "r2@3.5", "--max-time", "40") as live:
         hello = live.connect()
         assert hello["type"] == "hello" and hello["meta"]["mode"] == "live"
         assert hello["meta"]["agents"] == ["r1", "r2"]
@@ -52,6 +52,10 @@ def test_a_team_of_processes_is_shown_live_until_it_ends() -> None:
         state = live.until_state(lambda s: all(a["plans"] for a in s["agents"].values()), timeout=20)
         assert state["agents"]["r1"]["plans"][0]["plan"] == "BlocksWorldMission"
         assert "StackBlocks" in state["operator"]["running"]
+        # the kill -9 and the restart come from this process; the new r2 process's history comes again
+        live.until(lambda e: e["event"] == "fault" and e["fault"] == "crash" and e["agent"] == "r2", timeout=20)
+        live.until(lambda e: e["event"] == "fault" and e["fault"] == "recover" and e["agent"] == "r2", timeout=20)
+        live.until(lambda e: e["event"] == "note" and e["message"].startswith("a new process of r2"), timeout=20)
         # the team ends: the page shows the run's summary and stays up
         done = live.until_state(lambda s: not s["status"]["running"], timeout=30)
         summary = done["status"]["summary"]

@@ -155,7 +155,8 @@ class TeamFeed:
         t = round(self.now(), 6)
         lead = f"a new process of {name}: its history again" if again else f"{name}'s history"
         dropped = int(answer.get("dropped") or 0)
-        note = f"{lead}: {len(answer['events'])} events" + (
+        count = len(answer["events"])
+        note = f"{lead}: {count} event{'s' * (count != 1)}" + (
             f" (its first {dropped} are no longer kept)" if dropped else ""
         )
         self.put({"t": t, "agent": "-", "event": "note", "message": note})
