@@ -101,9 +101,18 @@ class CenterFeed:
             except Exception:  # (the session closed under us: the agent is stopping)
                 return
 
-    def commands(self) -> list[dict[str, Any]]:
-        """The operator's commands received since the last call, in arrival order (for the agent's thread)."""
+    def commands(self, wait: float = 0.0) -> list[dict[str, Any]]:
+        """The operator's commands received since the last call, in arrival order (for the agent's thread).
+
+        Args:
+            wait: seconds to wait for a first command when none is there (0: do not wait).
+        """
         out = []
+        if wait > 0:
+            try:
+                out.append(self._commands.get(timeout=wait))
+            except queue.Empty:
+                return out
         while True:
             try:
                 out.append(self._commands.get_nowait())
