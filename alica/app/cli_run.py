@@ -120,7 +120,7 @@ def add_parser(sub: Any) -> None:
         action="store_true",
         help="run every agent in its own process (alica agent) over zenoh on loopback, on the wall clock; "
         "--crash is then a kill -9, --recover a restart, --partition cuts the links between groups; "
-        "times are wall seconds",
+        "times are wall seconds; with --center this process serves the team's live page",
     )
     p.set_defaults(run=cmd_run)
 
