@@ -73,7 +73,7 @@ def test_a_late_center_gets_the_kept_history_then_the_new_events_once() -> None:
         try:
             for i in range(5):
                 feed({"t": float(i), "agent": "a1", "event": "tick", "i": i})
-            assert not feed.listened
+            assert not feed.listened and feed.published == 0  # nobody subscribes: nothing goes out
             histories: queue.Queue[dict[str, Any]] = queue.Queue()
             events: queue.Queue[tuple[str, dict[str, Any]]] = queue.Queue()
             with CenterLink(endpoint, "feedtest", histories.put, lambda n, e: events.put((n, e))) as link:

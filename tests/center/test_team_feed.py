@@ -19,6 +19,9 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import Any
 
+import pytest
+
+from alica.app.cli import main
 from alica.comm.zenoh_transport import free_endpoints
 from alica.io import plans_dir
 from tests.center.live_run import TOKEN, Live, live_run
@@ -220,3 +223,15 @@ def test_a_center_refuses_an_endpoint_nothing_listens_on_and_a_bad_prefix() -> N
     assert misplaced.returncode == 1 and "--key-prefix and --wait go with --team" in misplaced.stderr
     not_an_endpoint = _center_fails("--team", "localhost")
     assert not_an_endpoint.returncode == 1 and "looks like 'tcp/127.0.0.1:7447'" in not_an_endpoint.stderr
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--show-tree"], "--center shows the team in a web page; it does not go with --show-tree"),
+        (["--speed", "2"], "--speed only work in the simulated run"),
+    ],
+)
+def test_a_process_run_with_the_center_refuses_what_does_not_fit(capsys, argv, message) -> None:  # type: ignore[no-untyped-def]
+    assert main(["run", *TEAM, "--processes", "--center", "--center-port", "0", *argv]) == 1
+    assert message in capsys.readouterr().err
