@@ -16,6 +16,12 @@ With ``--json`` it prints one JSON object per line on standard output: a
 line when it stops (the agent's part of ``alica run``'s summary plus its
 transport's counters and its world model's digest).
 
+Unless ``--no-center-feed``, the agent publishes its trace events for a
+control center (``alica center --team ENDPOINT``) on zenoh, answers a late
+center's question for its history, and applies the operator's commands (a
+goal, facts, a decision on a plan proposed under ``--review``) between two
+ticks (:mod:`alica.comm.center_feed`).
+
 Exit codes: 0 the root plan succeeded, 1 it failed or is still running when
 the agent stops (time limit, Ctrl-C, SIGTERM), 2 wrong usage.
 """
@@ -112,6 +118,19 @@ def add_parser(sub: Any) -> None:
         action="store_true",
         help="MAGiC: as the leader of a planning problem, split the search over the agents in its state",
     )
+    p.add_argument(
+        "--review",
+        action="store_true",
+        help="the operator reviews every plan this agent generates as a planning problem's leader, from a control "
+        "center (alica center --team), before the team runs it",
+    )
+    p.add_argument(
+        "--no-center-feed",
+        dest="center_feed",
+        action="store_false",
+        help="do not publish this agent's events for control centers nor take the operator's commands from them "
+        "(by default it does: with no center listening it only keeps its last events in memory)",
+    )
     add_skills_option(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace")
     p.add_argument("--json", action="store_true", help="print status and summary lines as JSON")
@@ -191,7 +210,10 @@ def _run(
     roleset = pick_roleset(library, (s.role for s in specs.values()), args.roleset)
     roster = assign_roles(specs, roleset)
     config = engine_config(
-        frequency=args.frequency, planner_seconds=0.3 / args.frequency, parallel_planning=args.parallel_planning
+        frequency=args.frequency,
+        planner_seconds=0.3 / args.frequency,
+        parallel_planning=args.parallel_planning,
+        review=args.review,
     )
     header = trace_header(
         plans=[args.plan],
@@ -203,10 +225,13 @@ def _run(
         clock="wall",
     )
     trace = JsonlTrace(args.trace, header=header, line_buffered=True) if args.trace else None  # kept up to a kill -9
-    observers: tuple[Any, ...] = ()
-    if trace is not None:
-        sink = trace
-        observers = (lambda event: sink({**event, "t": round(event["t"] - start, 6)}),)  # seconds since the start
+    sinks: list[Any] = [trace] if trace is not None else []
+
+    def observe(event: dict[str, Any]) -> None:
+        record = {**event, "t": round(event["t"] - start, 6)}  # seconds since the start
+        for sink in sinks:
+            sink(record)
+
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGTERM, signal.SIGINT)}
     pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])
@@ -222,6 +247,16 @@ def _run(
         )
     except ValueError as exc:
         raise AlicaError(f"alica agent {args.name}: {exc}") from None
+    feed = None
+    if args.center_feed:
+        from alica.comm.center_feed import CenterFeed
+
+        try:
+            feed = CenterFeed(transport, header, start)
+        except BaseException:
+            transport.close()
+            raise
+        sinks.append(feed)
     fallback = default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None
     try:
         engine = AgentEngine(
@@ -236,7 +271,7 @@ def _run(
             config=config,
             skills=SkillBinder(None, wiring.registry, fallback),
             seed=args.seed,
-            observers=observers,
+            observers=(observe,) if sinks else (),
             listen_first=2 * config.broadcast_interval,
         )
         status = ["running"]
@@ -246,6 +281,9 @@ def _run(
                 _, literals_now = pending.pop(0)
                 for positive, pred, fact_args in literals_now:
                     (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
+            if feed is not None:
+                for command in feed.commands():
+                    apply_command(engine, command)
 
         world = _WorldTrace()
         engine.world_model.on_change(world.touch)
@@ -288,6 +326,8 @@ def _run(
             world_facts=[str(fact) for fact in engine.world_model.facts()],
         )
     finally:
+        if feed is not None:
+            feed.close()
         transport.close()
         for what, count in sorted(transport.errors.items()):
             print(f"alica agent {args.name}: {count} message(s) could not be decoded, from {what}", file=sys.stderr)
@@ -304,6 +344,58 @@ def _run(
             f"at {summary['path'] or '-'}"
         )
     return 0 if summary["status"] == "success" else 1
+
+
+def apply_command(engine: Any, command: dict[str, Any]) -> None:
+    """Apply one operator's command from a control center (:class:`alica.comm.center_feed.CenterFeed`) to ``engine``.
+
+    The same checks as in a simulated team (:class:`alica.engine.runner.SimulatedTeam`): a goal or a
+    decision for a planning problem the plan file does not have, or a malformed command, changes
+    nothing; the agent says why in a ``note`` event.
+
+    Commands: ``{"what": "goal", "problem", "goal"}``; ``{"what": "facts", "facts": [[positive, predicate,
+    [args]], ...]}``; ``{"what": "decision", "problem", "generation", "action", "order", "pins"}``.
+    """
+    from alica.engine import PlanDecision
+
+    what = command.get("what")
+    try:
+        if what == "goal":
+            problem, goal = command.get("problem"), command.get("goal")
+            if not isinstance(problem, str) or not isinstance(goal, str):
+                raise ValueError("a goal names its problem and its goal as text")
+            engine.set_problem(problem, goal=goal)
+        elif what == "facts":
+            facts = command.get("facts")
+            if not isinstance(facts, list):
+                raise ValueError("facts come as a list of [positive, predicate, [args]]")
+            checked = []
+            for fact in facts:
+                if (
+                    not isinstance(fact, list)
+                    or len(fact) != 3
+                    or not isinstance(fact[1], str)
+                    or not isinstance(fact[2], list)
+                ):
+                    raise ValueError(f"a fact is [positive, predicate, [args]], not {fact!r}")
+                checked.append((bool(fact[0]), fact[1], tuple(fact[2])))
+            for positive, pred, fact_args in checked:
+                (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
+        elif what == "decision":
+            problem, generation = command.get("problem"), command.get("generation")
+            if not isinstance(problem, str) or not isinstance(generation, int) or isinstance(generation, bool):
+                raise ValueError("a decision names its problem and the generation it answers")
+            order = command.get("order")
+            decision = PlanDecision(
+                command.get("action"),  # type: ignore[arg-type]  # checked by PlanDecision
+                tuple(order) if isinstance(order, list) else None,
+                command.get("pins") or {},
+            )
+            engine.decide_plan(problem, generation, decision)
+        else:
+            raise ValueError(f"no such operator's command: {what!r}")
+    except (AlicaError, ValueError, TypeError) as exc:
+        engine.emit("note", message=f"the operator's command {what!r} is refused: {exc}")
 
 
 class _WorldTrace:

@@ -120,7 +120,7 @@ def add_parser(sub: Any) -> None:
         action="store_true",
         help="run every agent in its own process (alica agent) over zenoh on loopback, on the wall clock; "
         "--crash is then a kill -9, --recover a restart, --partition cuts the links between groups; "
-        "times are wall seconds",
+        "times are wall seconds; with --center this process serves the team's live page",
     )
     p.set_defaults(run=cmd_run)
 
@@ -183,10 +183,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
     session = live_session(args)
-    if args.center and (args.processes or args.show_tree):
-        raise AlicaError(
-            "--center runs a simulated team in this process; it does not go with --processes or --show-tree"
-        )
+    if args.center and args.show_tree:
+        raise AlicaError("--center shows the team in a web page; it does not go with --show-tree")
     registry = skill_registry(args)
     library, entry = _load(args.plan, Loader(skills=registry))
     if args.name is None:
@@ -202,8 +200,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         registry, plan_skills(library, plan), world=args.world is not None, stand_ins=args.stand_ins, plan=plan
     )
     if args.processes:
-        header = _trace_header(args, library, plan, roles, None) if args.trace else None
-        return _run_processes(args, plan, list(agents), wiring, header)
+        header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
+        return _run_processes(args, plan, list(agents), wiring, header, library, session)
     with run_world(args, sorted(agents)) as (world, perception):
         return _run_team(args, library, plan, roles, wiring, world, perception, session)
 
@@ -334,9 +332,19 @@ def _run_team(
 
 
 def _run_processes(
-    args: argparse.Namespace, plan: str, names: list[str], wiring: Any, header: dict[str, Any] | None = None
+    args: argparse.Namespace,
+    plan: str,
+    names: list[str],
+    wiring: Any,
+    header: dict[str, Any] | None = None,
+    library: Any = None,
+    session: Any = None,
 ) -> int:
-    """``alica run --processes``: one ``alica agent`` per agent (:mod:`alica.app.processes`)."""
+    """``alica run --processes``: one ``alica agent`` per agent (:mod:`alica.app.processes`).
+
+    With ``--center`` (``session``), this process serves the team's live page
+    (:mod:`alica.app.center.team_feed`) from before the agents start until SIGTERM after they ended.
+    """
     import tempfile
     from pathlib import Path
 
@@ -352,6 +360,7 @@ def _run_processes(
             ("--delay", args.delay > 0),
             ("--jitter", args.jitter > 0),
             ("--trace-messages", args.trace_messages),
+            ("--speed", args.speed != 1.0),
         )
         if used
     ]
@@ -387,14 +396,23 @@ def _run_processes(
         options.append("--stand-ins")
     if args.parallel_planning:
         options.append("--parallel-planning")
+    if args.review:
+        options.append("--review")
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
         team = ProcessTeam(args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition))
+        live = _ProcessCenter(session, team, header, library) if session is not None else None
         interrupted = False
         try:
+            if live is not None:
+                live.serve()
             team.launch()
-            team.run(faults, args.max_time, on_started=_announce)
+            team.run(faults, args.max_time, on_started=live.started if live is not None else _announce)
         except KeyboardInterrupt:
             interrupted = True
+        except BaseException:
+            if live is not None:
+                live.close()
+            raise
         finally:
             team.stop()
         summary = team.summary(plan, args.seed)
@@ -407,9 +425,63 @@ def _run_processes(
         print(json.dumps(summary, indent=2, sort_keys=True))
     else:
         _print_summary(summary, args.trace)
+    if live is not None:
+        live.finish(summary)
     if interrupted:
         return 130
     return 0 if summary["success"] else 1
+
+
+class _ProcessCenter:
+    """``alica run --processes --center``: the live page of the team of processes this run started."""
+
+    def __init__(self, session: Any, team: Any, header: dict[str, Any] | None, library: Any) -> None:
+        from alica.app.center.team_feed import TeamFeed
+
+        assert header is not None
+        self.session, self.team, self.header, self.library = session, team, header, library
+        self.feed = TeamFeed([agent.listen for agent in team.agents.values()], "alica")
+        team.on_fault = self.feed.put  # kill -9, restarts and partitions are this process's doing
+        self.server: Any = None
+        self.loop: Any = None
+
+    def serve(self) -> None:
+        """Serve the page now (the team's events come once its agents are up)."""
+        from alica.app.center.team_feed import start_live
+
+        s = self.session
+        self.feed.start = self.team.start
+        hub, self.server, self.loop = start_live(
+            self.feed, self.header, self.library, s.host, s.port, s.token, sys.stdout
+        )
+        self.hub = hub
+
+    def started(self, count: int, at: float) -> None:
+        """Every agent process is up: connect to the team (the clock counts from the team's launch)."""
+        self.feed.start = self.team.start
+        _announce(count, at)
+        try:
+            self.feed.open()
+        except AlicaError as exc:
+            print(f"alica run: the control center sees no agent: {exc}", file=sys.stderr, flush=True)
+
+    def finish(self, summary: dict[str, Any]) -> None:
+        """The team ended: the page shows the summary until Ctrl-C or SIGTERM."""
+        from alica.app.center.team_feed import wait_for_stop
+
+        self.hub.finish(summary)
+        print("the run is over; the control center stays up until Ctrl-C", file=sys.stderr, flush=True)
+        try:
+            wait_for_stop()
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        if self.loop is not None:
+            self.loop.close()
+        if self.server is not None:
+            self.server.should_exit = True
+        self.feed.close()
 
 
 def _announce(count: int, at: float) -> None:

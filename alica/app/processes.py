@@ -90,6 +90,8 @@ class ProcessTeam:
         self.workdir = workdir
         self.start = time.time()
         self.faults: list[dict[str, Any]] = []
+        self.on_fault: Callable[[dict[str, Any]], None] | None = None
+        """Called with each fault's trace event as it happens (the control center's hub)."""
         self._lock = threading.Lock()
         self.relays: dict[tuple[str, str], LinkRelay] = {}
         endpoints = free_endpoints(len(names))
@@ -300,6 +302,8 @@ class ProcessTeam:
             **fields,
         }
         self.faults.append(record)
+        if self.on_fault is not None:
+            self.on_fault(dict(record))
 
     # -- results ------------------------------------------------------------------
 

@@ -258,28 +258,17 @@ class ZenohTransport(Transport):
     def _config(
         connect: tuple[str, ...], listen: tuple[str, ...], mode: str, lease: float, extra: Mapping[str, object] | None
     ) -> zenoh.Config:
-        for endpoint in (*connect, *listen):
-            if not isinstance(endpoint, str) or "/" not in endpoint:
-                raise ValueError(f"a zenoh endpoint looks like 'tcp/127.0.0.1:7447', got {endpoint!r}")
-        settings: dict[str, object] = {
-            "mode": mode,
-            "connect/endpoints": list(connect),
-            "listen/endpoints": list(listen),
-            "scouting/multicast/enabled": False,
-            "scouting/gossip/enabled": False,
-            "transport/shared_memory/enabled": False,
-            "transport/link/tx/lease": int(lease * 1000),
-            "timestamping/enabled": {"router": True, "peer": True, "client": True},
-            "connect/retry": {"period_init_ms": 100, "period_max_ms": 1000, "period_increase_factor": 2},
-        }
-        settings.update(extra or {})
-        config = zenoh.Config()
-        for key, value in settings.items():
-            try:
-                config.insert_json5(key, json.dumps(value))
-            except Exception as exc:  # (zenoh reports a bad key or value as a generic error)
-                raise ValueError(f"zenoh configuration {key} = {value!r} is not accepted: {exc}") from None
-        return config
+        return zenoh_config(connect, listen, mode, lease, extra)
+
+    @property
+    def session(self) -> Any:
+        """The zenoh session, for more keys of this agent under :attr:`team` (e.g. :class:`~alica.comm.center_feed.CenterFeed`)."""
+        return self._session
+
+    @property
+    def team(self) -> str:
+        """The team's key prefix."""
+        return self._team
 
     # ------------------------------------------------------------------ the Transport interface
 
@@ -684,6 +673,38 @@ class ZenohTransport(Transport):
     def _check_open(self, what: str) -> None:
         if self._closed:
             raise ValueError(f"transport of {self._id!r} is closed; it can no longer {what}")
+
+
+def zenoh_config(
+    connect: tuple[str, ...], listen: tuple[str, ...], mode: str, lease: float, extra: Mapping[str, object] | None
+) -> zenoh.Config:
+    """A zenoh configuration as the team's sessions use it (see the module docstring); ``extra`` goes last.
+
+    Raises:
+        ValueError: an endpoint that is not ``proto/address``, or a setting zenoh does not accept.
+    """
+    for endpoint in (*connect, *listen):
+        if not isinstance(endpoint, str) or "/" not in endpoint:
+            raise ValueError(f"a zenoh endpoint looks like 'tcp/127.0.0.1:7447', got {endpoint!r}")
+    settings: dict[str, object] = {
+        "mode": mode,
+        "connect/endpoints": list(connect),
+        "listen/endpoints": list(listen),
+        "scouting/multicast/enabled": False,
+        "scouting/gossip/enabled": False,
+        "transport/shared_memory/enabled": False,
+        "transport/link/tx/lease": int(lease * 1000),
+        "timestamping/enabled": {"router": True, "peer": True, "client": True},
+        "connect/retry": {"period_init_ms": 100, "period_max_ms": 1000, "period_increase_factor": 2},
+    }
+    settings.update(extra or {})
+    config = zenoh.Config()
+    for key, value in settings.items():
+        try:
+            config.insert_json5(key, json.dumps(value))
+        except Exception as exc:  # (zenoh reports a bad key or value as a generic error)
+            raise ValueError(f"zenoh configuration {key} = {value!r} is not accepted: {exc}") from None
+    return config
 
 
 def free_endpoints(count: int, host: str = "127.0.0.1") -> list[str]:

@@ -14,6 +14,16 @@ def _cmd_center(args: argparse.Namespace) -> int:
     from alica.app.center.server import plan_app, replay_app, serve
 
     token = args.token or secrets.token_urlsafe(24)
+    if args.team is not None:
+        from alica.app.center.team_feed import JOIN_WAIT, serve_team
+
+        wait = JOIN_WAIT if args.wait is None else args.wait
+        if not wait > 0:
+            raise AlicaError(f"--wait must be a positive number of seconds, got {args.wait}")
+        serve_team(args.team, args.key_prefix or "alica", args.host, args.port, token, wait=wait)
+        return 0
+    if args.key_prefix is not None or args.wait is not None:
+        raise AlicaError("--key-prefix and --wait go with --team (a running team of processes)")
     if args.trace is not None:
         from alica.app.center.replay import Replay
         from alica.app.center.trace_file import TraceFormatError, load_trace
@@ -107,16 +117,37 @@ def add_parser(sub: Any) -> None:
     """Register ``alica center``."""
     p = sub.add_parser(
         "center",
-        help="serve the control center: replay a trace or draw a plan file in a web page",
+        help="serve the control center: a running team of processes, a trace replay or a plan file in a web page",
         description="Serve the control center's web page on HOST:PORT and print the one line to open, "
         "http://HOST:PORT/?token=TOKEN. Every request needs the token. --trace replays a recorded trace "
         "(time slider, play at 1x-10x, next fault or replan, agents, event log, map of poses, team map and objects, "
         "blocks table, each agent's plan tree with its current states); --plan draws "
-        "the plan tree of a plan file. Stop it with Ctrl-C.",
+        "the plan tree of a plan file; --team serves the live page of a running team of processes (alica agent, alica run "
+        "--processes) reached at one agent's zenoh listen endpoint: every agent's events since its start, then as they "
+        "happen, and the operator's actions (goal, facts, decisions under --review). Without any agent of the team "
+        "answering within --wait seconds it says so on one line and exits 1. Stop it with Ctrl-C.",
     )
     what = p.add_mutually_exclusive_group(required=True)
     what.add_argument("--trace", metavar="FILE", help="a trace (JSON Lines) to replay")
     what.add_argument("--plan", metavar="FILE", help="a plan file (YAML or XML) to draw")
+    what.add_argument(
+        "--team",
+        action="append",
+        metavar="ENDPOINT",
+        help="a zenoh listen endpoint of an agent of a running team, e.g. tcp/127.0.0.1:7447 (repeatable: the "
+        "first reached is used, and the team is reached through it)",
+    )
+    p.add_argument(
+        "--key-prefix",
+        metavar="PREFIX",
+        help="with --team: the team's zenoh key prefix, as its agents' --key-prefix (default alica)",
+    )
+    p.add_argument(
+        "--wait",
+        type=float,
+        metavar="S",
+        help="with --team: seconds to wait for a first agent to answer (default 10)",
+    )
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     p.add_argument("--port", type=port_number, default=8765, help="port (default 8765; 0 picks a free one)")
     p.add_argument("--token", help="the access token (default: a new random one)")

@@ -244,7 +244,7 @@ class TeamView:
     def _operator(self, kind: str, event: Mapping[str, Any]) -> None:
         """The operator's side: proposals waiting for a decision, goals set, the plans shared."""
         if kind == "proposal" and isinstance(event.get("problem"), str):
-            fields = ("generation", "leader", "cost", "goal", "steps", "tasks", "error", "t")
+            fields: tuple[str, ...] = ("generation", "leader", "cost", "goal", "steps", "tasks", "error", "t")
             self.proposals[event["problem"]] = {k: event[k] for k in fields if k in event}
         elif kind == "operator" and isinstance(event.get("problem"), str):
             problem = event["problem"]
