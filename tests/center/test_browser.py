@@ -350,3 +350,26 @@ def test_a_replay_of_a_demo_trace_jumps_to_its_replans(replan_trace: Path) -> No
             page.wait_for_function(
                 f"Math.abs(parseFloat(document.getElementById('slider').value) - {replans[1]}) < 1e-6"
             )
+
+
+def test_the_live_page_of_a_team_of_processes_shows_its_agents_and_accepts_its_plan() -> None:
+    from playwright.sync_api import sync_playwright
+
+    _browser_or_skip()
+    facts = "on(a, b) and ontable(b) and ontable(c) and clear(a) and clear(c) and handempty(r1) and handempty(r2)@0"
+    team = [str(plans_dir() / "blocksworld" / "mission.yaml"), "--agents", "r1:Manipulator,r2:Manipulator"]
+    team += ["--stand-ins", "--fact", facts, "--processes", "--review", "--max-time", "60"]
+    with live_run(*team) as live, sync_playwright() as p:
+        browser = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1400, "height": 1000})
+            page.goto(live.url, timeout=20_000)
+            page.wait_for_selector("body[data-ready=yes]", timeout=20_000)
+            page.wait_for_selector('#agents-body tr[data-agent="r1"]', timeout=20_000)
+            page.wait_for_selector('#agents-body tr[data-agent="r2"]', timeout=20_000)
+            page.wait_for_selector(".proposal button.accept", timeout=30_000)
+            page.locator(".proposal button.accept").first.click()
+            page.wait_for_selector('#running-plan p.running[data-problem="StackBlocks"]', timeout=30_000)
+            page.screenshot(path=str(SHOTS / "live-processes.png"), full_page=True)
+        finally:
+            browser.close()
