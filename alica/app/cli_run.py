@@ -451,9 +451,7 @@ class _ProcessCenter:
 
         s = self.session
         self.feed.start = self.team.start
-        hub, self.server, self.loop = start_live(
-            self.feed, self.header, self.library, s.host, s.port, s.token, sys.stdout
-        )
+        hub, self.server, self.loop = start_live(self.feed, self.header, self.library, s.host, s.port, s.token, s.out)
         self.hub = hub
 
     def started(self, count: int, at: float) -> None:

@@ -110,7 +110,8 @@ def live_session(args: argparse.Namespace) -> Any:
         return None
     from alica.app.center.live import LiveSession
 
-    return LiveSession(args.speed, args.center_host, args.center_port, args.center_token)
+    out = sys.stderr if getattr(args, "json", False) else sys.stdout  # --json keeps standard output for the JSON
+    return LiveSession(args.speed, args.center_host, args.center_port, args.center_token, out=out)
 
 
 def add_parser(sub: Any) -> None:
