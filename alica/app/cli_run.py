@@ -465,7 +465,7 @@ class _ProcessCenter:
 
     def finish(self, summary: dict[str, Any]) -> None:
         """The team ended: the page shows the summary until Ctrl-C or SIGTERM."""
-        from alica.app.center.team_feed import wait_for_stop
+        from alica.app.center.live import wait_for_stop
 
         self.hub.finish(summary)
         print("the run is over; the control center stays up until Ctrl-C", file=sys.stderr, flush=True)

@@ -167,3 +167,23 @@ class StallingPlanner(Planner):
         while True:
             expansions += 100
             yield Progress(expansions)
+
+
+def events(recorder: Any, kind: str, **match: object) -> list[dict[str, Any]]:
+    """The recorded events of ``kind`` whose fields equal ``match``."""
+    return [e for e in recorder.events if e["event"] == kind and all(e.get(k) == v for k, v in match.items())]
+
+
+def child_plan(sim: SimulatedTeam, agent: str) -> str | None:
+    """The plan running in the first child slot of ``agent``'s root state (the planning problem's)."""
+    node = sim.engines[agent].root.slots[0].node
+    return node.plan.name if node is not None else None
+
+
+def run_until(sim: SimulatedTeam, condition: Any, max_ticks: int = 600) -> None:
+    """Tick ``sim`` until ``condition()`` holds, at most ``max_ticks`` ticks."""
+    for _ in range(max_ticks):
+        if condition():
+            return
+        sim.tick()
+    raise AssertionError("condition not reached")

@@ -8,30 +8,13 @@ from alica.engine import PlanDecision
 from alica.errors import AlicaError
 from alica.prophet import made_plans
 from alica.prophet.review import describe_proposal
-from tests.prophet.blocks_team import BlockSkills, blocks_team, goal_holds
+from tests.prophet.blocks_team import BlockSkills, blocks_team, child_plan, events, goal_holds, run_until
 
 PROBLEM = "StackBlocks"
 WORK = ("Pickup", "Unstack", "Stack", "Putdown")
 TABLE = [["a"], ["b"], ["c"], ["d"]]
 """Four blocks on the table; with the goal below one robot stacks c on d, then a on b (two independent tasks)."""
 TWO_PAIRS = "on(a, b) and on(c, d)"
-
-
-def events(recorder, kind, **match):
-    return [e for e in recorder.events if e["event"] == kind and all(e.get(k) == v for k, v in match.items())]
-
-
-def child_plan(sim, agent):
-    node = sim.engines[agent].root.slots[0].node
-    return node.plan.name if node is not None else None
-
-
-def run_until(sim, condition, max_ticks=600):
-    for _ in range(max_ticks):
-        if condition():
-            return
-        sim.tick()
-    raise AssertionError("condition not reached")
 
 
 def proposals(recorder, **match):

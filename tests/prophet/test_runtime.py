@@ -14,26 +14,9 @@ from alica.prophet import engine_config
 from alica.prophet.planners import PLANNERS
 from alica.testing import scripted
 from tests.engine.helpers import library, team, where
-from tests.prophet.blocks_team import SUSSMAN, BlockSkills, blocks_team, goal_holds
+from tests.prophet.blocks_team import SUSSMAN, BlockSkills, blocks_team, child_plan, events, goal_holds, run_until
 
 KEY = "BlocksWorldMission/Stacking/StackBlocks"
-
-
-def events(recorder, kind, **match):
-    return [e for e in recorder.events if e["event"] == kind and all(e.get(k) == v for k, v in match.items())]
-
-
-def child_plan(sim, agent):
-    node = sim.engines[agent].root.slots[0].node
-    return node.plan.name if node is not None else None
-
-
-def run_until(sim, condition, max_ticks=600):
-    for _ in range(max_ticks):
-        if condition():
-            return
-        sim.tick()
-    raise AssertionError("condition not reached")
 
 
 def test_wait_plan_while_planning_then_the_team_switches_to_the_first_plan():

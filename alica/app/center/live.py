@@ -233,16 +233,23 @@ class LiveSession:
             return
         self.hub.finish(summary)
         print("the run is over; the control center stays up until Ctrl-C", file=sys.stderr, flush=True)
-        stop = threading.Event()
-        previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
         try:
-            while not stop.wait(0.5):
-                pass
-        except KeyboardInterrupt:
-            pass
+            wait_for_stop()
         finally:
-            signal.signal(signal.SIGTERM, previous)
             self.server.should_exit = True
+
+
+def wait_for_stop() -> None:
+    """Block until SIGTERM or Ctrl-C (the page stays up meanwhile)."""
+    stop = threading.Event()
+    previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    try:
+        while not stop.wait(0.5):
+            pass
+    except KeyboardInterrupt:
+        pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def drive(

@@ -25,7 +25,6 @@ Time is seconds since the team's start, as the agents count it (the
 
 from __future__ import annotations
 
-import signal
 import sys
 import threading
 import time
@@ -33,7 +32,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, TextIO
 
-from alica.app.center.live import LiveHub
+from alica.app.center.live import LiveHub, wait_for_stop
 from alica.app.center.team_view import TeamView
 from alica.engine import PlanDecision
 from alica.errors import AlicaError
@@ -259,19 +258,6 @@ def start_live(
     feed.attach(hub)
     loop = CommandLoop(hub, RemoteTeam(feed, known if library is not None else None)).start()
     return hub, server, loop
-
-
-def wait_for_stop() -> None:
-    """Block until SIGTERM or Ctrl-C."""
-    stop = threading.Event()
-    previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    try:
-        while not stop.wait(0.5):
-            pass
-    except KeyboardInterrupt:
-        pass
-    finally:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def serve_team(

@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from alica.app.center.team_view import header_roles
 from alica.engine.trace import read_trace
 from alica.errors import TraceFormatError
 
@@ -36,14 +37,7 @@ class Trace:
     @property
     def roles(self) -> dict[str, str]:
         """Agent -> role, as the header names them (none for a version-1 trace)."""
-        agents = self.meta.get("agents")
-        if not isinstance(agents, dict):
-            return {}
-        return {
-            str(name): str(info["role"])
-            for name, info in agents.items()
-            if isinstance(info, dict) and isinstance(info.get("role"), str)
-        }
+        return header_roles(self.meta)
 
 
 def load_trace(path: str | Path) -> Trace:
