@@ -351,7 +351,8 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
 
     The same checks as in a simulated team (:class:`alica.engine.runner.SimulatedTeam`): a goal or a
     decision for a planning problem the plan file does not have, or a malformed command, changes
-    nothing; the agent says why in a ``note`` event.
+    nothing; the agent says why in a ``note`` event. A command applied goes into the agent's trace as an
+    ``operator`` event with ``applied: true`` (so a process team's merged trace holds the operator's actions).
 
     Commands: ``{"what": "goal", "problem", "goal"}``; ``{"what": "facts", "facts": [[positive, predicate,
     [args]], ...]}``; ``{"what": "decision", "problem", "generation", "action", "order", "pins"}``.
@@ -365,6 +366,7 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
             if not isinstance(problem, str) or not isinstance(goal, str):
                 raise ValueError("a goal names its problem and its goal as text")
             engine.set_problem(problem, goal=goal)
+            engine.emit("operator", what="goal", problem=problem, goal=goal, applied=True)
         elif what == "facts":
             facts = command.get("facts")
             if not isinstance(facts, list):
@@ -381,6 +383,8 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
                 checked.append((bool(fact[0]), fact[1], tuple(fact[2])))
             for positive, pred, fact_args in checked:
                 (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
+            texts = [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in checked]
+            engine.emit("operator", what="facts", facts=texts, applied=True)
         elif what == "decision":
             problem, generation = command.get("problem"), command.get("generation")
             if not isinstance(problem, str) or not isinstance(generation, int) or isinstance(generation, bool):
@@ -392,6 +396,9 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
                 command.get("pins") or {},
             )
             engine.decide_plan(problem, generation, decision)
+            described = decision.describe()
+            what_done = described.pop("action")
+            engine.emit("operator", what=what_done, problem=problem, generation=generation, applied=True, **described)
         else:
             raise ValueError(f"no such operator's command: {what!r}")
     except (AlicaError, ValueError, TypeError) as exc:

@@ -44,6 +44,36 @@ def test_an_agent_applies_a_goal_facts_and_a_decision() -> None:
     apply_command(engine, {**pins, "pins": {"T0": "r1"}})
     assert engine.decisions["StackBlocks"][-1] == (3, PlanDecision("modify", (1, 0), {"T0": "r1"}))
     assert not [e for e in events if e["event"] == "note"]
+    applied = [{k: v for k, v in e.items() if k != "t"} for e in events if e["event"] == "operator"]
+    assert applied == [  # the agent's trace holds what it applied
+        {
+            "agent": "r1",
+            "event": "operator",
+            "what": "goal",
+            "problem": "StackBlocks",
+            "goal": "on(c, a)",
+            "applied": True,
+        },
+        {"agent": "r1", "event": "operator", "what": "facts", "facts": ["checked(a)", "not clear(b)"], "applied": True},
+        {
+            "agent": "r1",
+            "event": "operator",
+            "what": "accept",
+            "problem": "StackBlocks",
+            "generation": 2,
+            "applied": True,
+        },
+        {
+            "agent": "r1",
+            "event": "operator",
+            "what": "modify",
+            "problem": "StackBlocks",
+            "generation": 3,
+            "applied": True,
+            "order": [1, 0],
+            "pins": {"T0": "r1"},
+        },
+    ]
 
 
 def test_an_agent_refuses_what_it_cannot_apply_with_a_note() -> None:
@@ -64,6 +94,7 @@ def test_an_agent_refuses_what_it_cannot_apply_with_a_note() -> None:
     assert "'maybe'" in notes[2]
     assert "no such operator's command: 'reboot'" in notes[5]
     assert engine.overrides == {} and engine.decisions == {}
+    assert not [e for e in events if e["event"] == "operator"]
 
 
 def test_a_late_center_gets_the_kept_history_then_the_new_events_once() -> None:
