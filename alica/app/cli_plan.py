@@ -132,6 +132,8 @@ def _megabytes(text: str) -> float:
 
 def cmd_plan(args: argparse.Namespace) -> int:
     """Run ``alica plan``; returns the exit code."""
+    from alica.prophet.pddl import PddlError
+
     start = time.monotonic()
     limits = Limits(args.time_limit, args.memory_limit)
     if args.planner is None and Path(args.domain).suffix.lower() not in PLAN_FILE_SUFFIXES:
@@ -142,6 +144,23 @@ def cmd_plan(args: argparse.Namespace) -> int:
         planner = args.planner or "builtin"
         result = PlanResult(exc.status, None, planner, None, time.monotonic() - start, 0, str(exc))
         return _report(args, planner, result, lambda plan: plan.cost)
+    except PddlError as exc:  # found while grounding: FILE:LINE:COL: error: ... when it has a place
+        return _refuse(args, exc)
+    except AlicaError as exc:
+        if not args.json:
+            raise
+        return _refuse(args, exc)
+
+
+def _refuse(args: argparse.Namespace, exc: Exception) -> int:
+    """An input the planner refuses: the message on standard error; with --json also ``{"solved": false, "error"}``."""
+    from alica.prophet.pddl import PddlError
+
+    text = str(exc)
+    if args.json:
+        print(json.dumps({"solved": False, "error": text}))
+    print(text if isinstance(exc, PddlError) else f"alica: error: {text}", file=sys.stderr)
+    return EXIT_ERROR
 
 
 def _plan(args: argparse.Namespace, limits: Limits) -> int:
@@ -162,8 +181,7 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
         domain = read_domain(args.domain, limits)
         problem = read_problem(args.problem, domain, limits)
     except PddlError as exc:
-        print(str(exc), file=sys.stderr)
-        return EXIT_ERROR
+        return _refuse(args, exc)
     planner = get_planner(args.planner)
     if getattr(planner, "reads_files", False):
         _check_features(planner, domain, problem)
@@ -193,8 +211,7 @@ def _plan_parallel(args: argparse.Namespace, limits: Limits) -> int:
             memory_mb=args.memory_limit,
         )
     except PddlError as exc:
-        print(str(exc), file=sys.stderr)
-        return EXIT_ERROR
+        return _refuse(args, exc)
     message = "" if run.outcome is None else run.outcome.message
     if run.outcome is None:
         message = f"time limit {args.time_limit:g} s reached before the round ended"

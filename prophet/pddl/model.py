@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from alica.prophet.planner import Feature
+from alica.source import SourceSpan
 
 OBJECT = "object"
 """The root type."""
@@ -143,12 +144,14 @@ class Action:
         parameters: typed parameters, in order.
         precondition: a formula (``And(())`` when absent).
         effect: an effect tree (``And(())`` when absent).
+        span: where ``(:action`` is in its file (for errors found after reading; not part of equality).
     """
 
     name: str
     parameters: tuple[TypedName, ...]
     precondition: Formula = And(())
     effect: Effect = And(())
+    span: SourceSpan | None = field(default=None, compare=False)
 
     @property
     def cost(self) -> int | float | FluentTerm | None:

@@ -38,6 +38,12 @@ ObjectsOf = Callable[[str], list[str]]
 """The objects of a type (subtypes included)."""
 
 MAX_CLAUSES = 4096
+TOO_MANY = (
+    f"unsupported construct: the formula expands into more than {MAX_CLAUSES} disjuncts "
+    "(an 'or' or 'exists' inside a 'forall', or a negated 'and'); the builtin planner does not compile these "
+    "into derived predicates yet"
+)
+TOO_MANY_HINT = "plan this domain with --planner fd (Fast Downward), or split the disjunction into separate actions"
 """The most conjunctions a formula may expand into."""
 
 
@@ -133,9 +139,9 @@ def _dnf(formula: Formula, positive: bool) -> tuple[Clause, ...]:
             for branch in branches:
                 out = tuple(a + b for a in out for b in branch)
                 if len(out) > MAX_CLAUSES:
-                    raise PddlError(f"a formula expands into more than {MAX_CLAUSES} disjuncts; simplify it")
+                    raise PddlError(TOO_MANY)
         if len(out) > MAX_CLAUSES:
-            raise PddlError(f"a formula expands into more than {MAX_CLAUSES} disjuncts; simplify it")
+            raise PddlError(TOO_MANY)
         return out
     raise TypeError(f"not a quantifier-free formula: {formula!r}")
 

@@ -247,7 +247,7 @@ def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
             precondition = _empty_or(value, lambda v, scope=dict(parameters): reader.formula(v, scope))
         else:
             effect = _empty_or(value, lambda v, scope=dict(parameters): reader.effect(v, scope))
-    return Action(name, parameters, precondition, effect)
+    return Action(name, parameters, precondition, effect, span=source.span(section.offset))
 
 
 def _empty_or(node: Node, read):  # type: ignore[no-untyped-def]

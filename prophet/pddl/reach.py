@@ -24,7 +24,7 @@ from operator import itemgetter
 
 from alica.prophet.pddl.errors import PddlError
 from alica.prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
-from alica.prophet.pddl.normal import Clause, dnf, expand, flatten_effect
+from alica.prophet.pddl.normal import TOO_MANY, TOO_MANY_HINT, Clause, dnf, expand, flatten_effect
 from alica.prophet.planner import Limits
 
 CHECK_EVERY = 4096
@@ -147,7 +147,16 @@ class Fixpoint:
         self.has_costs = any(costs for _, costs in flat.values())
         self._schemas: list[_Schema] = []
         for action in domain.actions:
-            for clause in dnf(expand(action.precondition, self.objects_of)):
+            try:
+                clauses = dnf(expand(action.precondition, self.objects_of))
+            except PddlError as exc:
+                if exc.span is not None:
+                    raise
+                hint = TOO_MANY_HINT if exc.message == TOO_MANY else ""
+                raise PddlError(
+                    f"the precondition of action '{action.name}': {exc.message}", action.span, hint
+                ) from None
+            for clause in clauses:
                 schema = self._schema(action.name, action.parameters, clause, *flat[action.name])
                 if schema is not None:
                     self._schemas.append(schema)

@@ -14,7 +14,9 @@ from dataclasses import dataclass, field
 from alica.prophet.pddl.errors import PddlError
 from alica.source import SourceSpan
 
-_TOKEN = re.compile(r"[()]|;[^\n]*|[^\s();]+")
+_TOKEN = re.compile(r"[()]|;[^\n]*|\??[^\s();?]+|\?")
+"""A parenthesis, a comment, or a word; a ``?`` always starts a new word, as Fast Downward reads it
+(``(aircraft?a)`` is ``aircraft`` and ``?a``)."""
 
 SECTIONS = frozenset(
     {

@@ -127,7 +127,8 @@ def test_an_invalid_plan_from_a_back_end_is_an_error(alica, blocks, monkeypatch:
 def test_a_failing_back_end_is_an_error(alica, blocks, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(planners, "get_planner", lambda name: _Scripted(None, PlanStatus.ERROR, "it broke"))
     run = alica("plan", *blocks("4-0"), "--json")
-    assert run.code == 1 and run.out == ""
+    assert run.code == 1
+    assert json.loads(run.out) == {"solved": False, "error": "planner 'scripted' failed: it broke"}
     assert "planner 'scripted' failed: it broke" in run.err
 
 
