@@ -238,7 +238,6 @@ def _run_team(
     perception: Any,
     session: Any = None,
 ) -> int:
-    from alica.app.center.live import drive
     from alica.app.trace_world import WorldTrace, team_grid, tee
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
     from alica.lang import literals
@@ -303,11 +302,12 @@ def _run_team(
     for text in args.fact:
         what, at, _ = _timed("--fact", text)
         team.set_facts(literals(what), at=at)
+    if session is not None:  # the operator's actions run and the wall clock catches up between two ticks
+        session.pace(team)
+        team.after_tick(lambda now: session.pace(team))
     try:
         if args.show_tree:
             _run_showing(team, args, changed, running_tree)
-        elif session is not None:
-            drive(team, session, ticks=args.ticks, until_done=args.ticks is None, max_time=args.max_time)
         elif args.ticks is not None:
             team.run(ticks=args.ticks)
         else:

@@ -109,31 +109,46 @@ class Live:
         return self.state
 
 
+ADDRESS = re.compile(r"http://127\.0\.0\.1:(\d+)/\?token=(\S+)")
+"""The one line a control center prints to open."""
+
+
+def stop(process: subprocess.Popen[str]) -> None:
+    """SIGTERM, then kill if the process is not gone within 20 s."""
+    process.terminate()
+    try:
+        process.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait(timeout=20)
+
+
+@contextmanager
+def serving(argv: list[str], stream: str = "stdout") -> Iterator[tuple[str, subprocess.Popen[str]]]:
+    """Start ``alica ARGV`` in a process, read its address line from ``stream``, and stop it afterwards."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "alica.app.cli", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    try:
+        source = process.stdout if stream == "stdout" else process.stderr
+        assert source is not None
+        line = source.readline().strip()
+        if not ADDRESS.fullmatch(line):
+            process.kill()
+            _, err = process.communicate(timeout=20)
+            raise AssertionError(f"no address line, got {line!r}; stderr: {(err or '')[-2000:]}")
+        yield line, process
+    finally:
+        stop(process)
+
+
 @contextmanager
 def live_run(*args: str, command: str = "run") -> Iterator[Live]:
     """Start ``alica COMMAND ARGS --center`` on a free port and stop it afterwards (SIGTERM, then kill)."""
-    process = subprocess.Popen(
-        [sys.executable, "-m", "alica.app.cli", command, *args, "--center", "--center-port", "0"]
-        + ["--center-token", TOKEN],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    live = Live("", process)
-    try:
-        assert process.stdout is not None
-        line = process.stdout.readline().strip()
-        if not re.fullmatch(r"http://127\.0\.0\.1:\d+/\?token=\S+", line):
-            process.kill()
-            _, err = process.communicate(timeout=20)
-            raise AssertionError(f"no address line, got {line!r}; stderr: {err[-2000:]}")
-        live.url = line
-        yield live
-    finally:
-        live.stack.close()
-        process.terminate()
+    argv = [command, *args, "--center", "--center-port", "0", "--center-token", TOKEN]
+    with serving(argv) as (line, process):
+        live = Live(line, process)
         try:
-            process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=20)
+            yield live
+        finally:
+            live.stack.close()

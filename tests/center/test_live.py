@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.center.live_run import BLOCKS, TOKEN, live_run
+from tests.center.live_run import BLOCKS, TOKEN, live_run, serving
 
 
 def _proposal(generation: int, error: bool = False):  # type: ignore[no-untyped-def]
@@ -134,18 +134,9 @@ def test_a_demo_serves_its_run_live_and_the_page_shows_the_end() -> None:
 
 def test_with_json_the_address_goes_to_standard_error_and_standard_output_stays_json() -> None:
     import json
-    import re
-    import subprocess
-    import sys
 
-    command = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", "1", "--blocks", "2"]
-    command += ["--seed", "1", "--speed", "50", "--json", "--center", "--center-port", "0"]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        assert process.stderr is not None and process.stdout is not None
-        assert re.fullmatch(r"http://127\.0\.0\.1:\d+/\?token=\S+", process.stderr.readline().strip())
+    argv = ["demo", "blocksworld", "--agents", "1", "--blocks", "2", "--seed", "1", "--speed", "50", "--json"]
+    with serving([*argv, "--center", "--center-port", "0"], stream="stderr") as (_, process):
+        assert process.stdout is not None
         summary = json.loads(process.stdout.readline())  # the run's JSON line, written when the run ends
         assert summary["success"] is True
-    finally:
-        process.terminate()
-        process.wait(timeout=20)

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 import re
-import subprocess
-import sys
 import urllib.request
 from pathlib import Path
 
@@ -19,6 +17,7 @@ from alica.app.center.trace_file import load_trace
 from alica.io import plans_dir
 
 from .conftest import TOKEN
+from .live_run import serving
 
 
 def _client(trace: Path) -> TestClient:
@@ -153,15 +152,7 @@ def test_the_plan_view_draws_a_plan_file(file: str, root: str | None, expected: 
 
 
 def test_the_start_up_line_names_the_real_port_and_the_page_loads(recorded_trace: Path) -> None:
-    process = subprocess.Popen(
-        [sys.executable, "-m", "alica.app.cli", "center", "--trace", str(recorded_trace), "--port", "0"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert process.stdout is not None
-        line = process.stdout.readline().strip()
+    with serving(["center", "--trace", str(recorded_trace), "--port", "0"]) as (line, _):
         match = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=([A-Za-z0-9_-]{20,})", line)
         assert match, line
         assert int(match.group(1)) > 0
@@ -171,13 +162,6 @@ def test_the_start_up_line_names_the_real_port_and_the_page_loads(recorded_trace
         with pytest.raises(urllib.error.HTTPError) as refused:
             urllib.request.urlopen(f"http://127.0.0.1:{match.group(1)}/api/meta", timeout=10)
         assert refused.value.code == 403
-    finally:
-        process.terminate()
-        try:
-            process.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=10)
 
 
 def test_a_blocks_world_demo_trace_replays(tmp_path: Path) -> None:

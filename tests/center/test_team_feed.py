@@ -24,7 +24,7 @@ import pytest
 from alica.app.cli import main
 from alica.comm.zenoh_transport import free_endpoints
 from alica.io import plans_dir
-from tests.center.live_run import TOKEN, Live, live_run
+from tests.center.live_run import TOKEN, Live, live_run, stop
 
 PLAN = str(plans_dir() / "blocksworld" / "mission.yaml")
 FACTS = "on(a, b) and ontable(b) and ontable(c) and clear(a) and clear(c) and handempty(r1) and handempty(r2)@0"
@@ -107,15 +107,6 @@ class _Lines:
             raise AssertionError(f"no line within {timeout} s") from None
 
 
-def _stop(process: subprocess.Popen[str]) -> None:
-    process.terminate()
-    try:
-        process.wait(timeout=15)
-    except subprocess.TimeoutExpired:
-        process.kill()
-        process.wait(timeout=15)
-
-
 @contextmanager
 def _agents(*extra: str) -> Iterator[list[str]]:
     """Two ``alica agent`` processes (r2 connects to r1) under --review: they wait for the operator; their endpoints."""
@@ -136,7 +127,7 @@ def _agents(*extra: str) -> Iterator[list[str]]:
         yield endpoints
     finally:
         for process in processes:
-            _stop(process)
+            stop(process)
 
 
 @contextmanager
@@ -157,7 +148,7 @@ def _center(*argv: str) -> Iterator[Live]:
         finally:
             live.stack.close()
     finally:
-        _stop(process)
+        stop(process)
 
 
 def test_a_center_that_joins_late_gets_the_history_and_decides() -> None:

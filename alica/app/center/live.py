@@ -1,15 +1,15 @@
 """The control center's live mode: a running simulated team's events, shared with the web server.
 
 The team runs on the main thread in simulated time, paced to the wall clock
-(:func:`drive`); the web server runs in a thread of its own with its event
-loop (:func:`start`). :class:`LiveHub` sits between them:
+(:meth:`LiveSession.pace` after every tick); the web server runs in a thread of its own with its event
+loop (:meth:`LiveSession.start`). :class:`LiveHub` sits between them:
 
 * it is one of the team's observers: every trace event is copied, stamped
   with the wall time it happened at, folded into the team's view (the same
   fold a replay uses, :class:`~alica.app.center.team_view.TeamView`) and
   handed to the server's listeners;
 * the operator's actions (a goal, facts, a decision on a proposed plan) are
-  callables queued by the server and run by :func:`drive` on the team's
+  callables queued by the server and run by :meth:`LiveSession.pace` on the team's
   thread between two ticks, so the team is never touched from two threads.
 """
 
@@ -67,7 +67,7 @@ class LiveHub:
         self._lock = threading.Lock()
         self._listeners: set[Listener] = set()
         self._commands: queue.Queue[tuple[Command, concurrent.futures.Future[Any]]] = queue.Queue()
-        self._snapshot: tuple[int, float, str] = (-1, -1.0, "")
+        self._snapshot: tuple[tuple[int, float, bool], str] = ((-1, -1.0, True), "")
         self._clock_told = -math.inf
 
     # -- the team's side -------------------------------------------------
@@ -147,13 +147,13 @@ class LiveHub:
     def snapshot_json(self) -> str:
         """The team's state now as JSON (computed once per change, shared by every page)."""
         with self._lock:
-            count, t = len(self.events), float(self.status["t"])
-            if self._snapshot[:2] != (count, t) or not self.status["running"]:
+            key = (len(self.events), float(self.status["t"]), bool(self.status["running"]))
+            if self._snapshot[0] != key:
                 state = self.view.snapshot()
-                state["t"] = max(float(state.get("t") or 0.0), t)
+                state["t"] = max(float(state.get("t") or 0.0), key[1])
                 state["status"] = dict(self.status)
-                self._snapshot = (count, t, json.dumps(state))
-            return self._snapshot[2]
+                self._snapshot = (key, json.dumps(state))
+            return self._snapshot[1]
 
     def _wake(self, force: bool = False) -> None:
         with self._lock:
@@ -250,27 +250,3 @@ def wait_for_stop() -> None:
         pass
     finally:
         signal.signal(signal.SIGTERM, previous)
-
-
-def drive(
-    team: Any,
-    session: LiveSession,
-    *,
-    ticks: int | None = None,
-    max_time: float | None = None,
-    until_done: bool = True,
-) -> None:
-    """Run ``team`` like :meth:`SimulatedTeam.run`, at the session's pace, the operator's actions between ticks."""
-    limit = max_time if max_time is not None else float("inf")
-    count = 0
-    session.pace(team)
-    while True:
-        if ticks is not None and count >= ticks:
-            break
-        if until_done and team.done():
-            break
-        if team.now() >= limit:
-            break
-        team.tick()
-        count += 1
-        session.pace(team)
