@@ -55,7 +55,7 @@ from dataclasses import dataclass, field, replace
 from enum import Enum
 
 from alica.errors import PlannerError
-from alica.lang import literals
+from alica.lang import literal_text, literals
 from alica.lang.fact import Fact
 from alica.model import (
     Binding,
@@ -380,10 +380,7 @@ def step_token(plan: str, index: int) -> str:
 
 def conjunction(literal_set: Iterable[Literal]) -> str:
     """Ground literals as a formula: ``on(a, b) and not clear(c)``."""
-    return " and ".join(
-        ("" if positive else "not ") + (f"{name}({', '.join(str(a) for a in args)})" if args else name)
-        for positive, (name, args) in literal_set
-    )
+    return " and ".join(literal_text(positive, name, args) for positive, (name, args) in literal_set)
 
 
 def _condition(pre: Sequence[Literal], robot: str, after: Sequence[str] = ()) -> Condition | None:

@@ -358,6 +358,7 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
     [args]], ...]}``; ``{"what": "decision", "problem", "generation", "action", "order", "pins"}``.
     """
     from alica.engine import PlanDecision
+    from alica.lang import literal_text
 
     what = command.get("what")
     try:
@@ -383,7 +384,7 @@ def apply_command(engine: Any, command: dict[str, Any]) -> None:
                 checked.append((bool(fact[0]), fact[1], tuple(fact[2])))
             for positive, pred, fact_args in checked:
                 (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
-            texts = [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in checked]
+            texts = [literal_text(p, n, a) for p, n, a in checked]
             engine.emit("operator", what="facts", facts=texts, applied=True)
         elif what == "decision":
             problem, generation = command.get("problem"), command.get("generation")

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 from alica.allocation import AgentSpec, assign_roles
@@ -23,7 +23,7 @@ from alica.engine.child import PlanDecision
 from alica.engine.config import EngineConfig
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError
-from alica.lang import Registry
+from alica.lang import Registry, literal_text
 from alica.lang.skills import SkillRegistry
 from alica.model import PlanLibrary, RoleSet
 from alica.worldmodel import WorldModel
@@ -103,8 +103,6 @@ class SimulatedTeam:
             robots sense into their world models.
         step_world: whether :meth:`tick` steps the world (``False`` when a caller
             runs several teams in one world and steps it itself).
-        review: the operator reviews every generated plan before the team runs it
-            (sets ``review`` in the engines' config; see :meth:`decide_plan`).
     """
 
     def __init__(
@@ -128,7 +126,6 @@ class SimulatedTeam:
         world: Any = None,
         perception: Callable[[SimulatedTeam], None] | None = None,
         step_world: bool = True,
-        review: bool = False,
     ) -> None:
         if not agents:
             raise AlicaError("a team needs at least one agent")
@@ -141,8 +138,6 @@ class SimulatedTeam:
         self.plan = plan
         self.seed = seed
         self.config = config or EngineConfig()
-        if review:
-            self.config = replace(self.config, review=True)
         self.roleset = pick_roleset(library, (s.role for s in specs.values()), roleset)
         self.roles = assign_roles(specs, self.roleset)
         self.world = world
@@ -338,7 +333,7 @@ class SimulatedTeam:
                 continue
             for positive, pred, args in facts:
                 (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *args)
-        texts = [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts]
+        texts = [literal_text(p, n, a) for p, n, a in facts]
         if by_operator:
             self._operator("facts", facts=texts)
             return

@@ -66,7 +66,7 @@ from alica.lang.prelude import default_registry
 from alica.lang.registry import Entry, Registry
 from alica.lang.unparse import unparse
 from alica.lang.vocabulary import ENGINE_FACTS, ENGINE_VARIABLES, Symbol, Vocabulary, default_vocabulary
-from alica.lang.walk import atoms, calls, free_names, literals, walk
+from alica.lang.walk import atoms, calls, free_names, literal_text, literals, walk
 
 __all__ = [
     "ENGINE_FACTS",
@@ -102,6 +102,7 @@ __all__ = [
     "evaluate",
     "free_names",
     "holds",
+    "literal_text",
     "literals",
     "parse",
     "unparse",

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 
 from alica.errors import FormulaError
 from alica.lang.ast import (
@@ -145,6 +145,13 @@ def literals(node_or_text: Node | str, *, text: str = "") -> list[Literal]:
     """
     node, text = _prepare(node_or_text, text)
     return [_literal(item, text)[2] for item in _conjuncts(node)]
+
+
+def literal_text(positive: bool, name: str, args: Iterable[object] = ()) -> str:
+    """A literal written back as formula text: ``on(a, b)``, ``not clear(c)``, ``start``."""
+    shown = tuple(args)
+    atom = f"{name}({', '.join(map(str, shown))})" if shown else name
+    return atom if positive else f"not {atom}"
 
 
 def atoms(node_or_text: Node | str, *, text: str = "") -> list[Node]:

@@ -9,13 +9,13 @@ decision on a proposed plan names the generation it answers.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from typing import Any
 
 from alica.errors import AlicaError, FormulaError, PlannerError
 from alica.lang.ast import Call, Name
 from alica.lang.parser import parse
-from alica.lang.walk import atoms, literals
+from alica.lang.walk import atoms, literal_text, literals
 from alica.model import PlanLibrary
 
 DECISIONS = ("accept", "decline", "modify")
@@ -74,11 +74,7 @@ def check_goal(known: Mapping[str, dict[str, Any]], problem: str, text: str) -> 
                 "column": column,
                 "hint": "",
             }
-    return {"ok": True, "literals": [("" if p else "not ") + _atom(n, a) for p, n, a in found]}
-
-
-def _atom(name: str, args: Sequence[object]) -> str:
-    return f"{name}({', '.join(map(str, args))})" if args else name
+    return {"ok": True, "literals": [literal_text(p, n, a) for p, n, a in found]}
 
 
 def check_facts(text: str) -> dict[str, Any]:
@@ -89,7 +85,7 @@ def check_facts(text: str) -> dict[str, Any]:
         found = literals(text)
     except FormulaError as exc:
         return _error(exc)
-    return {"ok": True, "literals": [("" if p else "not ") + _atom(n, a) for p, n, a in found]}
+    return {"ok": True, "literals": [literal_text(p, n, a) for p, n, a in found]}
 
 
 def decision(body: Mapping[str, Any]) -> tuple[str, int, str, tuple[int, ...] | None, dict[str, str]]:

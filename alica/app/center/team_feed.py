@@ -36,6 +36,7 @@ from alica.app.center.live import LiveHub, wait_for_stop
 from alica.app.center.team_view import TeamView
 from alica.engine import PlanDecision
 from alica.errors import AlicaError
+from alica.lang.walk import literal_text
 
 TICK = 0.1
 """Wall seconds between two turns of the loop that runs the operator's actions and moves the clock on."""
@@ -44,7 +45,7 @@ JOIN_WAIT = 10.0
 
 
 def _texts(facts: Iterable[tuple[bool, str, tuple[object, ...]]]) -> list[str]:
-    return [("" if p else "not ") + (f"{n}({', '.join(map(str, a))})" if a else n) for p, n, a in facts]
+    return [literal_text(p, n, a) for p, n, a in facts]
 
 
 class RemoteTeam:

@@ -29,10 +29,11 @@ def survey_team(skills: BlockSkills, agents=("r1", "r2"), seed: int = 0, review:
         "SurveyMission",
         dict.fromkeys(agents, "Surveyor"),
         seed=seed,
-        config=engine_config(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3),
+        config=engine_config(
+            frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3, review=review
+        ),
         skills={name: skills.factory(name) for name in SKILLS},
         observers=[recorder],
-        review=review,
     )
     sim.set_facts([(True, "at", (agent, "base")) for agent in agents])
     for engine in sim.engines.values():
