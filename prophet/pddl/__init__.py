@@ -30,6 +30,7 @@ from alica.prophet.pddl.model import (
     Problem,
     TypedName,
     When,
+    either,
 )
 from alica.prophet.pddl.parser import SUPPORTED_REQUIREMENTS, parse_domain, parse_problem, read_domain, read_problem
 from alica.prophet.pddl.writer import write_domain, write_formula, write_problem
@@ -58,6 +59,7 @@ __all__ = [
     "Problem",
     "TypedName",
     "When",
+    "either",
     "parse_domain",
     "parse_problem",
     "read_domain",

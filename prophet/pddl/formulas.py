@@ -22,6 +22,7 @@ from alica.prophet.pddl.model import (
     Predicate,
     TypedName,
     When,
+    either,
 )
 from alica.prophet.pddl.sexpr import Node, SList, Source, Symbol
 from alica.prophet.planner import Feature
@@ -81,7 +82,7 @@ def expect_list(source: Source, node: Node, what: str) -> SList:
 
 
 def parse_typed_list(
-    source: Source, items: tuple[Node, ...], *, variables: bool, types: dict[str, str] | None, what: str
+    source: Source, items: tuple[Node, ...], *, variables: bool, types: dict[str, tuple[str, ...]] | None, what: str
 ) -> list[tuple[TypedName, int]]:
     """``a b - t c`` as ``[((a, t), offset), ((b, t), ...), ((c, object), ...)]``.
 
@@ -89,11 +90,12 @@ def parse_typed_list(
         source: the text, for error places.
         items: the list's items.
         variables: whether the names are variables (``?x``).
-        types: known types (child -> parent), or None to accept any type (the ``:types`` list itself).
+        types: known types (child -> parents), or None to accept any type (the ``:types`` list itself).
         what: what the names are, for messages.
 
     Raises:
-        PddlError: a bad name, a missing or unknown type, or ``either`` types.
+        PddlError: a bad name, a missing or unknown type, or ``(either ...)`` where it has no meaning
+            (the type list itself, objects and constants).
     """
     out: list[tuple[TypedName, int]] = []
     pending: list[tuple[str, int]] = []
@@ -105,12 +107,9 @@ def parse_typed_list(
                 raise source.error(item.offset, f"expected a type after '-' in the {what}")
             type_node = items[index + 1]
             if isinstance(type_node, SList):
-                raise source.error(
-                    type_node.offset, "unsupported construct '(either ...)' types", "declare a common supertype"
-                )
-            type_name = expect_name(source, type_node, "a type name")
-            if types is not None and type_name != OBJECT and type_name not in types:
-                raise source.error(type_node.offset, f"unknown type '{type_name}'", "declare it in (:types ...)")
+                type_name = _either(source, type_node, variables=variables, types=types, what=what)
+            else:
+                type_name = _known_type(source, type_node, types)
             if not pending:
                 raise source.error(item.offset, f"expected names before '- {type_name}' in the {what}")
             out.extend(((name, type_name), offset) for name, offset in pending)
@@ -127,6 +126,42 @@ def parse_typed_list(
         index += 1
     out.extend(((name, OBJECT), offset) for name, offset in pending)
     return out
+
+
+def _known_type(source: Source, node: Node, types: dict[str, tuple[str, ...]] | None) -> str:
+    """A type name, checked against the declared ``types`` (unless None)."""
+    name = expect_name(source, node, "a type name")
+    if types is not None and name != OBJECT and name not in types:
+        raise source.error(node.offset, f"unknown type '{name}'", "declare it in (:types ...)")
+    return name
+
+
+def _either(
+    source: Source, node: SList, *, variables: bool, types: dict[str, tuple[str, ...]] | None, what: str
+) -> str:
+    """``(either t1 t2 ...)`` after ``-``: the :func:`~alica.prophet.pddl.model.either` type name."""
+    if not node.items or not isinstance(node.items[0], Symbol) or node.items[0].text.lower() != "either":
+        raise source.error(node.offset, f"expected a type name or '(either type ...)' in the {what}")
+    if types is None:
+        raise source.error(
+            node.offset,
+            "'(either ...)' in the type list",
+            "declare the type once under each parent instead, as 'area - object' and 'area - surface'",
+        )
+    if not variables:
+        raise source.error(
+            node.offset,
+            f"'(either ...)' in the {what}: an object or constant has one type",
+            "give it one type, or declare a type below each of the types and use that",
+        )
+    if len(node.items) < 2:
+        raise source.error(node.offset, "expected at least one type in '(either ...)'")
+    members = []
+    for item in node.items[1:]:
+        if isinstance(item, SList):
+            raise source.error(item.offset, "expected a type name in '(either ...)', found a list")
+        members.append(_known_type(source, item, types))
+    return either(members)
 
 
 @dataclass(slots=True)
@@ -147,7 +182,7 @@ class FormulaReader:
     predicates: dict[str, Predicate]
     functions: dict[str, Predicate]
     objects: dict[str, str]
-    types: dict[str, str] | None
+    types: dict[str, tuple[str, ...]] | None
     strict: bool = True
     used: set[Feature] = field(default_factory=set)
 

@@ -15,7 +15,31 @@ OBJECT = "object"
 """The root type."""
 
 TypedName = tuple[str, str]
-"""A ``(name, type)`` pair: a parameter, variable, constant or object."""
+"""A ``(name, type)`` pair: a parameter, variable, constant or object.
+
+A variable's type may be ``(either t1 t2 ...)`` (see :func:`either`): then it stands for an
+object of any of those types."""
+
+
+def either(members: list[str] | tuple[str, ...]) -> str:
+    """The name of the type ``(either m1 m2 ...)``: members sorted, repeats dropped, ``object`` absorbs all.
+
+    >>> either(["crate", "storearea", "crate"])
+    '(either crate storearea)'
+    >>> either(["area"])
+    'area'
+    """
+    unique = sorted(set(members))
+    if OBJECT in unique:
+        return OBJECT
+    return unique[0] if len(unique) == 1 else f"(either {' '.join(unique)})"
+
+
+def either_members(kind: str) -> tuple[str, ...]:
+    """The member types of an ``(either ...)`` type name; ``(kind,)`` for a plain type."""
+    if kind.startswith("(either ") and kind.endswith(")"):
+        return tuple(kind[len("(either ") : -1].split())
+    return (kind,)
 
 
 @dataclass(frozen=True, slots=True)
@@ -199,7 +223,9 @@ class Domain:
     Attributes:
         name: the domain name.
         requirements: the features it needs (declared, ``:adl`` expanded, and those found in use; always STRIPS).
-        types: child type -> parent type (``object`` is the implicit root and no key).
+        types: child type -> its parent types, sorted (``object`` is the implicit root
+            and no key; a type declared under several parents, as ``area - object`` and ``area - surface``,
+            has them all).
         constants: typed constants.
         predicates: predicate declarations.
         functions: function (numeric fluent) declarations.
@@ -210,7 +236,7 @@ class Domain:
 
     name: str
     requirements: frozenset[Feature]
-    types: dict[str, str] = field(default_factory=dict, hash=False)
+    types: dict[str, tuple[str, ...]] = field(default_factory=dict, hash=False)
     constants: tuple[TypedName, ...] = ()
     predicates: tuple[Predicate, ...] = ()
     functions: tuple[Predicate, ...] = ()
@@ -226,14 +252,24 @@ class Domain:
         return next((a for a in self.actions if a.name == name), None)
 
     def is_subtype(self, child: str, parent: str) -> bool:
-        """Whether ``child`` is ``parent`` or below it."""
+        """Whether ``child`` is ``parent`` or below it (through any of its parents).
+
+        ``parent`` may be an ``(either ...)`` type: then ``child`` must be below one of its members.
+        """
+        if parent == OBJECT or child == parent:
+            return True
+        wanted = set(either_members(parent))
         seen: set[str] = set()
-        while child != parent:
-            if child in seen or child == OBJECT:
-                return parent == OBJECT
-            seen.add(child)
-            child = self.types.get(child, OBJECT)
-        return True
+        stack = [child]
+        while stack:
+            kind = stack.pop()
+            if kind in wanted:
+                return True
+            if kind in seen:
+                continue
+            seen.add(kind)
+            stack.extend(self.types.get(kind, ()))
+        return False
 
 
 @dataclass(frozen=True, slots=True)

@@ -175,13 +175,34 @@ def _sections(source: Source, top: SList, allowed: tuple[str, ...]) -> list[SLis
 
 
 def _typed(
-    source: Source, section: SList, variables: bool, types: dict[str, str] | None, what: str
+    source: Source, section: SList, variables: bool, types: dict[str, tuple[str, ...]] | None, what: str
 ) -> list[tuple[TypedName, int]]:
     return parse_typed_list(source, section.items[1:], variables=variables, types=types, what=what)
 
 
+def _check_type_cycles(
+    source: Source, types: dict[str, tuple[str, ...]], declared: list[tuple[TypedName, int]]
+) -> None:
+    """Refuse a type that is its own ancestor (``a - b``, ``b - a``), at the first declaration on the cycle."""
+    for (child, parent), offset in declared:
+        seen: set[str] = set()
+        stack = [parent]
+        while stack:
+            kind = stack.pop()
+            if kind == child:
+                raise source.error(offset, f"type '{child}' is its own ancestor (through '{parent}')")
+            if kind not in seen:
+                seen.add(kind)
+                stack.extend(types.get(kind, ()))
+
+
 def _declarations(
-    source: Source, section: SList, types: dict[str, str], what: str, functions: bool, limits: Limits | None = None
+    source: Source,
+    section: SList,
+    types: dict[str, tuple[str, ...]],
+    what: str,
+    functions: bool,
+    limits: Limits | None = None,
 ) -> list[Predicate]:
     out: list[Predicate] = []
     names: set[str] = set()
@@ -288,7 +309,7 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
     allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action")
     features: set[Feature] = {Feature.STRIPS}
     extra: set[str] = set()
-    types: dict[str, str] = {}
+    types: dict[str, tuple[str, ...]] = {}
     constants: list[TypedName] = []
     predicates: list[Predicate] = []
     functions: list[Predicate] = []
@@ -302,17 +323,25 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
             features |= more
             extra |= more_extra
         elif head == ":types":
-            for (child, parent), offset in _typed(source, section, False, None, "type list"):
+            declared = _typed(source, section, False, None, "type list")
+            for (child, parent), offset in declared:
                 if child == OBJECT:
                     continue
-                if child in types:
+                parents = types.get(child, ())
+                if parent in parents:
                     raise source.error(offset, f"duplicate type '{child}'")
-                types[child] = parent
-            for (child, parent), offset in _typed(source, section, False, None, "type list"):
+                # a type declared under several parents (area - object, area - surface) has them all;
+                # object is implicit beside another parent
+                if parent == OBJECT:
+                    types[child] = parents or (OBJECT,)
+                else:
+                    types[child] = tuple(sorted({*(p for p in parents if p != OBJECT), parent}))
+            for (child, parent), offset in declared:
                 if parent != OBJECT and parent not in types:
                     raise source.error(
                         offset, f"unknown type '{parent}' (parent of '{child}')", "declare it in (:types ...)"
                     )
+            _check_type_cycles(source, types, declared)
             features.add(Feature.TYPING)
         elif head == ":constants":
             for (const, kind), offset in _typed(source, section, False, types, "constant list"):

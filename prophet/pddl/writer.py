@@ -99,10 +99,11 @@ def _action(action: Action) -> str:
     return "\n".join(lines)
 
 
-def _types(types: dict[str, str]) -> str:
+def _types(types: dict[str, tuple[str, ...]]) -> str:
     by_parent: dict[str, list[str]] = {}
     for child in sorted(types):
-        by_parent.setdefault(types[child], []).append(child)
+        for parent in types[child] or (OBJECT,):
+            by_parent.setdefault(parent, []).append(child)
     groups = [f"{' '.join(children)} - {parent}" for parent, children in sorted(by_parent.items())]
     return "(:types\n    " + "\n    ".join(groups) + ")"
 

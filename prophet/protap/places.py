@@ -192,8 +192,8 @@ def _below(domain: Domain, kind: str) -> set[str]:
     changed = True
     while changed:
         changed = False
-        for child, parent in domain.types.items():
-            if parent in out and child not in out:
+        for child, parents in domain.types.items():
+            if child not in out and any(parent in out for parent in parents):
                 out.add(child)
                 changed = True
     return out

@@ -53,7 +53,7 @@ def test_model_of_blocks_and_rovers() -> None:
     assert problem.objects == (("d", "object"), ("b", "object"), ("a", "object"), ("c", "object"))
     rovers_domain = read_domain(rovers_path)
     assert rovers_domain.requirements == frozenset({Feature.STRIPS, Feature.TYPING})
-    assert rovers_domain.types["rover"] == "object"
+    assert rovers_domain.types["rover"] == ("object",)
     p01 = read_problem(rovers[0], rovers_domain)
     assert ("rover0", "rover") in p01.objects  # upper case in the file
 

@@ -16,6 +16,7 @@ from alica.prophet.pddl import (
     PddlError,
     Predicate,
     Problem,
+    either,
     parse_domain,
     parse_problem,
     write_domain,
@@ -24,7 +25,9 @@ from alica.prophet.pddl import (
 from alica.prophet.planner import Feature
 
 NAMES = st.sampled_from(["a", "b", "c", "d-1", "e_2"])
-TYPES = {"thing": "object", "box": "thing", "cup": "thing"}
+TYPES = {"thing": ("object",), "box": ("thing",), "cup": ("thing",), "mug": ("box", "cup")}
+KINDS = ["object", *TYPES, either(["box", "cup"]), either(["mug", "thing"])]
+"""Parameter types: plain, one with two parents (mug) and (either ...) types."""
 
 
 @st.composite
@@ -32,12 +35,12 @@ def domains(draw: st.DrawFn) -> Domain:
     """A small random domain with all features declared."""
     arities = draw(st.lists(st.integers(0, 2), min_size=1, max_size=4))
     predicates = tuple(
-        Predicate(f"p{i}", tuple((f"?x{j}", draw(st.sampled_from(["object", *TYPES]))) for j in range(n)))
+        Predicate(f"p{i}", tuple((f"?x{j}", draw(st.sampled_from(KINDS))) for j in range(n)))
         for i, n in enumerate(arities)
     )
     actions = []
     for k in range(draw(st.integers(0, 3))):
-        params = tuple((f"?v{j}", draw(st.sampled_from(["object", *TYPES]))) for j in range(draw(st.integers(0, 2))))
+        params = tuple((f"?v{j}", draw(st.sampled_from(KINDS))) for j in range(draw(st.integers(0, 2))))
         terms = [p for p, _ in params] + ["k"]
 
         def atom() -> Atom:
