@@ -117,6 +117,9 @@ class GroundTask:
         axioms: the ground rules of the derived facts (empty without derived predicates).
         derived: the derived fact ids (a state's derived facts follow from its other facts through
             ``axioms``; :attr:`init` and :meth:`apply` include them).
+        negated_axioms: for the delete relaxation only, ``(head, body)`` rules of the facts that stand for
+            a negated derived fact (``(not@p ...)``): each body is one way all rules of ``p`` fail
+            (the rules' bodies negated and multiplied out; see :func:`_negated_rules`).
     """
 
     name: str
@@ -128,6 +131,7 @@ class GroundTask:
     unsolvable_reason: str | None = None
     axioms: tuple[GroundAxiom, ...] = ()
     derived: frozenset[int] = frozenset()
+    negated_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
     _ids: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def fact_id(self, text: str) -> int:
@@ -308,6 +312,7 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     derived_ids = frozenset(final[i] for i, f in enumerate(facts) if f[0] in derived_names and final[i] >= 0)
     derived_ids |= frozenset(ids[text_of[i]] for i in goal_ids if facts[i][0] in derived_names)
     init_state = frozenset(final[i] for i in init_ids if final[i] >= 0)
+    relaxed = _negated_rules(fix, negated, negated_derived, nf, table, fired_rules, final)
     return GroundTask(
         problem.name,
         tuple(names),
@@ -318,7 +323,54 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
         reason,
         axioms,
         derived_ids,
+        relaxed,
     )
+
+
+MAX_NEGATED_CLAUSES = 64
+"""The most conjunctions the negation of a derived fact's rules may multiply out into (beyond: true)."""
+
+
+def _negated_rules(  # type: ignore[no-untyped-def]
+    fix: Fixpoint, negated: set[GroundAtom], negated_derived: set[GroundAtom], nf, table: _Facts, rules, final
+) -> tuple[tuple[int, tuple[int, ...]], ...]:
+    """The rules of ``(not@p ...)`` for the relaxation: ``p`` fails when every rule of ``p`` has a false body.
+
+    A body literal's complement is the ``not-`` fact of a basic fact (or the basic fact of a ``not-``
+    fact), the ``not@`` fact of a derived fact, or, for a negated derived fact, the fact itself;
+    without one (no such fact in the task) the rule's failure is taken as possible (true), which
+    over-approximates as the relaxation may.
+    """
+    if not negated_derived:
+        return ()
+    complement: dict[int, int] = {}
+    for f in negated:
+        complement[table.id(f)] = table.id(nf(f))
+        complement[table.id(nf(f))] = table.id(f)
+    for f in negated_derived:
+        complement[table.id(f)] = table.id(nf(f))
+    by_head: dict[int, list[tuple[frozenset[int], frozenset[int]]]] = {}
+    for pre, head, naf, _ in rules:
+        by_head.setdefault(head, []).append((pre, naf))
+    out: set[tuple[int, tuple[int, ...]]] = set()
+    for f in sorted(negated_derived):
+        head = final[table.id(nf(f))]
+        if head < 0:
+            continue
+        clauses: list[frozenset[int]] = [frozenset()]
+        for pre, naf in by_head.get(table.id(f), []):
+            options = [complement.get(x) for x in pre] + list(naf)
+            if any(o is None for o in options):
+                continue  # this rule may fail in ways the task has no fact for: over-approximate
+            clauses = [c | {o} for c in clauses for o in options if o is not None]
+            if len(clauses) > MAX_NEGATED_CLAUSES:
+                clauses = [frozenset()]
+                break
+        for clause in clauses:
+            ids = [final[x] for x in clause]
+            if all(i >= 0 for i in ids):
+                out.add((head, tuple(sorted(ids))))
+    return tuple(sorted(out))
 
 
 def _build_positive(

@@ -138,11 +138,15 @@ class AxiomTask(CompiledTask):
     Attributes:
         derived_mask: the derived facts.
         axioms: per compiled axiom, ``(head, fluent positive body, negated derived body, layer)``.
+        relaxed_axioms: the rules the delete relaxation uses, ``(head, fluent body)``: the axioms
+            without their negated derived bodies, except that the facts standing for a negated
+            derived fact take the task's ``negated_axioms`` instead of their negation-as-failure rule.
         layers: per layer in increasing order, the axioms checked first (no positive body fact of
             their own layer) and, per fact of the layer, the axioms to check once it holds.
     """
 
     derived_mask: int = 0
+    relaxed_axioms: list[tuple[int, tuple[int, ...]]] = field(default_factory=list)
     axioms: list[tuple[int, tuple[int, ...], tuple[int, ...], int]] = field(default_factory=list)
     layers: list[tuple[list[int], dict[int, list[int]]]] = field(default_factory=list)
     ax_pre: list[int] = field(default_factory=list)
@@ -407,5 +411,9 @@ def compile_task(task: Any) -> CompiledTask:
         ct.ax_pre = [mask(p) for _, p, _, _ in kept_axioms]
         ct.ax_neg = [mask(g) for _, _, g, _ in kept_axioms]
         ct.ax_head = [1 << h for h, _, _, _ in kept_axioms]
+        negated = getattr(task, "negated_axioms", ())
+        negated_heads = {h for h, _ in negated}
+        ct.relaxed_axioms = [(h, p) for h, p, _, _ in kept_axioms if h not in negated_heads]
+        ct.relaxed_axioms += [(h, tuple(f for f in p if fluent[f])) for h, p in negated if usable(p)]
         ct.init = ct.closure(ct.init & ~ct.derived_mask)
     return ct

@@ -47,8 +47,8 @@ class Relaxed:
                 r_add.append(cadd)
                 r_cost.append(ct.cost[op])
                 r_op.append(op)
-        for head, pos, _neg, _layer in getattr(ct, "axioms", ()):  # derived facts: free, never preferred;
-            r_pre.append(pos)  # negated derived bodies are left out (true in the relaxation)
+        for head, pos in getattr(ct, "relaxed_axioms", ()):  # derived facts: free, never preferred
+            r_pre.append(pos)
             r_add.append((head,))
             r_cost.append(0)
             r_op.append(-1)
