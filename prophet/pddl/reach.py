@@ -202,7 +202,7 @@ class Fixpoint:
         preconditions = {a.name: self._precondition(a, compiler) for a in domain.actions}
         self.fluent |= domain.derived | set(compiler.arity)
         self.goal_literals, self.goal_reason = self._goal(problem.goal, compiler)
-        self.derived = set(domain.derived) | set(compiler.arity)
+        self.derived = set(domain.derived) | set(compiler.arity) | {r.predicate for r in compiler.rules}
         self.fluent |= self.derived
         self.layer = strata(compiler.rules, self.derived, compiler.origin)
         self._schemas: list[_Schema] = []
