@@ -343,22 +343,25 @@ def _negated_rules(  # type: ignore[no-untyped-def]
     """
     if not negated_derived:
         return ()
+    ids = table.ids  # looked up, never extended: ``final`` covers the facts numbered so far
     complement: dict[int, int] = {}
     for f in negated:
-        complement[table.id(f)] = table.id(nf(f))
-        complement[table.id(nf(f))] = table.id(f)
+        if f in ids and nf(f) in ids:
+            complement[ids[f]] = ids[nf(f)]
+            complement[ids[nf(f)]] = ids[f]
     for f in negated_derived:
-        complement[table.id(f)] = table.id(nf(f))
+        if f in ids and nf(f) in ids:
+            complement[ids[f]] = ids[nf(f)]
     by_head: dict[int, list[tuple[frozenset[int], frozenset[int]]]] = {}
     for pre, head, naf, _ in rules:
         by_head.setdefault(head, []).append((pre, naf))
     out: set[tuple[int, tuple[int, ...]]] = set()
     for f in sorted(negated_derived):
-        head = final[table.id(nf(f))]
+        head = final[ids[nf(f)]]
         if head < 0:
             continue
         clauses: list[frozenset[int]] = [frozenset()]
-        for pre, naf in by_head.get(table.id(f), []):
+        for pre, naf in by_head.get(ids.get(f, -1), []):
             options = [complement.get(x) for x in pre] + list(naf)
             if any(o is None for o in options):
                 continue  # this rule may fail in ways the task has no fact for: over-approximate
@@ -367,9 +370,9 @@ def _negated_rules(  # type: ignore[no-untyped-def]
                 clauses = [frozenset()]
                 break
         for clause in clauses:
-            ids = [final[x] for x in clause]
-            if all(i >= 0 for i in ids):
-                out.add((head, tuple(sorted(ids))))
+            body = [final[x] for x in clause]
+            if all(i >= 0 for i in body):
+                out.add((head, tuple(sorted(body))))
     return tuple(sorted(out))
 
 
