@@ -203,6 +203,9 @@ class Fixpoint:
         self.fluent |= domain.derived | set(compiler.arity)
         self.goal_literals, self.goal_reason = self._goal(problem.goal, compiler)
         self.derived = set(domain.derived) | set(compiler.arity) | {r.predicate for r in compiler.rules}
+        self.derived |= {
+            a.predicate for _, a in self.goal_literals if isinstance(a, Atom) and a.predicate == GOAL_PREDICATE
+        }
         self.fluent |= self.derived
         self.layer = strata(compiler.rules, self.derived, compiler.origin)
         self._schemas: list[_Schema] = []

@@ -140,7 +140,7 @@ STATES = st.tuples(
 )
 
 
-@settings(max_examples=1500, deadline=None)
+@settings(max_examples=120, deadline=None)
 @given(formula=formulas(), state=STATES, cap=st.sampled_from([1, 2, normal.MAX_CLAUSES]))
 def test_compiled_conditions_hold_exactly_where_the_formula_holds(formula: Formula, state, cap: int) -> None:  # type: ignore[no-untyped-def]
     """The goal and a precondition, compiled (axioms + DNF), agree with the validator's direct evaluation."""
