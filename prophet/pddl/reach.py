@@ -44,6 +44,7 @@ from alica.prophet.pddl.model import (
 )
 from alica.prophet.pddl.normal import TOO_MANY, Clause, EffectItem, dnf, expand, flatten_effect
 from alica.prophet.planner import Limits
+from alica.source import SourceSpan
 
 CHECK_EVERY = 4096
 """Steps of the fixpoint between two checks of the limits."""
@@ -196,7 +197,7 @@ class Fixpoint:
         for axiom in domain.axioms:
             compiler.add_rules(axiom.predicate, axiom.parameters, axiom.body, f"'{axiom.predicate}'", axiom.span)
         effects = {a.name: self._conditions(a, a.effect, dict(a.parameters), compiler) for a in domain.actions}
-        flat = {name: flatten_effect(effect, self.objects_of) for name, effect in effects.items()}
+        flat = {a.name: self._flatten(a, effects[a.name]) for a in domain.actions}
         self.fluent = {item.atom.predicate for items, _ in flat.values() for item in items}
         self.has_costs = any(costs for _, costs in flat.values())
         preconditions = {a.name: self._precondition(a, compiler) for a in domain.actions}
@@ -237,6 +238,15 @@ class Fixpoint:
         for schema in self._schemas:
             for i, (pred, _) in enumerate(schema.pos):
                 self._triggers.setdefault(pred, []).append((schema, i))
+
+    def _flatten(self, action: Action, effect: Effect) -> tuple[list[EffectItem], list]:
+        """The effect flattened (:func:`flatten_effect`); a refusal names the action's place."""
+        try:
+            return flatten_effect(effect, self.objects_of)
+        except PddlError as exc:
+            if exc.span is not None:
+                raise
+            raise PddlError(f"the effect of action '{action.name}': {exc.message}", action.span) from None
 
     def _precondition(self, action: Action, compiler: Compiler) -> list[tuple[tuple[TypedName, ...], Clause]]:
         """The precondition's conjunctions (with the variables of an ``exists`` each adds, if lifted).
@@ -700,6 +710,10 @@ class Fixpoint:
                 out.append((tuple(sorted(set(c_pos))), tuple(sorted(set(c_neg)))))
         return out
 
+    def _span(self, action: str) -> SourceSpan | None:
+        found = self._domain.action(action)
+        return found.span if found is not None else None
+
     def _cost(self, schema: _Schema, value) -> int:  # type: ignore[no-untyped-def]
         if not self.has_costs:
             return 1
@@ -708,11 +722,16 @@ class Fixpoint:
             if isinstance(cost, tuple):
                 fluent = (cost[0], *(value(a) for a in cost[1]))
                 if fluent not in self.values:
-                    raise PddlError(f"action {schema.action}: fluent {fact_text(fluent)} has no value in :init")
+                    raise PddlError(
+                        f"action {schema.action}: fluent {fact_text(fluent)} has no value in :init",
+                        self._span(schema.action),
+                    )
                 amount = self.values[fluent]
             else:
                 amount = cost
             if amount < 0 or amount != int(amount):
-                raise PddlError(f"action {schema.action}: cost {amount} is not a non-negative integer")
+                raise PddlError(
+                    f"action {schema.action}: cost {amount} is not a non-negative integer", self._span(schema.action)
+                )
             total += amount
         return int(total)
