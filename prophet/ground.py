@@ -9,8 +9,11 @@ objects). Negative preconditions and negated goals become positive
 while grounding; static facts (changed by no action) leave the preconditions.
 Those ``not-`` facts and when-effects need a second, ground relaxed exploration
 (over local integer fact ids); a task without them (plain STRIPS, such as
-Rovers) skips it, since the fixpoint's exploration is then exact. The garbage
-collector is paused while grounding (many objects, no cycles).
+Rovers) skips it, since the fixpoint's exploration is then exact. Derived
+predicates become ground axioms (:class:`GroundAxiom`) evaluated in every state
+(:func:`evaluate_axioms`); a negated derived fact is the derived fact
+``(not@p ...)``, never a ``not-`` fact. The garbage collector is paused while
+grounding (many objects, no cycles).
 
 With :class:`~alica.prophet.planner.Limits`, grounding checks the deadline and
 its estimated memory (:mod:`alica.prophet.pddl.reach`) inside the fixpoint and
@@ -200,8 +203,8 @@ def ground(domain: Domain, problem: Problem, limits: Limits | None = None) -> Gr
 
     Raises:
         PddlError: the problem uses names the domain lacks, a cost is missing or
-            not a non-negative integer, a goal is disjunctive, or conditional
-            effects make a negative precondition impossible to compile.
+            not a non-negative integer, the derived predicates are not stratifiable,
+            or conditional effects make a negative precondition impossible to compile.
         LimitReached: a limit was reached while grounding (the message says how far it got).
     """
     with collector_paused():
