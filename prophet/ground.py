@@ -120,9 +120,10 @@ class GroundTask:
         axioms: the ground rules of the derived facts (empty without derived predicates).
         derived: the derived fact ids (a state's derived facts follow from its other facts through
             ``axioms``; :attr:`init` and :meth:`apply` include them).
-        negated_axioms: for the delete relaxation only, ``(head, body)`` rules of the facts that stand for
-            a negated derived fact (``(not@p ...)``): each body is one way all rules of ``p`` fail
-            (the rules' bodies negated and multiplied out; see :func:`_negated_rules`).
+        relaxed_axioms: the rules the delete relaxation uses instead of ``axioms``, ``(head, body)``:
+            each axiom with its negated derived facts read through their ``(not@p ...)`` facts, and
+            for each ``(not@p ...)`` fact, rules saying that every rule of ``p`` fails (the rules'
+            bodies negated and multiplied out; see :func:`_relaxed_rules`).
     """
 
     name: str
@@ -134,7 +135,7 @@ class GroundTask:
     unsolvable_reason: str | None = None
     axioms: tuple[GroundAxiom, ...] = ()
     derived: frozenset[int] = frozenset()
-    negated_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
+    relaxed_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
     _ids: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def fact_id(self, text: str) -> int:
@@ -248,6 +249,8 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     negated -= negated_derived
     for rule in fix.rules:
         negated.update(f for f in rule.neg if f[0] not in derived)
+    if fix.rules:
+        _negations_for_relaxation(fix, negated, negated_derived)
     taken = {p.name for p in domain.predicates}
     not_names = {pred: _not_name(pred, taken) for pred in sorted({f[0] for f in negated})}
     not_names.update((pred, NOT_DERIVED + pred) for pred in {f[0] for f in negated_derived})
@@ -315,7 +318,7 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     derived_ids = frozenset(final[i] for i, f in enumerate(facts) if f[0] in derived_names and final[i] >= 0)
     derived_ids |= frozenset(ids[text_of[i]] for i in goal_ids if facts[i][0] in derived_names)
     init_state = frozenset(final[i] for i in init_ids if final[i] >= 0)
-    relaxed = _negated_rules(fix, negated, negated_derived, nf, table, fired_rules, final)
+    relaxed = _relaxed_rules(negated, negated_derived, nf, table, fired_rules, final)
     return GroundTask(
         problem.name,
         tuple(names),
@@ -334,18 +337,56 @@ MAX_NEGATED_CLAUSES = 64
 """The most conjunctions the negation of a derived fact's rules may multiply out into (beyond: true)."""
 
 
-def _negated_rules(  # type: ignore[no-untyped-def]
-    fix: Fixpoint, negated: set[GroundAtom], negated_derived: set[GroundAtom], nf, table: _Facts, rules, final
-) -> tuple[tuple[int, tuple[int, ...]], ...]:
-    """The rules of ``(not@p ...)`` for the relaxation: ``p`` fails when every rule of ``p`` has a false body.
+def _negations_for_relaxation(fix: Fixpoint, negated: set[GroundAtom], negated_derived: set[GroundAtom]) -> None:
+    """Add what the relaxation needs to read derived facts negated (in place).
 
-    A body literal's complement is the ``not-`` fact of a basic fact (or the basic fact of a ``not-``
-    fact), the ``not@`` fact of a derived fact, or, for a negated derived fact, the fact itself;
-    without one (no such fact in the task) the rule's failure is taken as possible (true), which
-    over-approximates as the relaxation may.
+    Every derived fact negated somewhere (a precondition, goal, condition or a rule's body) gets a
+    ``(not@p ...)`` fact; so does every derived fact in a body of its rules, and the basic facts of
+    those bodies get their ``(not-p ...)`` twins (kept up to date by the effects), so that the
+    negation of each rule can be written over facts. A basic fact an action both adds and deletes
+    under conditions gets no twin (its ``not-`` fact could not be kept up to date): its rules' failure
+    is over-approximated.
     """
-    if not negated_derived:
-        return ()
+    derived = fix.derived
+    rules_of: dict[GroundAtom, list] = {}
+    for rule in fix.rules:
+        rules_of.setdefault(rule.head, []).append(rule)
+    risky: set[GroundAtom] = set()
+    for action in fix.actions:
+        if action.conditional:
+            adds = set(action.add)
+            dels = set(action.delete)
+            for _, _, c_add, c_del in action.conditional:
+                adds.update(c_add)
+                dels.update(c_del)
+            risky |= adds & dels
+    work = list(negated_derived) + [g for rule in fix.rules for g in rule.neg if g[0] in derived]
+    seen: set[GroundAtom] = set()
+    while work:
+        f = work.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        negated_derived.add(f)
+        for rule in rules_of.get(f, ()):
+            for g in rule.pos:
+                if g[0] in derived:
+                    work.append(g)
+                elif g not in risky:
+                    negated.add(g)
+
+
+def _relaxed_rules(  # type: ignore[no-untyped-def]
+    negated: set[GroundAtom], negated_derived: set[GroundAtom], nf, table: _Facts, rules, final
+) -> tuple[tuple[int, tuple[int, ...]], ...]:
+    """The rules of the relaxation (:attr:`GroundTask.relaxed_axioms`), over final fact ids.
+
+    An axiom's negated derived fact is read through its ``(not@p ...)`` fact. ``(not@p ...)`` holds
+    when every rule of ``p`` has a false body: a body literal's complement is the ``not-`` fact of
+    a basic fact (or the basic fact of a ``not-`` fact), the ``not@`` fact of a derived fact, or, for
+    a negated derived fact, the fact itself; without one the rule's failure is taken as possible
+    (true), which over-approximates as the relaxation may.
+    """
     ids = table.ids  # looked up, never extended: ``final`` covers the facts numbered so far
     complement: dict[int, int] = {}
     for f in negated:
@@ -359,6 +400,14 @@ def _negated_rules(  # type: ignore[no-untyped-def]
     for pre, head, naf, _ in rules:
         by_head.setdefault(head, []).append((pre, naf))
     out: set[tuple[int, tuple[int, ...]]] = set()
+    not_heads = {ids[nf(f)] for f in negated_derived if nf(f) in ids}
+    for pre, head, naf, _ in rules:
+        if head in not_heads:
+            continue
+        body = [final[x] for x in pre] + [final[complement[x]] if x in complement else -2 for x in naf]
+        body = [x for x in body if x != -2]  # no not@ fact: left out (true), as the relaxation may
+        if all(x >= 0 for x in body):
+            out.add((final[head], tuple(sorted(set(body)))))
     for f in sorted(negated_derived):
         head = final[ids[nf(f)]]
         if head < 0:

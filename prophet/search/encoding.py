@@ -138,9 +138,9 @@ class AxiomTask(CompiledTask):
     Attributes:
         derived_mask: the derived facts.
         axioms: per compiled axiom, ``(head, fluent positive body, negated derived body, layer)``.
-        relaxed_axioms: the rules the delete relaxation uses, ``(head, fluent body)``: the axioms
-            without their negated derived bodies, except that the facts standing for a negated
-            derived fact take the task's ``negated_axioms`` instead of their negation-as-failure rule.
+        relaxed_axioms: the rules the delete relaxation uses, ``(head, fluent body)``: the task's
+            ``relaxed_axioms`` (negated derived facts read through their ``(not@p ...)`` facts, which
+            have rules of their own).
         layers: per layer in increasing order, the axioms checked first (no positive body fact of
             their own layer) and, per fact of the layer, the axioms to check once it holds.
     """
@@ -411,9 +411,7 @@ def compile_task(task: Any) -> CompiledTask:
         ct.ax_pre = [mask(p) for _, p, _, _ in kept_axioms]
         ct.ax_neg = [mask(g) for _, _, g, _ in kept_axioms]
         ct.ax_head = [1 << h for h, _, _, _ in kept_axioms]
-        negated = getattr(task, "negated_axioms", ())
-        negated_heads = {h for h, _ in negated}
-        ct.relaxed_axioms = [(h, p) for h, p, _, _ in kept_axioms if h not in negated_heads]
-        ct.relaxed_axioms += [(h, tuple(f for f in p if fluent[f])) for h, p in negated if usable(p)]
+        relaxed = getattr(task, "relaxed_axioms", ())
+        ct.relaxed_axioms = [(h, tuple(f for f in p if fluent[f])) for h, p in relaxed if usable(p)]
         ct.init = ct.closure(ct.init & ~ct.derived_mask)
     return ct
