@@ -101,8 +101,9 @@ OBJECTS = ("a", "b", "c")
 BASE = """(define (domain random)
   (:requirements :adl :derived-predicates)
   (:constants a b c)
-  (:predicates (p ?x) (q ?x) (r ?x ?y) (d ?x) (done))
+  (:predicates (p ?x) (q ?x) (r ?x ?y) (d ?x) (e ?x) (done))
   (:derived (d ?x) (or (p ?x) (exists (?y) (and (r ?x ?y) (not (q ?y))))))
+  (:derived (e ?x) (forall (?y) (imply (r ?x ?y) (or (q ?y) (not (d ?y))))))
   (:action flip-p :parameters (?x) :precondition (p ?x) :effect (not (p ?x)))
   (:action flip-q :parameters (?x) :precondition (q ?x) :effect (not (q ?x)))
   (:action flip-r :parameters (?x ?y) :precondition (r ?x ?y) :effect (not (r ?x ?y)))
@@ -114,7 +115,7 @@ BASE = """(define (domain random)
 def formulas(draw: st.DrawFn, depth: int = 3, scope: tuple[str, ...] = ()) -> Formula:
     terms = st.sampled_from((*scope, *OBJECTS))
     if depth == 0 or draw(st.integers(0, 3)) == 0:
-        kind = draw(st.sampled_from(["p", "q", "r", "d", "="]))
+        kind = draw(st.sampled_from(["p", "q", "r", "d", "e", "="]))
         if kind == "=":
             return Equals(draw(terms), draw(terms))
         if kind == "r":

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import pytest
 
+from alica.app.cli import main
 from alica.prophet.ground import GroundTask, ground
 from alica.prophet.pddl import Axiom, PddlError, parse_domain, parse_problem, write_domain
 from alica.prophet.pddl.model import Atom, Domain, Problem
@@ -232,3 +236,20 @@ def test_a_domain_without_derived_predicates_compiles_to_the_plain_task() -> Non
     task = ground(domain, parse_problem("(define (problem x) (:domain d) (:init (p)) (:goal (q)))", domain=domain))
     assert isinstance(task, GroundTask) and not task.axioms and not task.derived
     assert type(compile_task(task)).__name__ == "CompiledTask"
+
+
+def test_alica_plan_json_prints_a_derived_refusal_with_its_place(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    domain = tmp_path / "d.pddl"
+    domain.write_text(
+        "(define (domain d) (:requirements :derived-predicates)\n  (:predicates (p) (q))\n  (:derived (q) (p))\n"
+        "  (:action a :parameters () :precondition (p) :effect (q)))\n",
+        encoding="utf-8",
+    )
+    problem = tmp_path / "p.pddl"
+    problem.write_text("(define (problem x) (:domain d) (:init (p)) (:goal (q)))\n", encoding="utf-8")
+    code = main(["plan", str(domain), str(problem), "--json"])
+    answer = json.loads(capsys.readouterr().out)
+    assert code == 1 and answer["solved"] is False
+    assert answer["error"].startswith(f"{domain}:4:56: error: derived predicate 'q' in an action effect")
