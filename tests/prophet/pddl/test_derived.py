@@ -252,4 +252,4 @@ def test_alica_plan_json_prints_a_derived_refusal_with_its_place(
     code = main(["plan", str(domain), str(problem), "--json"])
     answer = json.loads(capsys.readouterr().out)
     assert code == 1 and answer["solved"] is False
-    assert answer["error"].startswith(f"{domain}:4:56: error: derived predicate 'q' in an action effect")
+    assert answer["error"].startswith(f"{domain}:4:55: error: derived predicate 'q' in an action effect")
