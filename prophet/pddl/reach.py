@@ -460,7 +460,7 @@ class Fixpoint:
 
     def estimate_bytes(self) -> int:
         """The estimated memory of the grounding so far (see :data:`BYTES_PER_ACTION`)."""
-        return len(self.actions) * BYTES_PER_ACTION + len(self._reached) * BYTES_PER_FACT
+        return (len(self.actions) + len(self.rules) // 2) * BYTES_PER_ACTION + len(self._reached) * BYTES_PER_FACT
 
     def check(self) -> None:
         """Check the limits (if any) now.
@@ -473,7 +473,9 @@ class Fixpoint:
             limits.check(
                 "grounding",
                 self.estimate_bytes(),
-                f"{len(self.actions)} ground actions, {len(self._reached)} facts so far",
+                f"{len(self.actions)} ground actions, "
+                + (f"{len(self.rules)} ground rules, " if self.rules else "")
+                + f"{len(self._reached)} facts so far",
                 FREE_SHARE * (limits.clock() - self._started),
             )
 
