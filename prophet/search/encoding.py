@@ -199,6 +199,29 @@ def _axiom_parts(
     return [out[k] for k in sorted(out)]
 
 
+def _changing_derived(axioms: Sequence[Any], derived: frozenset[int], fluent: list[bool]) -> set[int]:
+    """The derived facts that may change: those with a rule reading a changing basic fact or such a derived fact.
+
+    The others (no rule, or rules over static facts and such derived facts only) keep the value
+    they have in the initial state: they are compiled away like static facts.
+    """
+    readers: dict[int, list[int]] = {}
+    changing: set[int] = set()
+    for a in axioms:
+        for f in (*a.pos, *a.neg):
+            if f in derived:
+                readers.setdefault(f, []).append(a.head)
+            elif fluent[f]:
+                changing.add(a.head)
+    stack = list(changing)
+    while stack:
+        for head in readers.get(stack.pop(), ()):
+            if head not in changing:
+                changing.add(head)
+                stack.append(head)
+    return changing
+
+
 def _reachable(n_facts: int, init: set[int], pres: list[tuple[int, ...]], adds: list[tuple[int, ...]]) -> list[bool]:
     """Which relaxed actions a relaxed exploration from ``init`` reaches."""
     users: list[list[int]] = [[] for _ in range(n_facts)]
@@ -291,7 +314,8 @@ def compile_task(task: Any) -> CompiledTask:
                     fluent[f] = True
 
     task_axioms = getattr(task, "axioms", ())
-    for f in getattr(task, "derived", ()):  # recomputed in every state: never static
+    derived: frozenset[int] = getattr(task, "derived", frozenset())
+    for f in _changing_derived(task_axioms, derived, fluent):  # recomputed in every state
         fluent[f] = True
 
     def usable(ids: Sequence[int]) -> bool:
@@ -319,7 +343,11 @@ def compile_task(task: Any) -> CompiledTask:
                 r_add.append(tuple(f for f in cadd if fluent[f]))
                 r_of.append(k)
     n_ops = len(r_pre)
-    ax_cand = [a for a in task_axioms if usable(a.pos)]
+    ax_cand = [
+        a
+        for a in task_axioms
+        if fluent[a.head] and usable(a.pos) and not any(not fluent[f] and f in init_set for f in a.neg)
+    ]
     for a in ax_cand:  # negated derived bodies count as true in the relaxation
         r_pre.append(tuple(f for f in a.pos if fluent[f]))
         r_add.append((a.head,))
@@ -387,7 +415,7 @@ def compile_task(task: Any) -> CompiledTask:
         task=task,
         n_facts=n,
         init=mask([f for f in sorted(init_set) if fluent[f]]),
-        goal_mask=mask([f for f in goal if fluent[f]]),
+        goal_mask=mask([f for f in goal if fluent[f] or f not in init_set]),  # a static false goal: never
         goal=goal,
         source=source,
         pre=pre,
@@ -405,13 +433,13 @@ def compile_task(task: Any) -> CompiledTask:
         solvable_relaxed=all(f in relaxed_facts for f in goal),
     )
     if isinstance(ct, AxiomTask):
-        ct.derived_mask = mask(sorted(getattr(task, "derived", ())))
+        ct.derived_mask = mask(sorted(f for f in derived if fluent[f]))
         ct.axioms = kept_axioms
         ct.layers = _axiom_parts(kept_axioms)
         ct.ax_pre = [mask(p) for _, p, _, _ in kept_axioms]
         ct.ax_neg = [mask(g) for _, _, g, _ in kept_axioms]
         ct.ax_head = [1 << h for h, _, _, _ in kept_axioms]
         relaxed = getattr(task, "relaxed_axioms", ())
-        ct.relaxed_axioms = [(h, tuple(f for f in p if fluent[f])) for h, p in relaxed if usable(p)]
+        ct.relaxed_axioms = [(h, tuple(f for f in p if fluent[f])) for h, p in relaxed if fluent[h] and usable(p)]
         ct.init = ct.closure(ct.init & ~ct.derived_mask)
     return ct

@@ -253,3 +253,31 @@ def test_alica_plan_json_prints_a_derived_refusal_with_its_place(
     answer = json.loads(capsys.readouterr().out)
     assert code == 1 and answer["solved"] is False
     assert answer["error"].startswith(f"{domain}:4:55: error: derived predicate 'q' in an action effect")
+
+
+def test_derived_facts_over_static_facts_only_are_compiled_away() -> None:
+    domain = parse_domain(
+        """(define (domain links) (:requirements :strips :derived-predicates)
+  (:predicates (link ?x ?y) (linked ?x ?y) (at ?x) (seen ?x))
+  (:derived (linked ?x ?y) (link ?x ?y))
+  (:derived (linked ?x ?y) (exists (?z) (and (link ?x ?z) (linked ?z ?y))))
+  (:action go :parameters (?x ?y) :precondition (and (at ?x) (linked ?x ?y))
+    :effect (and (not (at ?x)) (at ?y) (seen ?y))))"""
+    )
+    problem = parse_problem(
+        "(define (problem p) (:domain links) (:objects a b c d) (:init (link a b) (link b c) (at a))"
+        " (:goal (and (seen c) (linked a c))))",
+        domain=domain,
+    )
+    task = ground(domain, problem)
+    ct = compile_task(task)
+    assert task.axioms and not getattr(ct, "axioms", None)  # (linked ...) never changes
+    assert all(task.fact_id("(linked a c)") not in pre for pre in ct.pre)
+    result = get_planner("builtin").solve(domain, problem)
+    assert result.plan is not None and [str(s) for s in result.plan.steps] == ["(go a c)"]
+    assert validate_plan((domain, problem), result.plan).valid
+    unreachable = parse_problem(
+        "(define (problem q) (:domain links) (:objects a b c d) (:init (link a b) (at a)) (:goal (linked a d)))",
+        domain=domain,
+    )
+    assert get_planner("builtin").solve(domain, unreachable).status is PlanStatus.UNSOLVABLE
