@@ -9,8 +9,11 @@ objects). Negative preconditions and negated goals become positive
 while grounding; static facts (changed by no action) leave the preconditions.
 Those ``not-`` facts and when-effects need a second, ground relaxed exploration
 (over local integer fact ids); a task without them (plain STRIPS, such as
-Rovers) skips it, since the fixpoint's exploration is then exact. The garbage
-collector is paused while grounding (many objects, no cycles).
+Rovers) skips it, since the fixpoint's exploration is then exact. Derived
+predicates become ground axioms (:class:`GroundAxiom`) evaluated in every state
+(:func:`evaluate_axioms`); a negated derived fact is the derived fact
+``(not@p ...)``, never a ``not-`` fact. The garbage collector is paused while
+grounding (many objects, no cycles).
 
 With :class:`~alica.prophet.planner.Limits`, grounding checks the deadline and
 its estimated memory (:mod:`alica.prophet.pddl.reach`) inside the fixpoint and
@@ -32,7 +35,6 @@ from operator import itemgetter
 
 from alica.prophet.pddl import Domain, PddlError, Problem
 from alica.prophet.pddl.model import Equals
-from alica.prophet.pddl.normal import dnf, expand
 from alica.prophet.pddl.reach import CHECK_EVERY, Fixpoint, GroundAction, fact_text
 from alica.prophet.planner import LimitReached, Limits, collector_paused
 
@@ -66,6 +68,43 @@ class GroundOperator:
     conditional: tuple[tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]], ...] = ()
 
 
+@dataclass(frozen=True, slots=True)
+class GroundAxiom:
+    """A ground rule of a derived fact, over fact ids.
+
+    Attributes:
+        head: the derived fact it makes true.
+        pos: fact ids that must hold (sorted).
+        neg: derived fact ids (of lower layers) that must not hold, by negation as failure (sorted).
+        layer: the stratum: layers are evaluated in increasing order, each to its fixpoint.
+    """
+
+    head: int
+    pos: tuple[int, ...]
+    neg: tuple[int, ...]
+    layer: int
+
+
+def evaluate_axioms(axioms: tuple[GroundAxiom, ...], derived: frozenset[int], state: frozenset[int]) -> frozenset[int]:
+    """``state`` with its derived facts recomputed from the basic ones (the stratified least fixpoint)."""
+    if not axioms:
+        return state
+    facts = set(state - derived)
+    by_layer: dict[int, list[GroundAxiom]] = {}
+    for axiom in axioms:
+        by_layer.setdefault(axiom.layer, []).append(axiom)
+    for layer in sorted(by_layer):
+        rules = by_layer[layer]
+        changed = True
+        while changed:
+            changed = False
+            for a in rules:
+                if a.head not in facts and all(p in facts for p in a.pos) and not any(n in facts for n in a.neg):
+                    facts.add(a.head)
+                    changed = True
+    return frozenset(facts)
+
+
 @dataclass(frozen=True)
 class GroundTask:
     """A grounded planning task: facts by id, the initial state, the goal and the operators.
@@ -78,6 +117,13 @@ class GroundTask:
         operators: the reachable ground operators.
         has_costs: whether the domain uses action costs.
         unsolvable_reason: why the task has no plan, when grounding already shows it (else None).
+        axioms: the ground rules of the derived facts (empty without derived predicates).
+        derived: the derived fact ids (a state's derived facts follow from its other facts through
+            ``axioms``; :attr:`init` and :meth:`apply` include them).
+        relaxed_axioms: the rules the delete relaxation uses instead of ``axioms``, ``(head, body)``:
+            each axiom with its negated derived facts read through their ``(not@p ...)`` facts, and
+            for each ``(not@p ...)`` fact, rules saying that every rule of ``p`` fails (the rules'
+            bodies negated and multiplied out; see :func:`_relaxed_rules`).
     """
 
     name: str
@@ -87,6 +133,9 @@ class GroundTask:
     operators: tuple[GroundOperator, ...]
     has_costs: bool
     unsolvable_reason: str | None = None
+    axioms: tuple[GroundAxiom, ...] = ()
+    derived: frozenset[int] = frozenset()
+    relaxed_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
     _ids: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def fact_id(self, text: str) -> int:
@@ -107,16 +156,19 @@ class GroundTask:
         return all(p in state for p in op.pre)
 
     def apply(self, state: frozenset[int], op: GroundOperator) -> frozenset[int]:
-        """The state after ``op`` (reference semantics: conditions read in ``state``, adds win)."""
+        """The state after ``op`` (reference semantics: conditions read in ``state``, adds win, derived facts
+        recomputed)."""
         if not op.conditional:
-            return (state - frozenset(op.delete)) | frozenset(op.add)
-        add = set(op.add)
-        delete = set(op.delete)
-        for condition, cond_add, cond_delete in op.conditional:
-            if all(c in state for c in condition):
-                add.update(cond_add)
-                delete.update(cond_delete)
-        return (state - delete) | add
+            after = (state - frozenset(op.delete)) | frozenset(op.add)
+        else:
+            add = set(op.add)
+            delete = set(op.delete)
+            for condition, cond_add, cond_delete in op.conditional:
+                if all(c in state for c in condition):
+                    add.update(cond_add)
+                    delete.update(cond_delete)
+            after = (state - delete) | add
+        return evaluate_axioms(self.axioms, self.derived, after) if self.axioms else after
 
     def is_goal(self, state: frozenset[int]) -> bool:
         """Whether ``state`` satisfies the goal."""
@@ -125,6 +177,10 @@ class GroundTask:
     def operator(self, name: str) -> list[GroundOperator]:
         """The operators called ``name`` (``(pick-up a)``); several when a disjunction was split."""
         return [op for op in self.operators if op.name == name]
+
+
+NOT_DERIVED = "not@"
+"""The prefix of the derived facts that hold when a derived fact does not (for negated derived preconditions)."""
 
 
 def _not_name(predicate: str, taken: set[str]) -> str:
@@ -148,8 +204,8 @@ def ground(domain: Domain, problem: Problem, limits: Limits | None = None) -> Gr
 
     Raises:
         PddlError: the problem uses names the domain lacks, a cost is missing or
-            not a non-negative integer, a goal is disjunctive, or conditional
-            effects make a negative precondition impossible to compile.
+            not a non-negative integer, the derived predicates are not stratifiable,
+            or conditional effects make a negative precondition impossible to compile.
         LimitReached: a limit was reached while grounding (the message says how far it got).
     """
     with collector_paused():
@@ -165,12 +221,7 @@ def _ground(domain: Domain, problem: Problem, limits: Limits | None) -> GroundTa
     fix = Fixpoint(domain, problem, limits)
     fix.run()
     fix.check()
-    goal_clauses = [c for c in dnf(expand(problem.goal, fix.objects_of)) if fix.clause_possible(c)]
-    if len(goal_clauses) > 1:
-        raise PddlError("unsupported construct: a disjunctive goal (or, exists, imply) cannot be grounded")
-    goal_literals = goal_clauses[0] if goal_clauses else ()
-    reason = None if goal_clauses else "the goal is false in every state (static facts or equalities)"
-    return _build(domain, problem, fix, goal_literals, reason)
+    return _build(domain, problem, fix, fix.goal_literals, fix.goal_reason)
 
 
 def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple, reason: str | None) -> GroundTask:
@@ -190,11 +241,19 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
         negated.update(action.neg)
         for _cond_pos, cond_neg, _, _ in action.conditional:
             negated.update(cond_neg)
-    init_fluent = {f for f in fix.init if f[0] in fluent}
-    if not negated and not any(action.conditional for action in fix.actions):
+    init_fluent = {f for f in fix.init if f[0] in fluent and f[0] not in fix.derived}
+    if not negated and not fix.rules and not any(action.conditional for action in fix.actions):
         return _build_positive(problem, fix, init_fluent, goal_pos, reason)
+    derived = fix.derived
+    negated_derived = {f for f in negated if f[0] in derived}  # through (not@p ...) rules, never effects
+    negated -= negated_derived
+    for rule in fix.rules:
+        negated.update(f for f in rule.neg if f[0] not in derived)
+    if fix.rules:
+        _negations_for_relaxation(fix, negated, negated_derived)
     taken = {p.name for p in domain.predicates}
     not_names = {pred: _not_name(pred, taken) for pred in sorted({f[0] for f in negated})}
+    not_names.update((pred, NOT_DERIVED + pred) for pred in {f[0] for f in negated_derived})
 
     def nf(fact: GroundAtom) -> GroundAtom:
         return (not_names[fact[0]], *fact[1:])
@@ -206,10 +265,26 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
         compiled.append(_compile(a, negated, nf, table))
         if not k % CHECK_EVERY:
             fix.check()
+    rules = [
+        (
+            frozenset(table.id(f) for f in (*r.pos, *(nf(g) for g in r.neg if g[0] not in derived))),
+            table.id(r.head),
+            frozenset(table.id(g) for g in r.neg if g[0] in derived),
+            r.layer,
+        )
+        for r in fix.rules
+    ]
+    rules += [
+        (frozenset(), table.id(nf(f)), frozenset({table.id(f)}), fix.layer[f[0]] + 1) for f in sorted(negated_derived)
+    ]
+    n_actions = len(compiled)
+    compiled += [(pre, frozenset({head}), frozenset(), ()) for pre, head, _, _ in rules]
     init_ids = {table.id(f) for f in init}
     goal_facts = [*goal_pos, *(nf(f) for f in goal_neg)]
     goal_ids = [table.id(f) for f in goal_facts]
     reached, fired = _reachable(len(table.ids), init_ids, compiled)
+    fired_rules = [rules[k - n_actions] for k in fired if k >= n_actions]
+    fired = [k for k in fired if k < n_actions]
     missing = [f for f, i in zip(goal_facts, goal_ids, strict=True) if not reached[i]]
     if reason is None and missing:
         reason = f"goal fact {fact_text(missing[0])} is not reachable even ignoring deletes"
@@ -225,15 +300,132 @@ def _build(domain: Domain, problem: Problem, fix: Fixpoint, goal_literals: tuple
     goal_final = {ids[text_of[i]] for i in goal_ids}
     fix.check()
     operators = _operators([(fix.actions[k], compiled[k]) for k in fired], final)
+    axioms = tuple(
+        sorted(
+            {
+                GroundAxiom(
+                    final[head],
+                    tuple(sorted({final[i] for i in pre})),
+                    tuple(sorted({final[i] for i in naf if final[i] >= 0})),
+                    layer,
+                )
+                for pre, head, naf, layer in fired_rules
+            },
+            key=lambda a: (a.layer, a.head, a.pos, a.neg),
+        )
+    )
+    derived_names = derived | {NOT_DERIVED + p for p in derived}
+    derived_ids = frozenset(final[i] for i, f in enumerate(facts) if f[0] in derived_names and final[i] >= 0)
+    derived_ids |= frozenset(ids[text_of[i]] for i in goal_ids if facts[i][0] in derived_names)
+    init_state = frozenset(final[i] for i in init_ids if final[i] >= 0)
+    relaxed = _relaxed_rules(negated, negated_derived, nf, table, fired_rules, final)
     return GroundTask(
         problem.name,
         tuple(names),
-        frozenset(final[i] for i in init_ids if final[i] >= 0),
+        evaluate_axioms(axioms, derived_ids, init_state),
         tuple(sorted(goal_final)),
         operators,
         fix.has_costs,
         reason,
+        axioms,
+        derived_ids,
+        relaxed,
     )
+
+
+MAX_NEGATED_CLAUSES = 64
+"""The most conjunctions the negation of a derived fact's rules may multiply out into (beyond: true)."""
+
+
+def _negations_for_relaxation(fix: Fixpoint, negated: set[GroundAtom], negated_derived: set[GroundAtom]) -> None:
+    """Add what the relaxation needs to read derived facts negated (in place).
+
+    Every derived fact negated somewhere (a precondition, goal, condition or a rule's body) gets a
+    ``(not@p ...)`` fact; so does every derived fact in a body of its rules, and the basic facts of
+    those bodies get their ``(not-p ...)`` twins (kept up to date by the effects), so that the
+    negation of each rule can be written over facts. A basic fact an action both adds and deletes
+    under conditions gets no twin (its ``not-`` fact could not be kept up to date): its rules' failure
+    is over-approximated.
+    """
+    derived = fix.derived
+    rules_of: dict[GroundAtom, list] = {}
+    for rule in fix.rules:
+        rules_of.setdefault(rule.head, []).append(rule)
+    risky: set[GroundAtom] = set()
+    for action in fix.actions:
+        if action.conditional:
+            adds = set(action.add)
+            dels = set(action.delete)
+            for _, _, c_add, c_del in action.conditional:
+                adds.update(c_add)
+                dels.update(c_del)
+            risky |= adds & dels
+    work = list(negated_derived) + [g for rule in fix.rules for g in rule.neg if g[0] in derived]
+    seen: set[GroundAtom] = set()
+    while work:
+        f = work.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        negated_derived.add(f)
+        for rule in rules_of.get(f, ()):
+            for g in rule.pos:
+                if g[0] in derived:
+                    work.append(g)
+                elif g not in risky:
+                    negated.add(g)
+
+
+def _relaxed_rules(  # type: ignore[no-untyped-def]
+    negated: set[GroundAtom], negated_derived: set[GroundAtom], nf, table: _Facts, rules, final
+) -> tuple[tuple[int, tuple[int, ...]], ...]:
+    """The rules of the relaxation (:attr:`GroundTask.relaxed_axioms`), over final fact ids.
+
+    An axiom's negated derived fact is read through its ``(not@p ...)`` fact. ``(not@p ...)`` holds
+    when every rule of ``p`` has a false body: a body literal's complement is the ``not-`` fact of
+    a basic fact (or the basic fact of a ``not-`` fact), the ``not@`` fact of a derived fact, or, for
+    a negated derived fact, the fact itself; without one the rule's failure is taken as possible
+    (true), which over-approximates as the relaxation may.
+    """
+    ids = table.ids  # looked up, never extended: ``final`` covers the facts numbered so far
+    complement: dict[int, int] = {}
+    for f in negated:
+        if f in ids and nf(f) in ids:
+            complement[ids[f]] = ids[nf(f)]
+            complement[ids[nf(f)]] = ids[f]
+    for f in negated_derived:
+        if f in ids and nf(f) in ids:
+            complement[ids[f]] = ids[nf(f)]
+    by_head: dict[int, list[tuple[frozenset[int], frozenset[int]]]] = {}
+    for pre, head, naf, _ in rules:
+        by_head.setdefault(head, []).append((pre, naf))
+    out: set[tuple[int, tuple[int, ...]]] = set()
+    not_heads = {ids[nf(f)] for f in negated_derived if nf(f) in ids}
+    for pre, head, naf, _ in rules:
+        if head in not_heads:
+            continue
+        body = [final[x] for x in pre] + [final[complement[x]] if x in complement else -2 for x in naf]
+        body = [x for x in body if x != -2]  # no not@ fact: left out (true), as the relaxation may
+        if all(x >= 0 for x in body):
+            out.add((final[head], tuple(sorted(set(body)))))
+    for f in sorted(negated_derived):
+        head = final[ids[nf(f)]]
+        if head < 0:
+            continue
+        clauses: list[frozenset[int]] = [frozenset()]
+        for pre, naf in by_head.get(ids.get(f, -1), []):
+            options = [complement.get(x) for x in pre] + list(naf)
+            if any(o is None for o in options):
+                continue  # this rule may fail in ways the task has no fact for: over-approximate
+            clauses = [c | {o} for c in clauses for o in options if o is not None]
+            if len(clauses) > MAX_NEGATED_CLAUSES:
+                clauses = [frozenset()]
+                break
+        for clause in clauses:
+            body = [final[x] for x in clause]
+            if all(i >= 0 for i in body):
+                out.add((head, tuple(sorted(body))))
+    return tuple(sorted(out))
 
 
 def _build_positive(
@@ -361,7 +553,7 @@ def _compile(
     action: GroundAction, negated: set[GroundAtom], nf: Callable[[GroundAtom], GroundAtom], table: _Facts
 ) -> Compiled:
     """Pre, add, delete and conditional effects with ``not-`` facts kept up to date, as local fact ids."""
-    if not negated and not action.conditional:  # the common case: nothing to keep up to date
+    if not negated and not action.neg and not action.conditional:  # the common case: nothing to keep up to date
         ids = table.ids
         new = ids.setdefault
         add_ids = frozenset([new(f, len(ids)) for f in action.add])

@@ -60,6 +60,8 @@ class Feature(Enum):
     """``(when ...)`` in effects."""
     ACTION_COSTS = "action-costs"
     """``(increase (total-cost) n)`` effects and a ``minimize (total-cost)`` metric."""
+    DERIVED_PREDICATES = "derived-predicates"
+    """``(:derived ...)`` rules: predicates that are a function of the others, never in effects or ``:init``."""
 
 
 class PlanStatus(Enum):

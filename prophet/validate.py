@@ -4,6 +4,11 @@ On a (domain, problem) pair the plan is checked at the lifted level (action
 names, argument types, preconditions as formulas, conditional effects, costs
 read from ``:init``); on a :class:`alica.prophet.ground.GroundTask` it is checked on
 the ground operators.
+
+Derived predicates are evaluated at the lifted level too: in each state, the
+derived atoms are the stratified least fixpoint of the ``:derived`` rules over
+the state's basic atoms (stratum by stratum, each rule's body read as a
+formula, repeated until nothing more holds).
 """
 
 from __future__ import annotations
@@ -13,10 +18,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from alica.prophet.ground import GroundTask
+from alica.prophet.pddl.adl import free_variables, nnf
 from alica.prophet.pddl.model import (
     OBJECT,
     And,
     Atom,
+    Axiom,
     Domain,
     Effect,
     Equals,
@@ -97,12 +104,79 @@ class _Lifted:
     def __init__(self, domain: Domain, problem: Problem) -> None:
         self.domain = domain
         self.objects = dict((*domain.constants, *problem.objects))
+        self._pools: dict[str, list[str]] = {}
+        self._plans: dict[int, tuple] = {}
         self.problem = problem
         self.values = problem.fluent_values
         self.has_costs = any(isinstance(e, Increase) for a in domain.actions for e in _walk(a.effect))
+        self.strata = _strata(domain.axioms, domain.derived)
+
+    def close(self, state: set[Atom]) -> set[Atom]:
+        """``state`` (basic atoms) with the derived atoms that follow from it."""
+        if not self.strata:
+            return state
+        full = set(state)
+        for axioms in self.strata:
+            todo = [(a, b) for a in axioms for b in self.bindings(a.parameters)]
+            changed = True
+            while changed and todo:
+                changed = False
+                left = []
+                for axiom, binding in todo:
+                    head = Atom(axiom.predicate, tuple(binding[v] for v, _ in axiom.parameters))
+                    if head in full:
+                        continue
+                    if self.true(axiom.body, binding, full):
+                        full.add(head)
+                        changed = True
+                    else:
+                        left.append((axiom, binding))
+                todo = left
+        return full
 
     def objects_of(self, kind: str) -> list[str]:
-        return [o for o, t in self.objects.items() if kind == OBJECT or self.domain.is_subtype(t, kind)]
+        if kind not in self._pools:
+            self._pools[kind] = [
+                o for o, t in self.objects.items() if kind == OBJECT or self.domain.is_subtype(t, kind)
+            ]
+        return self._pools[kind]
+
+    def true(self, formula: Formula, env: dict[str, str], state: set[Atom]) -> bool:
+        """Whether ``formula`` holds in ``state`` with its free variables bound as ``env`` says."""
+        if isinstance(formula, Atom):
+            return Atom(formula.predicate, tuple([env.get(a, a) for a in formula.args])) in state
+        if isinstance(formula, Equals):
+            return env.get(formula.left, formula.left) == env.get(formula.right, formula.right)
+        if isinstance(formula, Not):
+            return not self.true(formula.formula, env, state)
+        if isinstance(formula, And):
+            return all(self.true(p, env, state) for p in formula.parts)  # type: ignore[arg-type]
+        if isinstance(formula, Or):
+            return any(self.true(p, env, state) for p in formula.parts)
+        if isinstance(formula, Imply):
+            return not self.true(formula.condition, env, state) or self.true(formula.consequence, env, state)
+        if isinstance(formula, Exists | Forall):
+            plan = self._plans.get(id(formula))
+            if plan is None:
+                plan = self._plans[id(formula)] = (formula, *_join_plan(formula))
+            _, variables, levels = plan
+            found = self._search(variables, levels, 0, dict(env), state)
+            return found if isinstance(formula, Exists) else not found
+        raise TypeError(f"not a formula: {formula!r}")
+
+    def _search(self, variables: tuple, levels: tuple, k: int, env: dict[str, str], state: set[Atom]) -> bool:
+        """Whether some binding of ``variables[k:]`` makes every part of ``levels`` true (checked once bound)."""
+        for part in levels[k]:
+            if not self.true(part, env, state):
+                return False
+        if k == len(variables):
+            return True
+        name, kind = variables[k]
+        for obj in self.objects_of(kind):
+            env[name] = obj
+            if self._search(variables, levels, k + 1, env, state):
+                return True
+        return False
 
     def validate(self, steps: tuple[PlanStep, ...]) -> ValidationResult:
         state = set(self.problem.facts)
@@ -123,13 +197,14 @@ class _Lifted:
                 if not self.domain.is_subtype(self.objects[arg], kind):
                     return ValidationResult(False, cost, number, f"{where}: '{arg}' is no {kind} (parameter {param})")
             mapping = dict(zip((p for p, _ in action.parameters), args, strict=True))
-            unmet = self.unmet(substitute(action.precondition, mapping), state)  # type: ignore[arg-type]
+            full = self.close(state)
+            unmet = self.unmet(substitute(action.precondition, mapping), full)  # type: ignore[arg-type]
             if unmet is not None:
                 return ValidationResult(False, cost, number, f"{where}: precondition {unmet} does not hold")
             add: set[Atom] = set()
             delete: set[Atom] = set()
             step_cost = 0.0 if self.has_costs else 1.0
-            for effect in self.effects(substitute(action.effect, mapping), state):  # type: ignore[arg-type]
+            for effect in self.effects(substitute(action.effect, mapping), full):  # type: ignore[arg-type]
                 if isinstance(effect, Increase):
                     value = effect.value
                     if isinstance(value, FluentTerm):
@@ -145,13 +220,13 @@ class _Lifted:
                     add.add(effect)  # type: ignore[arg-type]
             state = (state - delete) | add
             cost += step_cost
-        unmet_goal = self.unmet(self.problem.goal, state)
+        unmet_goal = self.unmet(self.problem.goal, self.close(state))
         if unmet_goal is not None:
             return ValidationResult(False, cost, None, f"goal {unmet_goal} does not hold after the plan")
         return ValidationResult(True, cost, None, "")
 
     def holds(self, formula: Formula, state: set[Atom]) -> bool:
-        return self.unmet(formula, state) is None
+        return self.true(formula, {}, state)
 
     def unmet(self, formula: Formula, state: set[Atom]) -> str | None:
         """None when ``formula`` holds, else the first literal (or subformula) that does not."""
@@ -197,6 +272,60 @@ class _Lifted:
         if isinstance(effect, When):
             return self.effects(effect.effect, state) if self.holds(effect.condition, state) else []
         return [effect]
+
+
+def _join_plan(formula: Exists | Forall) -> tuple[tuple[tuple[str, str], ...], tuple[tuple[Formula, ...], ...]]:
+    """A quantifier as a search for a witness: ``exists`` of a conjunction, ``forall`` as ``not exists not``.
+
+    Nested quantifiers of the same kind are merged; each part of the conjunction is checked as soon
+    as its quantified variables are bound (a nested-loop join that prunes early).
+    """
+    variables = list(formula.variables)
+    body = formula.body
+    while isinstance(body, type(formula)) and not {v for v, _ in body.variables} & {v for v, _ in variables}:
+        variables.extend(body.variables)
+        body = body.body
+    parts: list[Formula]
+    if isinstance(formula, Exists):
+        parts = list(body.parts) if isinstance(body, And) else [body]  # type: ignore[arg-type,list-item]
+    else:
+        parts = [Not(p) for p in body.parts] if isinstance(body, Or) else [Not(body)]  # type: ignore[arg-type]
+    names = [v for v, _ in variables]
+    levels: list[list[Formula]] = [[] for _ in range(len(variables) + 1)]
+    for part in parts:
+        free = free_variables(part)
+        levels[max((names.index(v) + 1 for v in free if v in names), default=0)].append(part)
+    return tuple(variables), tuple(tuple(level) for level in levels)
+
+
+def _strata(axioms: tuple[Axiom, ...], derived: frozenset[str]) -> list[list[Axiom]]:
+    """The rules by stratum (a rule's negated derived predicates, in NNF, in lower strata)."""
+    if not axioms:
+        return []
+    edges: set[tuple[str, str, int]] = set()
+    for axiom in axioms:
+        stack: list[tuple[object, bool]] = [(nnf(axiom.body), True)]
+        while stack:
+            node, positive = stack.pop()
+            if isinstance(node, Atom) and node.predicate in derived:
+                edges.add((axiom.predicate, node.predicate, 0 if positive else 1))
+            elif isinstance(node, Not):
+                stack.append((node.formula, False))
+            elif isinstance(node, And | Or):
+                stack.extend((p, positive) for p in node.parts)
+            elif isinstance(node, Exists | Forall):
+                stack.append((node.body, positive))
+    level = dict.fromkeys(derived, 0)
+    for _ in range(len(level) + 1):
+        changed = False
+        for head, body, weight in edges:
+            if level[head] < level[body] + weight:
+                level[head] = level[body] + weight
+                changed = True
+        if not changed:
+            break
+    top = max(level.values(), default=0)
+    return [[a for a in axioms if level[a.predicate] == k] for k in range(top + 1)]
 
 
 def _walk(effect: Effect) -> list[Effect]:

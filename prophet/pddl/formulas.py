@@ -176,6 +176,7 @@ class FormulaReader:
         types: known types (None: any).
         strict: whether unknown predicates, functions and objects are errors (False without a domain).
         used: features found while reading.
+        derived: the derived predicates (an effect or ``:init`` naming one is an error).
     """
 
     source: Source
@@ -185,6 +186,7 @@ class FormulaReader:
     types: dict[str, tuple[str, ...]] | None
     strict: bool = True
     used: set[Feature] = field(default_factory=set)
+    derived: set[str] = field(default_factory=set)
 
     def term(self, node: Node, scope: dict[str, str]) -> str:
         """A variable in scope or a known object."""
@@ -299,7 +301,7 @@ class FormulaReader:
         if head == "not":
             if len(node.items) != 2 or not isinstance(node.items[1], SList):
                 raise self.source.error(node.offset, "expected '(not (predicate ...))' in an effect")
-            return Not(self.atom(node.items[1], scope))
+            return Not(self.changed_atom(node.items[1], scope))
         if head == "forall":
             names, inner = self._scoped(node, scope)
             return Forall(names, self.effect(node.items[2], inner))
@@ -314,7 +316,18 @@ class FormulaReader:
             raise self.source.error(
                 node.offset, f"unsupported construct: numeric effect '({head} ...)'", "only (increase (total-cost) x)"
             )
-        return self.atom(node, scope)
+        return self.changed_atom(node, scope)
+
+    def changed_atom(self, node: SList, scope: dict[str, str], where: str = "an action effect") -> Atom:
+        """An atom an effect (or ``:init``) sets: never one of a derived predicate."""
+        atom = self.atom(node, scope)
+        if atom.predicate in self.derived:
+            raise self.source.error(
+                node.offset,
+                f"derived predicate '{atom.predicate}' in {where}",
+                "derived predicates follow from the (:derived ...) rules; effects and :init name basic predicates only",
+            )
+        return atom
 
     def _increase(self, node: SList, scope: dict[str, str]) -> Increase:
         if len(node.items) != 3:

@@ -201,6 +201,30 @@ def top_level_parts(effect: Effect) -> list[Effect]:
 
 
 @dataclass(frozen=True, slots=True)
+class Axiom:
+    """``(:derived (predicate ?x - t ...) body)``: a rule for a derived predicate.
+
+    A derived predicate may have several rules (it holds when one body holds).
+
+    Attributes:
+        predicate: the derived predicate's name (declared in ``:predicates``).
+        parameters: the head's typed variables, in order.
+        body: the condition (any formula over the parameters).
+        span: where ``(:derived`` is in its file (for errors found after reading; not part of equality).
+    """
+
+    predicate: str
+    parameters: tuple[TypedName, ...]
+    body: Formula
+    span: SourceSpan | None = field(default=None, compare=False)
+
+    @property
+    def head(self) -> Atom:
+        """The head as an atom over the parameters."""
+        return Atom(self.predicate, tuple(v for v, _ in self.parameters))
+
+
+@dataclass(frozen=True, slots=True)
 class Metric:
     """``(:metric minimize (total-cost))``."""
 
@@ -232,6 +256,7 @@ class Domain:
         actions: action schemas.
         extra_requirements: declared requirement names that are no :class:`Feature`
             (``disjunctive-preconditions``, ``existential-preconditions``, ``universal-preconditions``).
+        axioms: the rules of the derived predicates (``:derived``), in file order.
     """
 
     name: str
@@ -242,6 +267,12 @@ class Domain:
     functions: tuple[Predicate, ...] = ()
     actions: tuple[Action, ...] = ()
     extra_requirements: frozenset[str] = frozenset()
+    axioms: tuple[Axiom, ...] = ()
+
+    @property
+    def derived(self) -> frozenset[str]:
+        """The names of the derived predicates (those with a ``:derived`` rule)."""
+        return frozenset(a.predicate for a in self.axioms)
 
     def predicate(self, name: str) -> Predicate | None:
         """The predicate called ``name``, or None."""

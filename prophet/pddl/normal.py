@@ -38,13 +38,14 @@ ObjectsOf = Callable[[str], list[str]]
 """The objects of a type (subtypes included)."""
 
 MAX_CLAUSES = 4096
-TOO_MANY = (
-    f"unsupported construct: the formula expands into more than {MAX_CLAUSES} disjuncts "
-    "(an 'or' or 'exists' inside a 'forall', or a negated 'and'); the builtin planner does not compile these "
-    "into derived predicates yet"
-)
-TOO_MANY_HINT = "plan this domain with --planner fd (Fast Downward), or split the disjunction into separate actions"
 """The most conjunctions a formula may expand into."""
+TOO_MANY = (
+    f"the formula expands into more than {MAX_CLAUSES} disjuncts "
+    "(an 'or' or 'exists' inside a 'forall', or a negated 'and')"
+)
+"""The message of the error :func:`dnf` raises beyond :data:`MAX_CLAUSES`: the grounder
+(:mod:`alica.prophet.pddl.reach`) then writes the formula over derived predicates
+(:mod:`alica.prophet.pddl.adl`) instead."""
 
 
 @dataclass(frozen=True, slots=True)

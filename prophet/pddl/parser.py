@@ -19,6 +19,7 @@ from alica.prophet.pddl.model import (
     Action,
     And,
     Atom,
+    Axiom,
     Domain,
     Effect,
     Equals,
@@ -66,7 +67,6 @@ _UNSUPPORTED = frozenset(
         "durative-actions",
         "duration-inequalities",
         "continuous-effects",
-        "derived-predicates",
         "timed-initial-literals",
         "preferences",
         "constraints",
@@ -166,7 +166,7 @@ def _sections(source: Source, top: SList, allowed: tuple[str, ...]) -> list[SLis
     for item in top.items[2:]:
         section = expect_list(source, item, "a section '(:keyword ...)'")
         head = section.head()
-        if head in (":derived", ":durative-action", ":constraints"):
+        if head in (":durative-action", ":constraints"):
             raise source.error(section.offset, f"unsupported construct '({head} ...)'")
         if head not in allowed:
             raise source.error(section.offset, f"expected one of {', '.join(allowed)}, found '{section.describe()}'")
@@ -271,6 +271,48 @@ def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
     return Action(name, parameters, precondition, effect, span=source.span(section.offset))
 
 
+def _derived(source: Source, section: SList, reader: FormulaReader) -> Axiom:
+    """``(:derived (predicate ?x - t ...) body)``, the predicate declared in ``:predicates``."""
+    if len(section.items) != 3:
+        raise source.error(section.offset, "expected '(:derived (predicate ?x ...) formula)'")
+    head = expect_list(source, section.items[1], "a derived predicate '(predicate ?x ...)'")
+    name = expect_name(source, head.items[0], "a predicate name") if head.items else ""
+    if not name:
+        raise source.error(head.offset, "expected a predicate name, found '()'")
+    declared = reader.predicates.get(name)
+    if declared is None:
+        raise source.error(
+            head.items[0].offset,
+            f"undefined derived predicate '{name}'",
+            "declare it in (:predicates ...) before the (:derived ...) rule",
+        )
+    typed = parse_typed_list(
+        source, head.items[1:], variables=True, types=reader.types, what=f"parameters of derived '{name}'"
+    )
+    counts = Counter(n for (n, _), _ in typed)
+    if len(counts) < len(typed):
+        pname, offset = next((n, o) for (n, _), o in typed if counts[n] > 1)
+        raise source.error(offset, f"duplicate parameter '{pname}' in '(:derived ({name}'")
+    if len(typed) != declared.arity:
+        raise source.error(
+            head.offset, f"wrong number of arguments for '{name}': expected {declared.arity}, found {len(typed)}"
+        )
+    parameters = tuple(p for p, _ in typed)
+    body = _empty_or(section.items[2], lambda v: reader.formula(v, dict(parameters)))
+    return Axiom(name, parameters, body, span=source.span(section.offset))
+
+
+def _derived_names(top: SList) -> set[str]:
+    """The predicate names that ``(:derived (name ...) ...)`` sections define (read before the sections)."""
+    names = set()
+    for item in top.items[2:]:
+        if isinstance(item, SList) and item.head() == ":derived" and len(item.items) > 1:
+            head = item.items[1]
+            if isinstance(head, SList) and head.items and isinstance(head.items[0], Symbol):
+                names.add(head.items[0].text)
+    return names
+
+
 def _empty_or(node: Node, read):  # type: ignore[no-untyped-def]
     """``()`` is the empty conjunction, anything else is read by ``read``."""
     if isinstance(node, SList) and not node.items:
@@ -306,15 +348,16 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
     if limits is not None:
         limits.check(stage)
     name = _check_header(source, top, "domain")
-    allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action")
+    allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action", ":derived")
     features: set[Feature] = {Feature.STRIPS}
     extra: set[str] = set()
     types: dict[str, tuple[str, ...]] = {}
     constants: list[TypedName] = []
     predicates: list[Predicate] = []
     functions: list[Predicate] = []
-    reader = FormulaReader(source, {}, {}, {}, types)
+    reader = FormulaReader(source, {}, {}, {}, types, derived=_derived_names(top))
     actions: list[Action] = []
+    axioms: list[Axiom] = []
     action_names: set[str] = set()
     for section in _sections(source, top, allowed):
         head = section.head()
@@ -355,6 +398,8 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
         elif head == ":functions":
             functions.extend(_declarations(source, section, types, "function", True, limits))
             reader.functions.update((f.name, f) for f in functions)
+        elif head == ":derived":
+            axioms.append(_derived(source, section, reader))
         else:
             action = _action(source, section, reader)
             if action.name in action_names:
@@ -370,6 +415,13 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
             extra |= more_extra
         if any(t != OBJECT for _, t in action.parameters):
             features.add(Feature.TYPING)
+    for axiom in axioms:
+        more, more_extra = formula_features(axiom.body)
+        features |= more
+        extra |= more_extra
+        features.add(Feature.DERIVED_PREDICATES)
+        if any(t != OBJECT for _, t in axiom.parameters):
+            features.add(Feature.TYPING)
     if any(t != OBJECT for p in (*predicates, *functions) for _, t in p.parameters):
         features.add(Feature.TYPING)
     return Domain(
@@ -381,6 +433,7 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
         tuple(functions),
         tuple(actions),
         frozenset(extra),
+        tuple(axioms),
     )
 
 
@@ -435,6 +488,7 @@ def _parse_problem(text: str, file: str, domain: Domain | None, limits: Limits |
         dict(domain.constants) if domain else {},
         types,
         strict,
+        derived=set(domain.derived) if domain else set(),
     )
     features: set[Feature] = set()
     extra: set[str] = set()
@@ -495,7 +549,7 @@ def _init_item(source: Source, node: Node, reader: FormulaReader) -> Atom | Flue
         return FluentValue(fluent, parse_number(source, item.items[2], f"the value of {fluent}"))
     if head in ("not", "and", "or", "forall", "exists", "when"):
         raise source.error(item.offset, f"unsupported construct '({head} ...)' in :init", "list the true facts only")
-    return reader.atom(item, {})
+    return reader.changed_atom(item, {}, ":init")
 
 
 def _metric(source: Source, section: SList, reader: FormulaReader) -> Metric:

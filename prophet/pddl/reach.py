@@ -22,10 +22,29 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from operator import itemgetter
 
+from alica.prophet.pddl.adl import GOAL_PREDICATE, Compiler, strata
 from alica.prophet.pddl.errors import PddlError
-from alica.prophet.pddl.model import OBJECT, Atom, Domain, Equals, FluentTerm, FluentValue, Problem
-from alica.prophet.pddl.normal import TOO_MANY, TOO_MANY_HINT, Clause, dnf, expand, flatten_effect
+from alica.prophet.pddl.model import (
+    OBJECT,
+    Action,
+    And,
+    Atom,
+    Domain,
+    Effect,
+    Equals,
+    FluentTerm,
+    FluentValue,
+    Forall,
+    Formula,
+    Not,
+    Or,
+    Problem,
+    TypedName,
+    When,
+)
+from alica.prophet.pddl.normal import TOO_MANY, Clause, EffectItem, dnf, expand, flatten_effect
 from alica.prophet.planner import Limits
+from alica.source import SourceSpan
 
 CHECK_EVERY = 4096
 """Steps of the fixpoint between two checks of the limits."""
@@ -86,6 +105,23 @@ class GroundAction:
     cost: int
 
 
+@dataclass(frozen=True, slots=True)
+class GroundRule:
+    """A reachable ground rule of a derived predicate: ``head`` holds when ``pos`` hold and ``neg`` do not.
+
+    Attributes:
+        head: the derived fact.
+        pos: positive body facts on changing (or derived) predicates.
+        neg: negated body facts on changing (or derived) predicates.
+        layer: the stratum of the head's predicate (negated derived body facts are of lower strata).
+    """
+
+    head: GroundAtom
+    pos: tuple[GroundAtom, ...]
+    neg: tuple[GroundAtom, ...]
+    layer: int
+
+
 CompiledAtom = tuple[str, tuple[Arg, ...]]
 
 
@@ -104,15 +140,30 @@ class _Schema:
     costs: tuple[int | float | tuple[str, tuple[Arg, ...]], ...]
     plans: tuple[tuple, ...] = ()
     fast: tuple = ()
+    n_args: int = -1
+    """How many of ``params`` are the action's (the rest come from an ``exists``); -1: all."""
+    axiom: bool = False
+    """Whether this is the rule of a derived predicate (its one effect adds the head)."""
 
 
 class Fixpoint:
     """The reachable ground actions of a problem (see the module docstring).
 
+    Derived predicates (the domain's ``:derived`` rules and those that
+    :mod:`alica.prophet.pddl.adl` makes for conditions too large to multiply
+    out) are grounded as rule schemas whose one effect adds the head: they are
+    kept apart from the actions in :attr:`rules`.
+
     Attributes:
-        fluent: predicates some action changes (the others are static).
+        fluent: predicates some action changes, and the derived ones (the others are static).
+        derived: the derived predicates (the domain's and the generated ones).
+        layer: per derived predicate, its stratum.
         init: the initial facts.
         actions: the reachable ground actions, in the order found.
+        rules: the reachable ground rules of derived predicates.
+        goal_literals: the goal as one conjunction of literals (a goal that is no conjunction
+            is the derived atom ``(goal@)``).
+        goal_reason: why the goal is false in every state (else None).
         has_costs: whether some action increases total-cost.
     """
 
@@ -142,24 +193,37 @@ class Fixpoint:
                 self.init.add(fact)
                 self._init_order.append(fact)
         self._init_predicates = {f[0] for f in self._init_order}
-        flat = {a.name: flatten_effect(a.effect, self.objects_of) for a in domain.actions}
+        compiler = Compiler(self.objects_of)
+        for axiom in domain.axioms:
+            compiler.add_rules(axiom.predicate, axiom.parameters, axiom.body, f"'{axiom.predicate}'", axiom.span)
+        effects = {a.name: self._conditions(a, a.effect, dict(a.parameters), compiler) for a in domain.actions}
+        flat = {a.name: self._flatten(a, effects[a.name]) for a in domain.actions}
         self.fluent = {item.atom.predicate for items, _ in flat.values() for item in items}
         self.has_costs = any(costs for _, costs in flat.values())
+        preconditions = {a.name: self._precondition(a, compiler) for a in domain.actions}
+        self.fluent |= domain.derived | set(compiler.arity)
+        self.goal_literals, self.goal_reason = self._goal(problem.goal, compiler)
+        self.derived = set(domain.derived) | set(compiler.arity) | {r.predicate for r in compiler.rules}
+        self.derived |= {
+            a.predicate for _, a in self.goal_literals if isinstance(a, Atom) and a.predicate == GOAL_PREDICATE
+        }
+        self.fluent |= self.derived
+        self.layer = strata(compiler.rules, self.derived, compiler.origin)
         self._schemas: list[_Schema] = []
         for action in domain.actions:
-            try:
-                clauses = dnf(expand(action.precondition, self.objects_of))
-            except PddlError as exc:
-                if exc.span is not None:
-                    raise
-                hint = TOO_MANY_HINT if exc.message == TOO_MANY else ""
-                raise PddlError(
-                    f"the precondition of action '{action.name}': {exc.message}", action.span, hint
-                ) from None
-            for clause in clauses:
-                schema = self._schema(action.name, action.parameters, clause, *flat[action.name])
+            for extra, clause in preconditions[action.name]:
+                schema = self._schema(action.name, action.parameters + extra, clause, *flat[action.name])
                 if schema is not None:
+                    schema.n_args = len(action.parameters)
                     self._schemas.append(schema)
+        for rule in compiler.rules:
+            head = [EffectItem(None, True, Atom(rule.predicate, rule.head))]
+            schema = self._schema(rule.predicate, rule.parameters, rule.clause, head, [])
+            if schema is not None:
+                schema.axiom = True
+                self._schemas.append(schema)
+        self.rules: list[GroundRule] = []
+        self._rule_seen: set[tuple] = set()
         self.actions: list[GroundAction] = []
         self._seen: set[tuple] = set()
         self._reached: set[GroundAtom] = set()
@@ -175,6 +239,70 @@ class Fixpoint:
             for i, (pred, _) in enumerate(schema.pos):
                 self._triggers.setdefault(pred, []).append((schema, i))
 
+    def _flatten(self, action: Action, effect: Effect) -> tuple[list[EffectItem], list]:
+        """The effect flattened (:func:`flatten_effect`); a refusal names the action's place."""
+        try:
+            return flatten_effect(effect, self.objects_of)
+        except PddlError as exc:
+            if exc.span is not None:
+                raise
+            raise PddlError(f"the effect of action '{action.name}': {exc.message}", action.span) from None
+
+    def _precondition(self, action: Action, compiler: Compiler) -> list[tuple[tuple[TypedName, ...], Clause]]:
+        """The precondition's conjunctions (with the variables of an ``exists`` each adds, if lifted).
+
+        Multiplied out as it is while that stays small; else through derived predicates.
+        """
+        try:
+            return [((), c) for c in dnf(expand(action.precondition, self.objects_of))]
+        except PddlError as exc:
+            if exc.span is not None:
+                raise
+            if exc.message != TOO_MANY:
+                raise PddlError(f"the precondition of action '{action.name}': {exc.message}", action.span) from None
+        return compiler.clauses(
+            action.precondition, action.parameters, f"action '{action.name}'", action.span, lift=True
+        )
+
+    def _conditions(self, action: Action, effect: Effect, scope: dict[str, str], compiler: Compiler) -> Effect:
+        """``effect`` with every ``when`` condition too large to multiply out written over derived predicates."""
+        if isinstance(effect, And):
+            return And(tuple(self._conditions(action, p, scope, compiler) for p in effect.parts))  # type: ignore[arg-type]
+        if isinstance(effect, Forall):
+            inner = {**scope, **dict(effect.variables)}
+            return Forall(effect.variables, self._conditions(action, effect.body, inner, compiler))  # type: ignore[arg-type]
+        if isinstance(effect, When):
+            body = self._conditions(action, effect.effect, scope, compiler)
+            try:
+                dnf(expand(effect.condition, self.objects_of))
+                return When(effect.condition, body)
+            except PddlError as exc:
+                if exc.span is not None or exc.message != TOO_MANY:
+                    raise
+            clauses = compiler.clauses(
+                effect.condition, tuple(scope.items()), f"action '{action.name}'", action.span, lift=False
+            )
+            condition: Formula = Or(
+                tuple(And(tuple(a if positive else Not(a) for positive, a in clause)) for _, clause in clauses)
+            )
+            return When(condition, body)
+        return effect
+
+    def _goal(self, goal: Formula, compiler: Compiler) -> tuple[Clause, str | None]:
+        """The goal as one conjunction: multiplied out if that gives one possible conjunction, else ``(goal@)``."""
+        try:
+            clauses = [c for c in dnf(expand(goal, self.objects_of)) if self.clause_possible(c)]
+        except PddlError as exc:
+            if exc.span is not None or exc.message != TOO_MANY:
+                raise
+            clauses = [(), ()]  # too many: the derived goal below
+        if not clauses:
+            return (), "the goal is false in every state (static facts or equalities)"
+        if len(clauses) == 1:
+            return clauses[0], None
+        compiler.add_rules(GOAL_PREDICATE, (), goal, "the goal", None)
+        return ((True, Atom(GOAL_PREDICATE, ())),), None
+
     def objects_of(self, kind: str) -> list[str]:
         """The objects of type ``kind`` or below it, in declaration order."""
         if kind not in self._types:
@@ -188,7 +316,11 @@ class Fixpoint:
             if isinstance(atom, Equals):
                 if (atom.left == atom.right) != positive:
                     return False
-            elif atom.predicate not in self.fluent and (((atom.predicate, *atom.args) in self.init) != positive):
+            elif (
+                atom.predicate not in self.fluent
+                and atom.predicate not in self._domain.derived
+                and (((atom.predicate, *atom.args) in self.init) != positive)
+            ):
                 return False
         return True
 
@@ -328,7 +460,7 @@ class Fixpoint:
 
     def estimate_bytes(self) -> int:
         """The estimated memory of the grounding so far (see :data:`BYTES_PER_ACTION`)."""
-        return len(self.actions) * BYTES_PER_ACTION + len(self._reached) * BYTES_PER_FACT
+        return (len(self.actions) + len(self.rules) // 2) * BYTES_PER_ACTION + len(self._reached) * BYTES_PER_FACT
 
     def check(self) -> None:
         """Check the limits (if any) now.
@@ -341,7 +473,9 @@ class Fixpoint:
             limits.check(
                 "grounding",
                 self.estimate_bytes(),
-                f"{len(self.actions)} ground actions, {len(self._reached)} facts so far",
+                f"{len(self.actions)} ground actions, "
+                + (f"{len(self.rules)} ground rules, " if self.rules else "")
+                + f"{len(self._reached)} facts so far",
                 FREE_SHARE * (limits.clock() - self._started),
             )
 
@@ -500,6 +634,14 @@ class Fixpoint:
                 return
         self._seen.add(key)
         pos = [(pred, *getter(ext)) for pred, getter in fast_pos]
+        if schema.axiom:
+            head = (plain[0][1], *plain[0][2](ext))
+            rule = (head, tuple(pos), tuple(neg))
+            if rule not in self._rule_seen:
+                self._rule_seen.add(rule)
+                self.rules.append(GroundRule(head, rule[1], rule[2], self.layer[head[0]]))
+            self._reach(head)
+            return
         add: list[GroundAtom] = []
         delete: list[GroundAtom] = []
         for positive, pred, getter in plain:
@@ -520,7 +662,7 @@ class Fixpoint:
         cost = self._cost(schema, value)
         action = GroundAction(
             schema.action,
-            args,
+            args if schema.n_args < 0 else args[: schema.n_args],
             tuple(pos),
             tuple(neg),
             tuple(add),
@@ -570,6 +712,10 @@ class Fixpoint:
                 out.append((tuple(sorted(set(c_pos))), tuple(sorted(set(c_neg)))))
         return out
 
+    def _span(self, action: str) -> SourceSpan | None:
+        found = self._domain.action(action)
+        return found.span if found is not None else None
+
     def _cost(self, schema: _Schema, value) -> int:  # type: ignore[no-untyped-def]
         if not self.has_costs:
             return 1
@@ -578,11 +724,16 @@ class Fixpoint:
             if isinstance(cost, tuple):
                 fluent = (cost[0], *(value(a) for a in cost[1]))
                 if fluent not in self.values:
-                    raise PddlError(f"action {schema.action}: fluent {fact_text(fluent)} has no value in :init")
+                    raise PddlError(
+                        f"action {schema.action}: fluent {fact_text(fluent)} has no value in :init",
+                        self._span(schema.action),
+                    )
                 amount = self.values[fluent]
             else:
                 amount = cost
             if amount < 0 or amount != int(amount):
-                raise PddlError(f"action {schema.action}: cost {amount} is not a non-negative integer")
+                raise PddlError(
+                    f"action {schema.action}: cost {amount} is not a non-negative integer", self._span(schema.action)
+                )
             total += amount
         return int(total)

@@ -7,6 +7,7 @@ from alica.prophet.pddl.model import (
     Action,
     And,
     Atom,
+    Axiom,
     Domain,
     Effect,
     Equals,
@@ -99,6 +100,11 @@ def _action(action: Action) -> str:
     return "\n".join(lines)
 
 
+def _axiom(axiom: Axiom) -> str:
+    head = f"({' '.join((axiom.predicate, _typed(axiom.parameters)))})".replace(" )", ")")
+    return f"  (:derived {head}\n    {write_formula(axiom.body, 4)})"
+
+
 def _types(types: dict[str, tuple[str, ...]]) -> str:
     by_parent: dict[str, list[str]] = {}
     for child in sorted(types):
@@ -132,6 +138,7 @@ def write_domain(domain: Domain) -> str:
             f"({' '.join((f.name, _typed(f.parameters)))}) - number".replace(" )", ")") for f in domain.functions
         )
         parts.append(f"  (:functions\n    {decls})")
+    parts.extend(_axiom(a) for a in domain.axioms)
     parts.extend(_action(a) for a in domain.actions)
     return "\n".join(parts) + ")\n"
 

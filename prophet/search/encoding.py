@@ -8,12 +8,19 @@ static false fact are dropped, and so are operators a relaxed exploration from
 the initial state never reaches. Successors are generated through a watch
 index: every operator watches one of its (fluent) preconditions, so a state
 only tests the operators watching one of its true facts.
+
+A task with derived predicates compiles to an :class:`AxiomTask`: its states
+hold the basic and the derived facts, and its successor (and initial state)
+recompute the derived facts from the basic ones, layer by layer (each layer
+to its fixpoint, negated derived facts of lower layers read as final), so
+that ``applicable`` and ``is_goal`` read derived facts like any other. A task
+without them keeps the plain :class:`CompiledTask` (no cost on that path).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 CondEffect = tuple[int, int, int]
@@ -124,6 +131,97 @@ class CompiledTask:
         return sum(cost[op] for op in ops)
 
 
+@dataclass(slots=True)
+class AxiomTask(CompiledTask):
+    """A compiled task with derived facts (see the module docstring).
+
+    Attributes:
+        derived_mask: the derived facts.
+        axioms: per compiled axiom, ``(head, fluent positive body, negated derived body, layer)``.
+        relaxed_axioms: the rules the delete relaxation uses, ``(head, fluent body)``: the task's
+            ``relaxed_axioms`` (negated derived facts read through their ``(not@p ...)`` facts, which
+            have rules of their own).
+        layers: per layer in increasing order, the axioms checked first (no positive body fact of
+            their own layer) and, per fact of the layer, the axioms to check once it holds.
+    """
+
+    derived_mask: int = 0
+    relaxed_axioms: list[tuple[int, tuple[int, ...]]] = field(default_factory=list)
+    axioms: list[tuple[int, tuple[int, ...], tuple[int, ...], int]] = field(default_factory=list)
+    layers: list[tuple[list[int], dict[int, list[int]]]] = field(default_factory=list)
+    ax_pre: list[int] = field(default_factory=list)
+    ax_neg: list[int] = field(default_factory=list)
+    ax_head: list[int] = field(default_factory=list)
+
+    def closure(self, state: int) -> int:
+        """``state`` (basic facts) with the derived facts that follow from them."""
+        ax_pre = self.ax_pre
+        ax_neg = self.ax_neg
+        ax_head = self.ax_head
+        axioms = self.axioms
+        for first, triggers in self.layers:
+            queue: list[int] = []
+            for a in first:
+                m = ax_pre[a]
+                if state & m == m and not state & ax_neg[a]:
+                    h = ax_head[a]
+                    if not state & h:
+                        state |= h
+                        queue.append(axioms[a][0])
+            while queue:
+                for a in triggers.get(queue.pop(), ()):
+                    m = ax_pre[a]
+                    if state & m == m and not state & ax_neg[a]:
+                        h = ax_head[a]
+                        if not state & h:
+                            state |= h
+                            queue.append(axioms[a][0])
+        return state
+
+    def successor(self, state: int, op: int) -> int:
+        """The state after ``op``, its derived facts recomputed."""
+        return self.closure(CompiledTask.successor(self, state, op) & ~self.derived_mask)
+
+
+def _axiom_parts(
+    axioms: list[tuple[int, tuple[int, ...], tuple[int, ...], int]],
+) -> list[tuple[list[int], dict[int, list[int]]]]:
+    """The layers of :class:`AxiomTask` (axioms as (head, positive body, negated body, layer))."""
+    layer_of = {head: layer for head, _, _, layer in axioms}
+    out: dict[int, tuple[list[int], dict[int, list[int]]]] = {}
+    for a, (_head, pos, _neg, layer) in enumerate(axioms):
+        first, triggers = out.setdefault(layer, ([], {}))
+        own = [f for f in pos if layer_of.get(f) == layer]
+        if not own:
+            first.append(a)
+        for f in own:
+            triggers.setdefault(f, []).append(a)
+    return [out[k] for k in sorted(out)]
+
+
+def _changing_derived(axioms: Sequence[Any], derived: frozenset[int], fluent: list[bool]) -> set[int]:
+    """The derived facts that may change: those with a rule reading a changing basic fact or such a derived fact.
+
+    The others (no rule, or rules over static facts and such derived facts only) keep the value
+    they have in the initial state: they are compiled away like static facts.
+    """
+    readers: dict[int, list[int]] = {}
+    changing: set[int] = set()
+    for a in axioms:
+        for f in (*a.pos, *a.neg):
+            if f in derived:
+                readers.setdefault(f, []).append(a.head)
+            elif fluent[f]:
+                changing.add(a.head)
+    stack = list(changing)
+    while stack:
+        for head in readers.get(stack.pop(), ()):
+            if head not in changing:
+                changing.add(head)
+                stack.append(head)
+    return changing
+
+
 def _reachable(n_facts: int, init: set[int], pres: list[tuple[int, ...]], adds: list[tuple[int, ...]]) -> list[bool]:
     """Which relaxed actions a relaxed exploration from ``init`` reaches."""
     users: list[list[int]] = [[] for _ in range(n_facts)]
@@ -215,6 +313,11 @@ def compile_task(task: Any) -> CompiledTask:
                 if f not in init_set:
                     fluent[f] = True
 
+    task_axioms = getattr(task, "axioms", ())
+    derived: frozenset[int] = getattr(task, "derived", frozenset())
+    for f in _changing_derived(task_axioms, derived, fluent):  # recomputed in every state
+        fluent[f] = True
+
     def usable(ids: Sequence[int]) -> bool:
         return all(fluent[f] or f in init_set for f in ids)
 
@@ -239,13 +342,26 @@ def compile_task(task: Any) -> CompiledTask:
                 r_pre.append(tuple(sorted(set(fpre) | {f for f in when if fluent[f]})))
                 r_add.append(tuple(f for f in cadd if fluent[f]))
                 r_of.append(k)
+    n_ops = len(r_pre)
+    ax_cand = [
+        a
+        for a in task_axioms
+        if fluent[a.head] and usable(a.pos) and not any(not fluent[f] and f in init_set for f in a.neg)
+    ]
+    for a in ax_cand:  # negated derived bodies count as true in the relaxation
+        r_pre.append(tuple(f for f in a.pos if fluent[f]))
+        r_add.append((a.head,))
     reached = _reachable(n, init_set, r_pre, r_add)
     keep_cand = [reached[a] for a in main]
     relaxed_facts = set(init_set)
-    for a, ok in enumerate(reached):
+    for a, ok in enumerate(reached[:n_ops]):
         if ok and keep_cand[r_of[a]]:
             relaxed_facts.update(r_add[a])
-    if not any(task.operators[i].conditional for i in cand):
+    for a, ok in enumerate(reached[n_ops:], n_ops):
+        if ok:
+            relaxed_facts.update(r_add[a])
+    kept_axioms = [(a.head, r_pre[n_ops + k], a.neg, a.layer) for k, a in enumerate(ax_cand) if reached[n_ops + k]]
+    if not task_axioms and not any(task.operators[i].conditional for i in cand):
         _keep_relevant(task, cand, keep_cand, fluent)
 
     source: list[int] = []
@@ -294,11 +410,12 @@ def compile_task(task: Any) -> CompiledTask:
             watch[min(p, key=lambda f: (uses[f], f))].append(op)
     watch_mask = mask([f for f in range(n) if watch[f]])
     goal = tuple(task.goal)
-    return CompiledTask(
+    kind = AxiomTask if task_axioms else CompiledTask
+    ct = kind(
         task=task,
         n_facts=n,
         init=mask([f for f in sorted(init_set) if fluent[f]]),
-        goal_mask=mask([f for f in goal if fluent[f]]),
+        goal_mask=mask([f for f in goal if fluent[f] or f not in init_set]),  # a static false goal: never
         goal=goal,
         source=source,
         pre=pre,
@@ -315,3 +432,14 @@ def compile_task(task: Any) -> CompiledTask:
         unit_cost=all(c == 1 for c in cost),
         solvable_relaxed=all(f in relaxed_facts for f in goal),
     )
+    if isinstance(ct, AxiomTask):
+        ct.derived_mask = mask(sorted(f for f in derived if fluent[f]))
+        ct.axioms = kept_axioms
+        ct.layers = _axiom_parts(kept_axioms)
+        ct.ax_pre = [mask(p) for _, p, _, _ in kept_axioms]
+        ct.ax_neg = [mask(g) for _, _, g, _ in kept_axioms]
+        ct.ax_head = [1 << h for h, _, _, _ in kept_axioms]
+        relaxed = getattr(task, "relaxed_axioms", ())
+        ct.relaxed_axioms = [(h, tuple(f for f in p if fluent[f])) for h, p in relaxed if fluent[h] and usable(p)]
+        ct.init = ct.closure(ct.init & ~ct.derived_mask)
+    return ct

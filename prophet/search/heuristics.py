@@ -47,6 +47,11 @@ class Relaxed:
                 r_add.append(cadd)
                 r_cost.append(ct.cost[op])
                 r_op.append(op)
+        for head, pos in getattr(ct, "relaxed_axioms", ()):  # derived facts: free, never preferred
+            r_pre.append(pos)
+            r_add.append((head,))
+            r_cost.append(0)
+            r_op.append(-1)
         n = ct.n_facts
         pre_of: list[list[int]] = [[] for _ in range(n)]
         multi_of: list[list[int]] = [[] for _ in range(n)]
@@ -65,6 +70,7 @@ class Relaxed:
         self.r_add = r_add
         self.r_cost = r_cost
         self.r_op = r_op
+        self.r_unit = [1 if op >= 0 else 0 for op in r_op]
         self.r_pre_mask = [mask(p) for p in r_pre]
         self.pre_of = pre_of
         self.zero = [a for a, p in enumerate(r_pre) if not p]
@@ -150,6 +156,7 @@ class Relaxed:
         r_pre = self.r_pre
         r_cost = self.r_cost
         r_op = self.r_op
+        r_unit = self.r_unit
         r_pre_mask = self.r_pre_mask
         used = bytearray(len(r_pre))
         done = bytearray(len(sup))
@@ -175,11 +182,11 @@ class Relaxed:
             if used[a]:
                 continue
             used[a] = 1
-            h += 1 if unit else r_cost[a]
+            h += r_unit[a] if unit else r_cost[a]
             m = r_pre_mask[a]
             if state & m == m:
                 op = r_op[a]
-                if op not in preferred:
+                if op >= 0 and op not in preferred:
                     preferred.append(op)
             for p in r_pre[a]:
                 if not done[p]:

@@ -30,6 +30,7 @@ class BuiltinPlanner(Planner):
             Feature.EQUALITY,
             Feature.CONDITIONAL_EFFECTS,
             Feature.ACTION_COSTS,
+            Feature.DERIVED_PREDICATES,
         }
     )
 

@@ -52,7 +52,7 @@ class Windows:
                 by_object.setdefault(name, []).append(op)
         self.by_object = by_object
         self.no_args = no_args
-        self.exact = not any(ct.cond)
+        self.exact = not any(ct.cond) and not getattr(ct, "axioms", None)  # derived facts: no swap analysis
         self.failed: dict[tuple[int, int, frozenset[str]], tuple[int, int]] = {}
         """Window searches that found nothing: (start, needed facts, objects) -> (bound, state limit)."""
 

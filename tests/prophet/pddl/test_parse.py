@@ -101,9 +101,9 @@ BROKEN = [
         r"d\.pddl:2:47: error: undefined variable '\?y'",
     ),
     (
-        "derived predicates",
+        "undeclared derived predicate",
         "(define (domain d) (:derived (p) (q)))",
-        r"d\.pddl:1:20: error: unsupported construct '\(:derived",
+        r"d\.pddl:1:31: error: undefined derived predicate 'p'",
     ),
     (
         "numeric effect",
