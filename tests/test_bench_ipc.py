@@ -69,3 +69,12 @@ def test_ipc_report_on_made_up_outcomes() -> None:
     assert "| invalid plans (ours) | 0 | 0 | met |" in text
     assert "### Problems ours fails (2)" in text
     assert "| d | p2 | ours | exit 1 | 0.30 | error: unsupported construct |" in text
+
+
+def test_ipc_report_counts_a_peer_plan_our_reader_refuses_as_solved_and_says_so() -> None:
+    bench = _bench()
+    ours = bench.Outcome(bench.Job(bench.OURS, "d", "p1", Path(), Path()), 0.2, "exit 1", note="error: '(:derived'")
+    fd = bench.Outcome(bench.Job(bench.FD, "d", "p1", Path(), Path()), 0.5, "ok", cost=3.0, valid="UNCHECKED")
+    text = bench.ipc_report([ours, fd], 30, 10)
+    assert "| coverage | ours 0/1 vs fd 1/1 (same run) | >= fd's count | missed |" in text
+    assert "includes 1 plan(s) our validator cannot read the task of (not validated): d/p1." in text
