@@ -651,15 +651,27 @@ def ipc_report(outcomes: Sequence[Outcome], limit: float, budget: float) -> str:
     ]
     out += ["\n### Issue 22's goals\n", markdown(["goal", "measured", "target", "status"], goals)]
 
+    def reason(run: Outcome) -> str:
+        if run.valid == "INVALID":
+            return f"invalid plan: {run.note}"
+        if run.status == "killed" and not run.note:
+            return f"no answer within its time limit + {GRACE_S:g} s grace: killed"
+        return run.note
+
     failing = []
     for d in domains:
         for p in keys[d]:
-            for planner in (OURS, ANYTIME):
-                run = by.get((planner, d, p))
-                if run is not None and not run.solved:
-                    reason = run.note if run.valid != "INVALID" else f"invalid plan: {run.note}"
-                    failing.append([d, p, planner, run.status, f"{run.wall_s:.2f}", reason.replace("|", "\\|")])
-    out.append(f"\n### Problems ours fails ({len(failing)})\n")
+            runs = [(name, r) for name, r in (("first", by.get((OURS, d, p))), ("anytime", by.get((ANYTIME, d, p))))]
+            fails = [(name, r) for name, r in runs if r is not None and not r.solved]
+            if len(fails) == 2 and (fails[0][1].status, reason(fails[0][1])) == (
+                fails[1][1].status,
+                reason(fails[1][1]),
+            ):
+                fails = [("first, anytime", fails[0][1])]
+            for name, run in fails:
+                failing.append([d, p, name, run.status, f"{run.wall_s:.2f}", reason(run).replace("|", "\\|")])
+    problems_failing = len({(row[0], row[1]) for row in failing})
+    out.append(f"\n### Problems ours fails ({problems_failing}; run: first plan, anytime or both)\n")
     out.append(markdown(["domain", "problem", "run", "status", "wall s", "reason"], failing) if failing else "none")
     return "\n".join(out)
 
