@@ -663,16 +663,19 @@ def ipc_report(outcomes: Sequence[Outcome], limit: float, budget: float) -> str:
         for p in keys[d]:
             runs = [(name, r) for name, r in (("first", by.get((OURS, d, p))), ("anytime", by.get((ANYTIME, d, p))))]
             fails = [(name, r) for name, r in runs if r is not None and not r.solved]
-            if len(fails) == 2 and (fails[0][1].status, reason(fails[0][1])) == (
-                fails[1][1].status,
-                reason(fails[1][1]),
-            ):
-                fails = [("first, anytime", fails[0][1])]
+            if len(fails) == 2 and fails[0][1].status == fails[1][1].status:
+                first, anytime = fails[0][1], fails[1][1]
+                walls = f"{first.wall_s:.2f} / {anytime.wall_s:.2f}"
+                fails = [("first, anytime", first)]
+            else:
+                walls = ""
             for name, run in fails:
-                failing.append([d, p, name, run.status, f"{run.wall_s:.2f}", reason(run).replace("|", "\\|")])
+                wall = walls or f"{run.wall_s:.2f}"
+                failing.append([d, p, name, run.status, wall, reason(run).replace("|", "\\|")])
     problems_failing = len({(row[0], row[1]) for row in failing})
     out.append(f"\n### Problems ours fails ({problems_failing}; run: first plan, anytime or both)\n")
-    out.append(markdown(["domain", "problem", "run", "status", "wall s", "reason"], failing) if failing else "none")
+    header = ["domain", "problem", "run", "status", "wall s (first / anytime)", "reason (the first run's)"]
+    out.append(markdown(header, failing) if failing else "none")
     return "\n".join(out)
 
 

@@ -68,7 +68,7 @@ def test_ipc_report_on_made_up_outcomes() -> None:
     assert "| anytime 10 s cost, summed | 0.70x | <= 0.8x | met |" in text
     assert "| invalid plans (ours) | 0 | 0 | met |" in text
     assert "### Problems ours fails (1; run: first plan, anytime or both)" in text
-    assert "| d | p2 | first, anytime | exit 1 | 0.30 | error: unsupported construct |" in text
+    assert "| d | p2 | first, anytime | exit 1 | 0.30 / 0.30 | error: unsupported construct |" in text
 
 
 def test_ipc_report_counts_a_peer_plan_our_reader_refuses_as_solved_and_says_so() -> None:
