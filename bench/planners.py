@@ -21,7 +21,18 @@ p01-p20 vs the IMPERA paper's Table 1, our first plan and ours after the anytime
 ours at most that on each); blocks after the anytime budget vs the optimum (goal: total at
 most 1.15x); the grounding time of Rovers p18-p20 (goal: at most 0.1 s each).
 
+With ``--suite ipc`` (issue 22) the 175 problems of the 26 domains in ``benchmarks/ipc/`` instead (airport
+and psr-small: each problem ``pNN-*.pddl`` with its own ``pNN-domain.pddl``), 30 s each: ours (first plan),
+Fast Downward lama-first, then ours with ``--anytime --time-limit 10`` on every problem. Each run is appended
+to ``build/bench/ipc_runs.tsv`` as it completes; at the end three markdown tables: per domain (solved, invalid,
+errors, total time and first-plan cost on the problems both solve, anytime cost vs FD's), issue 22's goals
+(met or missed) and the problems ours fails with the reason. ``--report-only`` prints the tables from that
+TSV (of a run stopped early, say).
+
 Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick]``
+
+or: ``.venv/bin/python bench/planners.py --suite ipc [--domains a,b] [--limit N] [--time-limit 30]
+[--anytime-budget 10] [--skip-anytime] [--skip-fd] [--report-only]``
 """
 
 from __future__ import annotations
@@ -37,6 +48,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -53,6 +65,7 @@ from alica.prophet.planners.planfile import parse_plan
 from alica.prophet.validate import validate_plan
 
 BENCHMARKS = ROOT / "benchmarks" / "pddl"
+IPC = ROOT / "benchmarks" / "ipc"
 OUT = ROOT / "build" / "bench"
 IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""
@@ -155,8 +168,8 @@ def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Out
         "-m",
         "alica.app.cli",
         "plan",
-        str(job.domain_file),
-        str(job.problem_file),
+        os.path.relpath(job.domain_file, ROOT),
+        os.path.relpath(job.problem_file, ROOT),
         "--json",
         "--time-limit",
         f"{limit:g}",
@@ -168,7 +181,7 @@ def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Out
         return Outcome(job, proc.wall_s, "killed")
     if proc.code != 0:
         status = {3: "unsolvable", 4: "timeout"}.get(proc.code or 0, f"exit {proc.code}")
-        return Outcome(job, proc.wall_s, status, note=_last_line(proc.err))
+        return Outcome(job, proc.wall_s, status, note=_json_error(proc.out) or _last_line(proc.err))
     summary = json.loads(proc.out)
     steps = parse_plan("\n".join(summary["plan"])).steps
     return _validated(Outcome(job, proc.wall_s, "ok"), steps, tasks, claimed=summary["cost"])
@@ -223,7 +236,12 @@ def run_pyperplan(job: Job, limit: float, tasks: Tasks) -> Outcome:
 
 
 def _validated(outcome: Outcome, steps: tuple[PlanStep, ...], tasks: Tasks, claimed: float | None) -> Outcome:
-    valid, cost, reason = tasks.check(outcome.job, steps)
+    try:
+        valid, cost, reason = tasks.check(outcome.job, steps)
+    except Exception as error:  # our reader refuses the task (a peer's plan on a domain ours cannot read)
+        outcome.steps, outcome.cost, outcome.valid = steps, claimed, "UNCHECKED"
+        outcome.note = "not validated: " + str(error).strip().splitlines()[0].replace(f"{ROOT}{os.sep}", "")
+        return outcome
     outcome.steps, outcome.cost = steps, cost
     outcome.valid = "VALID" if valid else "INVALID"
     if not valid:
@@ -231,6 +249,15 @@ def _validated(outcome: Outcome, steps: tuple[PlanStep, ...], tasks: Tasks, clai
     elif claimed is not None and abs(claimed - cost) > 1e-9:
         outcome.note = f"claimed cost {claimed}, validated {cost}"
     return outcome
+
+
+def _json_error(out: str) -> str:
+    """The first line of the error ``alica plan --json`` printed for a refused input ("" if none)."""
+    with contextlib.suppress(ValueError, AttributeError):
+        error = json.loads(out).get("error")
+        if error:
+            return str(error).strip().splitlines()[0]
+    return ""
 
 
 def _last_line(text: str) -> str:
@@ -481,30 +508,229 @@ def jobs_for(domains: Sequence[str], limit: int | None, quick: bool, planners: S
     return jobs + anytime
 
 
+RUN_HEADER = ("planner", "domain", "problem", "status", "valid", "cost", "wall_s", "note")
+GOAL_TIME, GOAL_ANYTIME, GOAL_FIRST = 1.0, 0.8, 1.1
+"""Issue 22's goals on the IPC suite: ours / FD on total time, anytime cost and first-plan cost."""
+
+
+def ipc_problems(domain: str, limit: int | None) -> list[Job]:
+    """The problems of ``benchmarks/ipc/DOMAIN`` (natural order), each with its domain file, as planner-less jobs.
+
+    A folder holds ``domain.pddl``, or (airport, psr-small) one ``pNN-domain.pddl`` per problem ``pNN-*.pddl``.
+    """
+    folder = IPC / domain
+    shared = folder / "domain.pddl"
+    jobs = []
+    for path in sorted((p for p in folder.glob("*.pddl") if "domain" not in p.name), key=lambda p: _order(p.stem)):
+        domain_file = shared if shared.exists() else folder / f"{path.stem.split('-')[0]}-domain.pddl"
+        if not domain_file.exists():
+            raise FileNotFoundError(f"no domain file for {path.relative_to(ROOT)}")
+        jobs.append(Job("", domain, path.stem, domain_file, path))
+    return jobs[:limit] if limit is not None else jobs
+
+
+def ipc_domains() -> list[str]:
+    """Every domain folder of ``benchmarks/ipc``."""
+    return sorted(p.name for p in IPC.iterdir() if p.is_dir())
+
+
+def ipc_jobs(domains: Sequence[str], limit: int | None, planners: Sequence[str]) -> list[Job]:
+    """Every job of an IPC run: per problem ours and FD (those in ``planners``); then the anytime runs."""
+    bases = [base for domain in domains for base in ipc_problems(domain, limit)]
+    first = [
+        Job(p, b.domain, b.problem, b.domain_file, b.problem_file) for b in bases for p in planners if p != ANYTIME
+    ]
+    later = [Job(ANYTIME, b.domain, b.problem, b.domain_file, b.problem_file) for b in bases if ANYTIME in planners]
+    return first + later
+
+
+def run_row(o: Outcome) -> list[object]:
+    """One run as a row of ``RUN_HEADER``."""
+    cost = "-" if o.cost is None else f"{o.cost:g}"
+    return [o.job.planner, o.job.domain, o.job.problem, o.status, o.valid, cost, f"{o.wall_s:.3f}", o.note]
+
+
+def read_runs(path: Path) -> list[Outcome]:
+    """The runs of a ``RUN_HEADER`` TSV (as :func:`run_row` wrote them), for a report without running."""
+    outcomes = []
+    for line in path.read_text(encoding="utf-8").splitlines()[1:]:
+        planner, domain, problem, status, valid, cost, wall, note = (line.split("\t") + [""] * 8)[:8]
+        job = Job(planner, domain, problem, Path(), Path())
+        value = None if cost == "-" else float(cost)
+        outcomes.append(Outcome(job, float(wall), status, cost=value, valid=valid, note=note))
+    return outcomes
+
+
+def _ratio(ours: float, peer: float) -> str:
+    return f"{ours / peer:.2f}x" if peer else "-"
+
+
+def ipc_report(outcomes: Sequence[Outcome], limit: float, budget: float) -> str:
+    """The IPC suite's tables as markdown: per domain, issue 22's goals, the problems ours fails."""
+    by = {(o.job.planner, o.job.domain, o.job.problem): o for o in outcomes}
+    domains = sorted({o.job.domain for o in outcomes})
+    has_fd = any(o.job.planner == FD for o in outcomes)
+    has_anytime = any(o.job.planner == ANYTIME for o in outcomes)
+    keys = {d: sorted({o.job.problem for o in outcomes if o.job.domain == d}, key=_order) for d in domains}
+
+    def sums(domain_list: Sequence[str]) -> list[float]:
+        n = solved_o = solved_f = invalid_o = invalid_f = errors = 0
+        t_o = t_f = c_o = c_f = a_o = a_f = 0.0
+        for d in domain_list:
+            for p in keys[d]:
+                ours, fd, anytime = by.get((OURS, d, p)), by.get((FD, d, p)), by.get((ANYTIME, d, p))
+                n += 1
+                solved_o += bool(ours and ours.solved)
+                solved_f += bool(fd and (fd.solved or fd.valid == "UNCHECKED"))
+                invalid_o += sum(1 for r in (ours, anytime) if r and r.valid == "INVALID")
+                invalid_f += bool(fd and fd.valid == "INVALID")
+                errors += bool(ours and ours.status.startswith("exit"))
+                if ours and fd and ours.solved and fd.solved:
+                    t_o, t_f = t_o + ours.wall_s, t_f + fd.wall_s
+                    c_o, c_f = c_o + (ours.cost or 0.0), c_f + (fd.cost or 0.0)
+                if anytime and fd and anytime.solved and fd.solved:
+                    a_o, a_f = a_o + (anytime.cost or 0.0), a_f + (fd.cost or 0.0)
+        return [n, solved_o, solved_f, invalid_o, invalid_f, errors, t_o, t_f, c_o, c_f, a_o, a_f]
+
+    def row(name: str, s: list[float]) -> list[object]:
+        n, so, sf, io, i_f, err, t_o, t_f, c_o, c_f, a_o, a_f = s
+        cells: list[object] = [name, int(n), int(so), int(sf) if has_fd else "-", f"{int(io)} / {int(i_f)}", int(err)]
+        cells += [f"{t_o:.2f}", f"{t_f:.2f}", _ratio(t_o, t_f), f"{c_o:g}", f"{c_f:g}", _ratio(c_o, c_f)]
+        cells += [f"{a_o:g}", f"{a_f:g}", _ratio(a_o, a_f)] if has_anytime else ["-", "-", "-"]
+        return cells
+
+    anytime_name = f"anytime {budget:g} s"
+    header = ["domain", "problems", "solved ours", f"solved fd ({limit:g} s)", "invalid ours / fd", "errors ours"]
+    header += ["time both ours s", "time both fd s", "time ratio", "first cost ours", "first cost fd", "first ratio"]
+    header += [f"{anytime_name} cost ours", f"{anytime_name} cost fd", f"{anytime_name} ratio"]
+    total = sums(domains)
+    rows = [row(d, sums([d])) for d in domains] + [row("total", total)]
+    out = [
+        f"### IPC suite: ours vs Fast Downward lama-first ({limit:g} s each, {anytime_name})\n",
+        markdown(header, rows),
+    ]
+    unchecked = [f"{o.job.domain}/{o.job.problem}" for o in outcomes if o.job.planner == FD and o.valid == "UNCHECKED"]
+    out.append(
+        "\n'time both' and 'first cost': the problems both ours (first plan) and FD solved; "
+        f"'{anytime_name}': the problems where ours after the anytime budget and FD have a plan; "
+        "errors: ours refused or crashed. Invalid plans count as unsolved."
+        + (
+            f" FD's solved count includes {len(unchecked)} plan(s) our validator cannot read the task of "
+            f"(not validated): {', '.join(unchecked)}."
+            if unchecked
+            else ""
+        )
+    )
+
+    n, so, sf, io, _, _, t_o, t_f, c_o, c_f, a_o, a_f = total
+
+    def goal(met: bool) -> str:
+        return "met" if met else "missed"
+
+    goals = [
+        ["coverage", f"ours {int(so)}/{int(n)} vs fd {int(sf)}/{int(n)} (same run)", ">= fd's count", goal(so >= sf)],
+        [
+            "total time on both-solved",
+            _ratio(t_o, t_f),
+            f"<= {GOAL_TIME:g}x",
+            goal(bool(t_f) and t_o <= GOAL_TIME * t_f),
+        ],
+        [
+            f"{anytime_name} cost, summed",
+            _ratio(a_o, a_f) if has_anytime else "not run",
+            f"<= {GOAL_ANYTIME:g}x",
+            goal(bool(a_f) and a_o <= GOAL_ANYTIME * a_f),
+        ],
+        [
+            "first-plan cost, summed",
+            _ratio(c_o, c_f),
+            f"<= {GOAL_FIRST:g}x",
+            goal(bool(c_f) and c_o <= GOAL_FIRST * c_f),
+        ],
+        ["invalid plans (ours)", str(int(io)), "0", goal(io == 0)],
+    ]
+    out += ["\n### Issue 22's goals\n", markdown(["goal", "measured", "target", "status"], goals)]
+
+    def reason(run: Outcome) -> str:
+        if run.valid == "INVALID":
+            return f"invalid plan: {run.note}"
+        if run.status == "killed" and not run.note:
+            return f"no answer within its time limit + {GRACE_S:g} s grace: killed"
+        return run.note
+
+    failing = []
+    for d in domains:
+        for p in keys[d]:
+            runs = [(name, r) for name, r in (("first", by.get((OURS, d, p))), ("anytime", by.get((ANYTIME, d, p))))]
+            fails = [(name, r) for name, r in runs if r is not None and not r.solved]
+            if len(fails) == 2 and fails[0][1].status == fails[1][1].status:
+                first, anytime = fails[0][1], fails[1][1]
+                walls = f"{first.wall_s:.2f} / {anytime.wall_s:.2f}"
+                fails = [("first, anytime", first)]
+            else:
+                walls = ""
+            for name, run in fails:
+                wall = walls or f"{run.wall_s:.2f}"
+                failing.append([d, p, name, run.status, wall, reason(run).replace("|", "\\|")])
+    problems_failing = len({(row[0], row[1]) for row in failing})
+    out.append(f"\n### Problems ours fails ({problems_failing}; run: first plan, anytime or both)\n")
+    header = ["domain", "problem", "run", "status", "wall s (first / anytime)", "reason (the first run's)"]
+    out.append(markdown(header, failing) if failing else "none")
+    return "\n".join(out)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the bench; returns the exit code."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
-        "--domains", default="blocks,rovers", help="comma-separated benchmark domains (default blocks,rovers)"
+        "--suite",
+        choices=("classic", "ipc"),
+        default="classic",
+        help="classic: benchmarks/pddl (blocks, rovers); ipc: the 26 domains of benchmarks/ipc (default classic)",
+    )
+    parser.add_argument(
+        "--domains", help="comma-separated benchmark domains (default blocks,rovers; for ipc every domain)"
     )
     parser.add_argument("--limit", type=int, help="the first N problems of each domain")
     parser.add_argument("--jobs", type=int, default=1, help="processes at a time (default 1: timings must not compete)")
     parser.add_argument("--quick", action="store_true", help="a few small problems per domain, for a smoke run")
-    parser.add_argument("--time-limit", type=float, default=60.0, metavar="S", help="wall seconds per run (default 60)")
+    parser.add_argument(
+        "--time-limit", type=float, metavar="S", help="wall seconds per run (default 60; 30 with --suite ipc)"
+    )
     parser.add_argument(
         "--anytime-budget",
         type=float,
         default=10.0,
         metavar="S",
-        help="ours --anytime on blocks with an optimum and Rovers p01-p20 (default 10)",
+        help="ours --anytime on blocks with an optimum and Rovers p01-p20, or every ipc problem (default 10)",
     )
     parser.add_argument("--planners", default=f"{OURS},fd,pyperplan", help="which of ours, fd, pyperplan (default all)")
+    parser.add_argument("--skip-anytime", action="store_true", help="ipc: no anytime runs")
+    parser.add_argument("--skip-fd", action="store_true", help="ipc: no Fast Downward runs")
+    parser.add_argument(
+        "--report-only",
+        action="store_true",
+        help="ipc: no runs, the tables from build/bench/ipc_runs.tsv (e.g. of a run stopped early)",
+    )
     args = parser.parse_args(argv)
+    if args.time_limit is None:
+        args.time_limit = 30.0 if args.suite == "ipc" else 60.0
 
-    names = {"ours": OURS, "fd": FD, "pyperplan": PYPERPLAN}
-    planners = [names[p.strip()] for p in args.planners.split(",") if p.strip()]
-    domains = [d.strip() for d in args.domains.split(",") if d.strip()]
-    jobs = jobs_for(domains, args.limit, args.quick, planners)
+    if args.suite == "ipc":
+        runs_path = OUT / "ipc_runs.tsv"
+        if args.report_only:
+            print(ipc_report(read_runs(runs_path), args.time_limit, args.anytime_budget))
+            return 0
+        domains = [d.strip() for d in args.domains.split(",") if d.strip()] if args.domains else ipc_domains()
+        planners = [OURS, *([] if args.skip_fd else [FD]), *([] if args.skip_anytime else [ANYTIME])]
+        jobs = ipc_jobs(domains, args.limit, planners)
+        OUT.mkdir(parents=True, exist_ok=True)
+        runs_path.write_text("\t".join(RUN_HEADER) + "\n", encoding="utf-8")
+    else:
+        names = {"ours": OURS, "fd": FD, "pyperplan": PYPERPLAN}
+        planners = [names[p.strip()] for p in args.planners.split(",") if p.strip()]
+        domains = [d.strip() for d in (args.domains or "blocks,rovers").split(",") if d.strip()]
+        jobs = jobs_for(domains, args.limit, args.quick, planners)
     tasks = Tasks()
     runners: dict[str, Callable[[Job], Outcome]] = {
         OURS: lambda j: run_ours(j, args.time_limit, tasks),
@@ -513,25 +739,34 @@ def main(argv: Sequence[str] | None = None) -> int:
         ANYTIME: lambda j: run_ours(j, args.anytime_budget, tasks, anytime=True),
     }
     print(f"{len(jobs)} runs, {args.jobs} at a time, {args.time_limit:g} s limit each", file=sys.stderr)
+    lock = threading.Lock()
 
     def one(job: Job) -> Outcome:
         outcome = runners[job.planner](job)
-        print(
-            f"  {job.planner:<18} {job.domain}/{job.problem:<16} {outcome.status:<10} {outcome.valid:<7} "
-            f"cost {_fmt(outcome.cost, 0):>4}  {outcome.wall_s:7.2f} s {outcome.note}",
-            file=sys.stderr,
-            flush=True,
-        )
+        with lock:
+            print(
+                f"  {job.planner:<18} {job.domain}/{job.problem:<16} {outcome.status:<10} {outcome.valid:<7} "
+                f"cost {_fmt(outcome.cost, 0):>4}  {outcome.wall_s:7.2f} s {outcome.note}",
+                file=sys.stderr,
+                flush=True,
+            )
+            if args.suite == "ipc":
+                with (OUT / "ipc_runs.tsv").open("a", encoding="utf-8") as runs:
+                    runs.write("\t".join(str(c).replace("\t", " ") for c in run_row(outcome)) + "\n")
         return outcome
 
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         outcomes = list(pool.map(one, jobs))
-    report(outcomes, args.time_limit, args.anytime_budget)
-    if "rovers" in domains and not args.quick:
-        grounding_table()
+    if args.suite == "ipc":
+        print(ipc_report(outcomes, args.time_limit, args.anytime_budget))
+    else:
+        report(outcomes, args.time_limit, args.anytime_budget)
+        if "rovers" in domains and not args.quick:
+            grounding_table()
     invalid = [o for o in outcomes if o.valid == "INVALID"]
     if invalid:
-        print(f"\n{len(invalid)} INVALID plan(s): see build/bench/planners_runs.tsv", file=sys.stderr)
+        runs_name = "ipc_runs" if args.suite == "ipc" else "planners_runs"
+        print(f"\n{len(invalid)} INVALID plan(s): see build/bench/{runs_name}.tsv", file=sys.stderr)
     return 1 if any(o.job.planner in (OURS, ANYTIME) and o.valid == "INVALID" for o in outcomes) else 0
 
 
