@@ -38,6 +38,7 @@ or: ``.venv/bin/python bench/planners.py --suite ipc [--domains a,b] [--limit N]
 from __future__ import annotations
 
 import argparse
+import compileall
 import contextlib
 import importlib.util
 import json
@@ -137,12 +138,30 @@ class Tasks:
         return result.valid, result.cost, result.reason
 
 
+def _child_env() -> dict[str, str]:
+    """The planners' environment: with bytecode caching, as an installed package has it.
+
+    Under ``PYTHONDONTWRITEBYTECODE`` an edited checkout recompiles its changed modules in every
+    process (0.1 s and more per run), while a peer installed by pip ships compiled bytecode.
+    """
+    env = dict(os.environ)
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
+def compile_bytecode() -> None:
+    """Compile the project's modules once, before any timed run (see :func:`_child_env`)."""
+    for folder in ("alica", "prophet", "skills", "worldsim", "plans"):
+        compileall.compile_dir(str(ROOT / folder), quiet=1)
+
+
 def run_process(command: Sequence[str], cwd: Path, timeout: float) -> Proc:
     """Run ``command`` in its own process group; kill the whole group after ``timeout`` wall seconds."""
     start = time.perf_counter()
     with subprocess.Popen(
         list(command),
         cwd=cwd,
+        env=_child_env(),
         stdin=subprocess.DEVNULL,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -713,6 +732,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="ipc: no runs, the tables from build/bench/ipc_runs.tsv (e.g. of a run stopped early)",
     )
     args = parser.parse_args(argv)
+    if not args.report_only:
+        compile_bytecode()
     if args.time_limit is None:
         args.time_limit = 30.0 if args.suite == "ipc" else 60.0
 
