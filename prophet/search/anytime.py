@@ -32,7 +32,7 @@ from collections.abc import Generator, Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from alica.prophet.planner import Done, Improved, Plan, PlanStatus, PlanStep, SearchEvent
+from alica.prophet.planner import Done, Improved, Limits, Plan, PlanStatus, PlanStep, SearchEvent
 from alica.prophet.search.astar import astar
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
@@ -118,6 +118,7 @@ def search_task(
     progress_every: int = 1000,
     optimal_pass: bool = True,
     first: FirstSearch | None = None,
+    limits: Limits | None = None,
 ) -> Iterator[SearchEvent]:
     """Search a grounded task (``GroundTask`` shape), yielding planner events.
 
@@ -130,11 +131,15 @@ def search_task(
             (and with inadmissible passes only) the run ends with
             ``Done(SOLVED)`` after one round.
         first: how the first plan is searched; ``None`` is ``FirstSearch()``.
+        limits: the run's deadline, checked while searching (every few expansions).
 
     Yields:
         ``Progress``, ``Improved`` for each cheaper plan, one final ``Done``.
+
+    Raises:
+        LimitReached: the deadline of ``limits`` passed (``Planner.search`` turns it into ``Done(TIMEOUT)``).
     """
-    stats = Stats(progress_every)
+    stats = Stats(progress_every, limits)
     reason = getattr(task, "unsolvable_reason", None)
     if reason:
         yield Done(PlanStatus.UNSOLVABLE, 0, str(reason))

@@ -63,8 +63,7 @@ def astar(
         expanded += 1
         if expanded > max_expansions:
             return None, False
-        if stats.expansions >= stats.next_progress:
-            stats.next_progress += stats.progress_every
+        if stats.progress_due():
             yield Progress(stats.expansions)
         for o in applicable(state):
             g2 = g + op_cost[o]

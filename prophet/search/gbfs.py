@@ -23,30 +23,58 @@ from collections.abc import Generator
 from dataclasses import dataclass
 from heapq import heappop, heappush
 
-from alica.prophet.planner import Progress
+from alica.prophet.planner import Limits, Progress
 from alica.prophet.search.encoding import CompiledTask
 from alica.prophet.search.heuristics import INF, Evaluator
+
+CHECK_EVERY = 16
+"""Expansions between two checks of the run's limits (a slow heuristic evaluates some 50 states a second)."""
 
 
 @dataclass(slots=True)
 class Stats:
-    """Counters shared by the searches of one planner run.
+    """Counters shared by the searches of one planner run, and the run's limits.
 
     Attributes:
         progress_every: expansions between two ``Progress`` events.
+        limits: the run's deadline, checked every :data:`CHECK_EVERY` expansions (``None``: none);
+            a search that passes it raises :class:`~alica.prophet.planner.LimitReached`.
         expansions: states expanded so far (all searches together).
         evaluations: heuristic evaluations so far.
         next_progress: the expansion count of the next ``Progress``.
+        next_check: the expansion count of the next check of the limits.
     """
 
     progress_every: int = 1000
+    limits: Limits | None = None
     expansions: int = 0
     evaluations: int = 0
     next_progress: int = 0
+    next_check: int = 0
 
     def __post_init__(self) -> None:
         self.progress_every = max(1, int(self.progress_every))
         self.next_progress = self.progress_every
+        self.next_check = CHECK_EVERY
+
+    def progress_due(self) -> bool:
+        """Whether a ``Progress`` event is due now; checks the limits on the way.
+
+        Progress events come every ``progress_every`` expansions whatever the clock says (MAGiC
+        counts search steps by them); the deadline only ends a run that is past it.
+
+        Raises:
+            LimitReached: the deadline has passed.
+        """
+        n = self.expansions
+        if n >= self.next_check:
+            self.next_check = n + CHECK_EVERY
+            if self.limits is not None:
+                self.limits.check("searching", done=f"{n} expansions")
+        if n >= self.next_progress:
+            self.next_progress += self.progress_every
+            return True
+        return False
 
 
 def trace(parent: dict[int, tuple[int, int]], state: int) -> list[int]:
@@ -145,8 +173,7 @@ def lazy_search(
         expanded += 1
         if expanded > max_expansions:
             return None, False
-        if stats.expansions >= stats.next_progress:
-            stats.next_progress += stats.progress_every
+        if stats.progress_due():
             yield Progress(stats.expansions)
         if h < best_h:
             best_h = h

@@ -61,8 +61,7 @@ def neighbourhood(
         edges[s] = out
         expanded += 1
         stats.expansions += 1
-        if stats.expansions >= stats.next_progress:
-            stats.next_progress += stats.progress_every
+        if stats.progress_due():
             yield Progress(stats.expansions)
     exhausted = not queue
     init = ct.init

@@ -66,5 +66,10 @@ class BuiltinPlanner(Planner):
                 f"{n_ops} ground operators over {n_facts} facts",
             )
         yield from search_task(
-            task, anytime=anytime, weights=self.weights, progress_every=self.progress_every, first=self.first
+            task,
+            anytime=anytime,
+            weights=self.weights,
+            progress_every=self.progress_every,
+            first=self.first,
+            limits=limits,
         )

@@ -157,8 +157,7 @@ class Windows:
             if expanded > limit:
                 return None
             stats.expansions += 1
-            if stats.expansions >= stats.next_progress:
-                stats.next_progress += stats.progress_every
+            if stats.progress_due():
                 yield Progress(stats.expansions)
             for k, o in enumerate(ops):
                 m = pre[k]

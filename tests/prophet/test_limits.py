@@ -22,6 +22,7 @@ from alica.prophet.ground import ground
 from alica.prophet.pddl import Domain, Problem, parse_domain, parse_problem
 from alica.prophet.pipeline import Found
 from alica.prophet.planner import Done, LimitReached, Limits, PlanStatus
+from alica.prophet.search.gbfs import CHECK_EVERY
 from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.world import read_world
 from tests.conftest import PLANS
@@ -118,6 +119,25 @@ def test_the_search_ends_with_done_naming_the_stage_instead_of_raising() -> None
     assert isinstance(events[-1], Done) and events[-1].status is PlanStatus.MEMORY
     result = BuiltinPlanner().solve(domain, problem, limits=Limits(memory_mb=0.05))
     assert result.status is PlanStatus.MEMORY and result.plan is None and "needs more than" in result.message
+
+
+def test_the_search_stops_at_the_deadline_within_a_few_expansions() -> None:
+    """The deadline is checked every CHECK_EVERY expansions, not only at Progress events (1,000 apart by default)."""
+    domain = parse_domain(BLOCKS)
+    # both towers at once: relaxed reachable, never reached, so the search runs until stopped
+    problem = parse_problem(
+        _blocks_problem(7).replace("(:goal (on b0 b1))", "(:goal (and (on b0 b1) (on b1 b0)))"), domain=domain
+    )
+    now = [0.0]
+    limits = Limits(seconds=10.0, clock=lambda: now[0])
+    events = BuiltinPlanner(progress_every=1).search(domain, problem, limits=limits)
+    first = next(events)
+    assert first.expansions == 1  # the search runs: one Progress per expansion
+    now[0] = 11.0  # the deadline passes
+    rest = list(events)
+    assert isinstance(rest[-1], Done) and rest[-1].status is PlanStatus.TIMEOUT
+    assert "reached while searching" in rest[-1].message
+    assert rest[-1].expansions <= CHECK_EVERY + 1
 
 
 def test_the_runtimes_grounding_is_bounded_by_the_problems_timeout() -> None:
