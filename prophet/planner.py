@@ -91,12 +91,14 @@ class LimitReached(PlannerError):
     Attributes:
         stage: what was running (``reading the problem``, ``grounding``, ``searching``).
         kind: ``"time"`` or ``"memory"``.
+        expansions: the search's expansions so far, when it was searching (else 0).
     """
 
-    def __init__(self, message: str, stage: str, kind: str) -> None:
+    def __init__(self, message: str, stage: str, kind: str, expansions: int = 0) -> None:
         super().__init__(message)
         self.stage = stage
         self.kind = kind
+        self.expansions = expansions
 
     @property
     def status(self) -> PlanStatus:
@@ -341,4 +343,4 @@ def _limited(events: Iterator[SearchEvent]) -> Iterator[SearchEvent]:
             expansions = event.expansions
             yield event
     except LimitReached as exc:
-        yield Done(exc.status, expansions, str(exc))
+        yield Done(exc.status, max(expansions, exc.expansions), str(exc))

@@ -23,7 +23,7 @@ from collections.abc import Generator
 from dataclasses import dataclass
 from heapq import heappop, heappush
 
-from alica.prophet.planner import Limits, Progress
+from alica.prophet.planner import LimitReached, Limits, Progress
 from alica.prophet.search.encoding import CompiledTask
 from alica.prophet.search.heuristics import INF, Evaluator
 
@@ -70,7 +70,11 @@ class Stats:
         if n >= self.next_check:
             self.next_check = n + CHECK_EVERY
             if self.limits is not None:
-                self.limits.check("searching", done=f"{n} expansions")
+                try:
+                    self.limits.check("searching", done=f"{n} expansions")
+                except LimitReached as exc:
+                    exc.expansions = n
+                    raise
         if n >= self.next_progress:
             self.next_progress += self.progress_every
             return True
