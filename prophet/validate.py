@@ -14,7 +14,7 @@ formula, repeated until nothing more holds).
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from alica.prophet.ground import GroundTask
@@ -110,29 +110,116 @@ class _Lifted:
         self.values = problem.fluent_values
         self.has_costs = any(isinstance(e, Increase) for a in domain.actions for e in _walk(a.effect))
         self.strata = _strata(domain.axioms, domain.derived)
+        self._stratum_plans: dict[int, tuple[list, dict[str, list]]] = {}
 
     def close(self, state: set[Atom]) -> set[Atom]:
-        """``state`` (basic atoms) with the derived atoms that follow from it."""
+        """``state`` (basic atoms) with the derived atoms that follow from it.
+
+        Stratum by stratum, every rule is tried on every binding of its head once; after that, only
+        the bindings a new fact can make true are tried again: those of rules whose body names the
+        new fact's predicate, with the head variables that atom shares equal to the fact's arguments
+        (within a stratum, derived predicates occur only positively, so facts are only ever added).
+        """
         if not self.strata:
             return state
         full = set(state)
-        for axioms in self.strata:
-            todo = [(a, b) for a in axioms for b in self.bindings(a.parameters)]
-            changed = True
-            while changed and todo:
-                changed = False
-                left = []
-                for axiom, binding in todo:
-                    head = Atom(axiom.predicate, tuple(binding[v] for v, _ in axiom.parameters))
-                    if head in full:
-                        continue
-                    if self.true(axiom.body, binding, full):
+        facts: set[tuple[str, ...]] = {(a.predicate, *a.args) for a in state}
+        for k, stratum in enumerate(self.strata):
+            heads, triggers = self._stratum_plan(k, stratum)
+            todo: Sequence[int] = range(len(heads))
+            while todo:
+                new: list[Atom] = []
+                for i in todo:
+                    body, binding, head = heads[i]
+                    if head not in full and body(binding, facts):
                         full.add(head)
-                        changed = True
-                    else:
-                        left.append((axiom, binding))
-                todo = left
+                        facts.add((head.predicate, *head.args))
+                        new.append(head)
+                again: set[int] = set()
+                for fact in new:
+                    for positions, index in triggers.get(fact.predicate, ()):
+                        again.update(index.get(tuple(fact.args[p] for p in positions), ()))
+                todo = sorted(again)
         return full
+
+    def _stratum_plan(self, k: int, stratum: list[Axiom]) -> tuple[list, dict[str, list]]:
+        """The stratum's (compiled body, binding, head) triples, and per derived predicate the bindings to try again.
+
+        A trigger is ``(positions, index)``: the argument positions of a body atom that hold head
+        variables, and an index from their values to the triples whose head has those values.
+        """
+        cached = self._stratum_plans.get(k)
+        if cached is not None:
+            return cached
+        heads: list[tuple[_Test, dict[str, str], Atom]] = []
+        triggers: dict[str, list[tuple[tuple[int, ...], dict[tuple[str, ...], list[int]]]]] = {}
+        names = {a.predicate for a in stratum}
+        for axiom in stratum:
+            first = len(heads)
+            body = self._compile(axiom.body)
+            for binding in self.bindings(axiom.parameters):
+                heads.append((body, binding, Atom(axiom.predicate, tuple(binding[v] for v, _ in axiom.parameters))))
+            variables = {v for v, _ in axiom.parameters}
+            for atom in _atoms_with_free(axiom.body, names, variables):
+                pairs = [(p, a) for p, a in enumerate(atom.args) if a in variables]
+                index: dict[tuple[str, ...], list[int]] = {}
+                for i in range(first, len(heads)):
+                    binding = heads[i][1]
+                    index.setdefault(tuple(binding[a] for _, a in pairs), []).append(i)
+                triggers.setdefault(atom.predicate, []).append((tuple(p for p, _ in pairs), index))
+        self._stratum_plans[k] = (heads, triggers)
+        return heads, triggers
+
+    def _compile(self, formula: Formula) -> _Test:
+        """``formula`` as a function of a binding and a set of ``(predicate, *args)`` facts (for :meth:`close`).
+
+        It decides what :meth:`true` decides, without walking the formula on every call.
+        """
+        if isinstance(formula, Atom):
+            predicate, args = formula.predicate, formula.args
+            if len(args) == 1 and args[0].startswith("?"):
+                only = args[0]
+                return lambda env, facts: (predicate, env[only]) in facts
+            flags = tuple(a.startswith("?") for a in args)
+            return lambda env, facts: (predicate, *[env[a] if v else a for a, v in zip(args, flags)]) in facts
+        if isinstance(formula, Equals):
+            left, right = formula.left, formula.right
+            return lambda env, facts: env.get(left, left) == env.get(right, right)
+        if isinstance(formula, Not):
+            inner = self._compile(formula.formula)
+            return lambda env, facts: not inner(env, facts)
+        if isinstance(formula, And | Or):
+            parts = tuple(self._compile(p) for p in formula.parts)  # type: ignore[arg-type]
+            if isinstance(formula, And):
+                return lambda env, facts: all(p(env, facts) for p in parts)
+            return lambda env, facts: any(p(env, facts) for p in parts)
+        if isinstance(formula, Imply):
+            condition, consequence = self._compile(formula.condition), self._compile(formula.consequence)
+            return lambda env, facts: not condition(env, facts) or consequence(env, facts)
+        if isinstance(formula, Exists | Forall):
+            variables, levels = _join_plan(formula)
+            names = tuple(v for v, _ in variables)
+            pools = tuple(tuple(self.objects_of(t)) for _, t in variables)
+            tests = tuple(tuple(self._compile(p) for p in level) for level in levels)
+            last = len(names)
+
+            def search(k: int, env: dict[str, str], facts: set[tuple[str, ...]]) -> bool:
+                for test in tests[k]:
+                    if not test(env, facts):
+                        return False
+                if k == last:
+                    return True
+                name = names[k]
+                for obj in pools[k]:
+                    env[name] = obj
+                    if search(k + 1, env, facts):
+                        return True
+                return False
+
+            if isinstance(formula, Exists):
+                return lambda env, facts: search(0, dict(env), facts)
+            return lambda env, facts: not search(0, dict(env), facts)
+        raise TypeError(f"not a formula: {formula!r}")
 
     def objects_of(self, kind: str) -> list[str]:
         if kind not in self._pools:
@@ -296,6 +383,31 @@ def _join_plan(formula: Exists | Forall) -> tuple[tuple[tuple[str, str], ...], t
         free = free_variables(part)
         levels[max((names.index(v) + 1 for v in free if v in names), default=0)].append(part)
     return tuple(variables), tuple(tuple(level) for level in levels)
+
+
+_Test = Callable[[dict[str, str], set[tuple[str, ...]]], bool]
+"""A compiled formula: whether it holds under a binding in a set of ``(predicate, *args)`` facts."""
+
+
+def _atoms_with_free(formula: Formula, predicates: set[str], free: set[str]) -> list[Atom]:
+    """The atoms of ``predicates`` in ``formula``, with the variables no quantifier above them rebinds
+    (an argument naming a rebound variable is renamed so that it matches no head variable)."""
+    out: list[Atom] = []
+    stack: list[tuple[object, frozenset[str]]] = [(formula, frozenset())]
+    while stack:
+        node, bound = stack.pop()
+        if isinstance(node, Atom):
+            if node.predicate in predicates:
+                out.append(Atom(node.predicate, tuple("?@" if a in bound else a for a in node.args)))
+        elif isinstance(node, Not):
+            stack.append((node.formula, bound))
+        elif isinstance(node, And | Or):
+            stack.extend((p, bound) for p in node.parts)
+        elif isinstance(node, Imply):
+            stack.extend([(node.condition, bound), (node.consequence, bound)])
+        elif isinstance(node, Exists | Forall):
+            stack.append((node.body, bound | {v for v, _ in node.variables} & free))
+    return out
 
 
 def _strata(axioms: tuple[Axiom, ...], derived: frozenset[str]) -> list[list[Axiom]]:

@@ -281,3 +281,34 @@ def test_derived_facts_over_static_facts_only_are_compiled_away() -> None:
         domain=domain,
     )
     assert get_planner("builtin").solve(domain, unreachable).status is PlanStatus.UNSOLVABLE
+
+
+
+@pytest.mark.parametrize(
+    "rule",
+    [
+        "(or (start ?x) (exists (?y) (and (linked ?y) (edge ?y ?x))))",
+        # the recursive atom under a quantifier that rebinds the head's ?x: it is not the head's ?x
+        "(or (start ?x) (exists (?z) (and (edge ?z ?x) (exists (?x) (and (= ?x ?z) (linked ?x))))))",
+    ],
+)
+@pytest.mark.parametrize("broken", [False, True])
+def test_the_validator_closes_a_long_recursive_chain(rule: str, broken: bool) -> None:
+    """Objects in reverse order: each pass over the rule's bindings links one more node."""
+    domain = parse_domain(
+        "(define (domain chain) (:requirements :adl :derived-predicates)"
+        " (:predicates (start ?x) (edge ?x ?y) (linked ?x))"
+        f" (:derived (linked ?x) {rule}))"
+    )
+    names = " ".join(f"n{i}" for i in reversed(range(12)))
+    edges = " ".join(f"(edge n{i} n{i + 1})" for i in range(11) if not (broken and i == 7))
+    problem = parse_problem(
+        f"(define (problem p) (:domain chain) (:objects {names}) (:init (start n0) {edges})"
+        " (:goal (forall (?x) (linked ?x))))",
+        domain=domain,
+    )
+    result = validate_plan((domain, problem), [])
+    assert result.valid is not broken
+    task = ground(domain, problem)
+    linked = {task.facts[f] for f in task.init if task.facts[f].startswith("(linked")}
+    assert len(linked) == (8 if broken else 12)  # the grounder's axioms agree
