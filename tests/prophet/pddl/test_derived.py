@@ -283,7 +283,6 @@ def test_derived_facts_over_static_facts_only_are_compiled_away() -> None:
     assert get_planner("builtin").solve(domain, unreachable).status is PlanStatus.UNSOLVABLE
 
 
-
 @pytest.mark.parametrize(
     "rule",
     [
