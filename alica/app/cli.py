@@ -12,12 +12,15 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from alica import __version__
 from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError, PlanFormatError
-from alica.model.library import Document
 from alica.source import Diagnostic
+
+if TYPE_CHECKING:
+    from alica.model.library import Document
 
 EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
 

@@ -10,8 +10,6 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
-import yaml
-
 from alica.app.skill_options import add_lunar_options, add_skills_option, lunar_field, skill_registry
 from alica.errors import AlicaError
 
@@ -59,6 +57,8 @@ def add_parser(sub: Any) -> None:
 
 
 def _params(items: list[str]) -> dict[str, object]:
+    import yaml  # lazy: every alica command builds this parser
+
     params: dict[str, object] = {}
     for item in items:
         key, sep, text = item.partition("=")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import secrets
 import sys
 from typing import Any
 
@@ -11,6 +10,8 @@ from alica.errors import AlicaError
 
 
 def _cmd_center(args: argparse.Namespace) -> int:
+    import secrets
+
     from alica.app.center.server import plan_app, replay_app, serve
 
     token = args.token or secrets.token_urlsafe(24)
