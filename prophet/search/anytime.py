@@ -37,6 +37,8 @@ from alica.prophet.search.astar import astar
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
+from alica.prophet.search.lama import lama_search
+from alica.prophet.search.landmarks import LandmarkCount
 from alica.prophet.search.neighbourhood import neighbourhood
 from alica.prophet.search.postprocess import improve
 from alica.prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
@@ -46,7 +48,7 @@ NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
 """The first and the largest state limit of the neighbourhood rounds after each plan."""
 RESTART_BUDGET = 20
 """The expansion budget of each restart, in multiples of the first search's expansions."""
-FIRST_HEURISTICS: tuple[str, ...] = ("ff", "ff_add_unit", "ff_cost")
+FIRST_HEURISTICS: tuple[str, ...] = ("lama", "ff", "ff_add_unit", "ff_cost")
 """The heuristics the first search may use (methods of :class:`~alica.prophet.search.heuristics.Relaxed`)."""
 
 
@@ -118,6 +120,7 @@ def search_task(
     progress_every: int = 1000,
     optimal_pass: bool = True,
     first: FirstSearch | None = None,
+    stats: Stats | None = None,
 ) -> Iterator[SearchEvent]:
     """Search a grounded task (``GroundTask`` shape), yielding planner events.
 
@@ -130,11 +133,13 @@ def search_task(
             (and with inadmissible passes only) the run ends with
             ``Done(SOLVED)`` after one round.
         first: how the first plan is searched; ``None`` is ``FirstSearch()``.
+        stats: the run's counters (expansions, evaluations), to read them
+            afterwards; ``None``: fresh ones (``progress_every`` applies then).
 
     Yields:
         ``Progress``, ``Improved`` for each cheaper plan, one final ``Done``.
     """
-    stats = Stats(progress_every)
+    stats = Stats(progress_every) if stats is None else stats
     reason = getattr(task, "unsolvable_reason", None)
     if reason:
         yield Done(PlanStatus.UNSOLVABLE, 0, str(reason))
@@ -145,8 +150,13 @@ def search_task(
         return
     relaxed = Relaxed(ct)
     first = FirstSearch() if first is None else first
-    evaluate: Evaluator = getattr(relaxed, first.heuristic)
-    ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
+    if first.heuristic == "lama":
+        lmcount = LandmarkCount(ct, relaxed)
+        ff = relaxed.ff_add_unit if ct.unit_cost else relaxed.ff_unit
+        ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
+    else:
+        evaluate: Evaluator = getattr(relaxed, first.heuristic)
+        ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
     if ops is None:
         yield Done(PlanStatus.UNSOLVABLE, stats.expansions, "every reachable state was expanded")
         return

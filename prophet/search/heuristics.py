@@ -15,6 +15,7 @@ state), empty for the other heuristics.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import cached_property
 from heapq import heappop, heappush
 
 from alica.prophet.search.encoding import CompiledTask, mask
@@ -89,6 +90,23 @@ class Relaxed:
     def ff_add_unit(self, state: int) -> tuple[float, list[int]]:
         """FF with h_add supporters, the relaxed plan's length as the estimate."""
         return self._ff_add(state, True)
+
+    @cached_property
+    def _unit_costs(self) -> list[int]:
+        return [1] * len(self.r_cost)
+
+    def ff_unit(self, state: int) -> tuple[float, list[int]]:
+        """FF with h_add supporters as if every action cost 1, the relaxed plan's length as the estimate.
+
+        LAMA's FF (``adapt_costs(one)``); the same as :meth:`ff_add_unit` on a task without action costs.
+        """
+        gm = self.goal_mask
+        if state & gm == gm:
+            return 0, []
+        cost, sup = self._explore_add(state, True, self._unit_costs)
+        if cost is None:
+            return INF, []
+        return self._extract(state, sup, True)
 
     def _ff_layered(self, state: int, unit: bool) -> tuple[float, list[int]]:
         gm = self.goal_mask
@@ -195,11 +213,16 @@ class Relaxed:
             return INF, []
         return self._extract(state, sup, unit)
 
-    def _explore_add(self, state: int, additive: bool) -> tuple[list | None, list[int]]:
-        """Generalised Dijkstra for h_add (``additive``) or h_max; costs per fact, supporters."""
+    def _explore_add(
+        self, state: int, additive: bool, costs: list[int] | None = None
+    ) -> tuple[list | None, list[int]]:
+        """Generalised Dijkstra for h_add (``additive``) or h_max; costs per fact, supporters.
+
+        ``costs``: the relaxed actions' costs (default: their own).
+        """
         pre_of = self.pre_of
         r_add = self.r_add
-        r_cost = self.r_cost
+        r_cost = self.r_cost if costs is None else costs
         is_goal = self.is_goal
         gm = self.goal_mask
         cost: list = self._inf[:]

@@ -1,0 +1,228 @@
+"""Fact landmarks with orderings, and LAMA's landmark-count heuristic.
+
+A *fact landmark* is a fact that every plan makes true at some point. The
+landmarks here are the causal landmarks of the delete relaxation from the
+initial state, found by Zhu and Givan's label propagation over the relaxed
+actions of :class:`~alica.prophet.search.heuristics.Relaxed` (operators,
+when-effects, and any zero-cost axioms alike): the label of a fact is the set
+of facts every relaxed path to it achieves first,
+
+    label(f) = {f} ∪ ⋂ over the relaxed actions a adding f of ⋃ over p in pre(a) of label(p),
+
+with ``label(f) = {f}`` for the facts of the initial state, computed to a
+fixpoint (labels only shrink once a fact is reached). The landmarks are the
+union of the goals' labels. Every plan is a relaxed plan, so each landmark
+holds at some point of every plan; this is complete for the causal fact
+landmarks of the relaxation (LAMA's RHW backchaining finds a subset of
+these, plus disjunctive ones, which this module does not make). Labels are
+``int`` bitsets, so a union is ``|`` and an intersection ``&``.
+
+Orderings: ``l`` in ``label(f)`` with ``l != f`` is a *natural* ordering
+(``l`` is true strictly before ``f`` first is, in every plan); ``l`` is a
+*greedy-necessary* predecessor of ``f`` when ``l`` is a precondition of every
+relaxed action that can first achieve ``f`` (one whose preconditions' labels
+do not hold ``f``).
+
+The heuristic (LAMA's landmark count) follows the landmarks a search path
+has *accepted*: those true in the initial state, then each landmark the
+moment it becomes true while its natural predecessors are all accepted
+already (the parent's accepted set). A state's estimate is the cost of the
+landmarks not accepted plus those *required again*: accepted, false now, and
+a goal or a greedy-necessary predecessor of a landmark not accepted. With
+``unit`` every landmark counts 1 (LAMA's first search); otherwise each costs
+its cheapest achiever (the cost-sum variant). Its preferred operators are
+the applicable operators that achieve a landmark the state needs and whose
+natural predecessors are accepted (simple landmarks, as LAMA's).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+
+from alica.prophet.search.encoding import CompiledTask, bits
+from alica.prophet.search.heuristics import Relaxed
+
+
+def fact_labels(
+    n_facts: int, init: int, r_pre: Sequence[Sequence[int]], r_add: Sequence[Sequence[int]]
+) -> list[int | None]:
+    """Zhu and Givan's labels (see the module docstring): per fact, a bitset, or ``None`` if unreachable."""
+    label: list[int | None] = [None] * n_facts
+    pre_of: list[list[int]] = [[] for _ in range(n_facts)]
+    unreached = [len(p) for p in r_pre]
+    for a, p in enumerate(r_pre):
+        for f in p:
+            pre_of[f].append(a)
+    queue: deque[int] = deque()
+    for f in bits(init):
+        label[f] = 1 << f
+        queue.append(f)
+
+    def fire(a: int) -> None:
+        alabel = 0
+        for p in r_pre[a]:
+            alabel |= label[p]  # type: ignore[operator]  # every precondition is reached
+        for g in r_add[a]:
+            old = label[g]
+            new = (1 << g) | alabel if old is None else old & ((1 << g) | alabel)
+            if new != old:
+                label[g] = new
+                queue.append(g)
+
+    for a, p in enumerate(r_pre):
+        if not p:
+            fire(a)
+    first = [True] * n_facts
+    while queue:
+        f = queue.popleft()
+        for a in pre_of[f]:
+            if first[f]:
+                unreached[a] -= 1
+            if not unreached[a]:
+                fire(a)
+        first[f] = False
+    return label
+
+
+class Landmarks:
+    """The fact landmarks of a relaxed task and their orderings.
+
+    Args:
+        relaxed: the relaxed task (its relaxed actions: preconditions, adds, costs).
+        init: the state the landmarks hold for (the task's initial state).
+
+    Attributes:
+        mask: the landmarks as a fact bitset.
+        parents: per fact, its natural predecessors among the landmarks (a bitset; 0 if none).
+        gn_children: per fact, the landmarks it is a greedy-necessary predecessor of (a bitset).
+        cost: per fact, its cheapest relaxed achiever's cost (0 for facts nothing adds).
+        goal_mask: the (fluent) goal facts.
+    """
+
+    def __init__(self, relaxed: Relaxed, init: int) -> None:
+        n = len(relaxed.is_goal)
+        label = fact_labels(n, init, relaxed.r_pre, relaxed.r_add)
+        goal = relaxed.goal_mask
+        lms = 0
+        for g in bits(goal):
+            lms |= label[g] or 0
+        self.mask = lms
+        self.goal_mask = goal
+        self.parents = [0] * n
+        self.gn_children = [0] * n
+        self.cost = [0] * n
+        self.reachable = all(label[g] is not None for g in bits(goal))
+        r_pre_mask = relaxed.r_pre_mask
+        shared = [-1] * n
+        cheapest: list[float] = [float("inf")] * n
+        for a, adds in enumerate(relaxed.r_add):
+            if any(label[p] is None for p in relaxed.r_pre[a]):
+                continue
+            alabel = 0
+            for p in relaxed.r_pre[a]:
+                alabel |= label[p] or 0
+            for g in adds:
+                if not lms >> g & 1:
+                    continue
+                cheapest[g] = min(cheapest[g], relaxed.r_cost[a])
+                if not alabel >> g & 1:  # a possible first achiever of g
+                    shared[g] &= r_pre_mask[a]
+        for f in bits(lms):
+            self.parents[f] = (label[f] or 0) & ~(1 << f) & lms
+            self.cost[f] = 0 if cheapest[f] == float("inf") else int(cheapest[f])
+            if shared[f] != -1 and not init >> f & 1:
+                for p in bits(shared[f] & lms):
+                    self.gn_children[p] |= 1 << f
+        self.gn_parents_mask = 0
+        for f in bits(lms):
+            if self.gn_children[f]:
+                self.gn_parents_mask |= 1 << f
+
+    def __len__(self) -> int:
+        return self.mask.bit_count()
+
+    def orderings(self) -> list[tuple[int, int]]:
+        """The natural orderings ``(before, after)`` between landmarks."""
+        return [(p, f) for f in bits(self.mask) for p in bits(self.parents[f])]
+
+    def greedy_necessary(self) -> list[tuple[int, int]]:
+        """The greedy-necessary orderings ``(before, after)`` between landmarks."""
+        return [(p, f) for p in bits(self.gn_parents_mask) for f in bits(self.gn_children[p])]
+
+
+class LandmarkCount:
+    """LAMA's landmark-count heuristic on a compiled task (see the module docstring).
+
+    Args:
+        ct: the compiled task.
+        relaxed: its relaxed task.
+        unit: count every landmark 1 (else its cheapest achiever's cost).
+    """
+
+    def __init__(self, ct: CompiledTask, relaxed: Relaxed, unit: bool = True) -> None:
+        self.ct = ct
+        self.landmarks = lm = Landmarks(relaxed, ct.init)
+        self.unit = unit
+        self.initial = ct.init & lm.mask
+        self._mask = lm.mask
+        self._parents = lm.parents
+        self._again = lm.goal_mask | lm.gn_parents_mask
+
+    def progress(self, accepted: int, state: int) -> int:
+        """The accepted set after reaching ``state`` from a state whose accepted set is ``accepted``."""
+        new = state & self._mask & ~accepted
+        if not new:
+            return accepted
+        parents = self._parents
+        gained = 0
+        while new:
+            low = new & -new
+            if not parents[low.bit_length() - 1] & ~accepted:
+                gained |= low
+            new ^= low
+        return accepted | gained
+
+    def needed(self, state: int, accepted: int) -> int:
+        """The landmarks ``state`` still needs: not accepted, or required again."""
+        future = self._mask & ~accepted
+        again = accepted & ~state & self._again
+        if again:
+            goal = self.landmarks.goal_mask
+            gn_children = self.landmarks.gn_children
+            for f in bits(again):
+                if goal >> f & 1 or gn_children[f] & future:
+                    future |= 1 << f
+        return future
+
+    def value(self, state: int, accepted: int) -> int:
+        """The estimate of ``state`` with the accepted set ``accepted``."""
+        needed = self.needed(state, accepted)
+        if self.unit:
+            return needed.bit_count()
+        cost = self.landmarks.cost
+        return sum(cost[f] for f in bits(needed))
+
+    def preferred(self, state: int, accepted: int, needed: int, applicable: Sequence[int]) -> list[int]:
+        """The applicable operators that achieve a needed landmark whose natural predecessors are accepted."""
+        ct = self.ct
+        add_mask = ct.add_mask
+        cond = ct.cond
+        parents = self._parents
+        out: list[int] = []
+        for op in applicable:
+            adds = add_mask[op] & needed
+            if cond[op]:
+                for cmask, cadd, _cdel in cond[op]:
+                    if state & cmask == cmask:
+                        adds |= cadd & needed
+            while adds:
+                low = adds & -adds
+                if not parents[low.bit_length() - 1] & ~accepted:
+                    out.append(op)
+                    break
+                adds ^= low
+        return out
+
+
+__all__ = ["LandmarkCount", "Landmarks", "fact_labels"]
