@@ -26,7 +26,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from bench.planners import GRACE_S, Job, Outcome, Tasks, _validated, run_fd, run_process  # noqa: E402
+from bench.planners import GRACE_S, Job, Outcome, Tasks, _validated, run_fd, run_process
 
 IPC = ROOT / "benchmarks" / "ipc"
 PDDL = ROOT / "benchmarks" / "pddl"
@@ -131,7 +131,9 @@ def summary_table(rows: dict, against: dict) -> str:
     for dom, items in doms.items():
         solved = sum(r["status"] == "VALID" for _k, r in items)
         other = sum(against.get(k, {}).get("status") == "VALID" for k, _r in items)
-        both = [(r, against[k]) for k, r in items if r["status"] == "VALID" and against.get(k, {}).get("status") == "VALID"]
+        both = [
+            (r, against[k]) for k, r in items if r["status"] == "VALID" and against.get(k, {}).get("status") == "VALID"
+        ]
         t1 = sum(float(a["wall_s"]) for a, _b in both)
         t2 = sum(float(b["wall_s"]) for _a, b in both)
         c1 = sum(float(a["cost"]) for a, _b in both)
@@ -186,11 +188,17 @@ def main(argv: Sequence[str] | None = None) -> int:
             if (job.domain, job.problem) in done:
                 continue
             if args.planner == "fd":
-                outcome, extra = run_fd(job, args.limit, tasks), {}
+                try:
+                    outcome, extra = run_fd(job, args.limit, tasks), {}
+                except Exception as error:  # our reader refuses the input (derived predicates): not validated
+                    outcome, extra = Outcome(job, 0.0, "unread", note=str(error)), {}
                 if outcome.wall_s > args.limit:
                     outcome.valid = "-"
             else:
-                outcome, extra = run_ours(job, args.limit + GRACE_S, tasks, args.first)
+                try:
+                    outcome, extra = run_ours(job, args.limit + GRACE_S, tasks, args.first)
+                except Exception as error:
+                    outcome, extra = Outcome(job, 0.0, "unread", note=str(error)), {}
                 if outcome.wall_s > args.limit:
                     outcome.valid = "-"
             status = outcome.valid if outcome.valid != "-" else outcome.status

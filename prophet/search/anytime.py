@@ -37,6 +37,7 @@ from alica.prophet.search.astar import astar
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
+from alica.prophet.search.jit import SwitchingFF
 from alica.prophet.search.lama import lama_search
 from alica.prophet.search.landmarks import LandmarkCount
 from alica.prophet.search.neighbourhood import neighbourhood
@@ -152,7 +153,10 @@ def search_task(
     first = FirstSearch() if first is None else first
     if first.heuristic == "lama":
         lmcount = LandmarkCount(ct, relaxed)
-        ff = relaxed.ff_add_unit if ct.unit_cost else relaxed.ff_unit
+        if ct.unit_cost:
+            ff = SwitchingFF(relaxed, relaxed.ff_add_unit)
+        else:
+            ff = SwitchingFF(relaxed, relaxed.ff_unit, [1] * len(relaxed.r_cost))
         ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
     else:
         evaluate: Evaluator = getattr(relaxed, first.heuristic)

@@ -213,9 +213,7 @@ class Relaxed:
             return INF, []
         return self._extract(state, sup, unit)
 
-    def _explore_add(
-        self, state: int, additive: bool, costs: list[int] | None = None
-    ) -> tuple[list | None, list[int]]:
+    def _explore_add(self, state: int, additive: bool, costs: list[int] | None = None) -> tuple[list | None, list[int]]:
         """Generalised Dijkstra for h_add (``additive``) or h_max; costs per fact, supporters.
 
         ``costs``: the relaxed actions' costs (default: their own).

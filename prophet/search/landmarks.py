@@ -7,7 +7,7 @@ actions of :class:`~alica.prophet.search.heuristics.Relaxed` (operators,
 when-effects, and any zero-cost axioms alike): the label of a fact is the set
 of facts every relaxed path to it achieves first,
 
-    label(f) = {f} ∪ ⋂ over the relaxed actions a adding f of ⋃ over p in pre(a) of label(p),
+    label(f) = {f} | AND over the relaxed actions a adding f of (OR over p in pre(a) of label(p)),
 
 with ``label(f) = {f}`` for the facts of the initial state, computed to a
 fixpoint (labels only shrink once a fact is reached). The landmarks are the
