@@ -26,7 +26,7 @@ from collections.abc import Generator
 from heapq import heappop, heappush
 
 from alica.prophet.planner import Progress
-from alica.prophet.search.encoding import CompiledTask, bits
+from alica.prophet.search.encoding import CompiledTask
 from alica.prophet.search.gbfs import Stats, trace
 from alica.prophet.search.heuristics import INF, Evaluator
 from alica.prophet.search.landmarks import LandmarkCount
@@ -42,6 +42,7 @@ def lama_search(
     boost: int = 1000,
     max_expansions: float = INF,
     seed: int | None = None,
+    landmark_preferred: bool = True,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """LAMA's lazy search with FF and the landmark count (see the module docstring).
 
@@ -68,7 +69,6 @@ def lama_search(
     needed_of = lmcount.needed
     lm_preferred = lmcount.preferred
     unit = lmcount.unit
-    lm_cost = lmcount.landmarks.cost
     parent: dict[int, tuple[int, int]] = {}
     accepted_of: dict[int, int] = {}
     closed: set[int] = set()
@@ -110,7 +110,7 @@ def lama_search(
         if h_ff == INF:
             continue
         needed = needed_of(state, accepted)
-        h_lm: float = needed.bit_count() if unit else sum(lm_cost[f] for f in bits(needed))
+        h_lm: float = needed.bit_count() if unit else lmcount.count(needed)
         accepted_of[state] = accepted
         stats.expansions += 1
         expanded += 1
@@ -131,7 +131,8 @@ def lama_search(
             prio[1] -= boost
             prio[3] -= boost
         pref = set(ff_pref)
-        pref.update(lm_preferred(state, accepted, needed, successors))
+        if landmark_preferred:
+            pref.update(lm_preferred(state, accepted, needed, successors))
         if shuffle is not None:
             successors = list(successors)
             shuffle(successors)

@@ -43,6 +43,9 @@ from collections.abc import Sequence
 from alica.prophet.search.encoding import CompiledTask, bits
 from alica.prophet.search.heuristics import Relaxed
 
+MAX_DISJUNCTION = 4
+"""The most facts of a disjunctive landmark (as LAMA's)."""
+
 
 def fact_labels(
     n_facts: int, init: int, r_pre: Sequence[Sequence[int]], r_add: Sequence[Sequence[int]]
@@ -100,7 +103,7 @@ class Landmarks:
         goal_mask: the (fluent) goal facts.
     """
 
-    def __init__(self, relaxed: Relaxed, init: int) -> None:
+    def __init__(self, relaxed: Relaxed, init: int, facts: Sequence[str] | None = None) -> None:
         n = len(relaxed.is_goal)
         label = fact_labels(n, init, relaxed.r_pre, relaxed.r_add)
         goal = relaxed.goal_mask
@@ -115,6 +118,7 @@ class Landmarks:
         self.reachable = all(label[g] is not None for g in bits(goal))
         r_pre_mask = relaxed.r_pre_mask
         shared = [-1] * n
+        first: list[list[int]] = [[] for _ in range(n)]
         cheapest: list[float] = [float("inf")] * n
         for a, adds in enumerate(relaxed.r_add):
             if any(label[p] is None for p in relaxed.r_pre[a]):
@@ -123,11 +127,13 @@ class Landmarks:
             for p in relaxed.r_pre[a]:
                 alabel |= label[p] or 0
             for g in adds:
+                if relaxed.r_cost[a] < cheapest[g]:
+                    cheapest[g] = relaxed.r_cost[a]
                 if not lms >> g & 1:
                     continue
-                cheapest[g] = min(cheapest[g], relaxed.r_cost[a])
                 if not alabel >> g & 1:  # a possible first achiever of g
                     shared[g] &= r_pre_mask[a]
+                    first[g].append(a)
         for f in bits(lms):
             self.parents[f] = (label[f] or 0) & ~(1 << f) & lms
             self.cost[f] = 0 if cheapest[f] == float("inf") else int(cheapest[f])
@@ -138,9 +144,53 @@ class Landmarks:
         for f in bits(lms):
             if self.gn_children[f]:
                 self.gn_parents_mask |= 1 << f
+        self.disjunctive: list[int] = []
+        self.disjunctive_children: list[int] = []
+        self.disjunctive_cost: list[int] = []
+        if facts is not None:
+            self._disjunctive(relaxed, init, facts, first, label, cheapest)
+
+    def _disjunctive(
+        self,
+        relaxed: Relaxed,
+        init: int,
+        facts: Sequence[str],
+        first: list[list[int]],
+        label: list[int | None],
+        cheapest: list[float],
+    ) -> None:
+        """Disjunctive landmarks, one level deep (see the module docstring)."""
+        pred = [name.strip("()").split(" ", 1)[0] for name in facts]
+        lms = self.mask
+        index: dict[int, int] = {}
+        for f in bits(lms & ~init):
+            achievers = first[f]
+            if not achievers:
+                continue
+            union: dict[str, int] = {}
+            count: dict[str, int] = {}
+            for a in achievers:
+                mine: dict[str, int] = {}
+                for p in relaxed.r_pre[a]:
+                    mine[pred[p]] = mine.get(pred[p], 0) | 1 << p
+                for name, m in mine.items():
+                    union[name] = union.get(name, 0) | m
+                    count[name] = count.get(name, 0) + 1
+            for name, m in union.items():
+                if count[name] != len(achievers) or m & (lms | init) or not 2 <= m.bit_count() <= MAX_DISJUNCTION:
+                    continue
+                if any(label[p] is None for p in bits(m)):
+                    continue
+                k = index.get(m)
+                if k is None:
+                    k = index[m] = len(self.disjunctive)
+                    self.disjunctive.append(m)
+                    self.disjunctive_children.append(0)
+                    self.disjunctive_cost.append(int(min(cheapest[p] for p in bits(m))))
+                self.disjunctive_children[k] |= 1 << f
 
     def __len__(self) -> int:
-        return self.mask.bit_count()
+        return self.mask.bit_count() + len(self.disjunctive)
 
     def orderings(self) -> list[tuple[int, int]]:
         """The natural orderings ``(before, after)`` between landmarks."""
@@ -154,33 +204,47 @@ class Landmarks:
 class LandmarkCount:
     """LAMA's landmark-count heuristic on a compiled task (see the module docstring).
 
+    Landmark ids: a fact landmark is its fact id; disjunctive landmark ``k`` is
+    ``ct.n_facts + k``. Accepted and needed sets are bitsets over these ids.
+
     Args:
         ct: the compiled task.
         relaxed: its relaxed task.
         unit: count every landmark 1 (else its cheapest achiever's cost).
+        disjunctive: find disjunctive landmarks too.
     """
 
-    def __init__(self, ct: CompiledTask, relaxed: Relaxed, unit: bool = True) -> None:
+    def __init__(self, ct: CompiledTask, relaxed: Relaxed, unit: bool = True, disjunctive: bool = True) -> None:
         self.ct = ct
-        self.landmarks = lm = Landmarks(relaxed, ct.init)
+        self.landmarks = lm = Landmarks(relaxed, ct.init, ct.task.facts if disjunctive else None)
         self.unit = unit
-        self.initial = ct.init & lm.mask
-        self._mask = lm.mask
+        n = ct.n_facts
+        self._dis = [(1 << (n + k), m, lm.disjunctive_children[k]) for k, m in enumerate(lm.disjunctive)]
+        dmask = 0
+        for bit, _m, _children in self._dis:
+            dmask |= bit
+        self.initial = ct.init & lm.mask  # no disjunctive landmark holds initially
+        self._mask = lm.mask | dmask
+        self._facts = lm.mask
         self._parents = lm.parents
         self._again = lm.goal_mask | lm.gn_parents_mask
+        self.cost = lm.cost + lm.disjunctive_cost
+        """Per landmark id, its cost in the cost-sum variant."""
 
     def progress(self, accepted: int, state: int) -> int:
         """The accepted set after reaching ``state`` from a state whose accepted set is ``accepted``."""
-        new = state & self._mask & ~accepted
-        if not new:
-            return accepted
-        parents = self._parents
+        new = state & self._facts & ~accepted
         gained = 0
-        while new:
-            low = new & -new
-            if not parents[low.bit_length() - 1] & ~accepted:
-                gained |= low
-            new ^= low
+        if new:
+            parents = self._parents
+            while new:
+                low = new & -new
+                if not parents[low.bit_length() - 1] & ~accepted:
+                    gained |= low
+                new ^= low
+        for bit, m, _children in self._dis:
+            if state & m and not accepted & bit:
+                gained |= bit
         return accepted | gained
 
     def needed(self, state: int, accepted: int) -> int:
@@ -193,29 +257,52 @@ class LandmarkCount:
             for f in bits(again):
                 if goal >> f & 1 or gn_children[f] & future:
                     future |= 1 << f
+        for bit, m, children in self._dis:
+            if accepted & bit and not state & m and children & future:
+                future |= bit
         return future
+
+    def count(self, needed: int) -> int:
+        """The estimate for the needed landmarks ``needed``."""
+        if self.unit:
+            return needed.bit_count()
+        cost = self.cost
+        return sum(cost[i] for i in bits(needed))
 
     def value(self, state: int, accepted: int) -> int:
         """The estimate of ``state`` with the accepted set ``accepted``."""
-        needed = self.needed(state, accepted)
-        if self.unit:
-            return needed.bit_count()
-        cost = self.landmarks.cost
-        return sum(cost[f] for f in bits(needed))
+        return self.count(self.needed(state, accepted))
 
     def preferred(self, state: int, accepted: int, needed: int, applicable: Sequence[int]) -> list[int]:
-        """The applicable operators that achieve a needed landmark whose natural predecessors are accepted."""
+        """The applicable operators that achieve a needed fact landmark whose natural predecessors are accepted.
+
+        Without any, those that achieve a fact of a needed disjunctive landmark (as LAMA's).
+        """
+        out = self._achieving(state, needed & self._facts, applicable, accepted)
+        if out or not self._dis:
+            return out
+        facts = 0
+        for bit, m, _children in self._dis:
+            if needed & bit:
+                facts |= m
+        return self._achieving(state, facts, applicable, None) if facts else out
+
+    def _achieving(self, state: int, targets: int, applicable: Sequence[int], accepted: int | None) -> list[int]:
         ct = self.ct
         add_mask = ct.add_mask
         cond = ct.cond
         parents = self._parents
         out: list[int] = []
         for op in applicable:
-            adds = add_mask[op] & needed
+            adds = add_mask[op] & targets
             if cond[op]:
                 for cmask, cadd, _cdel in cond[op]:
                     if state & cmask == cmask:
-                        adds |= cadd & needed
+                        adds |= cadd & targets
+            if accepted is None:
+                if adds:
+                    out.append(op)
+                continue
             while adds:
                 low = adds & -adds
                 if not parents[low.bit_length() - 1] & ~accepted:

@@ -34,9 +34,9 @@ def names(ct: CompiledTask, facts: int) -> set[str]:
 
 
 def reachable_avoiding(ct: CompiledTask, avoid: int, target: int) -> bool:
-    """Whether a state holding ``target`` is reachable from the initial state through states never holding ``avoid``."""
+    """Whether a state holding ``target`` is reachable from the initial state through states holding no fact of ``avoid`` (a mask)."""
     start = ct.init
-    if start >> avoid & 1:
+    if start & avoid:
         return False
     seen = {start}
     queue = deque([start])
@@ -46,7 +46,7 @@ def reachable_avoiding(ct: CompiledTask, avoid: int, target: int) -> bool:
             return True
         for op in ct.applicable(state):
             nxt = ct.successor(state, op)
-            if nxt >> avoid & 1 or nxt in seen:
+            if nxt & avoid or nxt in seen:
                 continue
             seen.add(nxt)
             queue.append(nxt)
@@ -82,15 +82,15 @@ def test_every_landmark_and_ordering_holds_on_every_plan_of_a_blocks_task() -> N
     lm = lmc.landmarks
     assert len(lm) > len(bits(ct.goal_mask))
     for f in bits(lm.mask & ~ct.init):
-        assert not reachable_avoiding(ct, f, ct.goal_mask), ct.task.facts[f]
+        assert not reachable_avoiding(ct, 1 << f, ct.goal_mask), ct.task.facts[f]
     for before, after in lm.orderings():
-        assert not reachable_avoiding(ct, before, 1 << after), (ct.task.facts[before], ct.task.facts[after])
+        assert not reachable_avoiding(ct, 1 << before, 1 << after), (ct.task.facts[before], ct.task.facts[after])
 
 
 @st.composite
 def strips_tasks(draw: st.DrawFn) -> GroundTask:
     n = draw(st.integers(3, 6))
-    facts = [f"f{i}" for i in range(n)]
+    facts = [f"{'pq'[i % 2]} {i}" for i in range(n)]  # two predicates: disjunctive landmarks group by them
     tb = TaskBuilder("random")
     for f in facts:
         tb.f(f)
@@ -115,9 +115,13 @@ def test_landmarks_and_orderings_are_sound_on_random_tasks(task: GroundTask, rng
     lm = lmc.landmarks
     assert lm.goal_mask & ~lm.mask == 0  # every goal is a landmark
     for f in bits(lm.mask & ~ct.init):
-        assert not reachable_avoiding(ct, f, ct.goal_mask)
+        assert not reachable_avoiding(ct, 1 << f, ct.goal_mask)
     for before, after in lm.orderings():
-        assert not reachable_avoiding(ct, before, 1 << after)
+        assert not reachable_avoiding(ct, 1 << before, 1 << after)
+    for facts, children in zip(lm.disjunctive, lm.disjunctive_children, strict=True):
+        assert not facts & ct.init
+        for child in bits(children):  # one of the facts holds before the child first does
+            assert not reachable_avoiding(ct, facts, 1 << child)
     for before, after in lm.greedy_necessary():  # a precondition of every first achiever: also natural
         assert (before, after) in set(lm.orderings())
     # along any path, the count is 0 exactly at the goal states
@@ -129,6 +133,23 @@ def test_landmarks_and_orderings_are_sound_on_random_tasks(task: GroundTask, rng
             break
         state = ct.successor(state, rng.choice(ops))
         accepted = lmc.progress(accepted, state)
+
+
+def test_a_disjunctive_landmark() -> None:
+    tb = TaskBuilder("disjunctive")
+    for truck in ("t1", "t2"):
+        tb.op("load", (truck,), [f"at {truck} A", "pkg A"], [f"in pkg {truck}"], ["pkg A"])
+        tb.op("unload", (truck,), [f"in pkg {truck}"], ["pkg B"], [f"in pkg {truck}"])
+        tb.op("drive", (truck,), [], [f"at {truck} A"])
+    ct, _relaxed, lmc = compiled(tb.task(["pkg A"], ["pkg B"]))
+    lm = lmc.landmarks
+    assert [names(ct, m) for m in lm.disjunctive] == [{"in pkg t1", "in pkg t2"}]  # from fact landmarks only
+    assert lmc.value(ct.init, lmc.initial) == 2  # pkg B, the package in one truck
+    state = 1 << ct.task.facts.index("in pkg t2")
+    accepted = lmc.progress(lmc.initial, state)
+    assert lmc.value(state, accepted) == 1
+    state = 1 << ct.task.facts.index("at t2 A")  # the package is in no truck and not at B
+    assert lmc.value(state, lmc.progress(accepted, state)) == 2  # the disjunction is required again
 
 
 def test_landmarks_come_from_when_effects_too() -> None:
