@@ -1,10 +1,11 @@
 """The builtin planner's run on a grounded task: a first plan, then cheaper ones.
 
-1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
-   finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
-   A :class:`FirstSearch` chooses another heuristic, a weight or a
-   tie-breaking seed for this search (MAGiC gives each agent its own); the
-   default is the search just described.
+1. LAMA's lazy greedy search (:mod:`alica.prophet.search.lama`: FF and the
+   landmark count, four open lists, preferred operators) finds a first plan
+   (or exhausts the reachable states: ``UNSOLVABLE``). A :class:`FirstSearch`
+   chooses another heuristic (lazy GBFS with one FF variant and its preferred
+   operators), a weight or a tie-breaking seed for this search (MAGiC gives
+   each agent its own); the default is the search just described.
 2. Quick window sweeps on it (:mod:`alica.prophet.search.windows`: stretches of the
    plan replanned among their own objects).
 3. Restarts: unbounded lazy searches with other heuristics and weights, each
@@ -57,14 +58,17 @@ FIRST_HEURISTICS: tuple[str, ...] = ("lama", "ff", "ff_add_unit", "ff_cost")
 class FirstSearch:
     """How the search for the first plan runs: lazy GBFS or lazy weighted A*.
 
-    ``FirstSearch()`` is the builtin planner's own first search (greedy, FF
-    with h_max supporters, the operators' order); other values lead to other
-    first plans, which is what MAGiC's shares differ in.
+    ``FirstSearch()`` is the builtin planner's own first search (LAMA's: greedy,
+    four open lists with FF and the landmark count, :mod:`alica.prophet.search.lama`;
+    the operators' order); other values lead to other first plans, which is what
+    MAGiC's shares differ in.
 
     Attributes:
-        heuristic: ``"ff"`` (h_max supporters, plan length), ``"ff_add_unit"``
-            (h_add supporters, plan length) or ``"ff_cost"`` (h_add supporters,
-            plan cost).
+        heuristic: ``"lama"`` (FF with unit-cost h_add supporters and the landmark
+            count, four open lists), or one heuristic with two open lists:
+            ``"ff"`` (h_max supporters, plan length; the default before
+            ``"lama"``), ``"ff_add_unit"`` (h_add supporters, plan length) or
+            ``"ff_cost"`` (h_add supporters, plan cost).
         weight: ``None`` for greedy search, else the weight w of ``g + w*h``.
         seed: a tie-breaking seed (successors inserted in a shuffled order);
             ``None``: the operators' order.
@@ -73,7 +77,7 @@ class FirstSearch:
         ValueError: an unknown heuristic, or a weight that is not a finite number > 0.
     """
 
-    heuristic: str = "ff"
+    heuristic: str = "lama"
     weight: float | None = None
     seed: int | None = None
 
