@@ -1,9 +1,9 @@
 """The builtin search's first plan on the IPC suite (``benchmarks/ipc``), beside Fast Downward lama-first.
 
 One problem at a time, each as a whole process with a wall limit (30 s): ours runs
-``search_task`` with a chosen first search (``--first``, default: the builtin
-planner's default) in a child process of this script (imports, parsing, grounding
-and search timed together, as ``alica plan`` does); Fast Downward runs its driver with
+``alica plan --json`` (the default first search), or ``search_task`` with another
+first search (``--first``) in a child process of this script (imports, parsing,
+grounding and search timed together); Fast Downward runs its driver with
 ``--alias lama-first`` (``bench/planners.py``'s ``run_fd``). Every plan is validated.
 Results go to ``build/bench/search_ipc-<tag>.tsv`` (one row per problem, appended as they
 come, so a later run with ``--resume`` skips the problems done) and a per-domain table to
@@ -96,14 +96,20 @@ def child(domain_file: str, problem_file: str, first: str) -> None:
 
 
 def run_ours(job: Job, limit: float, tasks: Tasks, first: str) -> tuple[Outcome, dict]:
-    command = [sys.executable, __file__, "--child", str(job.domain_file), str(job.problem_file), "--first", first]
+    """The default first search through ``alica plan --json`` itself; another one through :func:`child`."""
+    if first == "default":
+        command = [sys.executable, "-m", "alica.app.cli", "plan", str(job.domain_file), str(job.problem_file)]
+        command += ["--json", "--time-limit", f"{limit - GRACE_S:g}"]
+    else:
+        command = [sys.executable, __file__, "--child", str(job.domain_file), str(job.problem_file), "--first", first]
     proc = run_process(command, ROOT, limit)
     if proc.timed_out:
         return Outcome(job, proc.wall_s, "timeout"), {}
-    if proc.code != 0:
+    if proc.code != 0 and not proc.out.strip():
         return Outcome(job, proc.wall_s, f"exit {proc.code}", note=proc.err.strip().splitlines()[-1:]), {}
     summary = json.loads(proc.out)
-    if summary["plan"] is None:
+    summary.setdefault("first_s", summary.get("time_first_s"))
+    if summary.get("plan") is None:
         return Outcome(job, proc.wall_s, "unsolved"), summary
     from alica.prophet.planners.planfile import parse_plan
 

@@ -14,8 +14,17 @@ fixpoint (labels only shrink once a fact is reached). The landmarks are the
 union of the goals' labels. Every plan is a relaxed plan, so each landmark
 holds at some point of every plan; this is complete for the causal fact
 landmarks of the relaxation (LAMA's RHW backchaining finds a subset of
-these, plus disjunctive ones, which this module does not make). Labels are
-``int`` bitsets, so a union is ``|`` and an intersection ``&``.
+these, plus disjunctive ones). Labels are ``int`` bitsets, so a union is
+``|`` and an intersection ``&``.
+
+Disjunctive landmarks, RHW's way: when every possible first achiever of a
+landmark (one whose preconditions' labels hold none of its facts) has a
+precondition of one predicate, those preconditions together (2 to
+:data:`MAX_DISJUNCTION` facts, none true initially, none a fact landmark)
+are a disjunctive landmark, greedy-necessary before it; the search goes on
+backwards from each new one (at most :data:`MAX_DISJUNCTIVE_PER_FACT_LANDMARK`
+per fact landmark). The label propagation already holds every fact such
+backchaining could find.
 
 Orderings: ``l`` in ``label(f)`` with ``l != f`` is a *natural* ordering
 (``l`` is true strictly before ``f`` first is, in every plan); ``l`` is a
@@ -31,8 +40,10 @@ landmarks not accepted plus those *required again*: accepted, false now, and
 a goal or a greedy-necessary predecessor of a landmark not accepted. With
 ``unit`` every landmark counts 1 (LAMA's first search); otherwise each costs
 its cheapest achiever (the cost-sum variant). Its preferred operators are
-the applicable operators that achieve a landmark the state needs and whose
-natural predecessors are accepted (simple landmarks, as LAMA's).
+the applicable operators that achieve a fact landmark the state needs and
+whose natural predecessors are accepted, or else a fact of a needed
+disjunctive landmark (as LAMA's). A disjunctive landmark is accepted once one
+of its facts holds, and required again as a greedy-necessary one.
 """
 
 from __future__ import annotations
@@ -45,6 +56,8 @@ from alica.prophet.search.heuristics import Relaxed
 
 MAX_DISJUNCTION = 4
 """The most facts of a disjunctive landmark (as LAMA's)."""
+MAX_DISJUNCTIVE_PER_FACT_LANDMARK = 2
+"""At most this many disjunctive landmarks per fact landmark (a bound on the backchaining)."""
 
 
 def fact_labels(
@@ -89,11 +102,7 @@ def fact_labels(
 
 
 class Landmarks:
-    """The fact landmarks of a relaxed task and their orderings.
-
-    Args:
-        relaxed: the relaxed task (its relaxed actions: preconditions, adds, costs).
-        init: the state the landmarks hold for (the task's initial state).
+    """The fact landmarks of a relaxed task and their orderings (disjunctive landmarks too, given the facts' names).
 
     Attributes:
         mask: the landmarks as a fact bitset.
@@ -101,6 +110,15 @@ class Landmarks:
         gn_children: per fact, the landmarks it is a greedy-necessary predecessor of (a bitset).
         cost: per fact, its cheapest relaxed achiever's cost (0 for facts nothing adds).
         goal_mask: the (fluent) goal facts.
+        disjunctive: the disjunctive landmarks, as fact bitsets (only with ``facts``).
+        disjunctive_children: per disjunctive landmark, the landmarks it is a greedy-necessary
+            predecessor of, as landmark ids (a fact, or ``n_facts + k`` for disjunctive landmark ``k``).
+        disjunctive_cost: per disjunctive landmark, its cheapest relaxed achiever's cost.
+
+    Args:
+        relaxed: the relaxed task.
+        init: the initial state.
+        facts: the facts' names ``(predicate args...)``; with them, disjunctive landmarks too.
     """
 
     def __init__(self, relaxed: Relaxed, init: int, facts: Sequence[str] | None = None) -> None:
@@ -159,19 +177,34 @@ class Landmarks:
         label: list[int | None],
         cheapest: list[float],
     ) -> None:
-        """Disjunctive landmarks, one level deep (see the module docstring)."""
+        """Disjunctive landmarks, backchained from the fact landmarks and from each other (see the module docstring)."""
+        n = len(label)
         pred = [name.strip("()").split(" ", 1)[0] for name in facts]
         lms = self.mask
+        r_pre = relaxed.r_pre
+        alabel: dict[int, int] = {}
+        adders: list[list[int]] = [[] for _ in range(n)]
+        for a, adds in enumerate(relaxed.r_add):
+            if any(label[p] is None for p in r_pre[a]):
+                continue
+            m = 0
+            for p in r_pre[a]:
+                m |= label[p] or 0
+            alabel[a] = m
+            for g in adds:
+                adders[g].append(a)
         index: dict[int, int] = {}
-        for f in bits(lms & ~init):
-            achievers = first[f]
+        cap = MAX_DISJUNCTIVE_PER_FACT_LANDMARK * max(1, lms.bit_count())
+        todo: list[tuple[list[int], int]] = [(first[f], 1 << f) for f in bits(lms & ~init)]
+        while todo:
+            achievers, child = todo.pop(0)
             if not achievers:
                 continue
             union: dict[str, int] = {}
             count: dict[str, int] = {}
             for a in achievers:
                 mine: dict[str, int] = {}
-                for p in relaxed.r_pre[a]:
+                for p in r_pre[a]:
                     mine[pred[p]] = mine.get(pred[p], 0) | 1 << p
                 for name, m in mine.items():
                     union[name] = union.get(name, 0) | m
@@ -183,11 +216,16 @@ class Landmarks:
                     continue
                 k = index.get(m)
                 if k is None:
+                    if len(self.disjunctive) >= cap:
+                        continue
                     k = index[m] = len(self.disjunctive)
                     self.disjunctive.append(m)
                     self.disjunctive_children.append(0)
                     self.disjunctive_cost.append(int(min(cheapest[p] for p in bits(m))))
-                self.disjunctive_children[k] |= 1 << f
+                    # its own possible first achievers: those whose preconditions need none of its facts first
+                    own = sorted({a for p in bits(m) for a in adders[p] if not alabel[a] & m})
+                    todo.append((own, 1 << (n + k)))
+                self.disjunctive_children[k] |= child
 
     def __len__(self) -> int:
         return self.mask.bit_count() + len(self.disjunctive)

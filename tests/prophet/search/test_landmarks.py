@@ -33,8 +33,9 @@ def names(ct: CompiledTask, facts: int) -> set[str]:
     return {ct.task.facts[f] for f in bits(facts)}
 
 
-def reachable_avoiding(ct: CompiledTask, avoid: int, target: int) -> bool:
-    """Whether a state holding ``target`` is reachable from the initial state through states holding no fact of ``avoid`` (a mask)."""
+def reachable_avoiding(ct: CompiledTask, avoid: int, target: int, any_of: bool = False) -> bool:
+    """Whether a state holding ``target`` (``any_of``: one of its facts) is reachable from the initial state
+    through states holding no fact of ``avoid`` (a mask)."""
     start = ct.init
     if start & avoid:
         return False
@@ -42,7 +43,7 @@ def reachable_avoiding(ct: CompiledTask, avoid: int, target: int) -> bool:
     queue = deque([start])
     while queue:
         state = queue.popleft()
-        if state & target == target:
+        if (state & target) if any_of else (state & target == target):
             return True
         for op in ct.applicable(state):
             nxt = ct.successor(state, op)
@@ -118,10 +119,14 @@ def test_landmarks_and_orderings_are_sound_on_random_tasks(task: GroundTask, rng
         assert not reachable_avoiding(ct, 1 << f, ct.goal_mask)
     for before, after in lm.orderings():
         assert not reachable_avoiding(ct, 1 << before, 1 << after)
+    n = ct.n_facts
     for facts, children in zip(lm.disjunctive, lm.disjunctive_children, strict=True):
         assert not facts & ct.init
-        for child in bits(children):  # one of the facts holds before the child first does
-            assert not reachable_avoiding(ct, facts, 1 << child)
+        for child in bits(children):  # one of the facts holds before the child (a fact or a disjunction) first does
+            if child < n:
+                assert not reachable_avoiding(ct, facts, 1 << child)
+            else:
+                assert not reachable_avoiding(ct, facts, lm.disjunctive[child - n], any_of=True)
     for before, after in lm.greedy_necessary():  # a precondition of every first achiever: also natural
         assert (before, after) in set(lm.orderings())
     # along any path, the count is 0 exactly at the goal states
@@ -143,12 +148,19 @@ def test_a_disjunctive_landmark() -> None:
         tb.op("drive", (truck,), [], [f"at {truck} A"])
     ct, _relaxed, lmc = compiled(tb.task(["pkg A"], ["pkg B"]))
     lm = lmc.landmarks
-    assert [names(ct, m) for m in lm.disjunctive] == [{"in pkg t1", "in pkg t2"}]  # from fact landmarks only
-    assert lmc.value(ct.init, lmc.initial) == 2  # pkg B, the package in one truck
-    state = 1 << ct.task.facts.index("in pkg t2")
-    accepted = lmc.progress(lmc.initial, state)
+    assert [names(ct, m) for m in lm.disjunctive] == [{"in pkg t1", "in pkg t2"}, {"at t1 A", "at t2 A"}]
+    n = ct.n_facts
+    assert lm.disjunctive_children == [1 << ct.task.facts.index("pkg B"), 1 << n]  # backchained from the first
+    ids = {name: ct.task.facts.index(name) for name in ("pkg A", "at t2 A", "in pkg t2")}
+    state, accepted = ct.init, lmc.initial
+    assert lmc.value(state, accepted) == 3  # pkg B, the package in a truck, a truck at A
+    for fact in ("at t2 A", "in pkg t2"):
+        state |= 1 << ids[fact]
+        if fact == "in pkg t2":
+            state &= ~(1 << ids["pkg A"])
+        accepted = lmc.progress(accepted, state)
     assert lmc.value(state, accepted) == 1
-    state = 1 << ct.task.facts.index("at t2 A")  # the package is in no truck and not at B
+    state = ct.init & ~(1 << ids["pkg A"]) | 1 << ids["at t2 A"]  # the package in no truck, not at B
     assert lmc.value(state, lmc.progress(accepted, state)) == 2  # the disjunction is required again
 
 
