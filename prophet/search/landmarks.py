@@ -56,6 +56,8 @@ from alica.prophet.search.heuristics import Relaxed
 
 MAX_DISJUNCTION = 4
 """The most facts of a disjunctive landmark (as LAMA's)."""
+CACHE_SIZE = 100_000
+"""The most accepted sets whose live landmarks the count keeps (then it starts again)."""
 MAX_DISJUNCTIVE_PER_FACT_LANDMARK = 2
 """At most this many disjunctive landmarks per fact landmark (a bound on the backchaining)."""
 
@@ -194,6 +196,7 @@ class Landmarks:
             for g in adds:
                 adders[g].append(a)
         index: dict[int, int] = {}
+        used = 0
         cap = MAX_DISJUNCTIVE_PER_FACT_LANDMARK * max(1, lms.bit_count())
         todo: list[tuple[list[int], int]] = [(first[f], 1 << f) for f in bits(lms & ~init)]
         while todo:
@@ -216,8 +219,9 @@ class Landmarks:
                     continue
                 k = index.get(m)
                 if k is None:
-                    if len(self.disjunctive) >= cap:
+                    if len(self.disjunctive) >= cap or m & used:  # a fact is in one disjunctive landmark at most
                         continue
+                    used |= m
                     k = index[m] = len(self.disjunctive)
                     self.disjunctive.append(m)
                     self.disjunctive_children.append(0)
@@ -263,9 +267,16 @@ class LandmarkCount:
             dmask |= bit
         self.initial = ct.init & lm.mask  # no disjunctive landmark holds initially
         self._mask = lm.mask | dmask
+        self._dmask = dmask
+        self._dfacts = 0
+        self._dbit = [0] * n
+        for bit, m, _children in self._dis:
+            self._dfacts |= m
+            for f in bits(m):
+                self._dbit[f] = bit
+        self._cache: dict[int, int] = {}
         self._facts = lm.mask
         self._parents = lm.parents
-        self._again = lm.goal_mask | lm.gn_parents_mask
         self.cost = lm.cost + lm.disjunctive_cost
         """Per landmark id, its cost in the cost-sum variant."""
 
@@ -280,25 +291,49 @@ class LandmarkCount:
                 if not parents[low.bit_length() - 1] & ~accepted:
                     gained |= low
                 new ^= low
-        for bit, m, _children in self._dis:
-            if state & m and not accepted & bit:
-                gained |= bit
+        if self._dis:
+            gained |= self._true_disjunctive(state) & ~accepted
         return accepted | gained
 
-    def needed(self, state: int, accepted: int) -> int:
-        """The landmarks ``state`` still needs: not accepted, or required again."""
-        future = self._mask & ~accepted
-        again = accepted & ~state & self._again
-        if again:
-            goal = self.landmarks.goal_mask
+    def _true_disjunctive(self, state: int) -> int:
+        """The disjunctive landmarks (as id bits) with a fact true in ``state``."""
+        s = state & self._dfacts
+        out = 0
+        dbit = self._dbit
+        while s:
+            low = s & -s
+            out |= dbit[low.bit_length() - 1]
+            s ^= low
+        return out
+
+    def _live(self, accepted: int) -> int:
+        """The accepted landmarks that would be required again if false: goals, and greedy-necessary
+        predecessors of a landmark not accepted (cached per accepted set: siblings share theirs)."""
+        live = self._cache.get(accepted)
+        if live is None:
+            if len(self._cache) > CACHE_SIZE:
+                self._cache.clear()
+            unaccepted = self._mask & ~accepted
+            live = accepted & self.landmarks.goal_mask
             gn_children = self.landmarks.gn_children
-            for f in bits(again):
-                if goal >> f & 1 or gn_children[f] & future:
-                    future |= 1 << f
-        for bit, m, children in self._dis:
-            if accepted & bit and not state & m and children & future:
-                future |= bit
-        return future
+            for f in bits(accepted & self.landmarks.gn_parents_mask):
+                if gn_children[f] & unaccepted:
+                    live |= 1 << f
+            for bit, _m, children in self._dis:
+                if accepted & bit and children & unaccepted:
+                    live |= bit
+            self._cache[accepted] = live
+        return live
+
+    def needed(self, state: int, accepted: int) -> int:
+        """The landmarks ``state`` still needs: not accepted, or required again (accepted, false in ``state``, live)."""
+        needed = self._mask & ~accepted
+        live = self._live(accepted)
+        if live:
+            needed |= live & self._facts & ~state
+            if live & self._dmask:
+                needed |= live & self._dmask & ~self._true_disjunctive(state)
+        return needed
 
     def count(self, needed: int) -> int:
         """The estimate for the needed landmarks ``needed``."""
