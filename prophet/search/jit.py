@@ -14,8 +14,8 @@ the import, 0.35 s the first call of a cached kernel; the compiled code is
 cached on disk, ``cache=True``, and the first run on a machine compiles for a
 few seconds more), which most tasks never earn back: a search done in half a
 second does not wait for it. So :class:`SwitchingFF` starts in pure Python
-and switches only once the evaluations done amount to about half a second of
-pure-Python work (:data:`JIT_WORK`), and only if numba imports. On parking
+and switches only once the compiled FF would have saved that much on the
+evaluations done (a rent-or-buy rule), and only if numba imports. On parking
 (25,000 relaxed actions) the compiled FF does about 4,000 evaluations a second
 against 75 in pure Python; on visitall (3,500) 3,600 against 360.
 """
@@ -28,8 +28,10 @@ from typing import Any
 
 from alica.prophet.search.heuristics import INF, Relaxed
 
-JIT_WORK = 1_000_000
-"""The work (relaxed actions times evaluations) of pure-Python FF after which :class:`SwitchingFF` compiles."""
+JIT_WORK = 1_800_000
+"""The savings (in relaxed actions, see :class:`SwitchingFF`) after which it compiles: about 0.65 s."""
+JIT_OFFSET = 60
+"""Relaxed actions whose pure-Python evaluation costs about the compiled one's fixed cost per call."""
 
 _kernels: tuple[Any, Any] | None = None
 
@@ -140,16 +142,23 @@ class SwitchingFF:
     """An FF evaluator that starts in pure Python and moves to :class:`CompiledFF` once the work pays.
 
     Both give the same estimates and helpful operators, so where the switch
-    happens changes the run's speed only, never its result. The work is
-    counted as relaxed actions per evaluation; past ``work_limit`` (about
-    half a second of pure-Python evaluations), with numba importable, the
-    compiled evaluator is built and used from then on.
+    happens changes the run's speed only, never its result. It switches when
+    the evaluations done would have saved as much as loading numba costs
+    (about 0.65 s), as a rent-or-buy rule: a pure-Python evaluation costs
+    0.2-0.75 microseconds per relaxed action (measured on driverlog, depot,
+    elevators, satellite, visitall, pipesworld and parking), a compiled one
+    about 20 microseconds plus a twentieth of that, so each evaluation would
+    save about 0.35 microseconds times (relaxed actions - :data:`JIT_OFFSET`),
+    and the switch comes once these add up to ``work_limit`` (0.65 s over 0.35
+    microseconds). Parking (25,000 relaxed actions) switches after about 70
+    evaluations; a task of 270 (driverlog) after about 8,500, which few of its
+    searches need; tasks of fewer than 60 relaxed actions never switch.
 
     Args:
         relaxed: the relaxed task.
         python: the pure-Python evaluator it stands for (``relaxed.ff_add_unit`` or ``relaxed.ff_unit``).
         costs: the exploration's costs of that evaluator (``None``: the relaxed actions' own).
-        work_limit: the work (relaxed actions times evaluations) before the switch.
+        work_limit: the savings before the switch, in relaxed actions (see above).
     """
 
     def __init__(
@@ -163,8 +172,8 @@ class SwitchingFF:
         self.python = python
         self.costs = costs
         self.compiled: CompiledFF | None = None
-        self._step = len(relaxed.r_pre) + 1
-        self._left = work_limit if available() else -1
+        self._step = len(relaxed.r_pre) - JIT_OFFSET
+        self._left = work_limit if self._step > 0 and available() else -1
         self.evaluate = python
 
     def __call__(self, state: int) -> tuple[float, list[int]]:
@@ -178,4 +187,4 @@ class SwitchingFF:
         return self.evaluate(state)
 
 
-__all__ = ["JIT_WORK", "CompiledFF", "SwitchingFF", "available"]
+__all__ = ["JIT_OFFSET", "JIT_WORK", "CompiledFF", "SwitchingFF", "available"]
