@@ -15,7 +15,7 @@ cached on disk, ``cache=True``, and the first run on a machine compiles for a
 few seconds more), which most tasks never earn back: a search done in half a
 second does not wait for it. So :class:`SwitchingFF` starts in pure Python
 and switches only once the compiled FF would have saved that much on the
-evaluations done (a rent-or-buy rule), and only if numba imports. On parking
+evaluations done (a rent-or-buy rule, by the clock), and only if numba imports. On parking
 (25,000 relaxed actions) the compiled FF does about 4,000 evaluations a second
 against 75 in pure Python; on visitall (3,500) 3,600 against 360.
 """
@@ -24,14 +24,15 @@ from __future__ import annotations
 
 import importlib.util
 from collections.abc import Callable, Sequence
+from time import perf_counter
 from typing import Any
 
 from alica.prophet.search.heuristics import INF, Relaxed
 
-JIT_WORK = 1_800_000
-"""The savings (in relaxed actions, see :class:`SwitchingFF`) after which it compiles: about 0.65 s."""
-JIT_OFFSET = 60
-"""Relaxed actions whose pure-Python evaluation costs about the compiled one's fixed cost per call."""
+JIT_LOAD_S = 0.65
+"""What loading numba and the kernels costs a process (seconds; measured 0.6-0.7 s)."""
+JIT_CALL_S = 20e-6
+"""The fixed cost of one compiled evaluation (the state's conversion, the calls), seconds."""
 
 _kernels: tuple[Any, Any] | None = None
 
@@ -139,26 +140,26 @@ class CompiledFF:
 
 
 class SwitchingFF:
-    """An FF evaluator that starts in pure Python and moves to :class:`CompiledFF` once the work pays.
+    """An FF evaluator that starts in pure Python and moves to :class:`CompiledFF` once that pays.
 
     Both give the same estimates and helpful operators, so where the switch
-    happens changes the run's speed only, never its result. It switches when
-    the evaluations done would have saved as much as loading numba costs
-    (about 0.65 s), as a rent-or-buy rule: a pure-Python evaluation costs
-    0.2-0.75 microseconds per relaxed action (measured on driverlog, depot,
-    elevators, satellite, visitall, pipesworld and parking), a compiled one
-    about 20 microseconds plus a twentieth of that, so each evaluation would
-    save about 0.35 microseconds times (relaxed actions - :data:`JIT_OFFSET`),
-    and the switch comes once these add up to ``work_limit`` (0.65 s over 0.35
-    microseconds). Parking (25,000 relaxed actions) switches after about 70
-    evaluations; a task of 270 (driverlog) after about 8,500, which few of its
-    searches need; tasks of fewer than 60 relaxed actions never switch.
+    happens changes the run's speed only, never its result (which is why it
+    may go by the clock). It is a rent-or-buy rule: the switch comes once the
+    compiled FF would have saved as much as loading numba costs
+    (:data:`JIT_LOAD_S`) on the evaluations done so far, a compiled evaluation
+    taking about :data:`JIT_CALL_S` plus a twentieth of the pure-Python time
+    (measured: a pure-Python evaluation costs 0.2-0.75 microseconds per relaxed
+    action on driverlog, depot, elevators, satellite, visitall, pipesworld and
+    parking). Parking (13 ms an evaluation) switches after about 50
+    evaluations, visitall's larger grids (1 ms) after about 650, driverlog (90
+    microseconds) after about 10,000, which few of its searches need; tasks
+    whose evaluations take less than ``JIT_CALL_S`` never switch.
 
     Args:
         relaxed: the relaxed task.
         python: the pure-Python evaluator it stands for (``relaxed.ff_add_unit`` or ``relaxed.ff_unit``).
         costs: the exploration's costs of that evaluator (``None``: the relaxed actions' own).
-        work_limit: the savings before the switch, in relaxed actions (see above).
+        load_s: the savings (seconds) before the switch.
     """
 
     def __init__(
@@ -166,25 +167,25 @@ class SwitchingFF:
         relaxed: Relaxed,
         python: Callable[[int], tuple[float, list[int]]],
         costs: Sequence[int] | None = None,
-        work_limit: int = JIT_WORK,
+        load_s: float = JIT_LOAD_S,
     ) -> None:
         self.relaxed = relaxed
         self.python = python
         self.costs = costs
         self.compiled: CompiledFF | None = None
-        self._step = len(relaxed.r_pre) - JIT_OFFSET
-        self._left = work_limit if self._step > 0 and available() else -1
+        self._left = load_s if available() else INF
         self.evaluate = python
 
     def __call__(self, state: int) -> tuple[float, list[int]]:
-        left = self._left
-        if left > 0:
-            left -= self._step
-            self._left = left
-            if left <= 0:
-                self.compiled = CompiledFF(self.relaxed, self.costs, unit=True)
-                self.evaluate = self.compiled
-        return self.evaluate(state)
+        if self.compiled is not None or self._left == INF:
+            return self.evaluate(state)
+        start = perf_counter()
+        result = self.python(state)
+        self._left -= 0.95 * (perf_counter() - start) - JIT_CALL_S
+        if self._left <= 0:
+            self.compiled = CompiledFF(self.relaxed, self.costs, unit=True)
+            self.evaluate = self.compiled
+        return result
 
 
-__all__ = ["JIT_OFFSET", "JIT_WORK", "CompiledFF", "SwitchingFF", "available"]
+__all__ = ["JIT_CALL_S", "JIT_LOAD_S", "CompiledFF", "SwitchingFF", "available"]

@@ -235,8 +235,8 @@ def test_switching_to_the_compiled_ff_does_not_change_the_search() -> None:
     d = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
     ct = compile_task(grounding.ground(d, pddl.read_problem(BENCHMARKS / "rovers" / "p10.pddl", d)))
     relaxed = Relaxed(ct)
-    switching = SwitchingFF(relaxed, relaxed.ff_add_unit, work_limit=2000)
-    python = SwitchingFF(relaxed, relaxed.ff_add_unit, work_limit=0)
+    switching = SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=-1.0)  # switches after the first evaluation
+    python = SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=float("inf"))  # never switches
     from alica.prophet.search.lama import lama_search
 
     lmc = LandmarkCount(ct, relaxed)
