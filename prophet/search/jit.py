@@ -183,8 +183,14 @@ class SwitchingFF:
         result = self.python(state)
         self._left -= 0.95 * (perf_counter() - start) - JIT_CALL_S
         if self._left <= 0:
-            self.compiled = CompiledFF(self.relaxed, self.costs, unit=True)
-            self.evaluate = self.compiled
+            try:
+                compiled = CompiledFF(self.relaxed, self.costs, unit=True)
+                compiled(state)  # numba compiles (or loads) here: a failure keeps the pure-Python FF
+            except Exception:  # any numba or LLVM error: the search goes on in pure Python
+                self._left = INF
+                return result
+            self.compiled = compiled
+            self.evaluate = compiled
         return result
 
 

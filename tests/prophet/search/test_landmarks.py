@@ -275,3 +275,21 @@ def test_landmarks_of_an_unreachable_goal() -> None:
     ct = compile_task(tb.task([], ["y"]))
     lm = Landmarks(Relaxed(ct), ct.init)
     assert not lm.reachable
+
+
+def test_a_failing_compilation_keeps_the_pure_python_ff(monkeypatch: pytest.MonkeyPatch) -> None:
+    from alica.prophet.search import jit
+
+    class Broken:
+        def __init__(self, *args: object, **kwargs: object) -> None:
+            raise RuntimeError("no LLVM here")
+
+    monkeypatch.setattr(jit, "CompiledFF", Broken)
+    monkeypatch.setattr(jit, "available", lambda: True)
+    d = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
+    ct = compile_task(grounding.ground(d, pddl.read_problem(BENCHMARKS / "rovers" / "p05.pddl", d)))
+    relaxed = Relaxed(ct)
+    ff = jit.SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=-1.0)
+    states = random_states(ct, 20)
+    assert [ff(s) for s in states] == [relaxed.ff_add_unit(s) for s in states]
+    assert ff.compiled is None
