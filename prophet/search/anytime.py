@@ -157,10 +157,7 @@ def search_task(
     first = FirstSearch() if first is None else first
     if first.heuristic == "lama":
         lmcount = LandmarkCount(ct, relaxed)
-        if ct.unit_cost:
-            ff = SwitchingFF(relaxed, relaxed.ff_add_unit)
-        else:
-            ff = SwitchingFF(relaxed, relaxed.ff_unit, [1] * len(relaxed.r_cost))
+        ff = SwitchingFF(relaxed, relaxed.ff_unit, [1] * len(relaxed.r_cost))
         ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
     else:
         evaluate: Evaluator = getattr(relaxed, first.heuristic)
