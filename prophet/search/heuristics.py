@@ -118,14 +118,14 @@ class Relaxed:
             cost[f] = 0
             level.append(f)
             s ^= low
-        buckets: dict[int, list[int]] = {}
+        buckets: dict[float, list[int]] = {}
         for a in self.zero:
             for g in r_add[a]:
                 if 1 < cost[g]:
                     cost[g] = 1
                     sup[g] = a
                     buckets.setdefault(1, []).append(g)
-        c = 0
+        c: float = 0
         while True:
             for f in level:
                 if cost[f] != c:
