@@ -1,4 +1,4 @@
-"""The builtin planner: bitset states, FF with preferred operators, lazy GBFS, anytime weighted A*.
+"""The builtin planner: bitset states, FF and landmarks, LAMA's lazy search, anytime weighted A*.
 
 See ``docs/search.md``. Entry points: :class:`BuiltinPlanner` (the
 :class:`~alica.prophet.planner.Planner` interface) and :func:`search_task` (a

@@ -1,10 +1,11 @@
 """The builtin planner's run on a grounded task: a first plan, then cheaper ones.
 
-1. Lazy GBFS with FF (h_max supporters, plan length) and preferred operators
-   finds a first plan (or exhausts the reachable states: ``UNSOLVABLE``).
-   A :class:`FirstSearch` chooses another heuristic, a weight or a
-   tie-breaking seed for this search (MAGiC gives each agent its own); the
-   default is the search just described.
+1. LAMA's lazy greedy search (:mod:`alica.prophet.search.lama`: FF and the
+   landmark count, four open lists, preferred operators) finds a first plan
+   (or exhausts the reachable states: ``UNSOLVABLE``). A :class:`FirstSearch`
+   chooses another heuristic (lazy GBFS with one FF variant and its preferred
+   operators), a weight or a tie-breaking seed for this search (MAGiC gives
+   each agent its own); the default is the search just described.
 2. Quick window sweeps on it (:mod:`alica.prophet.search.windows`: stretches of the
    plan replanned among their own objects).
 3. Restarts: unbounded lazy searches with other heuristics and weights, each
@@ -37,6 +38,9 @@ from alica.prophet.search.astar import astar
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
+from alica.prophet.search.jit import SwitchingFF
+from alica.prophet.search.lama import lama_search
+from alica.prophet.search.landmarks import LandmarkCount
 from alica.prophet.search.neighbourhood import neighbourhood
 from alica.prophet.search.postprocess import improve
 from alica.prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
@@ -46,7 +50,7 @@ NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
 """The first and the largest state limit of the neighbourhood rounds after each plan."""
 RESTART_BUDGET = 20
 """The expansion budget of each restart, in multiples of the first search's expansions."""
-FIRST_HEURISTICS: tuple[str, ...] = ("ff", "ff_add_unit", "ff_cost")
+FIRST_HEURISTICS: tuple[str, ...] = ("lama", "ff", "ff_add_unit", "ff_cost")
 """The heuristics the first search may use (methods of :class:`~alica.prophet.search.heuristics.Relaxed`)."""
 
 
@@ -54,14 +58,17 @@ FIRST_HEURISTICS: tuple[str, ...] = ("ff", "ff_add_unit", "ff_cost")
 class FirstSearch:
     """How the search for the first plan runs: lazy GBFS or lazy weighted A*.
 
-    ``FirstSearch()`` is the builtin planner's own first search (greedy, FF
-    with h_max supporters, the operators' order); other values lead to other
-    first plans, which is what MAGiC's shares differ in.
+    ``FirstSearch()`` is the builtin planner's own first search (LAMA's: greedy,
+    four open lists with FF and the landmark count, :mod:`alica.prophet.search.lama`;
+    the operators' order); other values lead to other first plans, which is what
+    MAGiC's shares differ in.
 
     Attributes:
-        heuristic: ``"ff"`` (h_max supporters, plan length), ``"ff_add_unit"``
-            (h_add supporters, plan length) or ``"ff_cost"`` (h_add supporters,
-            plan cost).
+        heuristic: ``"lama"`` (FF with unit-cost h_add supporters and the landmark
+            count, four open lists), or one heuristic with two open lists:
+            ``"ff"`` (h_max supporters, plan length; the default before
+            ``"lama"``), ``"ff_add_unit"`` (h_add supporters, plan length) or
+            ``"ff_cost"`` (h_add supporters, plan cost).
         weight: ``None`` for greedy search, else the weight w of ``g + w*h``.
         seed: a tie-breaking seed (successors inserted in a shuffled order);
             ``None``: the operators' order.
@@ -70,7 +77,7 @@ class FirstSearch:
         ValueError: an unknown heuristic, or a weight that is not a finite number > 0.
     """
 
-    heuristic: str = "ff"
+    heuristic: str = "lama"
     weight: float | None = None
     seed: int | None = None
 
@@ -119,6 +126,7 @@ def search_task(
     optimal_pass: bool = True,
     first: FirstSearch | None = None,
     limits: Limits | None = None,
+    stats: Stats | None = None,
 ) -> Iterator[SearchEvent]:
     """Search a grounded task (``GroundTask`` shape), yielding planner events.
 
@@ -132,6 +140,8 @@ def search_task(
             ``Done(SOLVED)`` after one round.
         first: how the first plan is searched; ``None`` is ``FirstSearch()``.
         limits: the run's deadline, checked while searching (every few expansions).
+        stats: the run's counters (expansions, evaluations), to read them
+            afterwards; ``None``: fresh ones (``progress_every`` and ``limits`` apply then).
 
     Yields:
         ``Progress``, ``Improved`` for each cheaper plan, one final ``Done``.
@@ -139,7 +149,7 @@ def search_task(
     Raises:
         LimitReached: the deadline of ``limits`` passed (``Planner.search`` turns it into ``Done(TIMEOUT)``).
     """
-    stats = Stats(progress_every, limits)
+    stats = Stats(progress_every, limits) if stats is None else stats
     reason = getattr(task, "unsolvable_reason", None)
     if reason:
         yield Done(PlanStatus.UNSOLVABLE, 0, str(reason))
@@ -150,8 +160,13 @@ def search_task(
         return
     relaxed = Relaxed(ct)
     first = FirstSearch() if first is None else first
-    evaluate: Evaluator = getattr(relaxed, first.heuristic)
-    ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
+    if first.heuristic == "lama":
+        lmcount = LandmarkCount(ct, relaxed)
+        ff = SwitchingFF(relaxed, relaxed.ff_unit, [1] * len(relaxed.r_cost))
+        ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
+    else:
+        evaluate: Evaluator = getattr(relaxed, first.heuristic)
+        ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
     if ops is None:
         yield Done(PlanStatus.UNSOLVABLE, stats.expansions, "every reachable state was expanded")
         return

@@ -11,11 +11,6 @@ from __future__ import annotations
 from alica.prophet.search.encoding import CompiledTask
 
 
-def _applicable(ct: CompiledTask, state: int, op: int) -> bool:
-    m = ct.pre_mask[op]
-    return state & m == m
-
-
 def remove_loops(ct: CompiledTask, ops: list[int]) -> list[int]:
     """The plan without the segments that come back to an earlier state."""
     states = [ct.init]
@@ -39,6 +34,8 @@ def remove_loops(ct: CompiledTask, ops: list[int]) -> list[int]:
 def eliminate_actions(ct: CompiledTask, ops: list[int], *, max_rounds: int = 5) -> list[int]:
     """Greedy action elimination (see the module docstring)."""
     cost = ct.cost
+    pre_mask = ct.pre_mask
+    successor = ct.successor
     for _ in range(max_rounds):
         changed = False
         i = 0
@@ -47,8 +44,9 @@ def eliminate_actions(ct: CompiledTask, ops: list[int], *, max_rounds: int = 5) 
             s = state
             kept = ops[:i]
             for op in ops[i + 1 :]:
-                if _applicable(ct, s, op):
-                    s = ct.successor(s, op)
+                m = pre_mask[op]
+                if s & m == m:
+                    s = successor(s, op)
                     kept.append(op)
             if ct.is_goal(s) and (sum(cost[o] for o in kept), len(kept)) < (sum(cost[o] for o in ops), len(ops)):
                 ops = kept

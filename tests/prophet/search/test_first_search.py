@@ -16,17 +16,25 @@ def task(name: str):
     return grounding.ground(domain, pddl.read_problem(BENCHMARKS / "rovers" / f"{name}.pddl", domain))
 
 
-def test_the_default_first_search_is_unchanged() -> None:
+def test_the_default_first_search_is_lamas() -> None:
     t = task("p05")
     default = list(search_task(t, anytime=False, progress_every=10))
-    assert list(search_task(t, anytime=False, progress_every=10, first=FirstSearch())) == default
-    first = next(e for e in default if isinstance(e, Improved))
+    assert FirstSearch() == FirstSearch("lama")
+    assert list(search_task(t, anytime=False, progress_every=10, first=FirstSearch("lama"))) == default
+    check_plan(t, next(e for e in default if isinstance(e, Improved)).plan)
+
+
+def test_the_former_default_ff_search_is_unchanged() -> None:
+    t = task("p05")
+    events = list(search_task(t, anytime=False, progress_every=10, first=FirstSearch("ff")))
+    first = next(e for e in events if isinstance(e, Improved))
     assert (first.plan.cost, first.expansions) == (23, 77)  # the figures of the builtin planner before FirstSearch
 
 
 @pytest.mark.parametrize(
     "first",
-    [FirstSearch(h) for h in FIRST_HEURISTICS] + [FirstSearch("ff", 3.0), FirstSearch("ff", None, 1)],
+    [FirstSearch(h) for h in FIRST_HEURISTICS]
+    + [FirstSearch("ff", 3.0), FirstSearch("ff", None, 1), FirstSearch("lama", 3.0), FirstSearch("lama", None, 1)],
     ids=str,
 )
 def test_every_first_search_finds_a_valid_plan(first: FirstSearch) -> None:
@@ -40,9 +48,9 @@ def test_every_first_search_finds_a_valid_plan(first: FirstSearch) -> None:
 
 def test_other_first_searches_give_other_searches() -> None:
     t = task("p05")
-    runs = {str(f): list(search_task(t, anytime=False, first=f)) for f in (FirstSearch(), FirstSearch("ff_add_unit"))}
-    runs["ff seed"] = list(search_task(t, anytime=False, first=FirstSearch(seed=1)))
-    assert len({tuple(r) for r in runs.values()}) == 3
+    firsts = (FirstSearch(), FirstSearch("ff"), FirstSearch("ff_add_unit"), FirstSearch("ff", seed=1))
+    runs = {str(f): list(search_task(t, anytime=False, first=f)) for f in firsts}
+    assert len({tuple(r) for r in runs.values()}) == 4
 
 
 def test_the_builtin_planner_takes_a_first_search() -> None:
