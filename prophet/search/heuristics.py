@@ -71,6 +71,8 @@ class Relaxed:
         self.r_cost = r_cost
         self.r_op = r_op
         self.r_unit = [1 if op >= 0 else 0 for op in r_op]
+        self.has_rules = 0 in self.r_unit
+        """Whether some relaxed actions are derived-predicate rules (``r_op`` -1, free)."""
         self.r_pre_mask = [mask(p) for p in r_pre]
         self.pre_of = pre_of
         self.zero = [a for a, p in enumerate(r_pre) if not p]
@@ -108,6 +110,9 @@ class Relaxed:
         gm = self.goal_mask
         if state & gm == gm:
             return 0, []
+        if self.has_rules:  # derived-predicate rules are free: costs 0 and 1 need the heap
+            explored, sup = self._explore_add(state, True, self.r_unit)
+            return (INF, []) if explored is None else self._extract(state, sup, True)
         pre_of = self.pre_of
         r_add = self.r_add
         is_goal = self.is_goal

@@ -86,7 +86,9 @@ class CompiledFF:
         self.pre_of_idx = np.array([a for u in pre_of for a in u], dtype=i64)
         self.cost = np.array(relaxed.r_cost if costs is None else costs, dtype=i64)
         self.zero = np.array(relaxed.zero, dtype=i64)
-        self.unit = unit
+        # what the relaxed plan sums: 1 per operator and 0 per derived-predicate rule (as the pure-Python
+        # extraction counts), or the exploration's costs
+        self.counted = np.array(relaxed.r_unit, dtype=i64) if unit else self.cost
         self.r_op = relaxed.r_op
         self.goal_mask = relaxed.goal_mask
         self.cost_f = np.zeros(n, dtype=i64)
@@ -128,7 +130,7 @@ class CompiledFF:
         if not ok:
             return INF, []
         h, n_out = self.extract(
-            s, self.goals, self.sup, self.pre_ptr, self.pre_idx, self.cost, self.unit, self.used, self.done, self.out
+            s, self.goals, self.sup, self.pre_ptr, self.pre_idx, self.counted, False, self.used, self.done, self.out
         )
         r_op = self.r_op
         preferred: list[int] = []

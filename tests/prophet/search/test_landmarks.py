@@ -213,16 +213,18 @@ needs_numba = pytest.mark.skipif(not available(), reason="numba is not installed
         (BENCHMARKS / "rovers" / "domain.pddl", BENCHMARKS / "rovers" / "p05.pddl"),
         (IPC / "miconic-simpleadl" / "domain.pddl", IPC / "miconic-simpleadl" / "s1-2.pddl"),  # when-effects
         (IPC / "elevators-sat08-strips" / "domain.pddl", IPC / "elevators-sat08-strips" / "p01.pddl"),  # costs
+        (IPC / "optical-telegraphs" / "domain.pddl", IPC / "optical-telegraphs" / "p01-opt2.pddl"),  # free rules
     ],
-    ids=["rovers", "miconic-simpleadl", "elevators"],
+    ids=["rovers", "miconic-simpleadl", "elevators", "optical-telegraphs"],
 )
 def test_the_compiled_ff_equals_the_pure_python_one(domain: Path, problem: Path) -> None:
     d = pddl.read_domain(domain)
     ct = compile_task(grounding.ground(d, pddl.read_problem(problem, d)))
     relaxed = Relaxed(ct)
     unit = CompiledFF(relaxed)
-    ones = CompiledFF(relaxed, [1] * len(relaxed.r_cost))
+    ones = CompiledFF(relaxed, relaxed.r_unit)  # 1 per operator, 0 per derived-predicate rule
     cost = CompiledFF(relaxed, unit=False)
+    assert relaxed.has_rules == bool(ct.task.axioms)
     for state in random_states(ct, 150):
         if ct.unit_cost:
             assert unit(state) == relaxed.ff_add_unit(state)
