@@ -147,8 +147,8 @@ class ProblemPlanning:
         Raises:
             PlannerError: the planner does not support what the problem needs (raised at once).
         """
-        if limits is None:
-            limits = Limits(self.problem.timeout, DEFAULT_MEMORY_MB)
+        if limits is None:  # the wall-clock timeout bounds the grounding, never the search the caller budgets
+            limits = Limits(self.problem.timeout, DEFAULT_MEMORY_MB, bounds_search=False)
         events = self.planner.search(self.domain, self.pddl, anytime=anytime, limits=limits)
         return self._validate_events(events)
 
@@ -195,5 +195,14 @@ def plan_problem(
         PlannerError: the problem cannot be written as PDDL, or the planner is unknown.
     """
     domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
-    chosen = get_planner(planner or problem.planner, **dict(options or {}))
+    name = planner or problem.planner
+    chosen_options = dict(options or {})
+    if name == "builtin":
+        # A plan file's problem keeps FF's first search (FirstSearch("ff")): the shipped missions and
+        # their fault tests were built on its plans, and with LAMA's the lunar team hands its fetch to
+        # another robot and replans a fenced sample without end. ``options`` may choose another.
+        from alica.prophet.search.anytime import FirstSearch  # lazy: the planning layer's search
+
+        chosen_options.setdefault("first", FirstSearch("ff"))
+    chosen = get_planner(name, **chosen_options)
     return ProblemPlanning(problem, world, domain, pddl, chosen)

@@ -115,12 +115,16 @@ class Limits:
         memory_mb: the memory bound in MB; ``None``: none.
         clock: the clock the deadline is on (injected in tests).
         deadline: ``clock()`` at the start plus ``seconds``.
+        bounds_search: whether the deadline also bounds the search (checked every few expansions); False
+            when it bounds reading and grounding only and the caller budgets the search between its
+            events (the runtime plans a little every tick, in simulated time).
     """
 
     seconds: float | None = None
     memory_mb: float | None = None
     clock: Callable[[], float] = time.monotonic
     deadline: float | None = field(default=None)
+    bounds_search: bool = True
 
     def __post_init__(self) -> None:
         if self.deadline is None and self.seconds is not None:

@@ -71,5 +71,5 @@ class BuiltinPlanner(Planner):
             weights=self.weights,
             progress_every=self.progress_every,
             first=self.first,
-            limits=limits,
+            limits=limits if limits is not None and limits.bounds_search else None,
         )

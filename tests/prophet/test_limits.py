@@ -140,6 +140,23 @@ def test_the_search_stops_at_the_deadline_within_a_few_expansions() -> None:
     assert CHECK_EVERY <= rest[-1].expansions <= CHECK_EVERY + 1  # the count the search reached, not the last event's
 
 
+def test_a_deadline_for_the_grounding_only_leaves_the_search_to_its_caller() -> None:
+    """The runtime plans a little every tick: the problem's wall-clock timeout bounds its grounding, not its search."""
+    domain = parse_domain(BLOCKS)
+    problem = parse_problem(
+        _blocks_problem(7).replace("(:goal (on b0 b1))", "(:goal (and (on b0 b1) (on b1 b0)))"), domain=domain
+    )
+    now = [0.0]
+    limits = Limits(seconds=10.0, clock=lambda: now[0], bounds_search=False)
+    events = BuiltinPlanner(progress_every=1).search(domain, problem, limits=limits)
+    next(events)
+    now[0] = 11.0  # past the deadline: the search goes on while its caller takes events
+    for _ in range(10 * CHECK_EVERY):
+        event = next(events)
+        assert not isinstance(event, Done)
+    assert event.expansions > 10 * CHECK_EVERY
+
+
 def test_the_runtimes_grounding_is_bounded_by_the_problems_timeout() -> None:
     library = load_library(PLANS / "blocksworld" / "mission.yaml")
     names = [f"b{i}" for i in range(30)]
