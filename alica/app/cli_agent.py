@@ -37,6 +37,7 @@ import threading
 import time
 from typing import Any
 
+from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.skill_options import add_skills_option
 from alica.app.timed import timed
 from alica.errors import AlicaError
@@ -132,6 +133,7 @@ def add_parser(sub: Any) -> None:
         "(by default it does: with no center listening it only keeps its last events in memory)",
     )
     add_skills_option(p)
+    add_engine_options(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace")
     p.add_argument("--json", action="store_true", help="print status and summary lines as JSON")
     p.set_defaults(run=cmd_agent)
@@ -214,6 +216,7 @@ def _run(
         planner_seconds=0.3 / args.frequency,
         parallel_planning=args.parallel_planning,
         review=args.review,
+        **engine_settings(args),
     )
     header = trace_header(
         plans=[args.plan],

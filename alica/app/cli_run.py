@@ -16,6 +16,7 @@ import sys
 from typing import Any
 
 from alica.app.center.cli import add_live_options, live_session
+from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
@@ -110,6 +111,7 @@ def add_parser(sub: Any) -> None:
         "that act on a robot) instead of stopping with an error",
     )
     add_skills_option(p)
+    add_engine_options(p)
     p.add_argument(
         "--parallel-planning",
         action="store_true",
@@ -266,7 +268,10 @@ def _run_team(
         roles,
         seed=args.seed,
         config=engine_config(  # planning problems run with pRoPhEt MAS
-            frequency=args.frequency, parallel_planning=args.parallel_planning, review=args.review
+            frequency=args.frequency,
+            parallel_planning=args.parallel_planning,
+            review=args.review,
+            **engine_settings(args),
         ),
         roleset=args.roleset,
         loss=args.loss,
@@ -398,6 +403,7 @@ def _run_processes(
         options.append("--parallel-planning")
     if args.review:
         options.append("--review")
+    options += engine_arguments(args)
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
         team = ProcessTeam(args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition))
         live = _ProcessCenter(session, team, header, library) if session is not None else None

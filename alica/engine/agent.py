@@ -27,7 +27,16 @@ from alica.engine.slot import Repairs, Slot
 from alica.engine.solving import Solving, binding_names
 from alica.engine.status import ChildStatus
 from alica.engine.sync import SyncProcess, SyncTalk
-from alica.engine.team import SYNC_TOPIC, TEAM_TOPIC, WORLD_TOPIC, AuthorityClaim, PlanKey, TeamMessage, TeamView
+from alica.engine.team import (
+    SYNC_TOPIC,
+    TEAM_TOPIC,
+    WORLD_TOPIC,
+    AuthorityClaim,
+    Claim,
+    PlanKey,
+    TeamMessage,
+    TeamView,
+)
 from alica.errors import AlicaError
 from alica.lang import FactBase, Registry
 from alica.model import Behaviour, ChildRef, Plan, PlanLibrary, RoleSet, Transition
@@ -117,6 +126,10 @@ class AgentEngine:
         self.root_repairs = Repairs()
         self._failed_root: PlanNode | None = None
         self._next_root_try = float("-inf")
+        self.left: dict[PlanKey, Claim] = {}
+        """Plan instances this agent left after its task succeeded there, while their parent runs: still
+        claimed (no entry point, the successes), so a teammate learns the success even when the parent
+        moved on in the step the task succeeded."""
         self.carried: dict[PlanKey, tuple[str, dict[str, set[str]]]] = {}
         """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
         self.allocator = Allocator(self)
@@ -272,8 +285,8 @@ class AgentEngine:
             self._failed_root = None
             self.root_repairs.waiting_since = None
         else:
-            # try again when a teammate comes back or speaks, at the latest after a heartbeat
-            self._next_root_try = now + self.config.broadcast_interval
+            # try again in the next step, as the C++ engine does (a teammate may be heard, the world change)
+            self._next_root_try = now
 
     def _give_up_root(self, failed: PlanNode) -> None:
         """The root plan found no valid assignment for ``rejoin_wait`` seconds: the mission failed."""
@@ -293,7 +306,12 @@ class AgentEngine:
             self._start_root(now)
             return self.root is not None
 
-        self.root_repairs.repair(root, restart, lambda: self.root_plan.name not in self.root_repairs.dropped)
+        self.root_repairs.repair(
+            root,
+            restart,
+            lambda: self.root_plan.name not in self.root_repairs.dropped,
+            auto=self.config.auto_failure_handling,
+        )
 
     def _tick_behaviours(self, node: PlanNode, now: float) -> None:
         belief = self.belief
@@ -483,8 +501,8 @@ class AgentEngine:
         self.transport.publish(topic, payload, qos)
         self.stats["messages_out"] += 1
 
-    def claims(self) -> list[Any]:
-        """This agent's claims, root first."""
+    def claims(self) -> list[Claim]:
+        """This agent's claims, root first, then the instances it left with a success (``left``)."""
         out = []
         todo = [self.root] if self.root is not None else []
         while todo:
@@ -492,6 +510,11 @@ class AgentEngine:
             if node.status is not ChildStatus.FAILURE:
                 out.append(node.claim())
             todo.extend(reversed([s.node for s in node.slots if s.node is not None]))
+        for key in list(self.left):
+            if key[:-2] not in self.index:
+                del self.left[key]  # its parent ended: nobody needs the success any more
+            elif key not in self.index:
+                out.append(self.left[key])
         return out
 
     def _broadcast(self, now: float) -> None:

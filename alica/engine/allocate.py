@@ -44,6 +44,8 @@ class Allocator:
 
     def __init__(self, engine: AgentEngine) -> None:
         self.engine = engine
+        self._unallocated: dict[PlanKey, str] = {}
+        """Plan instance -> why its last allocation found no assignment (reported once, retried every step)."""
 
     def members(self, parent: PlanNode | None) -> tuple[str, ...]:
         """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""
@@ -139,10 +141,13 @@ class Allocator:
         engine.stats["allocations"] += 1
         assignment = result.assignment
         if assignment is None:
-            engine.emit("allocation", key="/".join(key), outcome="none", why=result.why)
+            if self._unallocated.get(key) != result.why:
+                self._unallocated[key] = result.why
+                engine.emit("allocation", key="/".join(key), outcome="none", why=result.why)
             if slot is not None:
                 slot.reason = f"no valid assignment: {result.why}"
             return None
+        self._unallocated.pop(key, None)
         plan = engine.plan_named(assignment.plan)
         node = PlanNode(engine, key, slot, plan, env, now)
         engine.index[key] = node
@@ -176,15 +181,20 @@ class Allocator:
             self._reuse_succeeded(node, now)
 
     def _reuse_succeeded(self, node: PlanNode, now: float) -> None:
-        """Agents whose task succeeded take success-required tasks nobody has done or is doing.
+        """Agents whose task succeeded take another entry point of the plan (the C++ engine's ``runMultiAgentPlan``).
 
         Every agent computes this from the same view, like any allocation: the
-        free agents (in success states) are allocated, by the same utility, to
-        the entry points that need a success and have nobody working on them.
+        free agents (in success states) are allocated, by the same utility,
+        first to the success-required entry points that still need a success
+        and have nobody working on them, then to any entry point with room left
+        (its ``max`` less the agents that succeeded or work there, e.g. an idle
+        task with min 0). An agent never goes back to an entry point in which it
+        succeeded; with no room anywhere it stays in its success state.
         """
         plan = node.plan
         successes = node.successes()
-        free, busy = [], set()
+        free: list[str] = []
+        working: dict[str, int] = {}
         for agent in node.members():
             entry = node.believed.get(agent)
             if entry is None or entry[1] is None:
@@ -193,26 +203,49 @@ class Allocator:
             if kind is StateKind.SUCCESS:
                 free.append(agent)
             elif kind is StateKind.NORMAL and entry[0] is not None:
-                busy.add(entry[0])
+                working[entry[0]] = working.get(entry[0], 0) + 1
         if not free:
             return
         needy = tuple(
             replace(ep, min=0, max=max(1, ep.max - successes.get(ep.name, 0)))
             for ep in plan.entry_points
-            if ep.success_required and successes.get(ep.name, 0) < max(ep.min, 1) and ep.name not in busy
+            if ep.success_required and successes.get(ep.name, 0) < max(ep.min, 1) and ep.name not in working
         )
-        if not needy:
+        moves = self._place(node, tuple(free), needy)
+        for _, ep in moves:
+            working[ep] = working.get(ep, 0) + 1
+        placed = {a for a, _ in moves}
+        for agent in free:
+            if agent in placed:
+                continue
+            roomy = tuple(
+                replace(ep, min=0, max=room)
+                for ep in plan.entry_points
+                if agent not in node.succeeded.get(ep.name, ())
+                and (room := ep.max - successes.get(ep.name, 0) - working.get(ep.name, 0)) > 0
+            )
+            move = self._place(node, (agent,), roomy)
+            for _, ep in move:
+                working[ep] = working.get(ep, 0) + 1
+            moves += move
+        if not moves:
             return
-        reduced = replace(plan, entry_points=needy)
-        result = allocate(
-            self._problem(tuple(free), (reduced,), {}, None, node.env, node.slot.parent if node.slot else None)
-        )
-        best = result.assignment
-        if best is None or all(ep is None for _, ep in best.entries):
-            return
-        moves = tuple((a, ep) for a, ep in best.entries if ep is not None)
+        moves = tuple(sorted(moves))
         self.engine.emit("allocation", key=node.key_text, plan=plan.name, reason="reuse", entries=dict(moves))
-        node.apply(Assignment(plan.name, moves, best.utility), now, "reuse")
+        node.apply(Assignment(plan.name, moves, 0.0), now, "reuse")
+
+    def _place(
+        self, node: PlanNode, agents: tuple[str, ...], entries: tuple[EntryPoint, ...]
+    ) -> tuple[tuple[str, str], ...]:
+        """The best moves of ``agents`` to ``entries`` by the plan's utility (an agent may also stay)."""
+        if not agents or not entries:
+            return ()
+        reduced = replace(node.plan, entry_points=entries)
+        context = node.slot.parent if node.slot else None
+        best = allocate(self._problem(agents, (reduced,), {}, None, node.env, context)).assignment
+        if best is None:
+            return ()
+        return tuple((a, ep) for a, ep in best.entries if ep is not None)
 
     def _reallocate(self, node: PlanNode, now: float) -> None:
         engine = self.engine
@@ -227,20 +260,25 @@ class Allocator:
             agents.append(agent)
             current[agent] = entry[0] if entry is not None else None
         agents_t = tuple(agents)
+        # a plan whose run-time condition fails scores -1: the child takes an alternative of its
+        # plan type whose conditions hold, if any (else the abort rule fails the plan)
+        runs = plan.run is None or engine.formulas.holds(plan.run.text, engine.belief_for(node), node.env)
         plans: tuple[Plan, ...] = (
-            (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan)
+            (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan if runs else None)
         )
-        if plan not in plans:
+        if runs and plan not in plans:
             plans = (plan, *plans)
+        if not plans:
+            return
         successes = {plan.name: node.successes()}
         old = Assignment(plan.name, tuple(sorted(current.items())), 0.0)
         problem = self._problem(agents_t, plans, successes, old, node.env, node.slot.parent if node.slot else None)
-        now_utility = utility(problem, plan, current) if agents_t else 0.0
+        now_utility = (utility(problem, plan, current) if agents_t else 0.0) if runs else -1.0
         result = allocate(problem)
         engine.stats["allocations"] += 1
         best = result.assignment
         if best is None:
-            if now_utility <= -1:
+            if runs and now_utility <= -1:
                 node.understaffed = True
                 node.fail(f"no valid assignment any more: {result.why}")
             return

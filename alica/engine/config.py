@@ -47,6 +47,13 @@ class EngineConfig:
             team runs it (a planning problem's leader proposes it and waits for
             :meth:`AgentEngine.decide_plan <alica.engine.agent.AgentEngine.decide_plan>`;
             the team runs the WaitPlan meanwhile). Off: plans run at once.
+        auto_failure_handling: a failed plan that no transition of its parent state
+            handles is repaired (retry, replace, propagate: :mod:`alica.engine.slot`),
+            as the C++ engine's ``AutoFailureHandling: true``. Off: a failed plan stays
+            failed, its parent state's ``failed`` conditions hold until a transition
+            leaves the state, nothing is retried and nothing fails upwards; a failed
+            root plan ends the agent's mission. A plan restarted for want of
+            teammates is not a failure and is restarted either way.
     """
 
     frequency: float = 30.0
@@ -64,6 +71,7 @@ class EngineConfig:
     authority_growth: float = 2.0
     children: Mapping[type, ChildKind] = field(default_factory=dict, hash=False)
     review: bool = False
+    auto_failure_handling: bool = True
 
     def __post_init__(self) -> None:
         positive = ("frequency", "broadcast_interval", "team_timeout", "cycle_window", "authority_min")

@@ -9,15 +9,16 @@ Each tick the engine visits the tree top-down. For one plan node:
    computed again; the agent switches only when the utility gains more than
    the plan's threshold (or the current assignment became invalid). An
    authority's assignment, while it lasts, replaces this step;
-3. **children**: the rules of the child plans run, and failed children are
-   repaired (see :mod:`alica.engine.slot`);
+3. **children**: the rules of the child plans run; a child plan that fails
+   shows as ``failed`` to this plan's conditions;
 4. **transitions**: the first out-transition of the agent's state whose
    condition holds fires (synchronised ones only together with the other
-   agents), up to ``max_rule_applications`` in a row;
+   agents), up to ``max_rule_applications`` in a row; a failed child is
+   repaired only when none fires (see :mod:`alica.engine.slot`);
 5. **abort**: a failure state, a run-time condition that no longer holds, or a
-   failed child no transition handles makes the plan fail for this agent;
-   the plan succeeds when every success-required entry point has enough
-   agents in success states.
+   failed child no transition handles makes the plan fail for this agent
+   (the last not with automatic failure handling off); the plan succeeds when
+   every success-required entry point has enough agents in success states.
 
 Behaviours are ticked after the rules (see :meth:`AgentEngine.tick`).
 """
@@ -79,6 +80,8 @@ class PlanNode:
         self.overridden_until = -1.0
         self.understaffed = False
         """The plan failed for want of agents (no valid assignment with the teammates alive now)."""
+        self.stopped = False
+        """The agent left this plan instance (a node replaced in mid-visit stops there)."""
         self._members: tuple[str, ...] | None = None
 
     def __repr__(self) -> str:
@@ -137,6 +140,17 @@ class PlanNode:
             del self.believed[agent]
             changed = True
         protection = engine.config.assignment_protection
+        for agent in team.alive():
+            if agent == me or agent in members:
+                continue
+            # a teammate that left this instance (its parent moved on) still counts where it succeeded
+            claim = team.claim(agent, self.key)
+            if claim is not None and claim.plan == self.plan.name:
+                for ep in claim.success:
+                    done = self.succeeded.setdefault(ep, set())
+                    if agent not in done:
+                        done.add(agent)
+                        changed = True
         for agent in sorted(members - {me}):
             claim = team.claim(agent, self.key)
             current = self.believed.get(agent)
@@ -227,7 +241,11 @@ class PlanNode:
         self.engine.drop_syncs(self)
 
     def stop(self) -> None:
-        """Stop every child: the agent leaves this plan."""
+        """Stop every child: the agent leaves this plan (what it succeeded in here is still claimed, see ``left``)."""
+        self.stopped = True
+        done = self.own_successes()
+        if done and self.slot is not None:
+            self.engine.left[self.key] = Claim(self.key, self.plan.name, None, None, done)
         self._leave_state()
         self.engine.forget(self)
 
@@ -262,11 +280,13 @@ class PlanNode:
             and now - min(self.predicted_at.values()) > engine.config.assignment_protection
         ):
             self.dirty = True
+        if self.slot is not None and self.slot.choice_changed():
+            self.dirty = True  # a plan of the type may run now, or may not any more
         if self.dirty:
             self.dirty = False
             self.integrate(now)
             engine.allocator.reallocate(self, now)
-            if self.failed:
+            if self.failed or self.stopped:
                 return
         for slot in list(self.slots):
             slot.visit(now)
@@ -292,6 +312,9 @@ class PlanNode:
             self.enter_state(transition.target, now)
         if self.failed:
             return
+        if not fired:
+            for slot in list(self.slots):
+                slot.repair_pending(now)
         self._abort_rule(fired)
         if not self.failed:
             self._check_success()
@@ -336,7 +359,7 @@ class PlanNode:
         if run is not None and not self.engine.formulas.holds(run.text, self.engine.belief_for(self), self.env):
             self.fail(f"run-time condition '{run.text}' no longer holds")
             return
-        if not fired:
+        if not fired and self.engine.config.auto_failure_handling:
             for slot in self.slots:
                 if slot.status is ChildStatus.FAILURE:
                     self.fail(

@@ -1,7 +1,12 @@
 """A child of an agent's current state: a behaviour, or a plan with its repair stages.
 
 Repair of a failed plan (IMPERA/ALICA failure handling), per child, and for
-the root plan (:class:`Repairs` does it for both):
+the root plan (:class:`Repairs` does it for both). A failed child plan is first
+shown to its parent: in the step it fails, the ``failed`` conditions of the
+parent state hold and the state's transitions are tried; only when none fires
+does the repair start (the C++ engine's ``continueOnFailure``). With automatic
+failure handling off (``EngineConfig.auto_failure_handling``) there is no
+repair: the plan stays failed until a transition leaves the state.
 
 1. **retry**: the first failure of a plan restarts it: every local agent goes
    back to the initial state of its entry point and the plan is allocated again;
@@ -55,6 +60,7 @@ class Repairs:
         alternatives: Callable[[], bool],
         *,
         may_retry: bool = True,
+        auto: bool = True,
     ) -> bool:
         """Stop the failed ``node``, then retry its plan, or replace it, or give up.
 
@@ -63,9 +69,11 @@ class Repairs:
             start: starts that plan again, or (``None``) the best plan left; whether one runs now.
             alternatives: whether any plan is left once the failed one is dropped.
             may_retry: whether a first failure may retry the plan.
+            auto: automatic failure handling; off, only a plan that failed for want of
+                teammates is restarted, and any other failure stays (``False``, no event).
 
         Returns:
-            ``False`` when the failure propagates.
+            ``False`` when the failure propagates (or, with ``auto`` off, stays).
         """
         engine = node.engine
         plan = node.plan
@@ -82,6 +90,8 @@ class Repairs:
             return True
         if node.understaffed:
             node.reason += f" (no valid assignment for {engine.config.rejoin_wait:g} s)"
+        if not auto:
+            return False
         count = self.failures[plan.name] = self.failures.get(plan.name, 0) + 1
         if count == 1 and may_retry:
             engine.emit("repair", key=node.key_text, stage="retry", plan=plan.name, reason=node.reason)
@@ -111,6 +121,7 @@ class Slot:
     __slots__ = (
         "element",
         "env",
+        "failed_node",
         "next_try",
         "node",
         "parent",
@@ -120,7 +131,9 @@ class Slot:
         "revision",
         "runner",
         "runtime",
+        "seen",
         "status",
+        "watch",
     )
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
@@ -139,6 +152,14 @@ class Slot:
         if not isinstance(self.element, (Behaviour, Plan, PlanType)):
             self.runtime = engine.children.runtime(self)
         self.revision = self.runtime.revision if self.runtime is not None else 0
+        self.failed_node: PlanNode | None = None
+        """The plan node that failed in this step, shown to the parent's transitions before it is repaired."""
+        element = self.element
+        self.watch = isinstance(element, PlanType) and any(
+            engine.plan_named(n).pre is not None or engine.plan_named(n).run is not None for n in element.plans
+        )
+        """A plan type with conditioned plans: which plans may run is looked at every step."""
+        self.seen: tuple[str, ...] | None = None
 
     @property
     def name(self) -> str:
@@ -186,12 +207,33 @@ class Slot:
         return tuple(library.plans[n] for n in names if n not in dropped)
 
     def startable(self, plans: tuple[Plan, ...], keep: Plan | None = None) -> tuple[Plan, ...]:
-        """The plans whose pre-condition holds now (``keep`` is kept regardless: it already runs)."""
+        """The plans whose pre-condition and run-time condition hold now (``keep`` is kept regardless: it runs)."""
         engine = self.parent.engine
         belief = engine.belief_for(self.parent)
+        holds = engine.formulas.holds
         return tuple(
-            p for p in plans if p is keep or engine.formulas.holds(p.pre.text if p.pre else None, belief, self.env)
+            p
+            for p in plans
+            if p is keep
+            or (
+                holds(p.pre.text if p.pre else None, belief, self.env)
+                and holds(p.run.text if p.run else None, belief, self.env)
+            )
         )
+
+    def choice_changed(self) -> bool:
+        """For a plan type whose plans have conditions: whether the plans that may run now changed.
+
+        The C++ engine looks at the allocation of a plan type every step; this engine
+        allocates again when an input changed, and the conditions of the type's plans are
+        such an input (conditionPlanTypeTest: a better plan's run-time condition comes true).
+        """
+        if not self.watch:
+            return False
+        now_ok = tuple(p.name for p in self.startable(self.candidates()))
+        changed = self.seen is not None and now_ok != self.seen
+        self.seen = now_ok
+        return changed
 
     # -- life ----------------------------------------------------------
 
@@ -201,7 +243,7 @@ class Slot:
         candidates = (only,) if only is not None else self.candidates()
         usable = self.startable(candidates)
         if not usable:
-            self._wait(now, "no plan whose pre-condition holds" if candidates else "no plan left")
+            self._wait(now, "no plan whose pre-condition and run-time condition hold" if candidates else "no plan left")
             return
         env = self.env if self.runtime is None else {**self.env, **self.runtime.bindings()}
         node = engine.allocator.start(self, usable, env, now)
@@ -214,10 +256,10 @@ class Slot:
         self.repairs.waiting_since = None
 
     def _wait(self, now: float, reason: str) -> None:
-        """Not startable now: try again after a broadcast interval (teammates or the world may change)."""
+        """Not startable now: try again in the next step (as the C++ engine does; teammates or the world may change)."""
         self.status = ChildStatus.WAITING
         self.reason = reason
-        self.next_try = now + self.parent.engine.config.broadcast_interval
+        self.next_try = now
 
     def visit(self, now: float) -> None:
         """Run the rules of the child plan, repair it when it failed (behaviours are ticked elsewhere)."""
@@ -249,6 +291,17 @@ class Slot:
             self.revision = runtime.revision
             self.start(now)
         else:
+            # shown to the parent's transitions first; repaired by repair_pending if none fires
+            self.node = None
+            self.failed_node = node
+            self.status = ChildStatus.FAILURE
+            self.reason = f"plan '{node.plan.name}' failed: {node.reason}"
+
+    def repair_pending(self, now: float) -> None:
+        """No transition of the parent state handled the plan that failed in this step: repair it now."""
+        node = self.failed_node
+        if node is not None:
+            self.failed_node = None
             self._repair(node, now)
 
     def _follow(self, runtime: ChildRuntime, now: float) -> bool:
@@ -278,7 +331,8 @@ class Slot:
             return self.node is not None
 
         self.node = None
-        if not self.repairs.repair(node, start, lambda: bool(self.candidates()), may_retry=may_retry):
+        auto = self.parent.engine.config.auto_failure_handling
+        if not self.repairs.repair(node, start, lambda: bool(self.candidates()), may_retry=may_retry, auto=auto):
             self.status = ChildStatus.FAILURE
             self.reason = f"plan '{node.plan.name}' failed: {node.reason}"
 
@@ -313,5 +367,8 @@ class Slot:
             self.runner.stop()
         if self.node is not None:
             self.node.stop()
+        if self.failed_node is not None:
+            self.failed_node.stop()
+            self.failed_node = None
         if self.runtime is not None:
             self.runtime.stop()

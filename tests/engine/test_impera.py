@@ -47,8 +47,12 @@ def test_scout_explores_and_amparo_transports(lunar):
     _found(sim, 3.0)
     summary = sim.run(until_done=True, max_time=120)
     assert summary["success"], summary
+    root = sim.engines["stummel"].root
+    assert root.succeeded["Transport1"] == {"amparo"} and root.succeeded["Transport2"] == {"stummel"}
+    # done with its task, Stummel goes to the free Explore entry point, which succeeds at once;
+    # Amparo cannot explore (priority -1) and stays where its task succeeded
+    assert sim.engines["stummel"].root.state == "SamplesFound"
     assert sim.engines["amparo"].root.state == "DeliveredA"
-    assert sim.engines["stummel"].root.state == "DeliveredB"
 
 
 def test_scout_crashes_and_stummel_explores(lunar):

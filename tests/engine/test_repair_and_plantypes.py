@@ -1,4 +1,9 @@
-"""Plan types: the best alternative is chosen by utility; repair retries, replaces, then propagates."""
+"""Plan types: the best alternative is chosen by utility; repair retries, replaces, then propagates.
+
+A parent state that handles its child's failure with a transition (``failed(Approach)``) sees the
+failure first, before any repair (the C++ engine's continueOnFailure); ``TopAuto`` has no such
+transition, so its child goes through the repair stages.
+"""
 
 from __future__ import annotations
 
@@ -42,6 +47,14 @@ plans:
           - {to: GaveUp, condition: "failed(Approach)"}
       - {name: Done, kind: success}
       - {name: GaveUp, kind: success}
+  - name: TopAuto
+    entry_points: [{task: Default, state: Try, min: 1, max: "*"}]
+    states:
+      - name: Try
+        children: [Approach]
+        transitions:
+          - {to: Done, condition: "succeeded(Approach)"}
+      - {name: Done, kind: success}
 """
 
 
@@ -64,23 +77,33 @@ def test_plan_type_takes_the_alternative_with_the_best_utility(tmp_path):
 def test_three_repair_stages(tmp_path):
     lib = library(tmp_path, PLANS)
     work, check = scripted(["failure"]), scripted(["failure"])
-    sim, trace = team(lib, "Top", {"w": "Worker"}, {"Work": work, "Check": check})
-    sim.run(ticks=20)
-    stages = [(e["stage"], e["plan"]) for e in trace.of("repair")]
-    assert stages == [
+    sim, trace = team(lib, "TopAuto", {"w": "Worker"}, {"Work": work, "Check": check})
+    sim.run(ticks=6)
+    stages = [(e["stage"], e["plan"]) for e in trace.of("repair", key="TopAuto/Try/Approach")]
+    assert stages[:4] == [
         ("retry", "ByWorking"),  # 1. the failed plan is restarted
         ("replace", "ByWorking"),  # 2. it failed again: the next-best alternative replaces it
         ("retry", "ByHelping"),  #    which gets its own retry
         ("propagate", "ByHelping"),  # 3. no alternative left: the plan type fails
     ]
-    assert len(work.instances) == 2 and len(check.instances) == 2
+    # no transition of Try handles the failed type: TopAuto fails, and its own repair starts
+    assert [e["stage"] for e in trace.of("repair", key="TopAuto")][:1] == ["retry"]
+
+
+def test_a_parent_that_handles_the_failure_sees_it_before_any_repair(tmp_path):
+    lib = library(tmp_path, PLANS)
+    work, check = scripted(["failure"]), scripted(["failure"])
+    sim, trace = team(lib, "Top", {"w": "Worker"}, {"Work": work, "Check": check})
+    sim.run(ticks=6)
+    assert not trace.of("repair")
+    assert len(work.instances) == 1 and not check.instances
     assert where(sim, "w") == ("Default", "GaveUp")
 
 
 def test_replacement_succeeds(tmp_path):
     lib = library(tmp_path, PLANS)
     sim, trace = team(
-        lib, "Top", {"w": "Worker"}, {"Work": scripted(["failure"]), "Check": scripted(["running", "success"])}
+        lib, "TopAuto", {"w": "Worker"}, {"Work": scripted(["failure"]), "Check": scripted(["running", "success"])}
     )
     sim.run(until_done=True, max_time=10)
     assert where(sim, "w") == ("Default", "Done")
