@@ -296,6 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
     from alica.app.center.cli import add_parser as add_center_parser
     from alica.app.cli_agent import add_parser as add_agent_parser
     from alica.app.cli_demo import add_parser as add_demo_parser
+    from alica.app.cli_import import add_parser as add_import_parser
     from alica.app.cli_plan import add_parser as add_plan_parser
     from alica.app.cli_protap import add_parser as add_protap_parser
     from alica.app.cli_run import add_parser as add_run_parser
@@ -310,6 +311,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_demo_parser(sub)
     add_protap_parser(sub)
     add_center_parser(sub)
+    add_import_parser(sub)
     return parser
 
 

@@ -1,0 +1,220 @@
+"""Import a folder of ALICA Plan Designer files: read, check, name, map, render.
+
+The steps, each in its own module:
+
+1. find the designer files (and the agent configs) under the folder, in sorted order;
+2. read each into typed records (:mod:`~alica.io.designer.records`), a bad file into errors;
+3. resolve references and refuse the files that cannot be imported (:mod:`~alica.io.designer.resolve`);
+4. name every element (:mod:`~alica.io.designer.naming`);
+5. map each file to one of our documents (:mod:`~alica.io.designer.plans`, :mod:`~alica.io.designer.elements`);
+6. render each as YAML text under a header (:mod:`~alica.io.designer.writer`).
+
+Nothing is written until :func:`write_result`; the same folder always gives
+the same result.
+"""
+
+from __future__ import annotations
+
+import posixpath
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from alica.io.designer.agent_config import agent_config_notes, other_config_note
+from alica.io.designer.context import Context, Mapped
+from alica.io.designer.elements import (
+    map_behaviour,
+    map_conditions,
+    map_plantype,
+    map_roleset,
+    map_tasks,
+    note_placeholder,
+    skill_catalogue,
+)
+from alica.io.designer.naming import SKILLS_FILE, allocate
+from alica.io.designer.plans import map_plan
+from alica.io.designer.records import (
+    KINDS,
+    BehaviourRec,
+    ConditionRepoRec,
+    FileRec,
+    PlaceholderRec,
+    PlanRec,
+    PlanTypeRec,
+    RoleSetRec,
+    TaskRepoRec,
+    read_file,
+)
+from alica.io.designer.report import FileError, Note
+from alica.io.designer.resolve import Index, Resolver, decide
+from alica.io.designer.writer import document_text, header, skills_text
+
+#: The name of the C++ engine's agent config files.
+AGENT_CONFIG = "alica.yaml"
+
+
+@dataclass
+class ImportResult:
+    """What an import gives.
+
+    Attributes:
+        files: the number of designer files read (plans, behaviours, plan types, role sets,
+            task and condition repositories, placeholders).
+        outputs: output files (relative to the output folder, ``/``-separated) -> their text, sorted.
+        notes: every note, by file and key.
+        errors: every error, by file and key; a file with an error is not written.
+    """
+
+    files: int = 0
+    outputs: dict[str, str] = field(default_factory=dict)
+    notes: list[Note] = field(default_factory=list)
+    errors: list[FileError] = field(default_factory=list)
+
+    @property
+    def complete(self) -> bool:
+        """Whether every file was imported (notes allowed)."""
+        return not self.errors
+
+
+def _relative(root: Path, path: Path) -> str:
+    return path.relative_to(root).as_posix()
+
+
+def discover(src: Path) -> tuple[list[str], list[str], list[str]]:
+    """The designer files, agent configs and other config files under ``src`` (relative, sorted)."""
+    designer, configs, other = [], [], []
+    for path in sorted(src.rglob("*")):
+        if not path.is_file():
+            continue
+        rel = _relative(src, path)
+        ext = path.suffix.lower().lstrip(".")
+        if ext in KINDS:
+            designer.append(rel)
+        elif path.name.lower() == AGENT_CONFIG:
+            configs.append(rel)
+        elif ext == "conf":
+            other.append(rel)
+    return sorted(designer), sorted(configs), sorted(other)
+
+
+def _read_text(path: Path, rel: str) -> tuple[str | None, FileError | None]:
+    try:
+        return path.read_bytes().decode("utf-8-sig"), None
+    except UnicodeDecodeError as exc:
+        return None, FileError(rel, "", f"not UTF-8 text (byte {exc.start})")
+    except OSError as exc:
+        return None, FileError(rel, "", f"cannot read the file: {exc.strerror or exc}")
+
+
+def _describe(record: FileRec) -> str:
+    kind = KINDS[record.file.rsplit(".", 1)[-1].lower()]
+    return f"{kind} '{record.name}', id {record.id}"
+
+
+def import_designer(src: Path, reserved_skills: Iterable[str] = ()) -> ImportResult:
+    """Import every designer file under ``src``.
+
+    Args:
+        src: the folder of the designer files (e.g. a package's ``etc``).
+        reserved_skills: skill names already declared (the installed catalogue); a generated skill
+            never takes one (it would run that skill instead of the behaviour's own).
+
+    Returns:
+        The outputs, notes and errors; nothing is written.
+    """
+    designer, configs, others = discover(src)
+    result = ImportResult(files=len(designer))
+    records: dict[str, FileRec] = {}
+    unreadable: list[str] = []
+    read_errors: list[FileError] = []
+    for rel in designer:
+        text, problem = _read_text(src / rel, rel)
+        if text is None:
+            unreadable.append(rel)
+            if problem is not None:
+                read_errors.append(problem)
+            continue
+        record, errors = read_file(text, rel)
+        read_errors.extend(errors)
+        if record is None:
+            unreadable.append(rel)
+        else:
+            records[rel] = record
+    index = Index(records, unreadable)
+    decision = decide(index, unreadable, read_errors)
+    accepted = [f for f in sorted(records) if f not in decision.refused]
+    written = [f for f in accepted if not isinstance(records[f], PlaceholderRec)]
+    names = allocate(records, written, reserved_skills)
+    ctx = Context(records, Resolver(index, decision.refused, decision.cut), names)
+    mapped: dict[str, Mapped] = {}
+    for rel in written:  # plans first: they tell which standard conditions stay predicates
+        record = records[rel]
+        if isinstance(record, PlanRec):
+            mapped[rel] = map_plan(ctx, record)
+    for rel in written:
+        record = records[rel]
+        if isinstance(record, TaskRepoRec):
+            mapped[rel] = map_tasks(ctx, record)
+        elif isinstance(record, RoleSetRec):
+            mapped[rel] = map_roleset(ctx, record)
+        elif isinstance(record, BehaviourRec):
+            mapped[rel] = map_behaviour(ctx, record)
+        elif isinstance(record, PlanTypeRec):
+            mapped[rel] = map_plantype(ctx, record)
+    for rel in written:
+        record = records[rel]
+        if isinstance(record, ConditionRepoRec):
+            mapped[rel] = map_conditions(ctx, record)
+    for rel in accepted:
+        record = records[rel]
+        if isinstance(record, PlaceholderRec):
+            note_placeholder(ctx, record)
+    notes = names.notes + decision.notes + ctx.notes
+    for rel in configs:
+        text, problem = _read_text(src / rel, rel)
+        if text is None:
+            if problem is not None:
+                result.errors.append(problem)
+            continue
+        config_notes, config_errors = agent_config_notes(text, rel)
+        notes += config_notes
+        result.errors += config_errors
+    notes += [other_config_note(rel) for rel in others]
+    notes.sort(key=Note.sort_key)
+    by_file: dict[str, list[str]] = {}
+    for note in notes:
+        by_file.setdefault(note.file, []).append(f"{note.key}: {note.message}" if note.key else note.message)
+    outputs: dict[str, str] = {}
+    for rel, m in mapped.items():
+        out = names.outputs[rel]
+        folder = posixpath.dirname(out)
+        imports = sorted({posixpath.relpath(names.outputs[n], folder or ".") for n in m.needs if n in names.outputs})
+        if m.skills:
+            imports.append(posixpath.relpath(SKILLS_FILE, folder or "."))
+        head = header(f"the ALICA Plan Designer file {rel}", _describe(records[rel]), by_file.get(rel, []))
+        outputs[out] = document_text(m.document, imports, head)
+    behaviours = [r for r in (records[f] for f in written) if isinstance(r, BehaviourRec)]
+    if behaviours:
+        head = header(
+            "the ALICA Plan Designer's behaviours",
+            "one skill per behaviour, without parameters; give each an implementation with --skills MODULE",
+            [],
+        )
+        outputs[SKILLS_FILE] = skills_text(skill_catalogue(ctx, behaviours), head)
+    result.outputs = dict(sorted(outputs.items()))
+    result.notes = notes
+    result.errors = sorted(decision.errors + result.errors)
+    return result
+
+
+def write_result(result: ImportResult, out: Path) -> list[str]:
+    """Write the outputs under ``out`` (created if needed); returns the files written, relative and sorted.
+
+    Raises:
+        OSError: a file cannot be written.
+    """
+    for rel, text in result.outputs.items():
+        target = out.joinpath(*rel.split("/"))
+        target.parent.mkdir(parents=True, exist_ok=True)
+        target.write_text(text, encoding="utf-8")
+    return list(result.outputs)
