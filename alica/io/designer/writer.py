@@ -4,7 +4,8 @@ The body is :func:`alica.io.dump.document_data` written by
 :func:`alica.io.yaml_format.write_yaml`, the same as ``alica convert``
 writes. Two things are made explicit because they carry the designer's
 values: every entry point's ``min``, ``max`` (``"*"`` for the designer's
-2147483647) and ``success_required``, and every plan's utility threshold.
+2147483647) and ``success_required``, every plan's utility threshold and
+every synchronisation's timeouts.
 The header names the designer file and lists the notes about it.
 """
 
@@ -16,7 +17,7 @@ from collections.abc import Sequence
 
 from alica.io.dump import document_data
 from alica.io.yaml_format import write_yaml
-from alica.model import Document
+from alica.model import Document, Plan
 
 _ENTRY_KEYS = ("name", "task", "state", "min", "max", "success_required")
 _PLAN_KEYS = (
@@ -42,7 +43,11 @@ def _ordered(data: dict[str, object], keys: Sequence[str]) -> dict[str, object]:
     return out
 
 
-def _explicit_plan(plan: dict[str, object], threshold: float) -> dict[str, object]:
+def _number(value: float) -> int | float:
+    return int(value) if float(value).is_integer() else value
+
+
+def _explicit_plan(plan: dict[str, object], model: Plan) -> dict[str, object]:
     entries = plan.get("entry_points")
     if isinstance(entries, list):
         fixed: list[object] = []
@@ -57,16 +62,22 @@ def _explicit_plan(plan: dict[str, object], threshold: float) -> dict[str, objec
         plan["entry_points"] = fixed
     utility = plan.get("utility")
     if not isinstance(utility, dict):
-        plan["utility"] = {"threshold": int(threshold) if float(threshold).is_integer() else threshold}
+        plan["utility"] = {"threshold": _number(model.utility.threshold)}
+    syncs = plan.get("synchronisations")
+    if isinstance(syncs, list):
+        for data, sync in zip(syncs, model.synchronisations, strict=True):
+            if isinstance(data, dict):
+                data.setdefault("talk_timeout", _number(sync.talk_timeout))
+                data.setdefault("sync_timeout", _number(sync.sync_timeout))
+                data.setdefault("fail_on_timeout", sync.fail_on_timeout)
     return _ordered(plan, _PLAN_KEYS)
 
 
 def header(origin: str, what: str, notes: Sequence[str]) -> str:
     """The comment at the top of an output file: where it came from (``origin``), what it holds, the notes about it."""
-    lines = [
-        f"Imported by 'alica import-designer' from {origin}",
-        f"({what}). A new import overwrites this file.",
-    ]
+    lines = textwrap.wrap(
+        f"Imported by 'alica import-designer' from {origin} ({what}). A new import overwrites this file.", width=96
+    )
     if notes:
         lines += ["", "Notes on this file:"]
         for note in notes:
@@ -80,7 +91,7 @@ def document_text(document: Document, imports: Sequence[str], head: str) -> str:
     plans = data.get("plans")
     if isinstance(plans, list):
         data["plans"] = [
-            _explicit_plan(p, plan.utility.threshold) if isinstance(p, dict) else p
+            _explicit_plan(p, plan) if isinstance(p, dict) else p
             for p, plan in zip(plans, document.plans, strict=True)
         ]
     return head + write_yaml({"alica": 1, **data})
