@@ -152,9 +152,7 @@ def test_role_priorities_name_tasks(library: PlanLibrary) -> None:
     }
 
 
-def test_name_clashes_are_renamed_with_a_note(
-    imported: tuple[Path, dict[str, object]], library: PlanLibrary
-) -> None:
+def test_name_clashes_are_renamed_with_a_note(imported: tuple[Path, dict[str, object]], library: PlanLibrary) -> None:
     _, report = imported
     assert library.plans["Tackle"].name == "Tackle"
     behaviour = library.behaviours["TackleBehaviour"]
@@ -200,7 +198,9 @@ def test_constructs_without_counterpart_are_noted(imported: tuple[Path, dict[str
 def test_output_files_say_where_they_came_from(imported: tuple[Path, dict[str, object]]) -> None:
     out, _ = imported
     text = (out / "plans" / "SimpleTestPlan.yaml").read_text(encoding="utf-8")
-    assert text.startswith("# Imported by 'alica import-designer' from the ALICA Plan Designer file plans/SimpleTestPlan.pml")
+    assert text.startswith(
+        "# Imported by 'alica import-designer' from the ALICA Plan Designer file plans/SimpleTestPlan.pml"
+    )
     assert "# Notes on this file:" in text
     skills = data(out / "skills.yaml")["skills"]
     assert isinstance(skills, list) and len(skills) == 26

@@ -1,0 +1,71 @@
+"""Imported designer plans run on our engine: scripted skills, conditions set as facts."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from alica.app.cli import main
+from alica.engine import EngineConfig, SimulatedTeam, TraceRecorder
+from alica.io import Loader
+from alica.io.designer import import_designer, write_result
+from alica.testing import scripted
+from tests.io.test_designer_helpers import designer_folder
+
+
+@pytest.fixture(scope="module")
+def out(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The shared designer folder imported once."""
+    folder = tmp_path_factory.mktemp("designer") / "out"
+    result = import_designer(designer_folder())
+    assert result.complete
+    write_result(result, folder)
+    return folder
+
+
+def test_simple_test_plan_runs_its_behaviour_and_moves_on_when_the_condition_holds(out: Path) -> None:
+    library = Loader(search_path=[out]).load(out / "plans" / "SimpleTestPlan.yaml", out / "roles" / "Roleset.yaml")
+    midfield, attack = scripted(["running"]), scripted(["running"])
+    recorder = TraceRecorder()
+    sim = SimulatedTeam(
+        library,
+        "SimpleTestPlan",
+        {"a": "Attacker"},
+        skills={"MidFieldStandard": midfield, "Attack": attack},
+        observers=[recorder],
+        config=EngineConfig(frequency=10.0),
+    )
+    engine = sim.engines["a"]
+    # 1. the agent enters TestState1 and its behaviour MidFieldStandard runs
+    sim.run(ticks=5)
+    assert engine.root is not None and (engine.root.ep, engine.root.state) == ("DefaultTask", "TestState1")
+    assert len(midfield.instances) == 1 and midfield.instances[0].ticks > 1
+    assert not attack.instances and not recorder.of("transition")
+    # 2. the C++ condition IsAnyChildStatus is a predicate: once the fact holds, the transition fires
+    engine.world_model.assert_fact("IsAnyChildStatus")
+    sim.run(ticks=3)
+    assert (engine.root.ep, engine.root.state) == ("DefaultTask", "TestState2")
+    (fired,) = recorder.of("transition")
+    assert (fired["source"], fired["target"]) == ("TestState1", "TestState2")
+    assert len(attack.instances) == 1  # TestState2 runs Attack
+
+
+def test_alica_run_with_stand_ins_and_facts(out: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # alica run takes one file: a two-line mission file imports the plan and a role set
+    mission = out / "adjacent_mission.yaml"
+    mission.write_text("imports: [plans/AdjacentSuccessSubPlan.yaml, roles/Roleset.yaml]\n", encoding="utf-8")
+    argv = ["run", str(mission), "--name", "AdjacentSuccessSubPlan", "--agents", "a:Attacker", "--stand-ins", "--json"]
+    try:
+        # without the conditions' facts the agent waits in its first state
+        assert main([*argv, "--max-time", "3"]) == 1
+        waiting = json.loads(capsys.readouterr().out)
+        assert waiting["agents"]["a"]["path"] == "AdjacentSuccessSubPlan:EntryState"
+        # Entry2Wait at 1 s, Wait2Suc at 2 s: the plan reaches its success state
+        assert main([*argv, "--fact", "Entry2Wait@1", "--fact", "Wait2Suc@2"]) == 0
+        done = json.loads(capsys.readouterr().out)
+        assert done["success"] and done["agents"]["a"]["path"] == "AdjacentSuccessSubPlan:SucState"
+        assert done["agents"]["a"]["transitions"] == 2
+    finally:
+        mission.unlink()
