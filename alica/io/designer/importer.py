@@ -33,6 +33,7 @@ from alica.io.designer.elements import (
 )
 from alica.io.designer.naming import SKILLS_FILE, allocate
 from alica.io.designer.plans import map_plan
+from alica.io.designer.reader import read_file
 from alica.io.designer.records import (
     KINDS,
     BehaviourRec,
@@ -43,7 +44,6 @@ from alica.io.designer.records import (
     PlanTypeRec,
     RoleSetRec,
     TaskRepoRec,
-    read_file,
 )
 from alica.io.designer.report import FileError, Note
 from alica.io.designer.resolve import Index, Resolver, decide

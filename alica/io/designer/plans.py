@@ -14,14 +14,12 @@ from __future__ import annotations
 
 import math
 
-from alica.io.designer.conditions import STANDARD_LIBRARY, standard_formula
 from alica.io.designer.context import Context, Mapped, inline_condition, mapping_text, plural, variable_names, variables
 from alica.io.designer.names import Namespace, is_placeholder
 from alica.io.designer.naming import base_reserved
 from alica.io.designer.records import (
     UNBOUNDED_CARDINALITY,
     BehaviourRec,
-    ConditionRepoRec,
     PlanRec,
     PlanTypeRec,
     StateRec,
@@ -30,6 +28,7 @@ from alica.io.designer.records import (
 )
 from alica.io.designer.report import Construct
 from alica.io.designer.resolve import CHILD_KINDS
+from alica.io.designer.transitions import transition_condition
 from alica.model import (
     UNBOUNDED,
     Binding,
@@ -334,67 +333,13 @@ class _PlanMapper:
         return out, names
 
     def _condition(self, t: TransitionRec, name: str) -> Condition:
-        what = f"transition '{name}' of {self.owner}"
-        if t.legacy is not None and (t.legacy.text.strip() or t.legacy.variables or t.legacy.quantifiers):
-            self.note(
-                f"{t.key}.preCondition",
-                Construct.LEGACY_CONDITION,
-                f"the inline condition '{t.legacy.name}' of {what} ('{t.legacy.text}', {t.legacy.variables} variable(s)) "
-                "is not imported",
-            )
-        if t.outputs:
-            self.note(
-                f"{t.key}.keyMapping.output",
-                Construct.KEY_MAPPING,
-                f"the output mapping of {what} ({mapping_text(t.outputs)}) is not imported",
-            )
-        if t.condition is None:
-            self.note(
-                f"{t.key}.condition",
-                Construct.NO_CONDITION,
-                f"{what} has no condition in the designer: imported as 'false' (a transition without a condition "
-                "fires at once here); write a formula",
-            )
-            return Condition(ConditionKind.TRANSITION, "false")
-        target = self.ctx.resolver.target(t.condition, ("condition",))
-        repo = self.ctx.records.get(target.file) if target is not None else None
-        if target is None or not isinstance(repo, ConditionRepoRec):
-            self.note(
-                f"{t.key}.condition",
-                Construct.DROPPED,
-                f"the condition '{t.condition.text}' of {what} is in a refused file: imported as 'false'",
-            )
-            return Condition(ConditionKind.TRANSITION, "false")
-        cond = next(c for c in repo.conditions if c.id == target.id)
         children = [(o, ours) for o, ours, _ in self.children.get(t.source or 0, [])]
-        formula = standard_formula(cond, t.inputs, children)
-        if formula.text is not None:
-            if formula.reason:
-                self.note(f"{t.key}.condition", Construct.STANDARD_CONDITION, f"{what}: {formula.reason}")
-            if t.inputs and not formula.consumed:
-                self.note(
-                    f"{t.key}.keyMapping.input",
-                    Construct.KEY_MAPPING,
-                    f"the input mapping of {what} ({mapping_text(t.inputs)}) is not imported",
-                )
-            return Condition(ConditionKind.TRANSITION, formula.text)
-        predicate = self.ctx.names.predicates[cond.id]
-        self.imports.add(target.file)
-        if cond.library == STANDARD_LIBRARY:
-            self.ctx.standard_predicates.add(cond.id)
-            self.note(
-                f"{t.key}.condition",
-                Construct.STANDARD_CONDITION,
-                f"standard condition {cond.name} of {what} has no formula here ({formula.reason}): declared as predicate "
-                f"'{predicate}'; write a formula or set it with --fact {predicate}@T",
-            )
-        if t.inputs:
-            self.note(
-                f"{t.key}.keyMapping.input",
-                Construct.KEY_MAPPING,
-                f"the input mapping of {what} ({mapping_text(t.inputs)}) is not imported: predicate '{predicate}' reads no blackboard",
-            )
-        return Condition(ConditionKind.TRANSITION, predicate)
+        condition, needs = transition_condition(
+            self.ctx, self.file, t, f"transition '{name}' of {self.owner}", children
+        )
+        if needs is not None:
+            self.imports.add(needs)
+        return condition
 
     # -- synchronisations --------------------------------------------------
 

@@ -73,10 +73,9 @@ class Index:
         for file in sorted(records):
             for element_id, kind, key in _referable(records[file]):
                 other = self.by_id.get(element_id)
-                if other is not None and other.file != file:
-                    self.errors.append(
-                        FileError(file, key, f"id {element_id} is also the id of an element of {other.file}")
-                    )
+                if other is not None:
+                    where = "another element of this file" if other.file == file else f"an element of {other.file}"
+                    self.errors.append(FileError(file, key, f"id {element_id} is also the id of {where}"))
                     continue
                 self.by_id.setdefault(element_id, Target(file, kind, element_id))
 
@@ -251,6 +250,16 @@ def _check_plan(c: _Checker, plan: PlanRec) -> None:
     states = [s.id for s in plan.states]
     transitions = [t.id for t in plan.transitions]
     variables = [v.id for v in plan.variables]
+    seen: dict[int, str] = {}
+    for element_id, key in (
+        [(s.id, s.key) for s in plan.states]
+        + [(t.id, t.key) for t in plan.transitions]
+        + [(e.id, e.key) for e in plan.entry_points]
+        + [(s.id, s.key) for s in plan.syncs]
+    ):
+        if element_id in seen:
+            c.errors.append(FileError(c.file, f"{key}.id", f"id {element_id} is also the id of {seen[element_id]}"))
+        seen.setdefault(element_id, key)
     for ep in plan.entry_points:
         if ep.task is None:
             c.errors.append(FileError(c.file, f"{ep.key}.task", "the entry point names no task"))

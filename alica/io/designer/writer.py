@@ -91,8 +91,7 @@ def document_text(document: Document, imports: Sequence[str], head: str) -> str:
     plans = data.get("plans")
     if isinstance(plans, list):
         data["plans"] = [
-            _explicit_plan(p, plan) if isinstance(p, dict) else p
-            for p, plan in zip(plans, document.plans, strict=True)
+            _explicit_plan(p, plan) if isinstance(p, dict) else p for p, plan in zip(plans, document.plans, strict=True)
         ]
     return head + write_yaml({"alica": 1, **data})
 
