@@ -36,14 +36,15 @@ def transition_condition(
         what: how notes name the transition.
         children: the children of its source state: (designer name, our name).
     """
-    if t.legacy is not None and (t.legacy.text.strip() or t.legacy.variables or t.legacy.quantifiers):
+    legacy = t.legacy
+    if legacy is not None and (legacy.text.strip() or legacy.variables or legacy.quantifiers):
+        shown = f"'{legacy.text}', " if legacy.text.strip() else ""
         ctx.note(
             file,
             f"{t.key}.preCondition",
             Construct.LEGACY_CONDITION,
-            f"the inline condition '{t.legacy.name}' of {what} ('{t.legacy.text}', "
-            f"{plural(t.legacy.variables, 'variable')}) "
-            "is not imported",
+            f"the inline condition of {what} ({shown}{plural(legacy.quantifiers, 'quantifier')}, "
+            f"{plural(legacy.variables, 'variable')}) is not imported; the transition keeps its named condition",
         )
     if t.outputs:
         ctx.note(
