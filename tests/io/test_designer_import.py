@@ -5,6 +5,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -227,3 +228,25 @@ def test_human_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> No
     assert "refused 0" in text
     assert "deactivated plan in a plan type: 1" in text
     assert "check it with: " in text
+
+
+def test_the_docs_show_what_the_import_prints(
+    imported: tuple[Path, dict[str, object]],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    out, _ = imported
+    page = (Path(__file__).resolve().parents[2] / "docs" / "coming_from_cpp.md").read_text(encoding="utf-8")
+    source = designer_folder()
+    monkeypatch.chdir(tmp_path)
+    blocks = re.findall(r"```(\w+)\n(.*?)```", page, re.DOTALL)
+    transcript = next(text for lang, text in blocks if lang == "text" and "$ alica import-designer" in text)
+    shown = transcript.split("$ alica validate")[0].splitlines()[1:]
+    assert main(["import-designer", str(source), "--out", "build/alica_tests"]) == 0
+    printed = {line.strip() for line in capsys.readouterr().out.splitlines()}
+    # every line the page shows, but the elided ones and the first (it names the folder as run from the checkout)
+    checked = [line.strip() for line in shown if "..." not in line and line.strip() and "read 110" not in line]
+    assert [line for line in checked if line not in printed] == []
+    yaml_block = next(text for lang, text in blocks if lang == "yaml" and "IsChildSuccessTestPlan" in text)
+    assert (out / "plans" / "IsChildSuccessTestPlan.yaml").read_text(encoding="utf-8") == yaml_block

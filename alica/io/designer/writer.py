@@ -75,9 +75,8 @@ def _explicit_plan(plan: dict[str, object], model: Plan) -> dict[str, object]:
 
 def header(origin: str, what: str, notes: Sequence[str]) -> str:
     """The comment at the top of an output file: where it came from (``origin``), what it holds, the notes about it."""
-    lines = textwrap.wrap(
-        f"Imported by 'alica import-designer' from {origin} ({what}). A new import overwrites this file.", width=96
-    )
+    lines = [f"Imported by 'alica import-designer' from {origin}"]
+    lines += textwrap.wrap(f"({what}). A new import overwrites this file.", width=96)
     if notes:
         lines += ["", "Notes on this file:"]
         for note in notes:
