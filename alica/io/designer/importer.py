@@ -123,76 +123,24 @@ def import_designer(src: Path, reserved_skills: Iterable[str] = ()) -> ImportRes
         The outputs, notes and errors; nothing is written.
     """
     designer, configs, others = discover(src)
-    result = ImportResult(files=len(designer))
-    records: dict[str, FileRec] = {}
-    unreadable: list[str] = []
-    read_errors: list[FileError] = []
-    for rel in designer:
-        text, problem = _read_text(src / rel, rel)
-        if text is None:
-            unreadable.append(rel)
-            if problem is not None:
-                read_errors.append(problem)
-            continue
-        record, errors = read_file(text, rel)
-        read_errors.extend(errors)
-        if record is None:
-            unreadable.append(rel)
-        else:
-            records[rel] = record
+    records, unreadable, read_errors = _read_all(src, designer)
     index = Index(records, unreadable)
     decision = decide(index, unreadable, read_errors)
     accepted = [f for f in sorted(records) if f not in decision.refused]
     written = [f for f in accepted if not isinstance(records[f], PlaceholderRec)]
     names = allocate(records, written, reserved_skills)
     ctx = Context(records, Resolver(index, decision.refused, decision.cut), names)
-    mapped: dict[str, Mapped] = {}
-    for rel in written:  # plans first: they tell which standard conditions stay predicates
-        record = records[rel]
-        if isinstance(record, PlanRec):
-            mapped[rel] = map_plan(ctx, record)
-    for rel in written:
-        record = records[rel]
-        if isinstance(record, TaskRepoRec):
-            mapped[rel] = map_tasks(ctx, record)
-        elif isinstance(record, RoleSetRec):
-            mapped[rel] = map_roleset(ctx, record)
-        elif isinstance(record, BehaviourRec):
-            mapped[rel] = map_behaviour(ctx, record)
-        elif isinstance(record, PlanTypeRec):
-            mapped[rel] = map_plantype(ctx, record)
-    for rel in written:
-        record = records[rel]
-        if isinstance(record, ConditionRepoRec):
-            mapped[rel] = map_conditions(ctx, record)
-    for rel in accepted:
-        record = records[rel]
-        if isinstance(record, PlaceholderRec):
-            note_placeholder(ctx, record)
+    mapped = _map_all(ctx, [records[f] for f in accepted])
     notes = names.notes + decision.notes + ctx.notes
+    errors = list(decision.errors)
     for rel in configs:
         text, problem = _read_text(src / rel, rel)
-        if text is None:
-            if problem is not None:
-                result.errors.append(problem)
-            continue
-        config_notes, config_errors = agent_config_notes(text, rel)
+        config_notes, config_errors = agent_config_notes(text, rel) if text is not None else ([], [])
         notes += config_notes
-        result.errors += config_errors
+        errors += config_errors + ([problem] if problem is not None else [])
     notes += [other_config_note(rel) for rel in others]
     notes.sort(key=Note.sort_key)
-    by_file: dict[str, list[str]] = {}
-    for note in notes:
-        by_file.setdefault(note.file, []).append(f"{note.key}: {note.message}" if note.key else note.message)
-    outputs: dict[str, str] = {}
-    for rel, m in mapped.items():
-        out = names.outputs[rel]
-        folder = posixpath.dirname(out)
-        imports = sorted({posixpath.relpath(names.outputs[n], folder or ".") for n in m.needs if n in names.outputs})
-        if m.skills:
-            imports.append(posixpath.relpath(SKILLS_FILE, folder or "."))
-        head = header(f"the ALICA Plan Designer file {rel}", _describe(records[rel]), by_file.get(rel, []))
-        outputs[out] = document_text(m.document, imports, head)
+    outputs = _render(ctx, mapped, notes)
     behaviours = [r for r in (records[f] for f in written) if isinstance(r, BehaviourRec)]
     if behaviours:
         head = header(
@@ -201,10 +149,62 @@ def import_designer(src: Path, reserved_skills: Iterable[str] = ()) -> ImportRes
             [],
         )
         outputs[SKILLS_FILE] = skills_text(skill_catalogue(ctx, behaviours), head)
-    result.outputs = dict(sorted(outputs.items()))
-    result.notes = notes
-    result.errors = sorted(decision.errors + result.errors)
-    return result
+    return ImportResult(len(designer), dict(sorted(outputs.items())), notes, sorted(errors))
+
+
+def _read_all(src: Path, designer: list[str]) -> tuple[dict[str, FileRec], list[str], list[FileError]]:
+    """The records of the files that could be read, the files that could not, and every problem found."""
+    records: dict[str, FileRec] = {}
+    unreadable: list[str] = []
+    errors: list[FileError] = []
+    for rel in designer:
+        text, problem = _read_text(src / rel, rel)
+        record, found = read_file(text, rel) if text is not None else (None, [problem] if problem else [])
+        errors.extend(found)
+        if record is None:
+            unreadable.append(rel)
+        else:
+            records[rel] = record
+    return records, unreadable, errors
+
+
+def _map_all(ctx: Context, records: list[FileRec]) -> dict[str, Mapped]:
+    """Map the accepted files (placeholders only get their note)."""
+    mapped: dict[str, Mapped] = {}
+    for record in records:  # plans first: they tell which standard conditions stay predicates
+        if isinstance(record, PlanRec):
+            mapped[record.file] = map_plan(ctx, record)
+    for record in records:
+        if isinstance(record, TaskRepoRec):
+            mapped[record.file] = map_tasks(ctx, record)
+        elif isinstance(record, RoleSetRec):
+            mapped[record.file] = map_roleset(ctx, record)
+        elif isinstance(record, BehaviourRec):
+            mapped[record.file] = map_behaviour(ctx, record)
+        elif isinstance(record, PlanTypeRec):
+            mapped[record.file] = map_plantype(ctx, record)
+        elif isinstance(record, PlaceholderRec):
+            note_placeholder(ctx, record)
+    for record in records:
+        if isinstance(record, ConditionRepoRec):
+            mapped[record.file] = map_conditions(ctx, record)
+    return mapped
+
+
+def _render(ctx: Context, mapped: dict[str, Mapped], notes: list[Note]) -> dict[str, str]:
+    """Each mapped file as YAML text under its header, by output path."""
+    by_file: dict[str, list[str]] = {}
+    for note in notes:
+        by_file.setdefault(note.file, []).append(f"{note.key}: {note.message}" if note.key else note.message)
+    outputs: dict[str, str] = {}
+    for rel, m in mapped.items():
+        out = ctx.names.outputs[rel]
+        folder = posixpath.dirname(out) or "."
+        needs = {posixpath.relpath(ctx.names.outputs[n], folder) for n in m.needs if n in ctx.names.outputs}
+        imports = sorted(needs) + ([posixpath.relpath(SKILLS_FILE, folder)] if m.skills else [])
+        head = header(f"the ALICA Plan Designer file {rel}", _describe(ctx.records[rel]), by_file.get(rel, []))
+        outputs[out] = document_text(m.document, imports, head)
+    return outputs
 
 
 def write_result(result: ImportResult, out: Path) -> list[str]:

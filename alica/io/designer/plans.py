@@ -269,7 +269,7 @@ class _PlanMapper:
             raw = task if is_placeholder(ep.name, ep.id) else ep.name
             name = space.claim(raw, task, "")
             if is_placeholder(ep.name, ep.id):
-                shown = f"'{ep.name}'" if ep.name.strip() else "no name"
+                shown = f"the name '{ep.name}'" if ep.name.strip() else "no name"
                 self.note(
                     f"{ep.key}.name",
                     Construct.UNNAMED,
