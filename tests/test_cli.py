@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import json
 import re
 import shutil
 import subprocess
+import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -230,3 +233,102 @@ def test_validate_reports_a_misspelt_condition_with_a_suggestion(
     plan.write_text(plan.read_text(encoding="utf-8").replace("succeded", "succeeded"), encoding="utf-8")
     code, out, err = run(capsys, "validate", str(plan))
     assert code == 0 and out.startswith("ok: "), err
+
+
+# --------------------------------------------------------------------------- a skill catalogue written as data
+
+SKILL_CATALOGUE = """\
+alica: 1
+skills:
+  - name: Attack
+    doc: "imported from the ALICA Plan Designer: behaviour Attack (Attack.beh#1402488848841)"
+    params:
+      - {name: goal, type: str, required: false, default: "", doc: "where to go"}
+      - {name: duration, type: float, default: 1.5}
+"""
+
+SKILL_PLAN = """\
+alica: 1
+imports: [skills.yaml]
+tasks: [Default]
+rolesets:
+  - name: Crew
+    roles:
+      - {name: Worker, priorities: {Default: 0.5}}
+behaviours:
+  - {name: Strike, skill: Attack, params: {goal: there}}
+plans:
+  - name: Job
+    entry_points:
+      - {task: Default, state: Working, min: 1, max: 1, success_required: true}
+    states:
+      - name: Working
+        children: [Strike]
+        transitions: [{to: Done, condition: "struck(self) or succeeded"}]
+      - {name: Done, kind: success}
+"""
+
+#: A skill module that binds an implementation to the catalogue's Attack.
+ATTACK_MODULE = """
+import py_trees
+from py_trees.common import Status
+
+from alica import ParamSpec
+
+
+class Attack(py_trees.behaviour.Behaviour):
+    def __init__(self, name, params, context):
+        super().__init__(name)
+        self.context = context
+
+    def update(self):
+        self.context.world_model.assert_fact("struck", self.context.agent)
+        return Status.SUCCESS
+
+
+def register(registry):
+    registry.declare_predicate("struck", 1, "the agent struck")
+    registry.declare("Attack", ParamSpec("goal", "str", required=False, default=""), implementation=Attack)
+"""
+
+
+@pytest.fixture
+def skills_project(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[Path]:
+    """A folder with a skill catalogue, a plan using it and a module implementing the skill; the working folder."""
+    (tmp_path / "skills.yaml").write_text(SKILL_CATALOGUE, encoding="utf-8")
+    (tmp_path / "job.yaml").write_text(SKILL_PLAN, encoding="utf-8")
+    (tmp_path / "attack_from_catalogue.py").write_text(ATTACK_MODULE, encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "path", [str(tmp_path), *sys.path])
+    yield tmp_path
+    sys.modules.pop("attack_from_catalogue", None)
+
+
+def test_a_plan_file_skill_catalogue_validates_and_runs(
+    skills_project: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (skills_project / "facts.yaml").write_text("predicates: [struck/1]\n", encoding="utf-8")
+    plan = SKILL_PLAN.replace("imports: [skills.yaml]", "imports: [skills.yaml, facts.yaml]")
+    (skills_project / "job.yaml").write_text(plan, encoding="utf-8")
+    code, out, err = run(capsys, "validate", str(skills_project))
+    assert code == 0 and out == "ok: 3 plan file(s) valid\n", err
+    code, out, _ = run(capsys, "run", "job.yaml", "--agents", "ann:Worker", "--stand-ins", "--json")
+    summary = json.loads(out)
+    assert code == 0 and summary["success"] and summary["skills"]["stand_ins"] == ["Attack"]
+    assert 1.5 <= summary["sim_time_s"] < 1.7  # the stand-in runs for the declared default duration
+    code, out, err = run(capsys, "run", "job.yaml", "--agents", "ann:Worker")
+    assert code == 1 and out == ""
+    assert "Job uses skills that have no implementation: Attack; pass --stand-ins" in err
+    assert "a plan file declares Attack in skills.yaml:3:5: a --skills MODULE whose register(registry)" in err
+
+
+def test_a_skills_module_binds_an_implementation_to_a_declared_skill(
+    skills_project: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert run(capsys, "validate", "job.yaml", "--skills", "attack_from_catalogue")[0] == 0
+    code, out, err = run(
+        capsys, "run", "job.yaml", "--agents", "ann:Worker", "--skills", "attack_from_catalogue", "--json"
+    )
+    assert code == 0, err
+    summary = json.loads(out)
+    assert summary["success"] and summary["skills"] == {"real": ["Attack"], "stand_ins": [], "world": None}

@@ -198,14 +198,29 @@ def cmd_run(args: argparse.Namespace) -> int:
         plan = args.name
     agents = _agents(args.agents)
     roles = _roles(library, agents, args.roleset)
-    wiring = skill_wiring(
-        registry, plan_skills(library, plan), world=args.world is not None, stand_ins=args.stand_ins, plan=plan
-    )
+    skills = plan_skills(library, plan)
+    try:
+        wiring = skill_wiring(registry, skills, world=args.world is not None, stand_ins=args.stand_ins, plan=plan)
+    except AlicaError as exc:
+        raise AlicaError(f"{exc}{_declared_in_files(registry, skills)}") from None
     if args.processes:
         header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
         return _run_processes(args, plan, list(agents), wiring, header, library, session)
     with run_world(args, sorted(agents)) as (world, perception):
         return _run_team(args, library, plan, roles, wiring, world, perception, session)
+
+
+def _declared_in_files(registry: Any, skills: list[str]) -> str:
+    """A note on the skills a plan file declared (``skills:``): how to bind an implementation to them."""
+    declared = [registry.get(name) for name in skills if name in registry]
+    declared = [s for s in declared if s.declared_at is not None and s.implementation is None]
+    if not declared:
+        return ""
+    where = ", ".join(f"{s.name} in {s.declared_at}" for s in declared)
+    return (
+        f"; a plan file declares {where}: a --skills MODULE whose register(registry) declares "
+        "the same name with an implementation binds one"
+    )
 
 
 def _trace_header(

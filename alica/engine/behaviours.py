@@ -92,7 +92,11 @@ class SkillBinder:
 
     Lookup order: ``overrides`` by behaviour name, then by skill name; the
     skill registry's implementation; then ``fallback`` (e.g. scripted test
-    doubles); else :class:`~alica.errors.UnknownSkillError`.
+    doubles); else :class:`~alica.errors.UnknownSkillError`, whose message
+    says how to bind an implementation. A skill declared in a plan file's
+    ``skills:`` section (which the loader adds to the registry it was given)
+    has no implementation, so it is built by ``fallback`` or not at all, like
+    a Python declaration without one.
 
     Args:
         overrides: factories by behaviour or skill name.
@@ -130,11 +134,12 @@ class SkillBinder:
         if found is None and self.fallback is not None:
             found = self.fallback(behaviour)
         if found is None:
-            raise UnknownSkillError(
-                f"behaviour '{behaviour.name}' needs skill '{behaviour.skill}', which has no implementation"
-                + (f" ({reason})" if reason else "")
-                + "; register one or run with scripted skills"
+            why = reason or (
+                f"skill '{behaviour.skill}' has no implementation; bind one with --skills MODULE, a module whose "
+                f"register(registry) declares '{behaviour.skill}' with an implementation, "
+                "or run scripted stand-ins with --stand-ins"
             )
+            raise UnknownSkillError(f"behaviour '{behaviour.name}' cannot run: {why}")
         self._cache[behaviour.name] = found
         return found
 

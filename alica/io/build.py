@@ -11,6 +11,7 @@ import math
 import re
 
 from alica.io.fields import Fields, Problems, kind_of, to_number
+from alica.io.skill_declarations import build_skills
 from alica.io.tree import Node
 from alica.lang.ast import KEYWORDS
 from alica.model import (
@@ -51,6 +52,7 @@ TOP_KEYS = (
     "imports",
     "predicates",
     "functions",
+    "skills",
     "tasks",
     "rolesets",
     "behaviours",
@@ -92,6 +94,7 @@ def build_document(tree: Node, path: str, problems: Problems) -> Document:
         imports=tuple(n for n, _ in top.names("imports")),
         predicates=_declarations(top, "predicates", problems),
         functions=_declarations(top, "functions", problems),
+        skills=build_skills(top, problems),
         tasks=tuple(_task(n, problems) for n in top.items("tasks")),
         rolesets=tuple(_roleset(n, problems) for n in top.items("rolesets")),
         behaviours=tuple(_behaviour(n, problems) for n in top.items("behaviours")),

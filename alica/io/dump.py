@@ -25,6 +25,8 @@ from alica.model import (
     PlanType,
     Role,
     RoleSet,
+    SkillDeclaration,
+    SkillParameter,
     State,
     StateKind,
     Task,
@@ -158,12 +160,31 @@ class _Dumper:
         _put(out, "imports", list(doc.imports), written)
         _put(out, "predicates", [_declaration(d) for d in doc.predicates], written)
         _put(out, "functions", [_declaration(d) for d in doc.functions], written)
+        _put(out, "skills", [self.skill(s) for s in doc.skills], written)
         _put(out, "tasks", [self.task(t) for t in doc.tasks], written)
         _put(out, "rolesets", [self.roleset(r) for r in doc.rolesets], written)
         _put(out, "behaviours", [self.behaviour(b) for b in doc.behaviours], written)
         _put(out, "plans", [self.plan(p) for p in doc.plans], written)
         _put(out, "plantypes", [self.plantype(p) for p in doc.plantypes], written)
         _put(out, "problems", [self.problem(p) for p in doc.problems], written)
+        return out
+
+    def skill(self, skill: SkillDeclaration) -> Data:
+        written = self.written(skill.span)
+        out: Data = {"name": skill.name}
+        _put(out, "doc", skill.doc, written, "")
+        _put(out, "capabilities", sorted(skill.capabilities), written)
+        _put(out, "params", [self.skill_parameter(p) for p in skill.params], written)
+        return out
+
+    def skill_parameter(self, p: SkillParameter) -> Data:
+        written = self.written(p.span)
+        out: Data = {"name": p.name}
+        _put(out, "type", p.type, written, "any")
+        _put(out, "required", p.required, written, p.default is None)
+        if p.default is not None:  # an empty list is a default too
+            out["default"] = _param(p.default)
+        _put(out, "doc", p.doc, written, "")
         return out
 
     def task(self, task: Task) -> Any:

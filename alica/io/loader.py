@@ -16,6 +16,7 @@ from pathlib import Path
 from alica.errors import PlanFormatError
 from alica.io.build import build_document
 from alica.io.fields import Problems
+from alica.io.skill_declarations import declare_skills
 from alica.io.tree import Node
 from alica.lang import Registry, default_registry
 from alica.lang.skill_plugins import default_registry as default_skills
@@ -143,7 +144,9 @@ class Loader:
     being read.
 
     Args:
-        skills: skill declarations behaviours are checked against.
+        skills: skill declarations behaviours are checked against, besides the
+            skills the plan files declare (:mod:`alica.io.skill_declarations`);
+            :meth:`load` adds those to it.
         functions: predicates and functions formulas may call.
         search_path: more folders imports may reach, besides the entry's folder,
             the shipped plans (:func:`plans_dir`) and the folders of the
@@ -287,13 +290,20 @@ class Loader:
     def load(self, *entries: str | os.PathLike[str]) -> PlanLibrary:
         """Load and validate the document set of one or more entry files.
 
+        The skills the set's files declare (``skills:``) are added to
+        :attr:`skills`, the registry this loader was given, except names it
+        declares in Python: a run that builds its skills from that registry then
+        knows them as declared skills without an implementation.
+
         Raises:
             PlanFormatError: with every problem found, if any.
         """
         documents, diagnostics = self.check(*entries)
         if diagnostics:
             raise PlanFormatError(diagnostics)
-        return PlanLibrary(tuple(documents))
+        library = PlanLibrary(tuple(documents))
+        declare_skills(self.skills, library.skills.values())
+        return library
 
     def document(self, path: str | os.PathLike[str]) -> Document:
         """One file's document, without validating references.
@@ -343,6 +353,7 @@ def load_library(
     Args:
         paths: entry files (their imports are followed).
         skills: skill declarations; by default the installed plug-ins (the shipped catalogue among them).
+            The skills the files declare are added to it (see :meth:`Loader.load`).
         functions: formula predicates and functions; the built-ins by default.
 
     Raises:

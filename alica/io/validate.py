@@ -17,6 +17,7 @@ from typing import Protocol, TypeVar
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
 from alica.io.reads import Read, agent_domains, reads
+from alica.io.skill_declarations import with_declarations
 from alica.lang import ENGINE_VARIABLES, Registry, Vocabulary, check, default_vocabulary, literals, parse
 from alica.lang.ast import Node, is_logical
 from alica.lang.skills import SkillRegistry
@@ -74,7 +75,8 @@ class Validator:
 
     Args:
         documents: the entry file's document and everything it imports.
-        skills: the skill declarations behaviours are checked against.
+        skills: the skill declarations behaviours are checked against, besides
+            the skills the documents declare (:mod:`alica.io.skill_declarations`).
         functions: the registered predicates and functions formulas may call.
         problems: where problems go.
         vocabulary: the predicates and functions every formula may read without a
@@ -91,7 +93,6 @@ class Validator:
         vocabulary: Vocabulary | None = None,
     ) -> None:
         self.documents = documents
-        self.skills = skills
         self.functions = functions
         self.problems = problems
         self.vocabularies = _Vocabularies(documents, vocabulary or default_vocabulary(), problems)
@@ -111,6 +112,9 @@ class Validator:
             abstract.extend(d.plantypes)
             abstract.extend(d.problems)
         self.abstract = self._unique("behaviour, plan, plan type or planning problem", abstract)
+        declared = self._unique("skill", (s for d in documents for s in d.skills))
+        #: The registry's Python declarations and the set's file declarations (the registry wins).
+        self.skills = with_declarations(skills, declared.values(), problems)
 
     def run(self) -> None:
         """Run every check."""

@@ -20,8 +20,13 @@ the shape the table below gives it. Tags and attributes are the YAML keys
     <alica>          version (-> 'alica')               import -> imports (names, or href="...")
                                                         predicate, function -> predicates,
                                                         functions (lists)
+                                                        skill -> skills (list)
                                                         task, roleset, behaviour, plan, plantype,
                                                         problem -> tasks ... problems (lists)
+    <skill>          name doc                           capability -> capabilities (names),
+                                                        parameter -> params (list)
+    <parameter> of a <skill>: name type required        default (value), when the attribute cannot
+                     default doc                        hold it (see "Skill declarations" below)
     <task>           name description
     <roleset>        name default_priority description  role -> roles (list)
     <role>           name description                   requires -> requires (names)
@@ -63,6 +68,9 @@ Shapes:
   ``<bind variable="goal">pos(a)</bind>``); the value is the ``value``
   attribute or the element's text.
 * **one**: a single element read as a mapping (``<utility>``, ``<signature>``).
+* **value**: a single element read like the value of a behaviour's ``<param>``
+  (``<default>0.3</default>``, ``<default type="str">1</default>``,
+  ``<default><item>0</item><item>0</item></default>``).
 * **text**: a single element holding text: formulas and descriptions. Write
   ``<`` and ``&`` as ``&lt;`` and ``&amp;`` or put the text in
   ``<![CDATA[...]]>``; the text's place is kept, so a formula error points at
@@ -85,6 +93,20 @@ else text), so ``value="0.3"`` is the number 0.3. ``type="str"`` keeps the
 text as text; a list is written as ``<item>`` children (``type="list"`` for an
 empty list); an item is written like a parameter without a name
 (``<item>1</item>``, ``<item type="str">true</item>``); no value means null.
+
+Skill declarations (``skills:`` in YAML, :mod:`alica.io.skill_declarations`)::
+
+    <skill name="Attack" doc="imported from the ALICA Plan Designer">
+      <capability>arm</capability>
+      <parameter name="goal" type="str" required="false" default="" doc="where to go"/>
+      <parameter name="corner" type="position" required="false"><default><item>0</item><item>0</item></default></parameter>
+    </skill>
+
+A parameter's ``default="..."`` attribute is read by the parameter's type:
+a float, int or bool default by YAML 1.1 scalar rules (``default="0.3"`` is
+0.3, ``default="true"`` is true), any other type's as text. A default the
+attribute cannot hold (a list, a number of an ``any`` parameter) is written as
+a ``<default>`` element.
 
 Numbers, flags and cardinalities are attribute text; the builder reads
 numeric text (``frequency="10"``, ``max="*"``, ``success_required="true"``).
@@ -120,6 +142,7 @@ from alica.io.xml_vocabulary import (
     NAMES,
     ONE,
     TEXT,
+    VALUE,
     resolve_scalar,
 )
 from alica.io.xml_write import write_xml
@@ -569,6 +592,9 @@ class _Reader:
                 put(known.key, self.mapping(child, known.spec), child_span)
             elif known.shape == TEXT:
                 put(known.key, self.text_element(child), child_span)
+            elif known.shape == VALUE:
+                attributes = {name: (value, at, value_at) for name, _, value, at, value_at in self.attributes(child)}
+                put(known.key, self.typed_value(child, child_tag, attributes), child_span)
             else:
                 collection = collections.get(known.key)
                 if collection is None:

@@ -19,6 +19,7 @@ NAMES = "names"
 ENTRIES = "entries"
 ONE = "one"
 TEXT = "text"
+VALUE = "value"
 
 
 @dataclass(frozen=True)
@@ -28,7 +29,7 @@ class _Child:
     Args:
         tag: the element's tag.
         key: the key it gives in the tree.
-        shape: ``list``, ``names``, ``entries``, ``one`` or ``text``.
+        shape: ``list``, ``names``, ``entries``, ``one``, ``text`` or ``value``.
         spec: for ``list``/``one`` the spec of the element, for ``entries`` the entry kind.
         attribute: for ``names``, an attribute that may hold the text instead (``href``).
         formula: whether the text is a formula (written as CDATA when it holds ``<>&``).
@@ -104,6 +105,7 @@ _SPECS: dict[str, _Spec] = {
             _Child("import", "imports", NAMES, attribute="href"),
             _Child("predicate", "predicates", LIST, "declaration"),
             _Child("function", "functions", LIST, "declaration"),
+            _Child("skill", "skills", LIST, "skill"),
             _Child("task", "tasks", LIST, "task"),
             _Child("roleset", "rolesets", LIST, "roleset"),
             _Child("behaviour", "behaviours", LIST, "behaviour"),
@@ -114,6 +116,12 @@ _SPECS: dict[str, _Spec] = {
         renamed=(("version", "alica"),),
     ),
     "declaration": _Spec(("name", "arity", "doc"), declared=True),
+    "skill": _Spec(
+        ("name", "doc"),
+        (_Child("capability", "capabilities", NAMES), _Child("parameter", "params", LIST, "skillparameter")),
+    ),
+    # 'default' is an attribute when its text reads back by the parameter's type, else a <default> element
+    "skillparameter": _Spec(("name", "type", "required", "doc"), (_Child("default", "default", VALUE),)),
     "task": _Spec(("name", "description"), (_DESCRIPTION,), item_text="name"),
     "roleset": _Spec(
         ("name", "default_priority", "description"),

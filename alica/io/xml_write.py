@@ -11,6 +11,7 @@ from lxml import etree
 
 from alica.io.build import DECLARED_NAME, RANGED_NAME, TYPE_RANGE, TYPED_NAME
 from alica.io.fields import to_number
+from alica.io.skill_declarations import coerce_default
 from alica.io.tree import Node
 from alica.io.xml_vocabulary import (
     _ENTRIES,
@@ -19,6 +20,7 @@ from alica.io.xml_vocabulary import (
     NAMES,
     ONE,
     TEXT,
+    VALUE,
     _Child,
     _yaml_float,
     resolve_scalar,
@@ -213,6 +215,12 @@ def _fill(el: Any, spec_name: str, data: dict[str, Any], where: str) -> None:
             if child.key in spec.attributes and not _as_element(child.key, value):
                 continue  # written as an attribute above
             _set_text(etree.SubElement(el, child.tag), value, where, child.formula)
+        elif child.shape == VALUE:
+            text = _attribute_text(value, data.get("type"))
+            if text is not None:
+                _set(el, child.key, value, where)
+            else:
+                _write_value(etree.SubElement(el, child.tag), value, where, as_text=True)
         elif child.shape == ONE:
             if not isinstance(value, dict):
                 raise ValueError(f"'{child.key}' of {where} must be a mapping to write it as XML")
@@ -248,6 +256,24 @@ def _fill(el: Any, spec_name: str, data: dict[str, Any], where: str) -> None:
     unknown = [k for k in data if k not in known]
     if unknown:
         raise ValueError(f"cannot write key '{unknown[0]}' of {where} as XML: the XML form has no such key")
+
+
+def _attribute_text(value: Any, kind: Any) -> str | None:
+    """A skill parameter's default as attribute text that reads back as the same value, or ``None``.
+
+    The reader reads a ``default="..."`` attribute by the parameter's type
+    (:func:`alica.io.skill_declarations.coerce_default`); a value that would
+    read back otherwise (a list, a number of an ``any`` parameter) needs the
+    ``<default>`` element.
+    """
+    if isinstance(value, (list, tuple)) or value is None:
+        return None
+    try:
+        text = _scalar_text(value, "a default")
+    except ValueError:
+        return None
+    back = coerce_default(text, kind if isinstance(kind, str) else "any")
+    return text if type(back) is type(value) and back == value else None
 
 
 def _write_entries(el: Any, child: _Child, value: Any, where: str) -> None:

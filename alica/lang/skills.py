@@ -18,6 +18,7 @@ from typing import Any
 
 from alica.errors import UnknownSkillError
 from alica.lang.vocabulary import Symbol, Vocabulary, default_vocabulary
+from alica.source import SourceSpan
 
 #: Parameter types a skill may declare, with what a literal value of each must be.
 PARAM_TYPES: dict[str, str] = {
@@ -102,7 +103,12 @@ class SkillSpec:
             ``None`` if not implemented yet.
         origin: where the declaration came from: ``alica`` for the shipped
             catalogue, else the plug-in module (set by the registry while a
-            plug-in registers).
+            plug-in registers), or the plan file that declared it.
+        declared_at: where a plan file's ``skills:`` section declared it
+            (:mod:`alica.io.skill_declarations`); ``None`` for a declaration
+            made in Python. A file-declared skill has no implementation: a
+            ``--skills MODULE`` whose ``register(registry)`` declares the same
+            name with one takes its place.
     """
 
     name: str
@@ -111,6 +117,7 @@ class SkillSpec:
     capabilities: frozenset[str] = frozenset()
     implementation: str | Callable[..., Any] | None = None
     origin: str = ""
+    declared_at: SourceSpan | None = None
 
     def param(self, name: str) -> ParamSpec | None:
         """The parameter called ``name``, if declared."""
@@ -220,8 +227,8 @@ class SkillRegistry:
         return sorted(self._specs)
 
     def copy(self) -> SkillRegistry:
-        """An independent registry with the same declarations."""
-        return SkillRegistry(dict(self._specs), self.origin)
+        """An independent registry with the same declarations and facts."""
+        return SkillRegistry(dict(self._specs), self.origin, self.facts.copy())
 
     def load(self, name: str) -> Callable[..., Any]:
         """Import and return the implementation of ``name``, as a factory ``(name, params, context)``.
@@ -238,7 +245,7 @@ class SkillRegistry:
         """
         spec = self.get(name)
         if spec.implementation is None:
-            raise UnknownSkillError(f"skill '{name}' is declared but has no implementation yet")
+            raise UnknownSkillError(unimplemented(spec))
         if not isinstance(spec.implementation, str):
             return _with_defaults(spec.implementation, spec)
         module_name, _, attribute = spec.implementation.partition(":")
@@ -253,6 +260,16 @@ class SkillRegistry:
         except AttributeError:
             raise UnknownSkillError(f"skill '{name}': module '{module_name}' has no '{attribute}'") from None
         return _with_defaults(implementation, spec)
+
+
+def unimplemented(spec: SkillSpec) -> str:
+    """Why ``spec`` cannot run, and how to give it an implementation."""
+    where = f" in {spec.declared_at}" if spec.declared_at is not None else ""
+    return (
+        f"skill '{spec.name}' is declared{where} but has no implementation yet; bind one with --skills MODULE, "
+        f"a module whose register(registry) declares '{spec.name}' with an implementation, "
+        "or run scripted stand-ins with --stand-ins"
+    )
 
 
 def _with_defaults(implementation: Callable[..., Any], spec: SkillSpec) -> Callable[..., Any]:

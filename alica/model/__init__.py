@@ -34,6 +34,7 @@ from alica.model.plan import (
 )
 from alica.model.planning import PlanningProblem
 from alica.model.roles import Priority, Role, RoleSet, Task
+from alica.model.skill import SkillDeclaration, SkillParameter
 
 __all__ = [
     "ANY_TYPE",
@@ -60,6 +61,8 @@ __all__ = [
     "Priority",
     "Role",
     "RoleSet",
+    "SkillDeclaration",
+    "SkillParameter",
     "State",
     "StateKind",
     "Summand",

@@ -12,6 +12,7 @@ from alica.model.declaration import Declaration
 from alica.model.plan import Plan, PlanType
 from alica.model.planning import PlanningProblem
 from alica.model.roles import RoleSet, Task
+from alica.model.skill import SkillDeclaration
 
 #: Anything a state can run.
 AbstractPlan = Behaviour | Plan | PlanType | PlanningProblem
@@ -65,11 +66,13 @@ class Document:
         imports: other files this one refers to, relative to it.
         predicates: the predicates declared here for formulas to read.
         functions: the functions declared here for formulas to read.
+        skills: the skills declared here (:mod:`alica.model.skill`), visible to the whole document set.
     """
 
     imports: tuple[str, ...] = ()
     predicates: tuple[Declaration, ...] = ()
     functions: tuple[Declaration, ...] = ()
+    skills: tuple[SkillDeclaration, ...] = ()
     tasks: tuple[Task, ...] = ()
     rolesets: tuple[RoleSet, ...] = ()
     behaviours: tuple[Behaviour, ...] = ()
@@ -105,6 +108,11 @@ class PlanLibrary:
     def rolesets(self) -> dict[str, RoleSet]:
         """Role set name -> role set."""
         return _by_name(d.rolesets for d in self.documents)
+
+    @cached_property
+    def skills(self) -> dict[str, SkillDeclaration]:
+        """Skill name -> the declaration a plan file of the set wrote (Python declarations are not here)."""
+        return _by_name(d.skills for d in self.documents)
 
     @cached_property
     def behaviours(self) -> dict[str, Behaviour]:
@@ -158,8 +166,8 @@ class PlanLibrary:
         return self._sections() == other._sections()
 
     def _sections(self) -> tuple[Mapping[str, object], ...]:
-        """Name -> element of every section, in :data:`SECTIONS` order."""
-        return (self.tasks, self.rolesets, self.behaviours, self.plans, self.plantypes, self.problems)
+        """Name -> element of every section, in :data:`SECTIONS` order, then the declared skills."""
+        return (self.tasks, self.rolesets, self.behaviours, self.plans, self.plantypes, self.problems, self.skills)
 
     def __hash__(self) -> int:
         return hash(tuple(sorted(self.plans)))

@@ -21,6 +21,12 @@ from tests.conftest import PLANS
 #: Every optional key written, each with its default value (zeros, false, empty text, '*').
 DEFAULTS = textwrap.dedent(
     """\
+    skills:
+      - name: S
+        doc: ''
+        params:
+          - {name: p, type: any, required: true, doc: ''}
+          - {name: q, type: any, required: false}
     tasks:
       - {name: T, description: ''}
     rolesets:

@@ -62,3 +62,17 @@ def test_xml_files_match_the_xsd() -> None:
     for path in FILES:
         if path.suffix == ".xml":
             assert xsd.validate(etree.parse(str(path))), (path, xsd.error_log)
+
+
+@pytest.mark.parametrize("first,second", [("yaml", "yaml"), ("xml", "xml"), ("xml", "yaml"), ("yaml", "xml")])
+def test_a_skill_catalogue_round_trips_like_the_shipped_files(tmp_path: Path, first: str, second: str) -> None:
+    from tests.io.test_skill_declarations import CATALOGUE, parameters
+
+    path = tmp_path / "skills.yaml"
+    path.write_text(CATALOGUE, encoding="utf-8")
+    original = load_document(path)
+    once, problems = read_text(dump_document(original, first), f"once.{first}", first)
+    assert not problems and once == original
+    twice, problems = read_text(dump_document(once, second), f"twice.{second}", second)
+    assert not problems and twice == original
+    assert [parameters(s) for s in twice.skills] == [parameters(s) for s in original.skills]

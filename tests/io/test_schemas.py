@@ -82,6 +82,11 @@ def test_handwritten_xml_validates_against_the_xsd() -> None:
         '<behaviour name="B"/>',
         '<behaviour name="B" skill="S"><param name="p" type="float" value="1"/></behaviour>',
         '<task name="T" colour="red"/>',
+        "<skill/>",
+        '<skill name="S"><parameter name="p" type="vector"/></skill>',
+        '<skill name="S"><parameter name="p" required="maybe"/></skill>',
+        '<skill name="S"><parameter type="int"/></skill>',
+        '<skill name="S"><param name="p"/></skill>',
         '<problem name="P"/>',
         "<whatever/>",
     ],
@@ -135,6 +140,7 @@ def test_handwritten_yaml_validates() -> None:
 ALTERNATIVES = """\
 alica: "1"
 imports: roles.yaml
+skills: [{name: S, capabilities: arm, params: [{name: p, type: float, required: "no", default: "0.5"}, {name: q}]}]
 tasks: Default
 behaviours:
   - name: B
@@ -194,6 +200,12 @@ def test_the_json_schema_accepts_every_builder_alternative() -> None:
             {"plans": [{"name": "P", "entry_points": [], "states": [{"name": "S", "children": [{"bind": {}}]}]}]},
         ),
         ("negative min", {"plans": [{"name": "P", "entry_points": [{"task": "T", "min": -1}], "states": []}]}),
+        ("skill without name", {"skills": [{"doc": "x"}]}),
+        ("unknown skill key", {"skills": [{"name": "S", "capabilites": ["arm"]}]}),
+        ("unknown parameter type", {"skills": [{"name": "S", "params": [{"name": "p", "type": "vector"}]}]}),
+        ("skill params a mapping", {"skills": [{"name": "S", "params": {"p": "int"}}]}),
+        ("parameter without name", {"skills": [{"name": "S", "params": [{"type": "int"}]}]}),
+        ("parameter default a mapping", {"skills": [{"name": "S", "params": [{"name": "p", "default": {"a": 1}}]}]}),
     ],
 )
 def test_the_json_schema_rejects_what_the_builder_rejects(case: str, data: Any) -> None:

@@ -31,6 +31,19 @@ predicates:
   - stuck/0
   - {name: found, arity: 1, doc: "a sample was found & <seen>"}
 functions: [pos/1, {name: battery, arity: 1}]
+skills:
+  - name: Attack
+    doc: "imported from the ALICA Plan Designer: behaviour Attack (Attack.beh#1402488848841) & <more>"
+    capabilities: [arm, camera]
+    params:
+      - {name: goal, type: str, required: false, default: "", doc: "where to go"}
+      - {name: times, type: int}
+      - {name: speed, type: float, default: 0.5}
+      - {name: careful, type: bool, required: false}
+      - {name: label, type: str, default: "0.3"}
+      - {name: corner, type: position, default: [0, 1.5]}
+      - {name: anything, default: 3}
+  - name: Wave
 tasks:
   - Default
   - {name: Explore, description: "map the area & look for <samples>"}
@@ -210,6 +223,13 @@ HANDWRITTEN_XML = """\
   <import href="roles.yaml"/>
   <predicate name="stuck" arity="0" doc="the robot cannot move"/>
   <function name="pos" arity="1"/>
+  <skill name="Attack" doc="imported">
+    <capability>arm</capability>
+    <parameter name="goal" type="str" required="false" default="" doc="where to go"/>
+    <parameter name="speed" type="float" default="0.5"/>
+    <parameter name="corner" type="position"><default><item>0</item><item>1</item></default></parameter>
+    <parameter name="times" type="int"/>
+  </skill>
   <task name="Explore" description="map the area"/>
   <task name="Transport"/>
   <roleset name="Impera" default_priority="0">
@@ -264,6 +284,15 @@ HANDWRITTEN_YAML = """\
 imports: [roles.yaml]
 predicates: [{name: stuck, arity: 0, doc: the robot cannot move}]
 functions: [pos/1]
+skills:
+  - name: Attack
+    doc: imported
+    capabilities: [arm]
+    params:
+      - {name: goal, type: str, required: false, default: "", doc: where to go}
+      - {name: speed, type: float, default: 0.5}
+      - {name: corner, type: position, default: [0, 1]}
+      - {name: times, type: int}
 tasks: [{name: Explore, description: map the area}, Transport]
 rolesets:
   - name: Impera
@@ -1246,9 +1275,48 @@ PLAN = _optional(
         max_size=2,
     ),
 )
+#: A default of each parameter type (``None``: no default).
+SKILL_DEFAULTS: dict[str, st.SearchStrategy[Any]] = {
+    "float": st.floats(allow_nan=False) | st.integers(-5, 5),
+    "int": st.integers(),
+    "bool": st.booleans(),
+    "str": TEXT,
+    "object": NAME,
+    "position": st.lists(st.floats(-10, 10), min_size=2, max_size=3),
+    "pose": st.lists(st.floats(-10, 10), min_size=3, max_size=3),
+    "list": st.lists(SCALARS, max_size=3),
+    "any": PARAM,
+}
+
+
+@st.composite
+def _skill_parameter(draw: st.DrawFn) -> dict[str, Any]:
+    kind = draw(st.sampled_from(sorted(SKILL_DEFAULTS)))
+    default = draw(st.none() | SKILL_DEFAULTS[kind])
+    out: dict[str, Any] = {"name": draw(NAME)}
+    if kind != "any" or draw(st.booleans()):
+        out["type"] = kind
+    if default is not None:
+        out["default"] = default
+        if draw(st.booleans()):
+            out["required"] = False
+    elif draw(st.booleans()):
+        out["required"] = draw(st.booleans())
+    if draw(st.booleans()):
+        out["doc"] = draw(TEXT)
+    return out
+
+
+SKILL = _optional(
+    {"name": NAME},
+    doc=TEXT,
+    capabilities=st.lists(NAME, max_size=2),
+    params=st.lists(_skill_parameter(), max_size=3, unique_by=lambda p: p["name"]),
+)
 DOCUMENT_DATA = _optional(
     {},
     imports=st.lists(NAME, max_size=2),
+    skills=st.lists(SKILL, max_size=2),
     tasks=st.lists(NAME | _optional({"name": NAME}, description=TEXT), max_size=3),
     rolesets=st.lists(
         _optional(
