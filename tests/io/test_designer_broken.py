@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from alica.app.cli import main
-from alica.io.designer import import_designer
+from alica.io import Loader, validate_paths
+from alica.io.designer import import_designer, write_result
 from tests.io.test_designer_helpers import write_json
 
 TASKS = {"id": 10, "name": "taskrepository", "tasks": [{"id": 11, "name": "Default"}, {"id": 12, "name": "Help"}]}
@@ -235,3 +239,68 @@ def test_usage_errors_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert "no ALICA Plan Designer files" in capsys.readouterr().err
     assert main(["import-designer", str(src)]) == 2  # --out is required
     assert not (tmp_path / "o").exists()
+
+
+def test_a_file_that_is_not_utf8_is_an_error(tmp_path: Path) -> None:
+    src = folder(tmp_path, {"Top.pml": plan(100, "Top", ["Work.beh#30"])})
+    (src / "plans" / "Latin.pml").write_bytes(b'{"id": 7, "name": "Gr\xfcn"}')
+    result = import_designer(src)
+    (error,) = result.errors
+    assert error.format() == "plans/Latin.pml:1:22: not UTF-8 text (byte 0xfc)"
+    assert "plans/Top.yaml" in result.outputs
+
+
+_JSON = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=8),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=5), inner, max_size=3),
+    max_leaves=6,
+)
+_REFERENCES = st.sampled_from(
+    ["Work.beh#30", "Top.pml#100", "taskrepository.tsk#11", "ConditionRepository.cnd#21", 101]
+)
+
+
+def _paths(value: object, prefix: tuple[object, ...] = ()) -> list[tuple[object, ...]]:
+    out = [prefix] if prefix else []
+    if isinstance(value, dict):
+        for key, item in value.items():
+            out += _paths(item, (*prefix, key))
+    elif isinstance(value, list):
+        for index, item in enumerate(value):
+            out += _paths(item, (*prefix, index))
+    return out
+
+
+def _set(root: object, path: tuple[object, ...], new: object) -> None:
+    """Replace the value at ``path`` by ``new``, if the path still leads somewhere after earlier changes."""
+    target = root
+    for depth, key in enumerate(path):
+        if isinstance(target, dict) and isinstance(key, str) and key in target:
+            container: dict[str, object] | list[object] = target
+        elif isinstance(target, list) and isinstance(key, int) and key < len(target):
+            container = target
+        else:
+            return
+        if depth == len(path) - 1:
+            container[key] = new  # type: ignore[index]
+            return
+        target = container[key]  # type: ignore[index]
+
+
+@settings(max_examples=40)
+@given(st.data())
+def test_a_mutated_plan_is_imported_or_refused_never_a_crash(data: st.DataObject) -> None:
+    child = plan(200, "Child", ["Work.beh#30"])
+    paths = _paths(child)
+    mutated = json.loads(json.dumps(child))
+    for _ in range(data.draw(st.integers(1, 3))):
+        _set(mutated, data.draw(st.sampled_from(paths)), data.draw(_JSON | _REFERENCES))
+    with tempfile.TemporaryDirectory() as tmp:
+        src = folder(Path(tmp), {"Child.pml": mutated, "Top.pml": plan(100, "Top", ["Child.pml#200", "Work.beh#30"])})
+        result = import_designer(src)  # never raises
+        assert all(e.file == "plans/Child.pml" for e in result.errors), [e.format() for e in result.errors]
+        assert "plans/Top.yaml" in result.outputs  # the parent is imported, with or without its child
+        out = Path(tmp) / "out"
+        write_result(result, out)
+        problems = validate_paths([out], Loader(search_path=[out]))
+        assert not problems, [p.format() for p in problems]

@@ -48,6 +48,7 @@ from alica.io.designer.records import (
 from alica.io.designer.report import FileError, Note
 from alica.io.designer.resolve import Index, Resolver, decide
 from alica.io.designer.writer import document_text, header, skills_text
+from alica.source import byte_place
 
 #: The name of the C++ engine's agent config files.
 AGENT_CONFIG = "alica.yaml"
@@ -99,11 +100,14 @@ def discover(src: Path) -> tuple[list[str], list[str], list[str]]:
 
 def _read_text(path: Path, rel: str) -> tuple[str | None, FileError | None]:
     try:
-        return path.read_bytes().decode("utf-8-sig"), None
-    except UnicodeDecodeError as exc:
-        return None, FileError(rel, "", f"not UTF-8 text (byte {exc.start})")
+        data = path.read_bytes()
     except OSError as exc:
         return None, FileError(rel, "", f"cannot read the file: {exc.strerror or exc}")
+    try:
+        return data.decode("utf-8-sig"), None
+    except UnicodeDecodeError as exc:
+        place = byte_place(data, exc.start, rel)
+        return None, FileError(rel, "", f"not UTF-8 text (byte 0x{data[exc.start]:02x})", place.line, place.column)
 
 
 def _describe(record: FileRec) -> str:
@@ -124,7 +128,7 @@ def import_designer(src: Path, reserved_skills: Iterable[str] = ()) -> ImportRes
     """
     designer, configs, others = discover(src)
     records, unreadable, read_errors = _read_all(src, designer)
-    index = Index(records, unreadable)
+    index = Index(records, [*unreadable, *(e.file for e in read_errors)])
     decision = decide(index, unreadable, read_errors)
     accepted = [f for f in sorted(records) if f not in decision.refused]
     written = [f for f in accepted if not isinstance(records[f], PlaceholderRec)]

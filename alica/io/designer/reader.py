@@ -76,7 +76,8 @@ def read_file(text: str, file: str) -> tuple[FileRec | None, list[FileError]]:
 def _id(view: View) -> int:
     value = view.ident("id")
     if value is None:
-        view.sink.add(view.path("id"), "missing id")
+        if not view.has("id"):  # a value of the wrong type is reported by ident()
+            view.sink.add(view.path("id"), "missing id")
         return 0
     return value
 

@@ -62,7 +62,8 @@ class Index:
 
     Args:
         records: the records of the files that could be read, by file.
-        unreadable: files that could not be read at all (their ids are unknown).
+        unreadable: files that could not be read, or not without errors: their ids are unknown or
+            unreliable, so a reference by their file name to an id nobody has is to a refused file.
     """
 
     def __init__(self, records: Mapping[str, FileRec], unreadable: Iterable[str]) -> None:
