@@ -72,15 +72,15 @@ class _PlanMapper:
         reachable = self._reachable()
         states = self._states(reachable)
         entry_points = self._entry_points()
-        transitions, sync_of = self._transitions(reachable)
-        syncs = self._syncs(transitions, sync_of)
-        transitions = [Transition(t.name, t.source, t.target, t.condition, syncs[1].get(t.name)) for t in transitions]
+        transitions, names = self._transitions(reachable)
+        syncs, joined = self._syncs(names)
+        transitions = [Transition(t.name, t.source, t.target, t.condition, joined.get(t.name)) for t in transitions]
         plan = Plan(
             self.name,
             tuple(entry_points),
             tuple(states),
             tuple(transitions),
-            tuple(syncs[0]),
+            tuple(syncs),
             plan_variables,
             pre,
             run,
@@ -343,9 +343,7 @@ class _PlanMapper:
 
     # -- synchronisations --------------------------------------------------
 
-    def _syncs(
-        self, transitions: list[Transition], names: dict[int, str]
-    ) -> tuple[list[Synchronisation], dict[str, str]]:
+    def _syncs(self, names: dict[int, str]) -> tuple[list[Synchronisation], dict[str, str]]:
         """The synchronisations, and the synchronisation of each synchronised transition (by transition name)."""
         space = Namespace(base_reserved())
         by_id = {t.id: t for t in self.rec.transitions}
