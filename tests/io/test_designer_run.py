@@ -69,3 +69,60 @@ def test_alica_run_with_stand_ins_and_facts(out: Path, tmp_path: Path, capsys: p
         assert done["agents"]["a"]["transitions"] == 2
     finally:
         mission.unlink()
+
+
+def _team(out: Path, plan: str, roleset: str, agents: dict[str, str]) -> tuple[SimulatedTeam, TraceRecorder]:
+    library = Loader(search_path=[out]).load(out / "plans" / f"{plan}.yaml", out / "roles" / f"{roleset}.yaml")
+    recorder = TraceRecorder()
+    config = EngineConfig(frequency=10.0, broadcast_interval=0.1, team_timeout=0.5, assignment_protection=0.3)
+    skills = {"Attack": scripted(["running"]), "AttackOpp": scripted(["running"])}
+    sim = SimulatedTeam(library, plan, agents, skills=skills, observers=[recorder], config=config)
+    return sim, recorder
+
+
+def _set(sim: SimulatedTeam, *names: str) -> None:
+    sim.set_facts([(True, name, ()) for name in names])
+
+
+def _in_child(sim: SimulatedTeam, agent: str) -> tuple[str | None, str | None]:
+    root = sim.engines[agent].root
+    assert root is not None
+    node = next(s.node for s in root.slots if s.node is not None)
+    return node.ep, node.state
+
+
+def test_multi_agent_plan_as_the_cpp_test_runs_it(out: Path) -> None:
+    """runMultiAgentPlan on the imported files: nase (Defender) and hairy (Attacker), as Alica.yaml sets them."""
+    sim, _ = _team(out, "MultiAgentTestMaster", "RolesetTA", {"nase": "Defender", "hairy": "Attacker"})
+    sim.run(ticks=10)
+    assert all(sim.engines[a].root.state == "Init" for a in ("nase", "hairy"))  # type: ignore[union-attr]
+    _set(sim, "Init2Start")
+    sim.run(ticks=3)
+    # the Attacker prefers AttackTask (0.6 against 0.5): hairy attacks, nase takes the other task
+    assert _in_child(sim, "hairy") == ("AttackTask", "OtherState")
+    assert _in_child(sim, "nase") == ("DefaultTask", "State1")
+    _set(sim, "StateOne2StateTwo", "Other2NewSuccessStateOne")
+    sim.run(ticks=2)
+    # hairy's task succeeded and its entry point is full: it takes the free Idle entry point
+    assert _in_child(sim, "hairy") == ("NewEntryPoint", "Idle")
+    assert _in_child(sim, "nase") == ("DefaultTask", "State2")
+    _set(sim, "Start2Finish")
+    sim.run(ticks=2)
+    assert all(sim.engines[a].root.state == "Finished" for a in ("nase", "hairy"))  # type: ignore[union-attr]
+
+
+def test_synchronised_transitions_fire_together_once_both_hold(out: Path) -> None:
+    """syncTransitionTest on the imported files: not before both conditions hold, then in the same step."""
+    sim, recorder = _team(out, "RealMasterPlanForSyncTest", "RolesetTA", {"nase": "Defender", "hairy": "Attacker"})
+    sim.run(ticks=5)
+    assert _in_child(sim, "hairy") == ("AttackTask", "FirstTaskFirstState")
+    assert _in_child(sim, "nase") == ("DefaultTask", "SecondTaskFirstState")
+    _set(sim, "FirstTaskFirstState2FirstTaskSecondState")
+    sim.run(ticks=10)
+    assert _in_child(sim, "hairy") == ("AttackTask", "FirstTaskFirstState")  # waits for its partner
+    _set(sim, "SecondTaskFirstState2SecondTaskSecondState")
+    sim.run(ticks=5)
+    assert _in_child(sim, "hairy") == ("AttackTask", "FirstTaskSecondState")
+    assert _in_child(sim, "nase") == ("DefaultTask", "SecondTaskSecondState")
+    fired = [e for e in recorder.of("transition") if e["name"] in ("FirstTaskTran", "SecondTaskTran")]
+    assert len(fired) == 2 and fired[0]["t"] == fired[1]["t"]
