@@ -10,6 +10,7 @@ from __future__ import annotations
 import random
 import re
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from alica.clock import Clock
@@ -53,6 +54,15 @@ def _substitute(text: str, env: Mapping[str, object]) -> str:
         return str(found) if isinstance(found, (str, int, float)) and not isinstance(found, bool) else match.group(0)
 
     return _NAME.sub(value, text)
+
+
+@dataclass(slots=True)
+class _Left:
+    """A success claimed for a plan instance the agent left, while its parent stays where it moved on to."""
+
+    claim: Claim
+    parent: PlanNode
+    entered: float | None = None
 
 
 class AgentEngine:
@@ -126,10 +136,10 @@ class AgentEngine:
         self.root_repairs = Repairs()
         self._failed_root: PlanNode | None = None
         self._next_root_try = float("-inf")
-        self.left: dict[PlanKey, Claim] = {}
-        """Plan instances this agent left after its task succeeded there, while their parent runs: still
-        claimed (no entry point, the successes), so a teammate learns the success even when the parent
-        moved on in the step the task succeeded."""
+        self.left: dict[PlanKey, _Left] = {}
+        """Plan instances this agent left after its task succeeded there: still claimed (no entry point,
+        the successes) while the parent stays in the state it moved on to, so a teammate learns the success
+        even when the parent moved on in the step the task succeeded."""
         self.carried: dict[PlanKey, tuple[str, dict[str, set[str]]]] = {}
         """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
         self.allocator = Allocator(self)
@@ -510,12 +520,22 @@ class AgentEngine:
             if node.status is not ChildStatus.FAILURE:
                 out.append(node.claim())
             todo.extend(reversed([s.node for s in node.slots if s.node is not None]))
-        for key in list(self.left):
-            if key[:-2] not in self.index:
-                del self.left[key]  # its parent ended: nobody needs the success any more
+        for key, left in list(self.left.items()):
+            parent = left.parent
+            if left.entered is None:
+                left.entered = parent.state_entered_at  # the state the parent moved on to
+            if self.index.get(parent.key) is not parent or parent.state_entered_at != left.entered:
+                del self.left[key]  # the parent ended or moved on again: the instance is history
             elif key not in self.index:
-                out.append(self.left[key])
+                out.append(left.claim)
         return out
+
+    def left_with_success(self, node: PlanNode) -> None:
+        """``node`` stops after this agent's task succeeded in it: keep claiming the success (``left``)."""
+        done = node.own_successes()
+        parent = node.slot.parent if node.slot is not None else None
+        if done and parent is not None:
+            self.left[node.key] = _Left(Claim(node.key, node.plan.name, None, None, done), parent)
 
     def _broadcast(self, now: float) -> None:
         config = self.config

@@ -189,7 +189,9 @@ class Allocator:
         and have nobody working on them, then to any entry point with room left
         (its ``max`` less the agents that succeeded or work there, e.g. an idle
         task with min 0). An agent never goes back to an entry point in which it
-        succeeded; with no room anywhere it stays in its success state.
+        succeeded, and an agent whose success state runs children (a guard, say:
+        the C++ engine's terminal states run none) stays there for the latter;
+        with no room anywhere it stays in its success state.
         """
         plan = node.plan
         successes = node.successes()
@@ -216,8 +218,9 @@ class Allocator:
             working[ep] = working.get(ep, 0) + 1
         placed = {a for a, _ in moves}
         for agent in free:
-            if agent in placed:
-                continue
+            entry = node.believed[agent]
+            if agent in placed or (entry[1] is not None and plan.state(entry[1]).children):
+                continue  # a success state that runs children keeps its agent busy (C++ terminal states have none)
             roomy = tuple(
                 replace(ep, min=0, max=room)
                 for ep in plan.entry_points

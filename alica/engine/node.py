@@ -243,9 +243,7 @@ class PlanNode:
     def stop(self) -> None:
         """Stop every child: the agent leaves this plan (what it succeeded in here is still claimed, see ``left``)."""
         self.stopped = True
-        done = self.own_successes()
-        if done and self.slot is not None:
-            self.engine.left[self.key] = Claim(self.key, self.plan.name, None, None, done)
+        self.engine.left_with_success(self)
         self._leave_state()
         self.engine.forget(self)
 

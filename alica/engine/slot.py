@@ -290,6 +290,8 @@ class Slot:
             runtime.execution_failed(node, now)
             self.revision = runtime.revision
             self.start(now)
+        elif node.understaffed:
+            self._repair(node, now)  # for want of teammates: not the plan's fault, restarted when the team allows
         else:
             # shown to the parent's transitions first; repaired by repair_pending if none fires
             self.node = None
