@@ -80,6 +80,8 @@ class PlanNode:
         self.overridden_until = -1.0
         self.understaffed = False
         """The plan failed for want of agents (no valid assignment with the teammates alive now)."""
+        self.former: set[str] = set()
+        """Teammates that were in this instance and left it (their successes here still count)."""
         self.stopped = False
         """The agent left this plan instance (a node replaced in mid-visit stops there)."""
         self._members: tuple[str, ...] | None = None
@@ -138,12 +140,14 @@ class PlanNode:
         changed = False
         for agent in [a for a in self.believed if a != me and a not in members]:
             del self.believed[agent]
+            self.former.add(agent)
             changed = True
         protection = engine.config.assignment_protection
-        for agent in team.alive():
-            if agent == me or agent in members:
+        for agent in self.former:
+            if agent in members or not team.is_alive(agent):
                 continue
-            # a teammate that left this instance (its parent moved on) still counts where it succeeded
+            # a teammate that left this instance (its parent moved on) still counts where it succeeded;
+            # only one that was in this instance: a new instance of the same key starts without it
             claim = team.claim(agent, self.key)
             if claim is not None and claim.plan == self.plan.name:
                 for ep in claim.success:

@@ -406,3 +406,46 @@ def test_alica_agent_takes_the_setting():
 
     args = build_parser().parse_args(["agent", "plans/x.yaml", "--name", "a", "--auto-failure-handling", "off"])
     assert args.auto_failure_handling == "off"
+
+
+# -- successes claimed after leaving an instance ---------------------------------------------
+
+AGAIN = """
+predicates: [doneA/0, again/1]
+behaviours:
+  - {name: Hold, skill: Wait}
+plans:
+  - name: X
+    entry_points:
+      - {name: A, task: Work, state: Working, min: 1, max: 1, success_required: true}
+      - {name: B, task: Help, state: Helping, min: 0, max: "*"}
+    states:
+      - {name: Working, children: [Hold], transitions: [{to: Done, condition: "doneA"}]}
+      - {name: Helping, children: [Hold]}
+      - {name: Done, kind: success}
+  - name: P
+    entry_points: [{task: Default, state: S, min: 1, max: "*"}]
+    states:
+      - {name: S, children: [X], transitions: [{to: T, condition: "succeeded(X)"}]}
+      - {name: T, transitions: [{to: S, condition: "again(self)"}]}
+"""
+
+
+def test_a_success_claimed_after_leaving_counts_once_and_not_in_a_new_instance(tmp_path):
+    lib = library(tmp_path, AGAIN)
+    agents = {"a": "Worker", "b": "Helper", "c": "Helper"}
+    sim, trace = team(lib, "P", agents, {"Wait": scripted(["running"])}, config=FAST)
+    sim.run(ticks=3)
+    assert where(sim, "a", 1) == ("A", "Working") and where(sim, "b", 1) == ("B", "Helping")
+    _fact(sim, "doneA")
+    sim.run(ticks=3)
+    # a succeeded and left X in the same step (its parent moved on); b and c learn it from a's claim
+    assert where(sim, "a") == where(sim, "b") == where(sim, "c") == ("Default", "T")
+    sim.set_facts([(False, "doneA", ()), (True, "again", ("b",)), (True, "again", ("c",))])
+    sim.run(ticks=1)
+    sim.set_facts([(False, "again", ("b",)), (False, "again", ("c",))])
+    sim.run(ticks=10)
+    # b and c in a new instance of X (the same key): a's old success does not count there
+    assert where(sim, "a") == ("Default", "T") and where(sim, "b") == where(sim, "c") == ("Default", "S")
+    assert {where(sim, "b", 1)[0], where(sim, "c", 1)[0]} == {"A", "B"}
+    assert len(trace.of("success", agent="b", plan="X")) == 1
