@@ -143,29 +143,21 @@ class PlanNode:
             self.former.add(agent)
             changed = True
         protection = engine.config.assignment_protection
-        for agent in self.former:
+        for agent in sorted(self.former):
             if agent in members or not team.is_alive(agent):
                 continue
             # a teammate that left this instance (its parent moved on) still counts where it succeeded;
             # only one that was in this instance: a new instance of the same key starts without it
             claim = team.claim(agent, self.key)
             if claim is not None and claim.plan == self.plan.name:
-                for ep in claim.success:
-                    done = self.succeeded.setdefault(ep, set())
-                    if agent not in done:
-                        done.add(agent)
-                        changed = True
+                changed |= self._count_successes(agent, claim)
         for agent in sorted(members - {me}):
             claim = team.claim(agent, self.key)
             current = self.believed.get(agent)
             predicted = self.predicted_at.get(agent)
             expired = predicted is not None and now - predicted > protection
             if claim is not None and claim.plan == self.plan.name:
-                for ep in claim.success:
-                    done = self.succeeded.setdefault(ep, set())
-                    if agent not in done:
-                        done.add(agent)
-                        changed = True
+                changed |= self._count_successes(agent, claim)
                 new = (claim.entry, claim.state)
                 if current == new:
                     self.predicted_at.pop(agent, None)
@@ -189,6 +181,16 @@ class PlanNode:
         if changed:
             self._children_membership_changed()
         return changed
+
+    def _count_successes(self, agent: str, claim: Claim) -> bool:
+        """Record the entry points ``agent`` says its task succeeded in here; whether any is new."""
+        new = False
+        for ep in claim.success:
+            done = self.succeeded.setdefault(ep, set())
+            if agent not in done:
+                done.add(agent)
+                new = True
+        return new
 
     def _children_membership_changed(self) -> None:
         for slot in self.slots:

@@ -160,6 +160,7 @@ class Slot:
         )
         """A plan type with conditioned plans: which plans may run is looked at every step."""
         self.seen: tuple[str, ...] | None = None
+        """The plans of the type that could run at the last look (``watch``)."""
 
     @property
     def name(self) -> str:
@@ -262,7 +263,7 @@ class Slot:
         self.next_try = now
 
     def visit(self, now: float) -> None:
-        """Run the rules of the child plan, repair it when it failed (behaviours are ticked elsewhere)."""
+        """Run the rules of the child plan; a failed one waits for :meth:`repair_pending` (behaviours are ticked elsewhere)."""
         if self.runner is not None:
             self.status = self.runner.status
             self.reason = self.runner.reason
