@@ -139,6 +139,11 @@ def test_c_plus_plus_conditions_are_declared_predicates(
     # an inline pre-condition is declared in its plan's file
     assert library.plans["SimpleTestPlan"].pre is not None
     assert library.plans["SimpleTestPlan"].pre.text == "SimpleTestPlanPreCondition"  # type: ignore[union-attr]
+    # a condition marked disabled is imported too (the C++ engine evaluates it: conditionPlanTypeTest), with a note
+    run = library.plans["RuntimeConditionPlan"].run
+    assert run is not None and run.text == "RuntimeConditionPlanRuntimeCondition"
+    disabled = [n["message"] for n in _notes(report, Construct.DISABLED_CONDITION)]
+    assert any("RuntimeConditionPlan" in m and "evaluates it all the same" in m for m in disabled)
 
 
 def test_role_priorities_name_tasks(library: PlanLibrary) -> None:

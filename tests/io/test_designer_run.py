@@ -38,6 +38,9 @@ def test_simple_test_plan_runs_its_behaviour_and_moves_on_when_the_condition_hol
         config=EngineConfig(frequency=10.0),
     )
     engine = sim.engines["a"]
+    # the plan's runtime condition is C++ in the designer (marked disabled there, evaluated all the same):
+    # a predicate here, which must hold for the plan to keep running
+    engine.world_model.assert_fact("SimpleTestPlanRuntimeCondition")
     # 1. the agent enters TestState1 and its behaviour MidFieldStandard runs
     sim.run(ticks=5)
     assert engine.root is not None and (engine.root.ep, engine.root.state) == ("DefaultTask", "TestState1")

@@ -85,7 +85,12 @@ def variables(ctx: Context, file: str, variables: tuple[Var, ...], owner: str) -
 def inline_condition(
     ctx: Context, file: str, cond: Cond | None, kind: ConditionKind, owner: str
 ) -> tuple[Condition | None, Declaration | None]:
-    """An inline pre, runtime or post condition: a declared 0-ary predicate, or nothing when it is switched off."""
+    """An inline pre, runtime or post condition: a declared 0-ary predicate.
+
+    A condition marked ``enabled: false`` is imported too: the C++ engine evaluates it all
+    the same (its ``conditionPlanTypeTest`` switches to ``RuntimeConditionPlan`` when that
+    plan's disabled runtime condition comes true).
+    """
     if cond is None:
         return None, None
     what = {ConditionKind.PRE: "pre", ConditionKind.RUN: "runtime", ConditionKind.POST: "post"}.get(kind, "")
@@ -94,9 +99,9 @@ def inline_condition(
             file,
             cond.key,
             Construct.DISABLED_CONDITION,
-            f"the {what} condition of {owner} is disabled in the designer: not imported",
+            f"the {what} condition of {owner} is marked disabled in the designer, but the C++ engine evaluates "
+            "it all the same: imported like any other",
         )
-        return None, None
     name = ctx.names.predicates[cond.id]
     if cond.quantifiers or cond.variables:
         ctx.note(

@@ -123,7 +123,7 @@ def _stem(file: str) -> str:
 
 
 def _inline(record: FileRec) -> list[tuple[Cond, str, str]]:
-    """The enabled inline conditions of a plan or behaviour: (condition, key, fallback name suffix)."""
+    """The inline conditions of a plan or behaviour, disabled ones too: (condition, key, fallback name suffix)."""
     out: list[tuple[Cond | None, str, str]] = []
     if isinstance(record, (PlanRec, BehaviourRec)):
         out += [(record.pre, "preCondition", "PreCondition"), (record.run, "runtimeCondition", "RuntimeCondition")]
@@ -134,7 +134,7 @@ def _inline(record: FileRec) -> list[tuple[Cond, str, str]]:
             if state.terminal:
                 suffix = f"{sanitize(state.name, 'State')}PostCondition"
                 out.append((state.post, f"{state.key}.postCondition", suffix))
-    return [(c, key, suffix) for c, key, suffix in out if c is not None and c.enabled]
+    return [(c, key, suffix) for c, key, suffix in out if c is not None]
 
 
 def allocate(records: Mapping[str, FileRec], accepted: Sequence[str], reserved_skills: Iterable[str]) -> Names:
