@@ -449,3 +449,96 @@ def test_a_success_claimed_after_leaving_counts_once_and_not_in_a_new_instance(t
     assert where(sim, "a") == ("Default", "T") and where(sim, "b") == where(sim, "c") == ("Default", "S")
     assert {where(sim, "b", 1)[0], where(sim, "c", 1)[0]} == {"A", "B"}
     assert len(trace.of("success", agent="b", plan="X")) == 1
+
+
+# -- testing (back and forth) ----------------------------------------------------------------
+
+BACK_FORTH = """
+behaviours:
+  - {name: CountIndefinitely, skill: Work}
+plans:
+  - name: BackForth
+    entry_points: [{task: Default, state: First}]
+    states:
+      - {name: First, children: [CountIndefinitely], transitions: [{to: Second, condition: "true"}]}
+      - {name: Second, children: [CountIndefinitely], transitions: [{to: First, condition: "true"}]}
+"""
+
+
+def test_back_and_forth_keeps_switching_and_its_behaviour_keeps_running(tmp_path):
+    """testing: two states whose transitions both hold keep switching, a bounded number of times a step."""
+    lib = library(tmp_path, BACK_FORTH)
+    count = scripted(["running"])
+    sim, trace = team(lib, "BackForth", {"w": "Worker"}, {"Work": count})
+    sim.run(ticks=10)
+    config = sim.config
+    assert len(trace.of("transition")) == 10 * config.max_rule_applications  # every step, never stuck in a loop
+    assert sum(instance.ticks for instance in count.instances) == 10  # a CountIndefinitely runs in every step
+    assert sim.engines["w"].root.status is ChildStatus.RUNNING
+
+
+# -- success tests ---------------------------------------------------------------------------
+
+SUCCESS = """
+predicates: [go/1]
+plans:
+  - name: SuccessOnCondPlan
+    variables: [x]
+    entry_points: [{task: Default, state: Entry}]
+    states:
+      - {name: Entry, transitions: [{to: Suc, condition: "go(x)"}]}
+      - {name: Suc, kind: success}
+  - name: WrapperA
+    entry_points: [{task: Default, state: Run}]
+    states:
+      - {name: Run, children: [{ref: SuccessOnCondPlan, bind: {x: a}}], transitions: [{to: Done, condition: "succeeded"}]}
+      - {name: Done, kind: success}
+  - name: WrapperB
+    entry_points: [{task: Default, state: Run}]
+    states:
+      - {name: Run, children: [{ref: SuccessOnCondPlan, bind: {x: b}}], transitions: [{to: Done, condition: "succeeded"}]}
+      - {name: Done, kind: success}
+  - name: MultiPlanInstanceSuccessTestPlan
+    entry_points: [{task: Default, state: ParallelExec}]
+    states:
+      - {name: ParallelExec, children: [WrapperA, WrapperB], transitions: [{to: Success, condition: "succeeded"}]}
+      - {name: Success, kind: success}
+  - name: AdjacentSuccessTestPlan
+    entry_points: [{task: Default, state: StateA}]
+    states:
+      - name: StateA
+        children: [{ref: SuccessOnCondPlan, bind: {x: a}}]
+        transitions: [{to: StateB, condition: "succeeded(SuccessOnCondPlan)"}]
+      - name: StateB
+        children: [{ref: SuccessOnCondPlan, bind: {x: a}}]
+        transitions: [{to: StateA, condition: "succeeded(SuccessOnCondPlan)"}]
+"""
+
+
+def test_two_instances_of_one_plan_succeed_separately(tmp_path):
+    lib = library(tmp_path, SUCCESS)
+    sim, trace = team(lib, "MultiPlanInstanceSuccessTestPlan", {"w": "Worker"}, {})
+    sim.run(ticks=3)
+    sim.set_facts([(True, "go", ("a",))])
+    sim.run(ticks=3)
+    root = sim.engines["w"].root
+    assert [s.status for s in root.slots] == [ChildStatus.SUCCESS, ChildStatus.RUNNING]  # WrapperA, WrapperB
+    assert root.state == "ParallelExec"
+    sim.set_facts([(True, "go", ("b",))])
+    sim.run(until_done=True, max_time=5)
+    assert where(sim, "w") == ("Default", "Success")
+    assert len(trace.of("success", plan="SuccessOnCondPlan")) == 2
+
+
+def test_a_fresh_instance_in_an_adjacent_state_is_not_successful(tmp_path):
+    lib = library(tmp_path, SUCCESS)
+    sim, trace = team(lib, "AdjacentSuccessTestPlan", {"w": "Worker"}, {})
+    sim.run(ticks=2)
+    sim.set_facts([(True, "go", ("a",))])
+    sim.run(ticks=1)
+    sim.set_facts([(False, "go", ("a",))])
+    sim.run(ticks=5)
+    # StateA's instance succeeded; the fresh one of StateB waits for its own condition
+    assert where(sim, "w") == ("Default", "StateB")
+    assert sim.engines["w"].root.slots[0].status is ChildStatus.RUNNING
+    assert len(trace.of("success", plan="SuccessOnCondPlan")) == 1
