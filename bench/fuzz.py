@@ -1,7 +1,7 @@
 """Fuzzing the readers: seeded mutants of the shipped plans and the benchmark PDDL, each in a bounded worker.
 
 Corpora: ``yaml`` and ``xml`` (the shipped plan files, :func:`alica.io.loader.plans_dir`),
-``pddl-domain`` and ``pddl-problem`` (``benchmarks/pddl/*/``). Mutant ``i`` of a corpus
+``pddl-domain`` and ``pddl-problem`` (``../shared/benchmarks/pddl/*/``). Mutant ``i`` of a corpus
 is made by ``random.Random(f"{seed}:{corpus}:{i}")`` from one of its files with one to
 three mutations: byte flips, token swaps, deletions, duplications, deep nesting,
 huge numbers and control characters.
@@ -53,8 +53,8 @@ OUTCOMES = ("ok", "rejected", "traceback", "hang", "memory")
 
 
 def pddl_folder() -> Path:
-    """The benchmark PDDL: the checkout's ``benchmarks/pddl``."""
-    return ROOT / "benchmarks" / "pddl"
+    """The benchmark PDDL: ``../shared/benchmarks/pddl`` beside the checkout."""
+    return ROOT / ".." / "shared" / "benchmarks" / "pddl"
 
 
 def corpus_files(corpus: str) -> list[Path]:

@@ -31,7 +31,7 @@ from alica.app.magic import run_lockstep
 from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.search import BuiltinPlanner
 
-ROVERS = Path(__file__).resolve().parent.parent / "benchmarks" / "pddl" / "rovers"
+ROVERS = Path(__file__).resolve().parent.parent / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
 
 FDP_COST = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """IMPERA Table 1: the cost FDP found on Rovers1-20."""

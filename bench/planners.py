@@ -1,4 +1,4 @@
-"""Our planner (``alica plan``) beside Fast Downward lama-first and pyperplan gbf-hff on the shipped PDDL benchmarks.
+"""Our planner (``alica plan``) beside Fast Downward lama-first and pyperplan gbf-hff on the standard PDDL benchmarks (read in place from ../shared/benchmarks).
 
 Every problem runs as a whole process, one at a time by default (the machine has 2
 cores; timings must not compete), with a wall limit (60 s):
@@ -21,7 +21,7 @@ p01-p20 vs the IMPERA paper's Table 1, our first plan and ours after the anytime
 ours at most that on each); blocks after the anytime budget vs the optimum (goal: total at
 most 1.15x); the grounding time of Rovers p18-p20 (goal: at most 0.1 s each).
 
-With ``--suite ipc`` (issue 22) the 175 problems of the 26 domains in ``benchmarks/ipc/`` instead (airport
+With ``--suite ipc`` (issue 22) the 175 problems of the 26 domains in ``../shared/benchmarks/ipc/`` instead (airport
 and psr-small: each problem ``pNN-*.pddl`` with its own ``pNN-domain.pddl``), 30 s each: ours (first plan),
 Fast Downward lama-first, then ours with ``--anytime --time-limit 10`` on every problem. Each run is appended
 to ``build/bench/ipc_runs.tsv`` as it completes; at the end three markdown tables: per domain (solved, invalid,
@@ -65,8 +65,8 @@ from alica.prophet.planners.fd import find_driver
 from alica.prophet.planners.planfile import parse_plan
 from alica.prophet.validate import validate_plan
 
-BENCHMARKS = ROOT / "benchmarks" / "pddl"
-IPC = ROOT / "benchmarks" / "ipc"
+BENCHMARKS = ROOT / ".." / "shared" / "benchmarks" / "pddl"
+IPC = ROOT / ".." / "shared" / "benchmarks" / "ipc"
 OUT = ROOT / "build" / "bench"
 IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""
@@ -533,7 +533,7 @@ GOAL_TIME, GOAL_ANYTIME, GOAL_FIRST = 1.0, 0.8, 1.1
 
 
 def ipc_problems(domain: str, limit: int | None) -> list[Job]:
-    """The problems of ``benchmarks/ipc/DOMAIN`` (natural order), each with its domain file, as planner-less jobs.
+    """The problems of ``../shared/benchmarks/ipc/DOMAIN`` (natural order), each with its domain file, as planner-less jobs.
 
     A folder holds ``domain.pddl``, or (airport, psr-small) one ``pNN-domain.pddl`` per problem ``pNN-*.pddl``.
     """
@@ -543,13 +543,13 @@ def ipc_problems(domain: str, limit: int | None) -> list[Job]:
     for path in sorted((p for p in folder.glob("*.pddl") if "domain" not in p.name), key=lambda p: _order(p.stem)):
         domain_file = shared if shared.exists() else folder / f"{path.stem.split('-')[0]}-domain.pddl"
         if not domain_file.exists():
-            raise FileNotFoundError(f"no domain file for {path.relative_to(ROOT)}")
+            raise FileNotFoundError(f"no domain file for {path}")
         jobs.append(Job("", domain, path.stem, domain_file, path))
     return jobs[:limit] if limit is not None else jobs
 
 
 def ipc_domains() -> list[str]:
-    """Every domain folder of ``benchmarks/ipc``."""
+    """Every domain folder of ``../shared/benchmarks/ipc``."""
     return sorted(p.name for p in IPC.iterdir() if p.is_dir())
 
 
@@ -705,7 +705,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--suite",
         choices=("classic", "ipc"),
         default="classic",
-        help="classic: benchmarks/pddl (blocks, rovers); ipc: the 26 domains of benchmarks/ipc (default classic)",
+        help="classic: ../shared/benchmarks/pddl (blocks, rovers); ipc: the 26 domains of ../shared/benchmarks/ipc (default classic)",
     )
     parser.add_argument(
         "--domains", help="comma-separated benchmark domains (default blocks,rovers; for ipc every domain)"

@@ -1,4 +1,4 @@
-"""The builtin search's first plan on the IPC suite (``benchmarks/ipc``), beside Fast Downward lama-first.
+"""The builtin search's first plan on the IPC suite (``../shared/benchmarks/ipc``), beside Fast Downward lama-first.
 
 One problem at a time, each as a whole process with a wall limit (30 s): ours runs
 ``alica plan --json`` (the default first search), or ``search_task`` with another
@@ -28,8 +28,8 @@ sys.path.insert(0, str(ROOT))
 
 from bench.planners import GRACE_S, Job, Outcome, Tasks, _validated, run_fd, run_process
 
-IPC = ROOT / "benchmarks" / "ipc"
-PDDL = ROOT / "benchmarks" / "pddl"
+IPC = ROOT / ".." / "shared" / "benchmarks" / "ipc"
+PDDL = ROOT / ".." / "shared" / "benchmarks" / "pddl"
 OUT = ROOT / "build" / "bench"
 FIELDS = ("domain", "problem", "status", "wall_s", "cost", "first_s", "expansions", "evaluations")
 

@@ -14,7 +14,7 @@ import pytest
 from alica.prophet.ground import GroundTask, ground
 from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl"
 
 MIXED = """(define (domain mixed) (:requirements :typing :negative-preconditions :equality :conditional-effects)
   (:types item place)

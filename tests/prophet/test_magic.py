@@ -34,7 +34,7 @@ from alica.prophet.search import BuiltinPlanner, FirstSearch
 from alica.prophet.validate import validate_plan
 from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
 
-ROVERS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl" / "rovers"
+ROVERS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
 
 
 @cache

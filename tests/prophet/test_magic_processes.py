@@ -9,7 +9,7 @@ from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.planner import PlanStatus
 from alica.prophet.validate import validate_plan
 
-ROVERS = Path(__file__).resolve().parents[2] / "benchmarks" / "pddl" / "rovers"
+ROVERS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
 
 
 def test_three_agent_processes_give_a_valid_plan_within_the_message_bound() -> None:

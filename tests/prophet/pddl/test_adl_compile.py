@@ -22,7 +22,7 @@ from alica.prophet.planners import get_planner
 from alica.prophet.search.encoding import compile_task
 from alica.prophet.validate import _Lifted, validate_plan
 
-IPC = Path(__file__).resolve().parents[3] / "benchmarks" / "ipc"
+IPC = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "ipc"
 
 # A tiny miconic-fulladl: the lift may stop at a floor only if every boarded passenger with the
 # non-stop flag gets off there, and no passenger of a conflicting group is waiting or riding.

@@ -9,7 +9,7 @@ import pytest
 from alica.prophet.ground import GroundTask, ground
 from alica.prophet.pddl import PddlError, parse_domain, parse_problem, read_domain, read_problem
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 def _task(domain_text: str, problem_text: str) -> GroundTask:

@@ -17,7 +17,7 @@ from alica.prophet.pddl import (
 )
 from alica.prophet.planner import Feature
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 def benchmark_sets() -> list[tuple[Path, list[Path]]]:

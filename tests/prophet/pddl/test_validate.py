@@ -11,7 +11,7 @@ from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_pr
 from alica.prophet.planner import Plan, PlanStep
 from alica.prophet.validate import validate_plan
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 GOOD = [
     ("pick-up", "b"),

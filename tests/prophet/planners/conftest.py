@@ -11,7 +11,7 @@ import pytest
 from alica.app.cli import main
 from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from alica.prophet.planner import Plan
 
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks" / "pddl"
+BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 @dataclass(frozen=True, slots=True)

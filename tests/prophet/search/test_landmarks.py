@@ -20,7 +20,7 @@ from alica.prophet.search.jit import CompiledFF, SwitchingFF, available
 from alica.prophet.search.landmarks import LandmarkCount, Landmarks
 from tests.prophet.search.helpers import BENCHMARKS, GroundTask, TaskBuilder, blocks_task, check_plan
 
-IPC = Path(__file__).resolve().parents[3] / "benchmarks" / "ipc"
+IPC = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "ipc"
 
 
 def compiled(task: GroundTask) -> tuple[CompiledTask, Relaxed, LandmarkCount]:
