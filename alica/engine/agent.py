@@ -166,6 +166,9 @@ class AgentEngine:
         for topic in self.children.routes:
             transport.subscribe(topic)
         self._world_changed = False
+        self.inputs = 0
+        """Moves on whenever something an allocation reads may have changed: teammates' claims and liveness,
+        the world, this agent's own plan tree. A child that found no assignment tries again when it moved."""
         self._liveliness = transport.tracks_liveliness
         """The transport reports who is alive (liveliness tokens): a teammate gone is taken out at once."""
         self._peers: frozenset[str] = frozenset()
@@ -176,6 +179,7 @@ class AgentEngine:
 
     def _on_world_change(self, keys: object) -> None:
         self._world_changed = True
+        self.inputs += 1
 
     # -- the tick ---------------------------------------------------------
 
@@ -199,6 +203,8 @@ class AgentEngine:
             payload = envelope.payload
             if topic == TEAM_TOPIC and isinstance(payload, TeamMessage):
                 changed, revived = self.team.integrate(payload, now)
+                if changed:
+                    self.inputs += 1
                 if revived:
                     self._welcome(payload.sender)
                 elif payload.sender not in self._greeted:
@@ -240,6 +246,7 @@ class AgentEngine:
         """A teammate taken out spoke again: take it back into the assignments and send it the world."""
         self._greeted.add(who)
         self.emit("team", change="back", who=who)
+        self.inputs += 1
         self._invalidate_all()
         self._next_root_try = self.now()
         self._publish(WORLD_TOPIC, self.world_model.snapshot(), QoS.RELIABLE)
@@ -257,6 +264,7 @@ class AgentEngine:
                 self._greeted.discard(who)  # when it comes back, it gets the world again
             self._peers = peers
         if lost:
+            self.inputs += 1
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self._invalidate_all()
@@ -295,8 +303,8 @@ class AgentEngine:
             self._failed_root = None
             self.root_repairs.waiting_since = None
         else:
-            # try again in the next step, as the C++ engine does (a teammate may be heard, the world change)
-            self._next_root_try = now
+            # try again when a teammate comes back or speaks, at the latest after a heartbeat
+            self._next_root_try = now + self.config.broadcast_interval
 
     def _give_up_root(self, failed: PlanNode) -> None:
         """The root plan found no valid assignment for ``rejoin_wait`` seconds: the mission failed."""
@@ -412,6 +420,7 @@ class AgentEngine:
     def tree_changed(self) -> None:
         """The plan tree changed: tell the team soon."""
         self._tree_changed = True
+        self.inputs += 1
 
     def forget(self, node: PlanNode) -> None:
         """A plan node stopped."""

@@ -45,7 +45,7 @@ class Allocator:
     def __init__(self, engine: AgentEngine) -> None:
         self.engine = engine
         self._unallocated: dict[PlanKey, str] = {}
-        """Plan instance -> why its last allocation found no assignment (reported once, retried every step)."""
+        """Plan instance -> why its last allocation found no assignment (reported once while it stays the same)."""
 
     def members(self, parent: PlanNode | None) -> tuple[str, ...]:
         """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""

@@ -133,6 +133,7 @@ class Slot:
         "runtime",
         "seen",
         "status",
+        "tried",
         "watch",
     )
 
@@ -148,6 +149,8 @@ class Slot:
         self.reason = ""
         self.repairs = Repairs()
         self.next_try = 0.0
+        self.tried = -1
+        """``engine.inputs`` at the last try that found nothing to start."""
         self.runtime: ChildRuntime | None = None
         if not isinstance(self.element, (Behaviour, Plan, PlanType)):
             self.runtime = engine.children.runtime(self)
@@ -257,10 +260,16 @@ class Slot:
         self.repairs.waiting_since = None
 
     def _wait(self, now: float, reason: str) -> None:
-        """Not startable now: try again in the next step (as the C++ engine does; teammates or the world may change)."""
+        """Not startable now: try again in the step an input changes (a teammate heard, the world), else after a heartbeat.
+
+        The C++ engine tries again in every step; trying when an allocation's inputs moved starts
+        the child in the same step, without allocating again and again while nothing changed.
+        """
+        engine = self.parent.engine
         self.status = ChildStatus.WAITING
         self.reason = reason
-        self.next_try = now
+        self.next_try = now + engine.config.broadcast_interval
+        self.tried = engine.inputs
 
     def visit(self, now: float) -> None:
         """Run the rules of the child plan; a failed one waits for :meth:`repair_pending` (behaviours are ticked elsewhere)."""
@@ -277,7 +286,7 @@ class Slot:
             if self.repairs.waited_out(now, self.parent.engine.config.rejoin_wait):
                 self.status = ChildStatus.FAILURE
                 self.reason = f"no valid assignment for {self.parent.engine.config.rejoin_wait:g} s: {self.reason}"
-            elif now >= self.next_try:
+            elif now >= self.next_try or self.parent.engine.inputs != self.tried:
                 self.start(now)
             return
         node = self.node
