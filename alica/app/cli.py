@@ -138,18 +138,18 @@ def _cmd_render(args: argparse.Namespace) -> int:
 
 
 def _relocated(imports: Sequence[str], source: Path, target: Path) -> list[str]:
-    """Relative imports of a file at ``source`` rewritten for a copy at ``target``: the same files, found from there."""
+    """The imports of a file at ``source`` rewritten for a copy at ``target``: the same files, found from there
+    (a shipped plan as ``alica:plans/...``)."""
+    from alica.io import import_reference
+    from alica.io.plan_paths import is_shipped_name
+
     src, dst = Path(os.path.abspath(source)).parent, Path(os.path.abspath(target)).parent
-    out = []
-    for entry in imports:
-        if Path(entry).is_absolute() or src == dst:
-            out.append(entry)
-            continue
-        try:
-            out.append(Path(os.path.relpath(src / entry, dst)).as_posix())
-        except ValueError:  # another drive: no relative path exists
-            out.append((src / entry).as_posix())
-    return out
+    return [
+        entry
+        if is_shipped_name(entry) or Path(entry).is_absolute() or src == dst
+        else import_reference(src / entry, dst)
+        for entry in imports
+    ]
 
 
 def _states_named_twice(document: Document) -> list[Diagnostic]:
@@ -171,7 +171,7 @@ def _states_named_twice(document: Document) -> list[Diagnostic]:
 
 
 def _cmd_convert(args: argparse.Namespace) -> int:
-    from alica.io import Loader, format_of, read_text
+    from alica.io import Loader, format_of, plan_path, read_text
     from alica.io.dump import document_data
     from alica.io.loader import parse_text
     from alica.io.xml_write import unwritable_text, write_xml
@@ -180,7 +180,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
     fmt, in_fmt = format_of(args.output), format_of(args.input)
     if fmt is None or in_fmt is None:
         raise AlicaError("convert needs files ending in .yaml, .yml or .xml, e.g. 'alica convert roles.yaml roles.xml'")
-    source, target = Path(args.input), Path(args.output)
+    source, target = plan_path(args.input), Path(args.output)
     loader = Loader()
     if not args.no_validate:
         loader.load(source)

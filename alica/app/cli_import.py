@@ -117,10 +117,5 @@ def _summary(result: ImportResult, src: Path, out: Path, written: Sequence[str],
 
 
 def _validate_hint(out: Path) -> None:
-    """How to validate the output: its files import each other across its folders."""
-    here = Path.cwd().resolve()
-    target = out.resolve()
-    if target.is_relative_to(here) and target != here:
-        print(f"\ncheck it with: alica validate {out}")
-    else:
-        print(f"\ncheck it with: ALICA_PLAN_PATH={out} alica validate {out}")
+    """How to validate the output (a project of its own: its files import each other across its folders)."""
+    print(f"\ncheck it with: alica validate {out}")

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 import time
 from collections.abc import Callable
@@ -265,7 +264,7 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
     """Plan a planning problem of a plan file offline; print the plan and its tasks, maybe emit the generated plan."""
     from dataclasses import replace
 
-    from alica.io import load_library
+    from alica.io import import_reference, load_library
     from alica.model import Condition, ConditionKind
     from alica.prophet.pipeline import plan_problem
     from alica.prophet.tasks import create_tasks, emit_yaml
@@ -322,7 +321,7 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
         )
         if args.emit_plan:
             out = Path(args.emit_plan)
-            imports = sorted({_relative(Path(d.path), out) for d in library.documents if d.path})
+            imports = sorted({import_reference(d.path, out.parent) for d in library.documents if d.path})
             out.parent.mkdir(parents=True, exist_ok=True)
             out.write_text(emit_yaml(created, imports), encoding="utf-8")
         return {
@@ -335,10 +334,6 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
         return result.plan.cost
 
     return _report(args, planning.planner.name, result.run, cost_of, tasks)
-
-
-def _relative(path: Path, out: Path) -> str:
-    return Path(os.path.relpath(path.resolve(), out.resolve().parent)).as_posix()
 
 
 def _check_features(planner: Any, domain: Any, problem: Any) -> None:

@@ -11,18 +11,21 @@ from alica.io.loader import (
     load_document,
     load_library,
     plan_files,
-    plans_dir,
     read_text,
     validate_paths,
 )
+from alica.io.plan_paths import PlanPathError, import_reference, plan_path, plans_dir
 
 __all__ = [
     "Loader",
+    "PlanPathError",
     "dump_document",
     "format_of",
+    "import_reference",
     "load_document",
     "load_library",
     "plan_files",
+    "plan_path",
     "plans_dir",
     "read_text",
     "validate_paths",

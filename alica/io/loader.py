@@ -7,7 +7,6 @@ lunar and blocks-world missions both have a ``Pickup``).
 
 from __future__ import annotations
 
-import importlib.util
 import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
@@ -16,6 +15,16 @@ from pathlib import Path
 from alica.errors import PlanFormatError
 from alica.io.build import build_document
 from alica.io.fields import Problems
+from alica.io.plan_paths import (
+    PLAN_PATH_VARIABLE,
+    PlanPathError,
+    default_search_path,
+    import_target,
+    plan_path,
+    project_root,
+    shown,
+)
+from alica.io.plan_paths import plans_dir as plans_dir  # re-exported: older imports name it here
 from alica.io.skill_declarations import declare_skills
 from alica.io.tree import Node
 from alica.lang import Registry, default_registry
@@ -28,34 +37,9 @@ from alica.source import Diagnostic, SourceSpan, byte_place
 FORMATS = {".yaml": "yaml", ".yml": "yaml", ".xml": "xml"}
 
 
-def plans_dir() -> Path:
-    """The shipped plans: the package data ``alica.plans`` (the checkout's ``plans/`` in an editable install).
-
-    Raises:
-        FileNotFoundError: the package was installed without its plans.
-    """
-    spec = importlib.util.find_spec("alica.plans")
-    locations = list(spec.submodule_search_locations or ()) if spec is not None else []
-    for location in locations:
-        folder = Path(location)
-        if (folder / "roles.yaml").is_file():
-            return folder
-    raise FileNotFoundError(
-        f"the shipped plans are missing from the installed package (looked in {locations or 'alica.plans'}); reinstall alica-teams"
-    )
-
-
 def format_of(path: str | os.PathLike[str]) -> str | None:
     """``yaml`` or ``xml`` by the file's ending, ``None`` for anything else."""
     return FORMATS.get(Path(path).suffix.lower())
-
-
-def shown(path: Path) -> str:
-    """A path as it appears in messages: relative to the working folder when inside it."""
-    try:
-        return os.path.relpath(path)
-    except ValueError:
-        return str(path)
 
 
 def parse_text(text: str, name: str, fmt: str) -> tuple[Node | None, list[Diagnostic]]:
@@ -92,10 +76,6 @@ def _import_nodes(tree: Node | None) -> list[Node]:
     return section.value if isinstance(section.value, list) else [section]
 
 
-#: Environment variable with more plan folders imports may reach (separated by ``os.pathsep``).
-PLAN_PATH_VARIABLE = "ALICA_PLAN_PATH"
-
-
 @dataclass
 class _Read:
     document: Document
@@ -115,33 +95,17 @@ def _bad_character(text: str) -> str | None:
     return None
 
 
-def _project(entry: Path) -> list[Path]:
-    """The working folder, when ``entry`` lies inside it: the project whose plans import each other."""
-    here = Path.cwd().resolve()
-    return [here] if entry.is_relative_to(here) and here != Path(here.anchor) else []
-
-
-def default_search_path() -> list[Path]:
-    """The plan folders every import may reach: the shipped plans and ``ALICA_PLAN_PATH``."""
-    folders: list[Path] = []
-    try:
-        folders.append(plans_dir())
-    except FileNotFoundError:
-        pass
-    folders.extend(Path(p) for p in os.environ.get(PLAN_PATH_VARIABLE, "").split(os.pathsep) if p.strip())
-    return folders
-
-
 @dataclass
 class Loader:
     """Reads plan files once each and validates document sets.
 
     Imports are confined: a file may import only files inside the folder of the
     entry file given to :meth:`check` or :meth:`load` (and its subfolders), the
-    working folder when the entry file lies in it (the project: ``alica validate
-    plans/lunar/mission.yaml`` may import ``plans/tasks.yaml``), or a folder of
-    the plan search path; anything else is reported at the import, without
-    being read.
+    entry file's project (the nearest folder above it holding ``.alica-project``,
+    ``pyproject.toml``, ``.git`` or ``.hg``: ``plans/lunar/mission.yaml`` may import
+    ``plans/tasks.yaml``), or a folder of the plan search path (the shipped plans,
+    ``alica:plans/...``, among them); anything else is reported at the import,
+    without being read. The working folder plays no part.
 
     Args:
         skills: skill declarations behaviours are checked against, besides the
@@ -207,7 +171,8 @@ class Loader:
         diagnostics: list[Diagnostic] = []
         seen: set[Path] = set()
         todo = [entry.resolve()]
-        roots = [todo[0].parent, *_project(todo[0]), *self._roots]
+        project = project_root(todo[0])
+        roots = [todo[0].parent, *([project] if project is not None else []), *self._roots]
         while todo:
             path = todo.pop(0)
             if path in seen:
@@ -217,7 +182,7 @@ class Loader:
             documents.append(read.document)
             diagnostics.extend(read.diagnostics)
             for raw, span in read.imports:
-                target, problem = self._target(path.parent, raw, span, roots)
+                target, problem = self._target(path, raw, span, roots)
                 if target is None:
                     if problem is not None:
                         diagnostics.append(problem)
@@ -244,7 +209,7 @@ class Loader:
         return documents, diagnostics
 
     def _target(
-        self, folder: Path, raw: str, span: SourceSpan, roots: list[Path]
+        self, importer: Path, raw: str, span: SourceSpan, roots: list[Path]
     ) -> tuple[Path | None, Diagnostic | None]:
         """The file an import names, or the problem with it (a bad path, or one outside ``roots``)."""
         shown_raw = raw if len(raw) <= 60 else raw[:57] + "..."
@@ -254,8 +219,10 @@ class Loader:
                 span, f"import path holds the control character {bad}", "write the file's path as plain text"
             )
         try:
-            target = (folder / raw).resolve()
+            target = import_target(importer, raw).resolve()
             target.is_file()
+        except PlanPathError as exc:
+            return None, Diagnostic(span, f"cannot use import path: {exc}", "fix the path")
         except (OSError, ValueError) as exc:
             reason = getattr(exc, "strerror", None) or str(exc)
             return None, Diagnostic(span, f"cannot use import path '{shown_raw}': {reason}", "fix the path")
@@ -263,8 +230,8 @@ class Loader:
             return None, Diagnostic(
                 span,
                 f"import '{shown_raw}' is outside the plan folders",
-                "import files under the entry file's folder or the plan search path "
-                f"(Loader(search_path=...) or {PLAN_PATH_VARIABLE})",
+                "import files under the entry file's folder or its project (the folder holding .alica-project, "
+                f"pyproject.toml or .git), shipped plans as alica:plans/..., or add a folder to {PLAN_PATH_VARIABLE}",
             )
         return target, None
 
@@ -279,7 +246,7 @@ class Loader:
         documents: dict[str, Document] = {}
         diagnostics: list[Diagnostic] = []
         for entry in entries:
-            docs, diags = self.document_set(Path(entry))
+            docs, diags = self.document_set(plan_path(entry))
             diagnostics.extend(diags)
             for doc in docs:
                 documents.setdefault(doc.path, doc)
@@ -311,7 +278,7 @@ class Loader:
         Raises:
             PlanFormatError: the file cannot be read or has structural problems.
         """
-        read = self.read(Path(path))
+        read = self.read(plan_path(path))
         if read.diagnostics:
             raise PlanFormatError(read.diagnostics)
         return read.document
@@ -326,7 +293,11 @@ def plan_files(paths: Iterable[str | os.PathLike[str]]) -> tuple[list[Path], lis
     files: list[Path] = []
     problems: list[Diagnostic] = []
     for raw in paths:
-        path = Path(raw)
+        try:
+            path = plan_path(raw)
+        except PlanPathError as exc:
+            problems.append(Diagnostic(SourceSpan(os.fspath(raw), 1, 1), str(exc), "check the path"))
+            continue
         if path.is_dir():
             files.extend(sorted(p for p in path.rglob("*") if p.is_file() and format_of(p) is not None))
         elif path.is_file():

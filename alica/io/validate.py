@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterable, Sequence
-from pathlib import Path
 from typing import Protocol, TypeVar
 
 from alica.errors import FormulaError
 from alica.io.fields import Problems, suggest
+from alica.io.plan_paths import import_target, plan_path
 from alica.io.reads import Read, agent_domains, reads
 from alica.io.skill_declarations import with_declarations
 from alica.lang import ENGINE_VARIABLES, Registry, Vocabulary, check, default_vocabulary, literals, parse
@@ -714,9 +714,8 @@ class _Vocabularies:
                 continue
             seen.add(id(current))
             out.append(current)
-            folder = Path(current.path).parent if current.path else Path()
             for name in current.imports:
-                target = self.by_path.get(_resolved(str(folder / name)))
+                target = self.by_path.get(_resolved(name, current.path))
                 if target is not None:
                     todo.append(target)
         return out
@@ -734,9 +733,10 @@ class _Vocabularies:
                 self.problems.add(d.span, f"{kind} {d}: {exc}", "declare each name as one kind only")
 
 
-def _resolved(path: str) -> str:
+def _resolved(path: str, importer: str | None = None) -> str:
+    """A plan file's path, or an import's of the file ``importer``, resolved (as given when it cannot be)."""
     try:
-        return str(Path(path).resolve())
+        return str((import_target(importer, path) if importer else plan_path(path)).resolve())
     except (OSError, ValueError):  # ValueError: a NUL byte in an import path
         return path
 

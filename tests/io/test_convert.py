@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from alica.app.cli import main
-from alica.io import load_document, load_library
+from alica.io import load_document, load_library, plan_path
 from alica.io.dump import document_data
 from alica.io.loader import parse_text, read_text
 from alica.io.xml_write import write_xml
@@ -137,7 +137,28 @@ def test_output_in_another_folder_loads_there(tmp_path: Path, capsys: pytest.Cap
     converted_library = load_library(out)
     assert converted_library == load_library(PLANS / "lunar" / "mission.yaml")
     imports = load_document(out).imports
-    assert imports and all(not Path(i).is_absolute() and (out.parent / i).resolve().is_file() for i in imports)
+    # the shipped files it imports by name, so the output stays valid wherever it is moved
+    assert imports and all(i.startswith("alica:plans/") and plan_path(i).is_file() for i in imports)
+    moved = tmp_path / "moved" / "deeper"
+    moved.parent.mkdir()
+    out.parent.rename(moved)
+    assert load_library(moved / out.name) == converted_library
+
+
+def test_own_imports_stay_relative_to_the_output(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    (tmp_path / "project" / "shared").mkdir(parents=True)
+    (tmp_path / "project" / ".alica-project").write_text("", encoding="utf-8")
+    (tmp_path / "project" / "shared" / "tasks.yaml").write_text("tasks: [T]\n")
+    src = tmp_path / "project" / "roles.yaml"
+    src.write_text(
+        "imports: [shared/tasks.yaml, alica:plans/skills/facts.yaml]\n"
+        "rolesets:\n  - {name: R, roles: [{name: A, priorities: {T: 1}}]}\n"
+    )
+    out = tmp_path / "project" / "xml" / "roles.xml"
+    code, _, err = run(capsys, "convert", str(src), str(out))
+    assert code == 0, err
+    assert load_document(out).imports == ("../shared/tasks.yaml", "alica:plans/skills/facts.yaml")
+    assert load_library(out).rolesets.keys() == load_library(src).rolesets.keys()
 
 
 def test_output_in_the_same_folder_keeps_imports(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

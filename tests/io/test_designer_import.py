@@ -64,12 +64,18 @@ def test_alica_validate_passes_on_the_output(
     imported: tuple[Path, dict[str, object]], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out, _ = imported
-    monkeypatch.chdir(out.parent)  # the output inside the working folder: its files import each other with ../
-    assert main(["validate", "out"]) == 0, capsys.readouterr().err[-3000:]
-    assert "ok: 109 plan file(s) valid" in capsys.readouterr().out
-    monkeypatch.chdir(out.parent.parent)
-    monkeypatch.setenv("ALICA_PLAN_PATH", str(out))  # or anywhere, with the output on the plan path
-    assert main(["validate", "-q", str(out)]) == 0, capsys.readouterr().err[-3000:]
+    monkeypatch.delenv("ALICA_PLAN_PATH", raising=False)
+    # its files import each other with ../: the marker file makes the output a project of its own,
+    # valid from any working folder
+    assert (out / ".alica-project").is_file()
+    for here in (out.parent, out / "roles", out.parent.parent):
+        monkeypatch.chdir(here)
+        assert main(["validate", str(out)]) == 0, capsys.readouterr().err[-3000:]
+        assert "ok: 109 plan file(s) valid" in capsys.readouterr().out
+    (out / ".alica-project").unlink()  # without it, a file may not climb out of its own folder
+    assert main(["validate", "-q", str(out)]) == 1
+    assert "is outside the plan folders" in capsys.readouterr().err
+    (out / ".alica-project").write_text("", encoding="utf-8")
 
 
 def test_counts_of_the_imported_elements(library: PlanLibrary) -> None:

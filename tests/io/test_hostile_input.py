@@ -247,15 +247,22 @@ def test_attribute_values_from_the_text_equal_the_parsers() -> None:
     assert task["description"].value == parsed.get("description")
 
 
-def test_imports_reach_the_project_folder_the_command_runs_in(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+@pytest.mark.parametrize("marker", [".alica-project", "pyproject.toml", ".git"])
+def test_imports_reach_the_entry_files_project_from_any_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, marker: str
+) -> None:
     monkeypatch.delenv("ALICA_PLAN_PATH", raising=False)
     project = tmp_path / "project"
     (project / "plans").mkdir(parents=True)
     (project / "plans" / "tasks.yaml").write_text("tasks: [Shared]\n", encoding="utf-8")
     (tmp_path / "secret.yaml").write_text("tasks: [Secret]\n", encoding="utf-8")
     entry = write_set(project / "plans" / "lunar", "../tasks.yaml")
-    assert "outside the plan folders" in Loader().check(entry)[1][0].message  # run from elsewhere
+    assert "outside the plan folders" in Loader().check(entry)[1][0].message  # no marker: its own folder only
     monkeypatch.chdir(project)
-    assert Loader().check(entry)[1] == []  # run in the project: plans/lunar may import plans/tasks.yaml
+    assert "outside the plan folders" in Loader().check(entry)[1][0].message  # the working folder plays no part
+    (project / marker).mkdir() if marker == ".git" else (project / marker).write_text("", encoding="utf-8")
+    for here in (project, tmp_path, project / "plans" / "lunar"):
+        monkeypatch.chdir(here)
+        assert Loader().check(entry)[1] == []  # plans/lunar may import plans/tasks.yaml, from anywhere
     escaping = write_set(project / "plans" / "other", "../../../secret.yaml")
     assert "outside the plan folders" in Loader().check(escaping)[1][0].message

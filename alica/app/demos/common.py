@@ -103,10 +103,9 @@ def planning_leader(team: Any) -> Any:
 
 
 def plan_yaml_text(created: Any, mission: Path, out: Path | None) -> str:
-    """The generated plan as YAML, importing the ``mission`` file from where it is written (``out``)."""
-    import os
-
+    """The generated plan as YAML, importing the ``mission`` file from where it is written (``out``):
+    a shipped mission as ``alica:plans/...``, so the file stays valid wherever it is moved."""
+    from alica.io import import_reference
     from alica.prophet.tasks import emit_yaml
 
-    where = out.resolve() if out is not None else Path.cwd()
-    return emit_yaml(created, imports=(Path(os.path.relpath(mission, where)).as_posix(),))
+    return emit_yaml(created, imports=(import_reference(mission, out if out is not None else Path.cwd()),))

@@ -48,6 +48,7 @@ from alica.io.designer.records import (
 from alica.io.designer.report import FileError, Note
 from alica.io.designer.resolve import Index, Resolver, decide
 from alica.io.designer.writer import document_text, header, skills_text
+from alica.io.plan_paths import PROJECT_MARKER
 from alica.source import byte_place
 
 #: The name of the C++ engine's agent config files.
@@ -221,4 +222,11 @@ def write_result(result: ImportResult, out: Path) -> list[str]:
         target = out.joinpath(*rel.split("/"))
         target.parent.mkdir(parents=True, exist_ok=True)
         target.write_text(text, encoding="utf-8")
+    if result.outputs:  # its files import each other across its folders: make it a project of its own
+        marker = out / PROJECT_MARKER
+        if not marker.exists():
+            marker.write_text(
+                "# Marks a project of alica plan files: files below this folder may import each other.\n",
+                encoding="utf-8",
+            )
     return list(result.outputs)
