@@ -23,6 +23,17 @@ if TYPE_CHECKING:
     from alica.model.library import Document
 
 EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
+#: A command whose reader closed the pipe: 128 + SIGPIPE, the status a shell shows for it.
+EXIT_BROKEN_PIPE = 141
+
+
+def _quiet_stdout() -> None:
+    """Point standard output at the null device: the interpreter's flush at exit finds no closed pipe."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):  # no file descriptor (a test's captured stream): nothing is flushed at exit
+        pass
 
 
 def _print_diagnostics(diagnostics: Sequence[Diagnostic]) -> None:
@@ -323,7 +334,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:
         return int(exc.code) if isinstance(exc.code, int) else EXIT_USAGE
     try:
-        return int(args.run(args))
+        code = int(args.run(args))
+        sys.stdout.flush()  # here, so that a reader that went away is noticed below, not at exit
+        return code
+    except BrokenPipeError:  # `alica ... | head`: the reader has all it wanted; exit quietly, as SIGPIPE would
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
     except PlanFormatError as exc:
         _print_diagnostics(exc.diagnostics)
         print(f"{len(exc.diagnostics)} problem(s) found", file=sys.stderr)
