@@ -196,6 +196,7 @@ def _run(
     settings: dict[str, object],
 ) -> int:
     from alica.allocation import AgentSpec, assign_roles
+    from alica.app.trace_sources import plan_path_names
     from alica.clock import SystemClock
     from alica.comm.zenoh_transport import ZenohTransport
     from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset, trace_header
@@ -226,6 +227,8 @@ def _run(
         frequency=args.frequency,
         recorder=args.name,  # this trace holds one agent's events
         clock="wall",
+        skills=args.skills,
+        plan_path=plan_path_names(),
     )
     trace = JsonlTrace(args.trace, header=header, line_buffered=True) if args.trace else None  # kept up to a kill -9
     sinks: list[Any] = [trace] if trace is not None else []

@@ -228,6 +228,7 @@ def _trace_header(
 ) -> dict[str, Any]:
     """The header of the run's trace: the plan file, the root plan, every agent's role, the seed, the world."""
     from alica.allocation import AgentSpec, assign_roles
+    from alica.app.trace_sources import plan_path_names
     from alica.app.trace_world import MAP_EVERY, world_header
     from alica.engine import pick_roleset, trace_header
 
@@ -239,6 +240,8 @@ def _trace_header(
         seed=args.seed,
         frequency=args.frequency,
         processes=bool(args.processes),
+        skills=args.skills,
+        plan_path=plan_path_names(),
         **world_header(
             world, args.world, pose_hz=args.pose_rate, map_every=MAP_EVERY if args.world == "lunar" else None
         ),

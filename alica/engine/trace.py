@@ -50,6 +50,8 @@ def trace_header(
     world: str = "none",
     bounds: Sequence[float] | None = None,
     roots: Mapping[str, str] | None = None,
+    skills: Sequence[str] = (),
+    plan_path: Sequence[str] = (),
     **extra: Any,
 ) -> dict[str, Any]:
     """The header line of a version-2 trace.
@@ -62,6 +64,10 @@ def trace_header(
         world: ``none``, ``blocks`` or ``lunar``.
         bounds: the world's field ``(xmin, ymin, xmax, ymax)`` in metres, with a world.
         roots: agent -> root plan for agents whose root is not ``root`` (an opposing team).
+        skills: the skill modules the run loaded besides the installed plug-ins (its ``--skills``), so
+            that a viewer can load the plans that use their skills.
+        plan_path: the plan folders the run's imports could reach besides the plan file's own
+            folder and project, as the run names them (the shipped plans as ``alica:plans``).
         **extra: further fields (the sampling rates, the robots' kinds...).
 
     Raises:
@@ -85,6 +91,8 @@ def trace_header(
         "seed": seed,
         "world": world,
         "bounds": [round(float(b), 3) for b in bounds] if bounds is not None else None,
+        "skills": [str(m) for m in skills],
+        "plan_path": [str(p) for p in plan_path],
     }
     return header
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Sequence
 from typing import Any
 
 from alica.errors import AlicaError
@@ -13,20 +14,23 @@ def _cmd_center(args: argparse.Namespace) -> int:
     import secrets
 
     from alica.app.center.server import plan_app, replay_app, serve
+    from alica.app.skill_options import skill_registry
 
     token = args.token or secrets.token_urlsafe(24)
+    if args.no_trace_skills and args.plan is not None:
+        raise AlicaError("--no-trace-skills goes with --trace or --team (it skips the modules a run recorded)")
+    registry = skill_registry(args)  # the --skills modules must load, whatever the mode (a clear error if not)
     if args.team is not None:
         from alica.app.center.team_feed import JOIN_WAIT, serve_team
 
         wait = JOIN_WAIT if args.wait is None else args.wait
         if not wait > 0:
             raise AlicaError(f"--wait must be a positive number of seconds, got {args.wait}")
-        serve_team(args.team, args.key_prefix or "alica", args.host, args.port, token, wait=wait)
+        serve_team(args.team, args.key_prefix or "alica", args.host, args.port, token, wait=wait, skills=args.skills)
         return 0
     if args.key_prefix is not None or args.wait is not None:
         raise AlicaError("--key-prefix and --wait go with --team (a running team of processes)")
     if args.trace is not None:
-        from alica.app.center.replay import Replay
         from alica.app.center.trace_file import TraceFormatError, load_trace
 
         try:
@@ -34,15 +38,45 @@ def _cmd_center(args: argparse.Namespace) -> int:
         except TraceFormatError as exc:  # already FILE:LINE: error: ..., as a compiler says it
             print(exc, file=sys.stderr)
             return 1
-        app = replay_app(Replay(trace), token)
+        replay, trees = trace_replay(trace, args.skills, header_skills=not args.no_trace_skills)
+        for note in trees["notes"]:
+            print(f"alica center: {note}", file=sys.stderr)
+        app = replay_app(replay, token, trees)
     else:
-        app = plan_app(args.plan, *plan_views(args.plan), token)
+        app = plan_app(args.plan, *plan_views(args.plan, registry), token)
     serve(app, args.host, args.port, token)
     return 0
 
 
-def plan_views(path: str) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
+def trace_replay(trace: Any, skills: Sequence[str] = (), *, header_skills: bool = True) -> tuple[Any, dict[str, Any]]:
+    """The replay of a loaded trace and its agents' plan trees.
+
+    The header's plan files are loaded with the skill modules and plan folders the header
+    records (:func:`~alica.app.trace_sources.viewer_sources`) plus ``skills``; what cannot be
+    loaded is in the trees' ``notes``.
+
+    Raises:
+        SkillPluginError: a module of ``skills`` cannot be loaded.
+    """
+    from pathlib import Path
+
+    from alica.app.center.plan_view import entry_states, trace_plans, trace_trees
+    from alica.app.center.replay import Replay
+    from alica.app.trace_sources import viewer_sources
+
+    sources = viewer_sources(trace.meta, skills, base=Path(trace.path).parent, header_skills=header_skills)
+    loaded = trace_plans(trace.meta, trace.path, sources.loader)
+    trees = trace_trees(trace.meta, trace.path, loaded=loaded)
+    trees["notes"] = [*sources.notes, *trees["notes"]]
+    return Replay(trace, entries=entry_states(loaded[0])), trees
+
+
+def plan_views(path: str, registry: Any = None) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
     """The plan trees (data and SVG) of a plan file's top-level plans.
+
+    Args:
+        registry: the skills the plans are checked against (:func:`~alica.app.skill_options.skill_registry`);
+            by default the installed plug-ins.
 
     Raises:
         PlanFormatError: the plan file does not load.
@@ -50,8 +84,9 @@ def plan_views(path: str) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
     """
     from alica.app.center.plan_view import plan_svg, plan_tree
     from alica.app.cli import _load, _roots
+    from alica.io import Loader
 
-    library, entry = _load(path)
+    library, entry = _load(path, Loader(skills=registry) if registry is not None else None)
     roots = _roots(library, entry, None)
     if not roots:
         raise AlicaError(f"{path} defines no plan, planning problem or behaviour to draw")
@@ -117,6 +152,8 @@ def live_session(args: argparse.Namespace) -> Any:
 
 def add_parser(sub: Any) -> None:
     """Register ``alica center``."""
+    from alica.app.skill_options import add_skills_option
+
     p = sub.add_parser(
         "center",
         help="serve the control center: a running team of processes, a trace replay or a plan file in a web page",
@@ -127,7 +164,9 @@ def add_parser(sub: Any) -> None:
         "the plan tree of a plan file; --team serves the live page of a running team of processes (alica agent, alica run "
         "--processes) reached at one agent's zenoh listen endpoint: every agent's events since its start, then as they "
         "happen, and the operator's actions (goal, facts, decisions under --review). Without any agent of the team "
-        "answering within --wait seconds it says so on one line and exits 1. Stop it with Ctrl-C.",
+        "answering within --wait seconds it says so on one line and exits 1. Plans that use your own skills load with "
+        "--skills MODULE; a trace's header records the skill modules and plan folders of its run, and the replay loads "
+        "them by itself (--no-trace-skills: not the modules). Stop it with Ctrl-C.",
     )
     what = p.add_mutually_exclusive_group(required=True)
     what.add_argument("--trace", metavar="FILE", help="a trace (JSON Lines) to replay")
@@ -149,6 +188,13 @@ def add_parser(sub: Any) -> None:
         type=float,
         metavar="S",
         help="with --team: seconds to wait for a first agent to answer (default 10)",
+    )
+    add_skills_option(p)
+    p.add_argument(
+        "--no-trace-skills",
+        action="store_true",
+        help="with --trace or --team: do not import the skill modules the run's trace header records "
+        "(only the installed plug-ins and --skills); plans that use their skills then draw no tree",
     )
     p.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1, this machine only)")
     p.add_argument("--port", type=port_number, default=8765, help="port (default 8765; 0 picks a free one)")

@@ -203,9 +203,10 @@ class LiveSession:
             AlicaError: the address cannot be bound.
         """
         from alica.app.center.operator import problems
+        from alica.app.center.plan_view import entry_states
         from alica.app.center.server import live_app, serve_in_thread
 
-        self.hub = LiveHub(header, TeamView(header))
+        self.hub = LiveHub(header, TeamView(header, entries=entry_states([library])))
         self.server = serve_in_thread(
             live_app(self.hub, problems(library), self.token), self.host, self.port, self.token, self.out
         )

@@ -9,6 +9,7 @@ after that.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -54,7 +55,7 @@ def _node(library: PlanLibrary, name: str, shown: set[str], refs: bool) -> dict[
         "kind": "plan",
         "name": name,
         "entry_points": [
-            {"task": ep.task, "min": ep.min, "max": format_cardinality(ep.max), "state": ep.state}
+            {"name": ep.name, "task": ep.task, "min": ep.min, "max": format_cardinality(ep.max), "state": ep.state}
             for ep in plan.entry_points
         ],
         "states": [
@@ -210,8 +211,62 @@ def plan_candidates(given: str, trace_path: str | Path) -> list[Path]:
     return [path, Path(trace_path).parent / path]
 
 
-def trace_trees(meta: dict[str, Any], trace_path: str | Path) -> dict[str, Any]:
+def trace_plans(
+    meta: dict[str, Any], trace_path: str | Path, make_loader: Callable[[], Loader] = Loader
+) -> tuple[list[PlanLibrary], list[str]]:
+    """The plan libraries of the plan files a trace's header names, and why any did not load.
+
+    Args:
+        make_loader: a new loader for each file (with the run's skills and plan folders,
+            :func:`alica.app.trace_sources.viewer_sources`).
+    """
+    files = meta.get("plans")
+    if not isinstance(files, list) or not files:
+        return [], ["the trace's header names no plan files: no plan trees"]
+    libraries: list[PlanLibrary] = []
+    notes: list[str] = []
+    for given in files:
+        library, why = _load_library(str(given), trace_path, make_loader)
+        if library is None:
+            notes.append(why)
+        else:
+            libraries.append(library)
+    return libraries, notes
+
+
+def entry_states(libraries: Iterable[PlanLibrary]) -> dict[str, dict[str, str]]:
+    """Plan -> entry point -> the state it starts in, for every plan of ``libraries``.
+
+    An allocation event names an agent's entry point (``entries``: agent -> entry point name,
+    which is the task's name unless the plan names it otherwise); a task's name stands for its
+    entry point too where the plan has one entry point of that task.
+    """
+    out: dict[str, dict[str, str]] = {}
+    for library in libraries:
+        for name, plan in library.plans.items():
+            if name in out:
+                continue
+            starts = {ep.name: ep.state for ep in plan.entry_points if ep.state is not None}
+            tasks = [ep.task for ep in plan.entry_points]
+            for ep in plan.entry_points:
+                if ep.state is not None and tasks.count(ep.task) == 1:
+                    starts.setdefault(ep.task, ep.state)
+            out[name] = starts
+    return out
+
+
+def trace_trees(
+    meta: dict[str, Any],
+    trace_path: str | Path,
+    make_loader: Callable[[], Loader] = Loader,
+    *,
+    loaded: tuple[list[PlanLibrary], list[str]] | None = None,
+) -> dict[str, Any]:
     """Each agent's plan tree, from the plan files a trace's header names.
+
+    Args:
+        make_loader: a new loader for each file (see :func:`trace_plans`).
+        loaded: what :func:`trace_plans` gave, when the caller has it already.
 
     Returns:
         ``{"trees": {ROOT: tree}, "agents": {AGENT: ROOT}, "notes": [...]}``: the trees
@@ -228,17 +283,10 @@ def trace_trees(meta: dict[str, Any], trace_path: str | Path) -> dict[str, Any]:
         plan = plan if isinstance(plan, str) else root
         if isinstance(plan, str):
             wanted[str(name)] = plan
-    files = meta.get("plans")
-    notes: list[str] = []
-    if not isinstance(files, list) or not files:
-        return {"trees": {}, "agents": {}, "notes": ["the trace's header names no plan files: no plan trees"]}
-    libraries: list[PlanLibrary] = []
-    for given in files:
-        library, why = _load_library(str(given), trace_path)
-        if library is None:
-            notes.append(why)
-        else:
-            libraries.append(library)
+    libraries, found_notes = loaded if loaded is not None else trace_plans(meta, trace_path, make_loader)
+    notes = list(found_notes)
+    if not isinstance(meta.get("plans"), list) or not meta.get("plans"):
+        return {"trees": {}, "agents": {}, "notes": notes}
     trees: dict[str, dict[str, Any]] = {}
     shown: dict[str, str] = {}
     for name, plan in wanted.items():
@@ -257,14 +305,16 @@ def trace_trees(meta: dict[str, Any], trace_path: str | Path) -> dict[str, Any]:
     return {"trees": trees, "agents": shown, "notes": notes}
 
 
-def _load_library(given: str, trace_path: str | Path) -> tuple[PlanLibrary | None, str]:
+def _load_library(
+    given: str, trace_path: str | Path, make_loader: Callable[[], Loader] = Loader
+) -> tuple[PlanLibrary | None, str]:
     candidates = plan_candidates(given, trace_path)
     tried = [p for p in candidates if p.is_file()]
     if not tried:
         where = " or ".join(str(p) for p in candidates) or given
         return None, f"plan file {given} not found (looked for {where}): no plan tree from it"
     try:
-        return Loader().load(tried[0]), ""
+        return make_loader().load(tried[0]), ""
     except (AlicaError, OSError, ValueError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         return None, f"plan file {given} does not load: {first}"

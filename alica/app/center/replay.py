@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import bisect
+from collections.abc import Mapping
 from typing import Any
 
 from alica.app.center.team_view import TeamView
@@ -24,12 +25,19 @@ class Replay:
     Args:
         trace: the loaded trace.
         checkpoint_every: events between two checkpoints of :meth:`state`'s fold.
+        entries: plan -> task -> entry state, from the trace's plan files (see :class:`TeamView`).
     """
 
-    def __init__(self, trace: Trace, checkpoint_every: int = CHECKPOINT_EVERY) -> None:
+    def __init__(
+        self,
+        trace: Trace,
+        checkpoint_every: int = CHECKPOINT_EVERY,
+        entries: Mapping[str, Mapping[str, str]] | None = None,
+    ) -> None:
         if checkpoint_every < 1:
             raise ValueError(f"checkpoint_every must be at least 1, got {checkpoint_every}")
         self.every = checkpoint_every
+        self.entries = entries
         self.trace = trace
         self.events = trace.events
         self.times = [float(e["t"]) for e in self.events]
@@ -110,7 +118,7 @@ class Replay:
         return view.snapshot(t=t)
 
     def _fresh_view(self) -> TeamView:
-        return TeamView(self.trace.meta, self.trace.roles, self.agents())
+        return TeamView(self.trace.meta, self.trace.roles, self.agents(), entries=self.entries)
 
     def _checkpoint(self) -> list[TeamView]:
         view = self._fresh_view()

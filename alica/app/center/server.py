@@ -115,11 +115,17 @@ def _number(request: Request, name: str) -> float | None:
         raise ValueError(f"'{name}' must be a number, not {raw!r}") from None
 
 
-def replay_app(replay: Replay, token: str) -> Starlette:
-    """The app of a trace replay: the page and ``/api/meta``, ``/api/events``, ``/api/state``, ``/api/next``, ``/api/trees``."""
+def replay_app(replay: Replay, token: str, trees: dict[str, Any] | None = None) -> Starlette:
+    """The app of a trace replay: the page and ``/api/meta``, ``/api/events``, ``/api/state``, ``/api/next``, ``/api/trees``.
+
+    Args:
+        trees: the agents' plan trees (:func:`~alica.app.center.plan_view.trace_trees`); by default
+            from the header's plan files, loaded with the installed skills.
+    """
     from alica.app.center.plan_view import trace_trees
 
-    trees = trace_trees(replay.trace.meta, replay.trace.path)
+    if trees is None:
+        trees = trace_trees(replay.trace.meta, replay.trace.path)
 
     async def page(request: Request) -> Response:
         return HTMLResponse(_static("replay.html"))
@@ -204,18 +210,26 @@ def _update(kind: str, events: list[dict[str, Any]], walls: list[float], count: 
     )
 
 
-def live_app(hub: LiveHub, known: dict[str, dict[str, Any]], token: str) -> Starlette:
+def live_app(
+    hub: LiveHub, known: dict[str, dict[str, Any]], token: str, trees: dict[str, Any] | None = None
+) -> Starlette:
     """The app of a live team: the page, ``/ws`` (events and state as they happen), and the operator's API.
 
     Args:
         hub: the running team's events and command queue.
         known: the planning problems the operator may set goals for (:func:`operator.problems`).
         token: the access token.
+        trees: the agents' plan trees; by default from the header's plan files (as the run's command
+            line named them), loaded with the header's skill modules and plan folders.
     """
 
-    from alica.app.center.plan_view import trace_trees
+    if trees is None:
+        from alica.app.center.plan_view import trace_trees
+        from alica.app.trace_sources import viewer_sources
 
-    trees = trace_trees(hub.header, Path.cwd() / "live")  # the run's plan files, as its command line named them
+        sources = viewer_sources(hub.header)
+        trees = trace_trees(hub.header, Path.cwd() / "live", sources.loader)
+        trees["notes"] = [*sources.notes, *trees["notes"]]
 
     def meta() -> dict[str, Any]:
         plans = hub.header.get("plans") or []

@@ -28,7 +28,7 @@ from __future__ import annotations
 import sys
 import threading
 import time
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -206,21 +206,27 @@ class TeamFeed:
             self.link.close()
 
 
-def load_problems(header: Mapping[str, Any]) -> tuple[Any, list[str]]:
+def load_problems(header: Mapping[str, Any], skills: Sequence[str] = ()) -> tuple[Any, list[str]]:
     """The plan library the header's plan files make, and notes on what did not load.
 
     The files are looked for as the agents' command lines named them, from the current folder
-    (:func:`~alica.app.center.plan_view.plan_candidates`).
+    (:func:`~alica.app.center.plan_view.plan_candidates`), and loaded with the skill modules and
+    plan folders the header records plus ``skills`` (:func:`~alica.app.trace_sources.viewer_sources`).
+
+    Raises:
+        SkillPluginError: a module of ``skills`` cannot be loaded.
     """
     from alica.app.center.plan_view import _load_library
+    from alica.app.trace_sources import viewer_sources
 
     files = header.get("plans")
     if not isinstance(files, list) or not files:
         return None, ["the agents' header names no plan file: the operator can plan for no problem"]
-    library, why = _load_library(str(files[0]), Path.cwd() / "team")
+    sources = viewer_sources(header, skills)
+    library, why = _load_library(str(files[0]), Path.cwd() / "team", sources.loader)
     if library is None:
-        return None, [f"{why}; the operator can plan for no problem"]
-    return library, []
+        return None, [*sources.notes, f"{why}; the operator can plan for no problem"]
+    return library, sources.notes
 
 
 class CommandLoop:
@@ -247,15 +253,31 @@ class CommandLoop:
 
 
 def start_live(
-    feed: TeamFeed, header: dict[str, Any], library: Any, host: str, port: int, token: str, out: TextIO
+    feed: TeamFeed,
+    header: dict[str, Any],
+    library: Any,
+    host: str,
+    port: int,
+    token: str,
+    out: TextIO,
+    skills: Sequence[str] = (),
 ) -> tuple[LiveHub, Any, CommandLoop]:
-    """Serve the live page for ``feed``'s team: the hub (fed from then on), the server, the loop of commands."""
+    """Serve the live page for ``feed``'s team: the hub (fed from then on), the server, the loop of commands.
+
+    Args:
+        skills: skill modules to load the plan trees with besides those the header records (``--skills``).
+    """
     from alica.app.center.operator import problems
+    from alica.app.center.plan_view import entry_states, trace_trees
     from alica.app.center.server import live_app, serve_in_thread
+    from alica.app.trace_sources import viewer_sources
 
     known = problems(library) if library is not None else {}
-    hub = LiveHub(header, TeamView(header))
-    server = serve_in_thread(live_app(hub, known, token), host, port, token, out)
+    hub = LiveHub(header, TeamView(header, entries=entry_states([library] if library is not None else [])))
+    sources = viewer_sources(header, skills)
+    trees = trace_trees(header, Path.cwd() / "team", sources.loader)  # the plan files as the agents named them
+    trees["notes"] = [*sources.notes, *trees["notes"]]
+    server = serve_in_thread(live_app(hub, known, token, trees), host, port, token, out)
     feed.attach(hub)
     loop = CommandLoop(hub, RemoteTeam(feed, known if library is not None else None)).start()
     return hub, server, loop
@@ -270,8 +292,12 @@ def serve_team(
     *,
     wait: float = JOIN_WAIT,
     out: TextIO = sys.stdout,
+    skills: Sequence[str] = (),
 ) -> None:
     """``alica center --team``: serve the live page of a running team of processes until Ctrl-C or SIGTERM.
+
+    Args:
+        skills: skill modules to load besides those the agents' header records (``--skills``).
 
     Raises:
         AlicaError: nothing listens at the endpoints, or no agent with the key prefix answered within ``wait`` s.
@@ -289,8 +315,8 @@ def serve_team(
             raise AlicaError(f"no agent of the team answered within {wait:g} s at {', '.join(feed.connect)}: {why}")
         assert feed.header is not None
         header = dict(feed.header)
-        library, notes = load_problems(header)
-        hub, server, loop = start_live(feed, header, library, host, port, token, out)
+        library, notes = load_problems(header, skills)
+        hub, server, loop = start_live(feed, header, library, host, port, token, out, skills)
         for note in notes:
             hub({"t": round(feed.now(), 6), "agent": "-", "event": "note", "message": note})
             print(f"alica center: {note}", file=sys.stderr, flush=True)

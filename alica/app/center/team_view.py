@@ -79,6 +79,9 @@ class TeamView:
         agents: the agents to show from the start (in this order), besides the header's; any
             other agent (not ``-``) is added when its first event comes.
         tracks: keep each robot's poses for ``snapshot(since=...)``.
+        entries: plan -> task -> the state its entry point starts in (from the plan files,
+            :func:`alica.app.center.plan_view.entry_states`): a plan node without a transition yet
+            is in the entry state of the agent's task there.
     """
 
     def __init__(
@@ -88,7 +91,9 @@ class TeamView:
         agents: Iterable[str] = (),
         *,
         tracks: bool = False,
+        entries: Mapping[str, Mapping[str, str]] | None = None,
     ) -> None:
+        self.entries = {plan: dict(tasks) for plan, tasks in (entries or {}).items()}
         self.roles = dict(header_roles(meta) if roles is None else roles)
         self.world = _world(meta)
         bounds = meta.get("bounds")
@@ -120,6 +125,7 @@ class TeamView:
         """An independent copy (the map, which is replaced and never changed, is shared)."""
         other = TeamView.__new__(TeamView)
         other.roles = self.roles
+        other.entries = self.entries  # never changed
         other.world = self.world
         other.bounds = self.bounds
         other.keep_tracks = self.keep_tracks
@@ -144,8 +150,9 @@ class TeamView:
         left out. Events of other kinds change nothing but the time.
 
         Traces do not record a plan's initial state: until its first transition a node's
-        state is ``None``, unless a node below it (``KEY/STATE/CHILD``) names it, which
-        :meth:`snapshot` fills in.
+        state is ``None``; :meth:`snapshot` fills it in from a node below it
+        (``KEY/STATE/CHILD`` names it), else from the entry point of the agent's task
+        (``entries``), else leaves it ``None``.
         """
         kind = event.get("event")
         t = event.get("t")
@@ -274,6 +281,8 @@ class TeamView:
                     below = next((n["key"] for n in plans if n["key"].startswith(node["key"] + "/")), None)
                     if below is not None:
                         node["state"] = below[len(node["key"]) + 1 :].split("/", 1)[0]
+                    elif node["task"] is not None:  # the entry state of the agent's task, from the plan file
+                        node["state"] = self.entries.get(str(node["plan"]), {}).get(str(node["task"]))
             deepest = plans[-1] if plans else _NO_NODE
             agents[name] = {
                 **who,

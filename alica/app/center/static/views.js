@@ -222,7 +222,7 @@
     if (mine && here.task) { out += ' <span class="task">task ' + esc(here.task) + "</span>"; }
     out += "<ul>";
     // Before the plan's first transition the trace does not say its state: the entry point of the agent's task does.
-    const entry = mine && !here.state ? (n.entry_points || []).find((e) => e.task === here.task) : null;
+    const entry = mine && !here.state ? ((n.entry_points || []).find((e) => e.name === here.task) || (n.entry_points || []).find((e) => e.task === here.task)) : null;
     const state = mine ? here.state || (entry ? entry.state : null) : null;
     for (const s of n.states) {
       const current = mine && state === s.name;
