@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from alica.app.demos.blocks_pictures import write_picture
 from alica.app.demos.common import StepCounter, plan_yaml_text, planning_leader
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
@@ -290,7 +291,7 @@ def run_demo(
         team.at(when, "demo action", functools.partial(action, team))
     wanted = set(goal_facts(goal))
     if out is not None:
-        _picture(world, out / "initial.png")
+        write_picture(world, out / "initial.png", goal=goal, title="initial: the start configuration")
     sample = None
     if sinks:
         sample = WorldTrace(
@@ -335,7 +336,7 @@ def run_demo(
         created = next(iter(latest_plans(e).values()), None) if (e := planning_leader(team)) is not None else None
         plan_yaml = plan_yaml_text(created, MISSION, out) if created is not None else ""
         if out is not None:
-            _picture(world, out / "final.png")
+            write_picture(world, out / "final.png", goal=goal, title=f"final: after {world.now():.1f} s simulated")
             if plan_yaml:
                 (out / "plan.yaml").write_text(plan_yaml, encoding="utf-8")
         return DemoResult(
@@ -359,10 +360,3 @@ def run_demo(
         if trace is not None:
             trace.close()
         world.close()
-
-
-def _picture(world: Any, path: Path) -> None:
-    from alica.worldsim.camera import snapshot
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    snapshot(world, path)
