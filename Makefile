@@ -30,10 +30,10 @@ $(STAMP): pyproject.toml
 # messages are lost; map, trace and plan in build/lunar), then the
 # blocks-world mission (planned at run time, real skills).
 demo: $(STAMP)
-	$(BIN)/alica validate plans/
-	$(BIN)/alica render plans/ --out build/plans
+	$(BIN)/alica validate alica:plans
+	$(BIN)/alica render alica:plans --out build/plans
 	$(BIN)/alica demo lunar --seed 1 --crash scout@20 --loss 0.1 --out build/lunar
-	$(BIN)/alica demo blocksworld --agents 3 --blocks 5 --seed 1 --out build/blocks
+	$(BIN)/alica demo blocksworld --robots 3 --blocks 5 --seed 1 --out build/blocks
 
 test: $(STAMP)
 	$(BIN)/python tools/quality.py

@@ -3,13 +3,12 @@
 from __future__ import annotations
 
 import re
-import shutil
 from pathlib import Path
 
 import pytest
 
 from alica.io import validate_paths
-from tests.conftest import PLANS, ROOT
+from tests.conftest import ROOT
 
 README = (ROOT / "README.md").read_text(encoding="utf-8")
 
@@ -23,10 +22,10 @@ def test_readme_starts_with_the_two_commands() -> None:
     assert first.splitlines()[0].startswith("make demo") and first.splitlines()[1].startswith("make test")
 
 
-def test_readme_plan_example_is_valid(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    shutil.copytree(PLANS, tmp_path / "plans")
-    monkeypatch.setenv("ALICA_PLAN_PATH", str(tmp_path / "plans"))  # the copy's '../' imports stay in plan folders
-    example = tmp_path / "plans" / "lunar" / "fetch_sample.yaml"
+def test_readme_plan_example_is_valid_in_an_empty_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delenv("ALICA_PLAN_PATH", raising=False)
+    monkeypatch.chdir(tmp_path)
+    example = tmp_path / "fetch_sample.yaml"  # it imports the shipped plans by name
     example.write_text(_blocks("yaml")[0], encoding="utf-8")
     problems = validate_paths([example])
     assert not problems, [p.format() for p in problems]
