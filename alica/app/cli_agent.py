@@ -38,6 +38,7 @@ import time
 from typing import Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
+from alica.app.options import add_time_limit, time_limit
 from alica.app.skill_options import add_skills_option
 from alica.app.timed import timed
 from alica.errors import AlicaError
@@ -57,7 +58,7 @@ def add_parser(sub: Any) -> None:
     p.add_argument("--role", help="this agent's role (default: from --agents, or the role called like the agent)")
     p.add_argument(
         "--agents",
-        metavar="NAME:ROLE,...",
+        metavar="NAME[:ROLE],...",
         help="the whole team, this agent included, as for alica run (default: this agent alone)",
     )
     p.add_argument("--root", metavar="PLAN", help="the root plan (default: the file's top-level plan)")
@@ -76,7 +77,9 @@ def add_parser(sub: Any) -> None:
         metavar="ENDPOINT",
         help="a zenoh endpoint to listen on, e.g. tcp/0.0.0.0:7447 (repeatable)",
     )
-    p.add_argument("--mode", choices=("peer", "client"), default="peer", help="zenoh mode (client: through a router)")
+    p.add_argument(
+        "--mode", choices=("peer", "client"), default="peer", help="zenoh mode (default peer; client: through a router)"
+    )
     p.add_argument(
         "--key-prefix",
         default="alica",
@@ -96,7 +99,7 @@ def add_parser(sub: Any) -> None:
         "--start-at",
         type=float,
         metavar="EPOCH",
-        help="the team's start, in seconds since the epoch, for the times of --fact and --max-time (default: now)",
+        help="the team's start, in seconds since the epoch, for the times of --fact and --time-limit (default: now)",
     )
     p.add_argument(
         "--fact",
@@ -105,8 +108,11 @@ def add_parser(sub: Any) -> None:
         metavar="LITERALS@T",
         help="the operator sets facts in this agent's world model T seconds after the start (repeatable)",
     )
-    p.add_argument(
-        "--max-time", type=float, metavar="S", help="stop S seconds after the start (default: run until stopped)"
+    add_time_limit(
+        p,
+        None,
+        "stop S wall seconds after the start (default: no limit, run until stopped)",
+        old=("--max-time",),
     )
     p.add_argument("--until-done", action="store_true", help="stop one second after the root plan succeeded or failed")
     p.add_argument(
@@ -166,6 +172,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
 
     if args.frequency <= 0:
         raise AlicaError(f"--frequency must be > 0, got {args.frequency}")
+    time_limit(args)
     registry = skill_registry(args)
     library, entry = _load(args.plan, Loader(skills=registry))
     plan = args.root
@@ -179,7 +186,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
         raise AlicaError(f"--name {args.name} is not in --agents ({', '.join(agents)}); the roster names every agent")
     if args.role is not None:
         agents[args.name] = args.role
-    roles = _roles(library, agents, args.roleset)
+    roles = _roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
     wiring = skill_wiring(registry, plan_skills(library, plan), world=False, stand_ins=args.stand_ins, plan=plan)
     settings = _zenoh_settings(args.zenoh)
@@ -314,7 +321,7 @@ def _run(
         began, began_cpu = time.monotonic(), sum(os.times()[:2])
         why = loop.run(
             until_done=args.until_done,
-            end_at=None if args.max_time is None else start + args.max_time,
+            end_at=None if args.time_limit is None else start + args.time_limit,
             before_tick=operator,
             after_tick=report,
         )

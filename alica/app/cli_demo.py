@@ -14,6 +14,15 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from alica.app.center.cli import add_live_options, live_session
+from alica.app.options import (
+    add_deprecated,
+    add_field_options,
+    add_time_limit,
+    count,
+    did_you_mean,
+    parse_roster,
+    time_limit,
+)
 from alica.app.timed import add_fault_options, add_network_options, partition, timed
 from alica.errors import AlicaError
 
@@ -31,10 +40,11 @@ def add_parser(sub: Any) -> None:
         "time from the simulated state, and opponent robots disturb the stacks. Exit 0 when the goal holds, 1 when the time "
         "limit passes first.",
     )
-    b.add_argument("--agents", type=_count(1), default=2, metavar="N", help="team robots r1..rN (default 2)")
-    b.add_argument("--opponents", type=_count(0), default=0, metavar="K", help="opponent robots o1..oK (default 0)")
+    b.add_argument("--robots", type=count(1), default=2, metavar="N", help="team robots r1..rN (default 2)")
+    add_deprecated(b, "--agents", "--robots", dest="robots", type=_old_robot_count, metavar="N")
+    b.add_argument("--opponents", type=count(0), default=0, metavar="K", help="opponent robots o1..oK (default 0)")
     b.add_argument(
-        "--blocks", type=_count(1), default=4, metavar="B", help="blocks of the random configurations (default 4)"
+        "--blocks", type=count(1), default=4, metavar="B", help="blocks of the random configurations (default 4)"
     )
     b.add_argument(
         "--seed", type=int, default=0, metavar="S", help="seeds the configurations, the world and the team (default 0)"
@@ -44,9 +54,7 @@ def add_parser(sub: Any) -> None:
         metavar="FILE",
         help="a YAML file with 'goal' (and optionally 'start') stacks, bottom first: goal: [[a, b], [c]]",
     )
-    b.add_argument(
-        "--time-limit", type=float, default=600.0, metavar="S", help="simulated seconds before giving up (default 600)"
-    )
+    add_time_limit(b, 600.0, "give up after S simulated seconds (default 600)")
     add_fault_options(
         b,
         crash="crash team robot NAME (r1..rN) at simulated second T: it stops, drops what it holds and goes silent "
@@ -76,17 +84,14 @@ def _add_lunar(demos: Any) -> None:
         "1 when the mission failed or the time limit passed first.",
     )
     lunar.add_argument(
-        "--robots",
+        "--agents",
         default="scout,stummel,amparo",
-        help="the team, from scout, stummel and amparo (default all three)",
+        metavar="NAME[:ROLE],...",
+        help="the team, from scout (Scout), stummel (Stummel) and amparo (Amparo); a role, if given, is the "
+        "robot's own (default scout,stummel,amparo)",
     )
-    lunar.add_argument(
-        "--samples", type=_count(1), default=6, metavar="N", help="drill samples on the field (default 6)"
-    )
-    lunar.add_argument("--rocks", type=_count(0), default=60, metavar="R", help="rocks on the field (default 60)")
-    lunar.add_argument(
-        "--size", type=float, default=40.0, metavar="M", help="side of the square field in metres (default 40)"
-    )
+    add_deprecated(lunar, "--robots", "--agents", dest="agents", metavar="NAMES")
+    add_field_options(lunar)
     choice = lunar.add_mutually_exclusive_group()
     choice.add_argument(
         "--goal", metavar="FORMULA", help="what to bring back, by the samples' names: 'at(green_white_red, g) and ...'"
@@ -96,7 +101,7 @@ def _add_lunar(demos: Any) -> None:
     )
     lunar.add_argument(
         "--pick",
-        type=_count(1),
+        type=count(1),
         default=2,
         metavar="K",
         help="without --goal or --collect: bring back the first K samples found (default 2)",
@@ -112,9 +117,7 @@ def _add_lunar(demos: Any) -> None:
         help="crash robot NAME at simulated second T, or NAME@grasp when it first lifts a sample it grasped (repeatable)",
     )
     add_network_options(lunar)
-    lunar.add_argument(
-        "--time-limit", type=float, default=900.0, metavar="S", help="simulated seconds before giving up (default 900)"
-    )
+    add_time_limit(lunar, 900.0, "give up after S simulated seconds (default 900)")
     lunar.add_argument("--out", metavar="DIR", help="write trace.jsonl, map.png and plan.yaml here")
     lunar.add_argument("--json", action="store_true", help="print the summary as JSON")
     lunar.add_argument("--gui", action="store_true", help="show the pybullet window")
@@ -142,7 +145,7 @@ def lunar_config(args: argparse.Namespace) -> Any:
         groups, start, end = partition(text)
         partitions.append(Partition(tuple(tuple(g) for g in groups), start, end))
     config = LunarConfig(
-        robots=tuple(r.strip() for r in args.robots.split(",") if r.strip()),
+        robots=_lunar_team(args.agents),
         samples=args.samples,
         rocks=args.rocks,
         size=args.size,
@@ -206,17 +209,41 @@ def cmd_lunar(args: argparse.Namespace) -> int:
     return 0 if result.success else 1
 
 
-def _count(least: int) -> Any:
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"'{text}' is not a whole number") from None
-        if value < least:
-            raise argparse.ArgumentTypeError(f"must be at least {least}, not {value}")
-        return value
+def _lunar_team(text: str) -> tuple[str, ...]:
+    """The robots of ``--agents`` for the lunar demo: a role, if given, must be the robot's own.
 
-    return parse
+    Raises:
+        AlicaError: not a roster, or a role that is not the robot's (with the closest role's name).
+    """
+    from alica.app.demos.lunar import ROLES
+
+    roster = parse_roster(text, "--agents")
+    for name, role in roster.items():
+        own = ROLES.get(name)
+        if role is None or own is None:  # an unknown robot: check_config names the robots there are
+            continue
+        if role != own:
+            given = "+" + "+".join(sorted(role)) if isinstance(role, frozenset) else role
+            roles = sorted(set(ROLES.values()))
+            hint = "" if given in roles else did_you_mean(given, roles)
+            raise AlicaError(
+                f"--agents: '{name}:{given}': in the lunar demo {name} has the role {own}{hint}; "
+                f"write {name} or {name}:{own}"
+            )
+    return tuple(roster)
+
+
+def _old_robot_count(text: str) -> int:
+    """``demo blocksworld --agents N``, the old spelling of ``--robots N``: a count, not a roster."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"'{text}' is not a count: the blocks demo names its robots r1..rN itself; give their number with --robots N"
+        ) from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, not {value}")
+    return value
 
 
 def read_goal_file(path: str) -> tuple[list[list[str]] | None, list[list[str]]]:
@@ -283,10 +310,9 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
     from alica.app.demos.blocksworld import DemoConfig, run_demo
 
     start, goal = read_goal_file(args.goal) if args.goal else (None, None)
-    if not args.time_limit > 0:
-        raise AlicaError(f"--time-limit must be a positive number of seconds, not {args.time_limit}")
+    time_limit(args)
     config = DemoConfig(
-        agents=args.agents,
+        agents=args.robots,
         opponents=args.opponents,
         blocks=args.blocks,
         seed=args.seed,
@@ -294,7 +320,7 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         goal=goal,
         time_limit=args.time_limit,
     )
-    actions = fault_actions(args.crash, args.recover, args.agents)
+    actions = fault_actions(args.crash, args.recover, args.robots)
     session = live_session(args)
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
     try:

@@ -27,6 +27,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from alica.app.options import add_deprecated
 from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError
 
@@ -81,15 +82,15 @@ def _goto_fault(text: str) -> tuple[str, int]:
 _WORLD_DEFAULTS: dict[str, Any] = {
     "uda_skill": "DetectCircles",
     "cell_size": 3.0,
-    "rocks": 4,
+    "grid_rocks": 4,
     "step_timeout": 120.0,
     "fail_goto": [],
 }
 
 
 def _problem_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--robots", type=_count, default=2, metavar="N", help="robots (default 2)")
-    p.add_argument("--grid", type=_grid, default=(5, 5), metavar="WxH", help="grid size (default 5x5)")
+    p.add_argument("--robots", type=_count, default=2, metavar="N", help="robots r1..rN (default 2)")
+    p.add_argument("--grid", type=_grid, default=(5, 5), metavar="WxH", help="grid size in cells (default 5x5)")
     p.add_argument("--goals", type=_count, default=3, metavar="K", help="goals at distinct random cells (default 3)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seeds the problem and the runs (default 0)")
 
@@ -146,7 +147,14 @@ def add_parser(sub: Any) -> None:
     w.add_argument(
         "--cell-size", type=_metres, default=None, metavar="M", help="side of a grid cell in metres (default 3)"
     )
-    w.add_argument("--rocks", type=_whole, default=None, metavar="N", help="rocks between the cells (default 4)")
+    w.add_argument(
+        "--grid-rocks",
+        type=_whole,
+        default=None,
+        metavar="N",
+        help="rocks on the field between the grid's cells (default 4); not the lunar field's --rocks of alica run",
+    )
+    add_deprecated(w, "--rocks", "--grid-rocks", dest="grid_rocks", type=_whole, metavar="N")
     w.add_argument(
         "--step-timeout",
         type=_seconds,
@@ -291,7 +299,7 @@ def _run_lunar(args: argparse.Namespace) -> int:
             layout=layout,
             uda=args.uda_skill,
             seed=args.seed + episode,
-            rocks=args.rocks,
+            rocks=args.grid_rocks,
             horizon=args.steps,
             step_timeout=args.step_timeout,
             faults=faults,

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import re
 import sys
 from typing import Any
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
+from alica.app.options import add_time_limit, did_you_mean, parse_roster, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
@@ -34,15 +34,16 @@ def add_parser(sub: Any) -> None:
         "are scripted stand-ins: they run for their duration parameter (Idle until its state is left when it is 0), "
         "others succeed after a while and write their post-condition. "
         "Exit 0 when the root plan succeeded (for every agent that has not crashed); 1 when it failed, when it did not "
-        "finish within the limit (--ticks N or --max-time S: both are limits), or on wrong input. "
+        "finish within the limit (--ticks N or --time-limit S: both are limits), or on wrong input. "
         "The summary gives each agent's last failure or allocation problem when the run does not succeed.",
     )
     p.add_argument("plan", metavar="PLAN", help="a plan file")
     p.add_argument(
         "--agents",
         required=True,
-        metavar="NAME:ROLE,...",
-        help="the team, e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; NAME:+cap1+cap2 derives the role from capabilities",
+        metavar="NAME[:ROLE],...",
+        help="the team (required), e.g. scout:Scout,stummel:Stummel; NAME alone takes the role of that name; "
+        "NAME:+cap1+cap2 derives the role from capabilities",
     )
     p.add_argument("--name", help="the root plan (default: the file's top-level plan)")
     p.add_argument("--roleset", help="the role set (default: the one holding the agents' roles)")
@@ -54,14 +55,13 @@ def add_parser(sub: Any) -> None:
     length.add_argument(
         "--until-done",
         action="store_true",
-        help="run until every agent's root plan ended, up to --max-time (the default)",
+        help="run until every agent's root plan ended, up to --time-limit (the default)",
     )
-    p.add_argument(
-        "--max-time",
-        type=float,
-        default=300.0,
-        metavar="S",
-        help="simulated seconds at most with --until-done (default 300)",
+    add_time_limit(
+        p,
+        300.0,
+        "give up after S simulated seconds with --until-done (default 300; wall seconds with --processes)",
+        old=("--max-time",),
     )
     p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
     add_network_options(p)
@@ -128,44 +128,46 @@ def add_parser(sub: Any) -> None:
 
 
 def _agents(text: str) -> dict[str, str | frozenset[str] | None]:
-    agents: dict[str, str | frozenset[str] | None] = {}
-    for part in (p.strip() for p in text.split(",")):
-        if not part:
-            continue
-        name, _, role = part.partition(":")
-        name, role = name.strip(), role.strip()
-        if not name or not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_\-]*", name):
-            raise AlicaError(f"--agents: '{part}' is not NAME or NAME:ROLE (names are letters, digits, '_' and '-')")
-        if name in agents:
-            raise AlicaError(f"--agents: agent '{name}' is given twice")
-        if role.startswith("+"):
-            caps = frozenset(c.strip() for c in role.split("+") if c.strip())
-            if not caps:
-                raise AlicaError(f"--agents: '{part}' names no capabilities; write NAME:+cap1+cap2")
-            agents[name] = caps
-        else:
-            agents[name] = role or None
-    if not agents:
-        raise AlicaError("--agents: give at least one agent, e.g. --agents scout:Scout")
-    return agents
+    """The roster of ``--agents NAME[:ROLE],...`` (:func:`alica.app.options.parse_roster`)."""
+    return parse_roster(text, "--agents")
 
 
-def _roles(library: Any, agents: dict[str, str | frozenset[str] | None], roleset: str | None) -> dict[str, Any]:
+def _roles(
+    library: Any,
+    agents: dict[str, str | frozenset[str] | None],
+    roleset: str | None,
+    options: dict[str, str] | None = None,
+) -> dict[str, Any]:
+    """Each agent's role (or capabilities); ``options`` names the option that gave an agent its role (``--agents``).
+
+    Raises:
+        AlicaError: a role no role set has (with the closest role's name), or no role set holding them all.
+    """
     from alica.allocation import AgentSpec
     from alica.engine import pick_roleset
 
+    sets = [library.rolesets[roleset]] if roleset in library.rolesets else list(library.rolesets.values())
+    known = sorted({r.name for rs in sets for r in rs.roles})
     names = {r.name.lower(): r.name for rs in library.rolesets.values() for r in rs.roles}
     out: dict[str, Any] = {}
     for name, role in agents.items():
+        option = (options or {}).get(name, "--agents")
         if isinstance(role, frozenset):
             out[name] = AgentSpec(capabilities=role)
             continue
         if role is None:
             if name.lower() not in names:
                 raise AlicaError(
-                    f"--agents: agent '{name}' has no role and no role is called like it; write {name}:ROLE (roles: {', '.join(sorted(set(names.values())))})"
+                    f"{option}: agent '{name}' has no role and no role is called like it{did_you_mean(name, known)}; "
+                    f"write {name}:ROLE (roles: {', '.join(known) or 'none'})"
                 )
             role = names[name.lower()]
+        elif role not in known:
+            where = f"role set '{roleset}' does not have" if roleset in library.rolesets else "no role set has"
+            raise AlicaError(
+                f"{option}: agent '{name}' has role '{role}', which {where}{did_you_mean(role, known)}; "
+                f"roles: {', '.join(known) or 'none'}"
+            )
         out[name] = role
     pick_roleset(library, [r for r in out.values() if isinstance(r, str)], roleset)
     return out
@@ -184,6 +186,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise AlicaError("--delay and --jitter must be >= 0 and --frequency > 0")
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
+    time_limit(args)
     session = live_session(args)
     if args.center and args.show_tree:
         raise AlicaError("--center shows the team in a web page; it does not go with --show-tree")
@@ -334,7 +337,7 @@ def _run_team(
         elif args.ticks is not None:
             team.run(ticks=args.ticks)
         else:
-            team.run(until_done=True, max_time=args.max_time)
+            team.run(until_done=True, max_time=args.time_limit)
     except KeyboardInterrupt:
         if session is None:
             raise
@@ -430,7 +433,7 @@ def _run_processes(
             if live is not None:
                 live.serve()
             team.launch()
-            team.run(faults, args.max_time, on_started=live.started if live is not None else _announce)
+            team.run(faults, args.time_limit, on_started=live.started if live is not None else _announce)
         except KeyboardInterrupt:
             interrupted = True
         except BaseException:
@@ -526,7 +529,7 @@ def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running
     while True:
         if args.ticks is not None and ticks >= args.ticks:
             break
-        if args.ticks is None and (team.done() or team.now() >= args.max_time):
+        if args.ticks is None and (team.done() or team.now() >= args.time_limit):
             break
         team.tick()
         ticks += 1
@@ -562,11 +565,27 @@ class _Reasons:
         if status == "success":
             return None
         last = self.last.get(name)
-        if status == "running":
-            waiting = _waiting(team.engines[name])
-            if waiting:
-                return f"{waiting}; last problem: {last}" if last else waiting
-        return last or ("not started" if status == "running" else None)
+        if status != "running":
+            return last
+        engine = team.engines[name]
+        says = "; ".join(f"{skill} says: {text}" for skill, text in _feedback(engine))
+        waiting = _waiting(engine)
+        parts = [p for p in (waiting, says, f"last problem: {last}" if waiting and last else last) if p]
+        return "; ".join(parts) or "not started"
+
+
+def _feedback(engine: Any) -> list[tuple[str, str]]:
+    """Each running behaviour of the agent's plan tree with its own word on its progress (``feedback_message``)."""
+    found: list[tuple[str, str]] = []
+    nodes = [engine.root] if engine.root is not None else []
+    while nodes:
+        node = nodes.pop(0)
+        for slot in node.slots:
+            if slot.feedback:
+                found.append((slot.name, slot.feedback))
+            if slot.node is not None:
+                nodes.append(slot.node)
+    return found
 
 
 def _waiting(engine: Any) -> str | None:
@@ -594,6 +613,30 @@ def _waiting(engine: Any) -> str | None:
     return f"{where}, waiting for one of: {'; '.join(conditions)}"
 
 
+#: What became of the copies a summary's ``messages`` counts, by key, in the words of the summary line.
+DROPPED = {
+    "dropped_loss": "dropped by loss",
+    "dropped_partition": "dropped by partitions",
+    "dropped_crash": "dropped at crashed receivers",
+    "dropped_closed": "dropped at closed receivers",
+    "dropped_lost": "lost for good (no longer in the sender's history)",
+    "dropped_undecodable": "not decodable",
+    "superseded": "replaced by a newer one before delivery",
+}
+
+
+def message_counts(messages: dict[str, int]) -> str:
+    """The summary's line on messages: publish calls, then what became of the copies per receiver.
+
+    Example: ``messages: 260 sent; copies to receivers: 256 delivered, 203 dropped by loss,
+    60 dropped at crashed receivers``.
+    """
+    fates = [f"{messages[key]} {words}" for key, words in DROPPED.items() if messages.get(key)]
+    return f"messages: {messages['sent']} sent; copies to receivers: {messages['delivered']} delivered, " + (
+        ", ".join(fates) if fates else "none dropped"
+    )
+
+
 def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
     failed = any(a["status"] == "failure" for a in summary["agents"].values())
     verdict = (
@@ -617,8 +660,7 @@ def _print_summary(summary: dict[str, Any], trace: str | None) -> None:
         print(f"real skills{where}: {', '.join(skills['real'])}")
     if skills.get("stand_ins"):
         print(f"scripted stand-ins (--stand-ins): {', '.join(skills['stand_ins'])}")
-    m = summary["messages"]
-    print(f"messages: {m['sent']} sent, {m['delivered']} delivered, {m['dropped']} dropped")
+    print(message_counts(summary["messages"]))
     if "world_models_agree" in summary:
         agree = "agree" if summary["world_models_agree"] else "DIFFER"
         print(f"world models of the running agents: {agree}")

@@ -10,6 +10,7 @@ import sys
 from collections.abc import Iterator
 from typing import Any
 
+from alica.app.options import add_time_limit, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option, lunar_field, skill_registry
 from alica.errors import AlicaError
 
@@ -26,7 +27,8 @@ def add_parser(sub: Any) -> None:
     r = skill_sub.add_parser(
         "run",
         help="run a skill until it ends",
-        description="Run a skill on one robot of a lunar or blocks world until it succeeds, fails or times out. Exit 0 on success, 1 otherwise.",
+        description="Run a skill on one robot of a lunar or blocks world until it succeeds, fails or reaches "
+        "--time-limit. Exit 0 on success, 1 otherwise.",
     )
     r.add_argument("name", metavar="NAME", help="the skill, e.g. MoveToPosition (alica list-skills lists them)")
     r.add_argument("--world", choices=("lunar", "blocks"), default="lunar", help="the scenario (default lunar)")
@@ -46,11 +48,11 @@ def add_parser(sub: Any) -> None:
         "(repeatable, in order): a pipeline step by step, e.g. --after DetectCircles --after CropCandidate "
         "for BlobDetect; the run stops at the first step that does not succeed",
     )
-    r.add_argument("--robot", help="the robot (default: the first one that has what the skills need)")
+    r.add_argument("--robot", metavar="NAME", help="the robot (default: the first one that has what the skills need)")
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
     add_lunar_options(r)
     r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
-    r.add_argument("--timeout", type=float, default=120.0, help="simulated seconds before giving up (default 120)")
+    add_time_limit(r, 120.0, "give up after S simulated seconds (default 120)", old=("--timeout",))
     r.add_argument("--json", action="store_true", help="print the result as JSON")
     add_skills_option(r)
     r.set_defaults(run=cmd_skill_run)
@@ -123,13 +125,13 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
         shared: dict[str, Any] = {"world_model": WorldModel(robot, clock=world.clock), "scratch": {}}
         for step in steps:
             run = run_skill(
-                step.name, world, robot, {}, timeout=args.timeout, seed=args.seed, registry=registry, **shared
+                step.name, world, robot, {}, timeout=args.time_limit, seed=args.seed, registry=registry, **shared
             )
             if not run.ok:
                 run.reason = f"step {step.name} before {args.name} did not succeed: {run.reason}"
                 return run
         return run_skill(
-            args.name, world, robot, params, timeout=args.timeout, seed=args.seed, registry=registry, **shared
+            args.name, world, robot, params, timeout=args.time_limit, seed=args.seed, registry=registry, **shared
         )
     finally:
         world.close()
@@ -140,6 +142,7 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
     from alica.skills.motion import configure_ompl
     from alica.skills.testing import run_skill
 
+    time_limit(args)
     registry = skill_registry(args)
     configure_ompl(args.seed)  # OMPL's generator is per process: seed it before any planner exists
     spec = registry.get(args.name)

@@ -12,7 +12,7 @@ Faults happen at wall seconds after the team's start: ``--crash NAME@T``
 is a ``kill -9`` of the agent's process, ``--recover NAME@T`` starts it
 again (a new incarnation with an empty memory, which catches up from its
 teammates). The run ends when every agent that has not crashed has
-finished its root plan, at ``--max-time``, or on Ctrl-C; then every
+finished its root plan, at ``--time-limit``, or on Ctrl-C; then every
 process gets SIGTERM, prints its summary and exits.
 """
 
@@ -338,7 +338,7 @@ class ProcessTeam:
     def summary(self, plan: str, seed: int) -> dict[str, Any]:
         """The run's summary, in the shape of the simulated run's (``SimulatedTeam.summary``)."""
         agents: dict[str, Any] = {}
-        sent = delivered = dropped = 0
+        sent = delivered = lost = undecodable = 0
         digests = {}
         for name, agent in self.agents.items():
             last = agent.summaries[-1] if agent.summaries else None
@@ -376,7 +376,8 @@ class ProcessTeam:
                 counters = summary.get("transport", {})
                 sent += int(counters.get("sent", 0))
                 delivered += int(counters.get("delivered", 0))
-                dropped += int(counters.get("lost", 0)) + int(counters.get("undecodable", 0))
+                lost += int(counters.get("lost", 0))
+                undecodable += int(counters.get("undecodable", 0))
             if status not in ("crashed", "exited"):
                 digests[name] = last.get("world_digest")
         statuses = [a["status"] for a in agents.values() if a["status"] not in ("crashed", "exited")]
@@ -390,7 +391,14 @@ class ProcessTeam:
             "done": bool(statuses) and all(s in ("success", "failure") for s in statuses),
             "success": bool(statuses) and all(s == "success" for s in statuses),
             "agents": agents,
-            "messages": {"sent": sent, "delivered": delivered, "dropped": dropped},
+            # publish calls, then copies per receiver; zenoh counts no loss of its own (it retransmits):
+            # a copy is lost for good when its sender no longer had it, or arrives and cannot be decoded
+            "messages": {
+                "sent": sent,
+                "delivered": delivered,
+                "dropped_lost": lost,
+                "dropped_undecodable": undecodable,
+            },
             "world_models_agree": len(set(digests.values())) <= 1,
             "faults": [describe_fault(f) for f in self.faults if f["fault"] != "heal"],
         }

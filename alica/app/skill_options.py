@@ -7,6 +7,8 @@ import os
 import sys
 from typing import TYPE_CHECKING, Any
 
+from alica.app.options import add_field_options
+
 if TYPE_CHECKING:
     from alica.lang.skills import SkillRegistry
 
@@ -27,12 +29,8 @@ def add_skills_option(parser: Any) -> None:
 
 
 def add_lunar_options(parser: Any) -> None:
-    """Add ``--rocks``, ``--samples`` and ``--size``: the lunar field of ``--world lunar``."""
-    parser.add_argument("--rocks", type=int, default=60, help="rocks on the lunar field (default 60)")
-    parser.add_argument("--samples", type=int, default=2, help="drill samples on the lunar field (default 2)")
-    parser.add_argument(
-        "--size", type=float, default=40.0, help="side of the square lunar field in metres (default 40)"
-    )
+    """Add ``--size``, ``--rocks`` and ``--samples``: the lunar field of ``--world lunar`` (shared defaults)."""
+    add_field_options(parser)
 
 
 def lunar_field(args: argparse.Namespace) -> Any:

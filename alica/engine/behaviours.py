@@ -199,6 +199,17 @@ class BehaviourRunner:
             self.reason = bt.feedback_message or f"skill '{model.skill}' failed"
         return self.status
 
+    @property
+    def feedback(self) -> str:
+        """What the running skill says of its progress (its py_trees ``feedback_message``, e.g. ``0.00 m to go``).
+
+        Empty when the skill has not started, has ended, or says nothing.
+        """
+        bt = self.bt
+        if bt is None or self.status is not ChildStatus.RUNNING:
+            return ""
+        return str(bt.feedback_message or "")
+
     def _start(self) -> bool:
         try:
             bt = self.factory(self.model.name, self.params, self.context)

@@ -415,7 +415,13 @@ class SimulatedTeam:
         return root_status(self.engines[name])
 
     def summary(self) -> dict[str, Any]:
-        """What happened: per agent and for the team, as plain data."""
+        """What happened: per agent and for the team, as plain data.
+
+        ``messages`` counts publish calls (``sent``), then copies per receiver (one publish to four
+        teammates makes four copies): ``delivered``, ``dropped_loss`` (lost on a lossy link),
+        ``dropped_partition``, ``dropped_crash`` (the receiver was crashed), ``dropped_closed`` and
+        ``superseded`` (a best-effort copy replaced by a newer one), as :class:`~alica.comm.NetStats`.
+        """
         agents = {name: describe_agent(engine, self.status_of(name)) for name, engine in self.engines.items()}
         stats = self.network.stats
         statuses = [a["status"] for a in agents.values() if a["status"] != "crashed"]
@@ -427,10 +433,14 @@ class SimulatedTeam:
             "done": self.done(),
             "success": bool(statuses) and all(s == "success" for s in statuses),
             "agents": agents,
-            "messages": {
+            "messages": {  # publish calls; then copies per receiver, by what became of them (NetStats)
                 "sent": stats.sent,
                 "delivered": stats.delivered,
-                "dropped": stats.dropped_loss + stats.dropped_partition + stats.dropped_crash,
+                "dropped_loss": stats.dropped_loss,
+                "dropped_partition": stats.dropped_partition,
+                "dropped_crash": stats.dropped_crash,
+                "dropped_closed": stats.dropped_closed,
+                "superseded": stats.superseded,
             },
             "faults": [describe_fault(f) for f in self.faults],
         }

@@ -17,7 +17,9 @@ def running_tree(engine: AgentEngine) -> str:
         scout [Scout]
         └─ LunarMission  task Explore  state Exploring  running
            └─ Explore  task GetMap  state Mapping  running
-              └─ BuildFirstMap  running
+              └─ BuildFirstMap  running  says: driving to (4.0, 2.5)
+
+    A running behaviour's own word on its progress (its ``feedback_message``) follows ``says:``.
     """
     lines = [f"{engine.name} [{engine.role}]" + ("  (not started)" if engine.root is None else "")]
     if engine.root is not None:
@@ -40,4 +42,5 @@ def _node(node: PlanNode, prefix: str, last: bool, lines: list[str]) -> None:
             _node(slot.node, child_prefix, final, lines)
         else:
             reason = f"  ({slot.reason})" if slot.reason else ""
-            lines.append(f"{child_prefix}{'└─ ' if final else '├─ '}{slot.name}  {slot.status.value}{reason}")
+            feedback = f"  says: {slot.feedback}" if slot.feedback else ""
+            lines.append(f"{child_prefix}{'└─ ' if final else '├─ '}{slot.name}  {slot.status.value}{reason}{feedback}")

@@ -187,6 +187,11 @@ class Slot:
         return self.parent.engine.allocator.members(self.parent)
 
     @property
+    def feedback(self) -> str:
+        """A running behaviour child's own word on its progress (:attr:`BehaviourRunner.feedback`); else empty."""
+        return self.runner.feedback if self.runner is not None else ""
+
+    @property
     def is_behaviour(self) -> bool:
         """Whether the child is a behaviour (else a plan, plan type or planning problem)."""
         return isinstance(self.element, Behaviour)

@@ -1,6 +1,6 @@
 """A team of processes over zenoh: ``alica run --processes`` end to end, with kill -9, restart and a partition.
 
-Every run is bounded by ``--max-time`` (wall seconds) and talks on loopback
+Every run is bounded by ``--time-limit`` (wall seconds) and talks on loopback
 only; the partition cuts the relays between the agents' links, never the
 host's network. The 3-agent lunar mission with stand-ins takes about 15 s.
 """
@@ -26,7 +26,7 @@ TICK = 1 / 30
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, dict]:
-    code = main(["run", LUNAR, *TEAM, "--processes", "--max-time", "60", "--json", *argv])
+    code = main(["run", LUNAR, *TEAM, "--processes", "--time-limit", "60", "--json", *argv])
     return code, json.loads(capsys.readouterr().out)
 
 
@@ -51,7 +51,9 @@ def test_a_lunar_team_of_processes_succeeds(capsys, tmp_path):
         ("scout", "stummel", "amparo"), "success"
     )
     assert summary["world_models_agree"]
-    assert summary["messages"]["delivered"] > 0 and summary["messages"]["dropped"] == 0
+    messages = summary["messages"]
+    assert set(messages) == {"sent", "delivered", "dropped_lost", "dropped_undecodable"}  # copies per receiver
+    assert messages["delivered"] > 0 and messages["dropped_lost"] == messages["dropped_undecodable"] == 0
     trace = events(tmp_path / "run.jsonl")
     assert {e["agent"] for e in trace} >= {"scout", "stummel", "amparo"}
     assert [e["t"] for e in trace] == sorted(e["t"] for e in trace)
@@ -83,7 +85,10 @@ def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
     trace_file = tmp_path / "run.jsonl"
     code, summary = run(capsys, "--partition", "scout|stummel,amparo@4-8", "--trace", str(trace_file))
     assert code == 0, summary
-    assert summary["world_models_agree"] and summary["messages"]["dropped"] == 0
+    assert (
+        summary["world_models_agree"]
+        and summary["messages"]["dropped_lost"] == summary["messages"]["dropped_undecodable"] == 0
+    )
     trace = events(trace_file)
     assert set(team_changes(trace, "lost", "scout")) == {"stummel", "amparo"}
     assert set(team_changes(trace, "lost", "stummel")) == {"scout"}
@@ -94,7 +99,7 @@ def test_a_partition_heals_with_world_models_converged(capsys, tmp_path):
 
 
 def test_ctrl_c_stops_every_agent_process(tmp_path):
-    argv = [sys.executable, "-m", "alica.app.cli", "run", LUNAR, *TEAM, "--processes", "--max-time", "60", "--json"]
+    argv = [sys.executable, "-m", "alica.app.cli", "run", LUNAR, *TEAM, "--processes", "--time-limit", "60", "--json"]
     process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=tmp_path)
     assert process.stderr is not None
     started = process.stderr.readline()  # the run says when every agent process is up
@@ -140,7 +145,7 @@ def test_writes_on_both_sides_of_a_partition_reach_everyone_once_it_heals(tmp_pa
         LUNAR,
         "scout,stummel,amparo",
         ["scout", "stummel", "amparo"],
-        ["--stand-ins", "--max-time", "40"],
+        ["--stand-ins", "--time-limit", "40"],
         tmp_path,
         relays=True,
         own={"scout": ["--fact", "found(a)@5"], "amparo": ["--fact", "found(b)@6"]},  # one robot's operator each
@@ -165,10 +170,12 @@ def test_a_planning_team_of_processes_plans_with_magic_across_them(capsys, tmp_p
     )
     trace_file = tmp_path / "run.jsonl"
     argv = ["run", blocks, "--agents", "r1:Manipulator,r2:Manipulator,r3:Manipulator", "--stand-ins", "--fact", facts]
-    code = main([*argv, "--parallel-planning", "--processes", "--max-time", "60", "--json", "--trace", str(trace_file)])
+    code = main(
+        [*argv, "--parallel-planning", "--processes", "--time-limit", "60", "--json", "--trace", str(trace_file)]
+    )
     summary = json.loads(capsys.readouterr().out)
     assert code == 0, summary
-    assert summary["messages"]["dropped"] == 0
+    assert summary["messages"]["dropped_lost"] == summary["messages"]["dropped_undecodable"] == 0
     trace = events(trace_file)
     [start] = [e for e in trace if e["event"] == "planner" and e["what"] == "magic"][:1]
     assert start["agents"] == ["r1", "r2", "r3"]
@@ -180,7 +187,7 @@ def test_alica_agent_writes_a_header_naming_itself(capsys, tmp_path):
     from alica.engine import read_trace
 
     path = tmp_path / "scout.jsonl"
-    argv = ["--name", "scout", "--agents", "scout", "--max-time", "0.3", "--listen", "tcp/127.0.0.1:0"]
+    argv = ["--name", "scout", "--agents", "scout", "--time-limit", "0.3", "--listen", "tcp/127.0.0.1:0"]
     main(["agent", LUNAR, "--stand-ins", *argv, "--key-prefix", "trace-header-test", "--trace", str(path)])
     capsys.readouterr()
     trace = read_trace(path)

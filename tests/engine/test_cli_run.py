@@ -22,7 +22,7 @@ def test_run_until_done_prints_a_summary(capsys):
             "scout,stummel,amparo",
             "--fact",
             "found(a) and found(b)@3",
-            "--max-time",
+            "--time-limit",
             "120",
         ]
     )
@@ -96,7 +96,10 @@ def test_partition_option(capsys):
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--agents", "scout:Pilot"], "no role set has the roles ['Pilot']"),
+        (
+            ["--agents", "scout:Pilot"],
+            "agent 'scout' has role 'Pilot', which no role set has; roles: Amparo, Scout, Stummel",
+        ),
         (["--agents", "robot1"], "agent 'robot1' has no role"),
         (["--agents", "a:Scout,a:Scout"], "given twice"),
         (["--agents", "scout", "--crash", "nobody@2"], "no agent named 'nobody'"),
@@ -178,12 +181,12 @@ def playground(tmp_path):
         ("Doomed", ["--ticks", "30"], 1),
         ("Doomed", ["--until-done"], 1),
         ("Endless", ["--ticks", "30"], 1),
-        ("Endless", ["--until-done", "--max-time", "2"], 1),
-        ("Endless", ["--max-time", "2"], 1),
+        ("Endless", ["--until-done", "--time-limit", "2"], 1),
+        ("Endless", ["--time-limit", "2"], 1),
     ],
 )
 def test_one_exit_code_rule_for_both_limits(playground, capsys, plan, limit, code):
-    """0 when the root plan succeeded; 1 when it failed or did not finish within --ticks or --max-time."""
+    """0 when the root plan succeeded; 1 when it failed or did not finish within --ticks or --time-limit."""
     assert main(["run", playground, "--name", plan, "--agents", "w:Worker", *limit]) == code
     out = capsys.readouterr().out
     verdict = {"Quick": "success", "Doomed": "failed", "Endless": "not finished"}[plan]
@@ -199,7 +202,7 @@ def test_one_exit_code_rule_for_both_limits(playground, capsys, plan, limit, cod
     ],
 )
 def test_summary_says_why_a_run_did_not_succeed(playground, capsys, plan, reason):
-    argv = ["run", playground, "--name", plan, "--agents", "w:Worker", "--max-time", "2"]
+    argv = ["run", playground, "--name", plan, "--agents", "w:Worker", "--time-limit", "2"]
     assert main(argv) == 1
     assert f"why w: {reason}" in capsys.readouterr().out
     assert main([*argv, "--json"]) == 1
@@ -214,7 +217,7 @@ def test_no_reason_on_success(playground, capsys):
 
 
 def test_crashed_agent_and_fault_times_print_as_given(capsys):
-    argv = ["run", LUNAR, "--stand-ins", "--agents", "scout,stummel,amparo", "--max-time", "3", "--crash", "scout@2"]
+    argv = ["run", LUNAR, "--stand-ins", "--agents", "scout,stummel,amparo", "--time-limit", "3", "--crash", "scout@2"]
     assert main([*argv, "--partition", "scout|stummel,amparo@1-2.5", "--recover", "scout@2.5"]) == 1
     out = capsys.readouterr().out
     assert "faults: partition scout|amparo,stummel@1-2.5; crash scout@2; recover scout@2.5" in out

@@ -168,7 +168,7 @@ def check_config(config: LunarConfig) -> None:
     unknown = [r for r in config.robots if r not in ROLES]
     if unknown or not config.robots or len(set(config.robots)) != len(config.robots):
         raise AlicaError(
-            f"--robots: {', '.join(config.robots) or 'none'}: name each of {', '.join(ROLES)} at most once"
+            f"--agents: {', '.join(config.robots) or 'none'}: name each of {', '.join(ROLES)} at most once"
         )
     if config.samples < 1 or config.rocks < 0:
         raise AlicaError(f"--samples must be >= 1 and --rocks >= 0, got {config.samples} and {config.rocks}")

@@ -163,12 +163,12 @@ def test_bad_world_input_gets_a_clear_error(capsys):
         (["--robots", "7"], "7 robots do not fit around a cell of 3 m"),
         (["--cell-size", "1"], "a cell of 1 m is too small"),
         (["--fail-goto", "r9@1"], "--fail-goto r9@1: no robot named r9"),
-        (["--rocks", "300"], "could only place"),
+        (["--grid-rocks", "300"], "could only place"),
     ]
     for extra, message in cases:
         assert main([*lunar, *extra]) == 1, extra
         assert message in capsys.readouterr().err, extra
     assert main([*lunar, "--fail-goto", "r1"]) == 2
     assert "ROBOT@STEP" in capsys.readouterr().err
-    assert main(["protap", "run", "--uda-skill", "DetectCircles", "--rocks", "2"]) == 1
-    assert "--uda-skill, --rocks: only with --world lunar" in capsys.readouterr().err
+    assert main(["protap", "run", "--uda-skill", "DetectCircles", "--grid-rocks", "2"]) == 1
+    assert "--uda-skill, --grid-rocks: only with --world lunar" in capsys.readouterr().err
