@@ -7,6 +7,7 @@ import pytest
 from alica.app.cli import main
 from alica.app.demos.lunar import Crash, LunarConfig, Operator, goal_samples, kind_name, parse_crash
 from alica.errors import AlicaError
+from alica.io import validate_paths
 
 
 class _WM:
@@ -131,3 +132,8 @@ def test_the_mission_brings_the_chosen_samples_to_g_on_a_small_field(tmp_path):
     assert carried <= {"amparo", "stummel"} and carried
     assert {p.name for p in tmp_path.iterdir()} >= {"trace.jsonl", "map.png", "plan.yaml", "plans"}
     assert len(list((tmp_path / "plans").glob("GetObjects_g*.yaml"))) == result["plans"]
+    # the generated plans import the mission by name: valid wherever the folder is moved
+    for written in [tmp_path / "plan.yaml", *(tmp_path / "plans").glob("*.yaml")]:
+        text = written.read_text(encoding="utf-8")
+        assert "alica:plans/lunar/" in text and "../" not in text, written
+        assert validate_paths([written]) == [], written
