@@ -47,21 +47,31 @@
     $("status").dataset.running = s.running ? "yes" : "no";
   }
 
+  // The log's rows, newest first: each event as a line of text (V.eventText); pose events only with "raw".
+  function logRow(e, raw, filter) {
+    const tr = V.logRow(e, raw);
+    tr.dataset.line = (e.event + " " + tr.textContent).toLowerCase();
+    if (filter && !tr.dataset.line.includes(filter)) { tr.hidden = true; }
+    return tr;
+  }
+
   function showLog(fresh) {
-    const filter = $("filter").value.trim().toLowerCase();
+    const filter = $("filter").value.trim().toLowerCase(), raw = $("raw").checked;
     const body = $("log-body");
     for (const e of fresh) {
-      const rest = {};
-      for (const k of Object.keys(e)) { if (k !== "t" && k !== "agent" && k !== "event") { rest[k] = e[k]; } }
-      const fields = JSON.stringify(rest);
-      const line = (e.event + " " + e.agent + " " + fields).toLowerCase();
-      const tr = el("tr", { "data-kind": e.event });
-      tr.dataset.line = line;
-      if (filter && !line.includes(filter)) { tr.hidden = true; }
-      for (const v of [Number(e.t).toFixed(3), e.agent, e.event, fields]) { tr.appendChild(el("td", {}, String(v))); }
-      body.prepend(tr);
+      if (V.logged(e, raw)) { body.prepend(logRow(e, raw, filter)); }
     }
     while (body.children.length > MAX_LOG) { body.removeChild(body.lastChild); }
+  }
+
+  // The raw toggle changed: the latest MAX_LOG rows again from the events kept.
+  function relog() {
+    const filter = $("filter").value.trim().toLowerCase(), raw = $("raw").checked;
+    const rows = [];
+    for (let i = events.length - 1; i >= 0 && rows.length < MAX_LOG; i--) {
+      if (V.logged(events[i], raw)) { rows.push(logRow(events[i], raw, filter)); }
+    }
+    $("log-body").replaceChildren(...rows);
   }
 
   function refilter() {
@@ -287,6 +297,7 @@
     $("set-goal").addEventListener("click", setGoal);
     $("set-facts").addEventListener("click", setFacts);
     $("filter").addEventListener("input", refilter);
+    $("raw").addEventListener("change", relog);
     connect();
   }
 

@@ -41,7 +41,7 @@
     V.operator($("operator-body"), state);
   }
 
-  function showLog(t) { V.log($("log-body"), events, $("filter").value, t); }
+  function showLog(t) { V.log($("log-body"), events, $("filter").value, t, $("raw").checked); }
 
   async function jump(kind) {
     const answer = await get("api/next?kind=" + kind + "&after=" + now());
@@ -86,6 +86,7 @@
     slider.min = meta.start; slider.max = meta.end; slider.value = meta.start;
     slider.addEventListener("input", () => showState());
     $("filter").addEventListener("input", () => showLog(now()));
+    $("raw").addEventListener("change", () => showLog(now()));
     $("play").addEventListener("click", () => { if (now() >= meta.end) { slider.value = meta.start; } setPlaying(!playing); });
     $("next-fault").addEventListener("click", () => jump("fault"));
     $("next-replan").addEventListener("click", () => jump("replan"));

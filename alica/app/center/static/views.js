@@ -5,7 +5,11 @@
 //   map(box, snapshot, tracks, meta)    top view: occupancy cells, objects, samples, robots and their tracks
 //   blocks(box, snapshot, meta)         side view of the blocks world's blocks (x across, z up)
 //   trees(box, snapshot, trees)         each agent's plan tree (GET /api/trees), its plans and states highlighted
-//   log(tbody, events, filter, t)       the events up to t (all without t), newest first, filtered by text
+//   log(tbody, events, filter, t, raw)  the events up to t (all without t), newest first, filtered by text; each a
+//                                       line of text (eventText); pose rows and map payloads only with raw
+//   eventText(event, raw)               one event as one line: "12.30 s  scout  transition Explore -> Return"
+//   placeLabels(items)                  label boxes that do not overlap (the map's greedy label placement)
+//   scaleLength(width)                  a round length in metres for a scale bar on a field this wide
 "use strict";
 (function () {
   const COLOURS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];
@@ -23,6 +27,18 @@
     return td;
   }
 
+  // A cell whose text may wrap inside names too: after _ / - . and between a lower-case letter and a capital
+  // (GetObjects_g1v1_amparo, DriveToObject), so that the agents table narrows without clipping.
+  function wrapCell(text) {
+    const td = document.createElement("td");
+    const parts = (text == null ? "-" : String(text)).split(/(?<=[_/.-])|(?<=[a-z])(?=[A-Z])/);
+    parts.forEach((part, i) => {
+      if (i > 0) { td.appendChild(document.createElement("wbr")); }
+      td.appendChild(document.createTextNode(part));
+    });
+    return td;
+  }
+
   function colour(names, name) { return COLOURS[Math.max(names.indexOf(name), 0) % COLOURS.length]; }
 
   function agents(tbody, snapshot) {
@@ -31,7 +47,7 @@
       const tr = document.createElement("tr");
       tr.dataset.agent = name;
       if (!a.alive) { tr.className = "dead"; }
-      for (const v of [name, a.role, a.task, a.alive ? "yes" : "no", a.plan, a.state, a.behaviour]) { tr.appendChild(cell(v)); }
+      for (const v of [name, a.role, a.task, a.alive ? "yes" : "no", a.plan, a.state, a.behaviour]) { tr.appendChild(wrapCell(v)); }
       tr.children[4].title = (a.plans || []).map((p) => p.plan + (p.state ? ": " + p.state : "")).join(" \u203a ");
       tbody.appendChild(tr);
     }
@@ -97,6 +113,7 @@
     let svg = '<svg xmlns="' + SVG + '" class="map" viewBox="' + num(x0) + " " + num(-y1) + " " + num(w) + " " + num(h) + '" preserveAspectRatio="xMidYMid meet">';
     svg += '<rect class="field" x="' + num(x0) + '" y="' + num(-y1) + '" width="' + num(w) + '" height="' + num(h) + '"/>';
     if (snapshot.map) { svg += gridCells(snapshot.map); }
+    svg += '<g class="leaders"></g>';
     const font = num(unit / 40);
     for (const [name, o] of Object.entries(snapshot.objects || {})) {
       if (typeof o.x !== "number" || typeof o.y !== "number") { continue; }
@@ -105,7 +122,7 @@
       const label = o.found !== undefined ? name + ": " + (o.found || "?") : (kind === "rock" ? "" : name);
       svg += '<g class="object ' + esc(kind) + (o.found !== undefined ? " found" : "") + '" data-name="' + esc(name) + '">';
       svg += '<circle cx="' + num(o.x) + '" cy="' + num(-o.y) + '" r="' + num(r) + '"/>';
-      if (label) { svg += '<text x="' + num(o.x + r) + '" y="' + num(-o.y - r) + '" font-size="' + font + '">' + esc(label) + "</text>"; }
+      if (label) { svg += labelText("object-name", o.x, o.y, r, o.found !== undefined ? 1 : 2, font, label); }
       svg += "</g>";
     }
     for (const [agent, list] of Object.entries(tracksNow || {})) {
@@ -123,9 +140,108 @@
         svg += '<line class="heading" x1="' + num(p.x) + '" y1="' + num(-p.y) + '" x2="' + num(p.x + 2 * r * Math.cos(p.yaw)) + '" y2="' + num(-p.y - 2 * r * Math.sin(p.yaw)) +
           '" stroke="' + c + '" stroke-width="' + num(unit / 200) + '"/>';
       }
-      svg += '<text class="robot-name" x="' + num(p.x) + '" y="' + num(-p.y - 1.5 * r) + '" font-size="' + num(unit / 25) + '">' + esc(agent) + "</text>";
+      svg += labelText("robot-name", p.x, p.y, r, 0, num(unit / 25), agent);
     }
+    svg += scaleBar(x0, y0, w, h);
     box.innerHTML = svg + "</svg>";
+    arrange(box.querySelector("svg.map"), unit, { x: x0, y: -y1, w, h });
+  }
+
+  // A label's text at its anchor (the point it names, a disc of radius r there); arrange() moves it.
+  // Priority: 0 robots, 1 found samples, 2 other objects (placed in that order).
+  function labelText(cls, x, y, r, priority, font, text) {
+    return '<text class="label ' + cls + '" x="' + num(x) + '" y="' + num(-y) + '" data-ax="' + num(x) + '" data-ay="' + num(-y) + '" data-r="' + num(r) +
+      '" data-priority="' + priority + '" font-size="' + font + '">' + esc(text) + "</text>";
+  }
+
+  // A round length for a scale bar on a field `width` metres wide: 1, 2 or 5 times a power of ten, near a fifth of it.
+  function scaleLength(width) {
+    const target = width / 5;
+    if (!(target > 0)) { return 1; }
+    const power = Math.pow(10, Math.floor(Math.log10(target)));
+    return [5, 2, 1].map((m) => m * power).find((v) => v <= target) || power;
+  }
+
+  // The scale bar in the field's lower left corner (SVG units are metres, y downwards).
+  function scaleBar(x0, y0, w, h) {
+    const length = scaleLength(w), unit = Math.max(w, h);
+    const left = x0 + w * 0.04, base = -y0 - h * 0.04, tick = unit / 80, stroke = unit / 300, font = unit / 35;
+    const text = String(Number(length.toPrecision(3))) + " m";
+    return '<g class="scale-bar" data-metres="' + length + '">' +
+      '<rect x="' + num(left - tick) + '" y="' + num(base - tick - 1.6 * font) + '" width="' + num(length + 2 * tick) + '" height="' + num(2 * tick + 1.6 * font) +
+      '" fill="#fff" fill-opacity="0.75"/>' +
+      '<path class="bar" d="M' + num(left) + "," + num(base - tick) + " V" + num(base) + " H" + num(left + length) + " V" + num(base - tick) +
+      '" fill="none" stroke="#222" stroke-width="' + num(stroke) + '"/>' +
+      '<text x="' + num(left + length / 2) + '" y="' + num(base - tick - 0.3 * font) + '" font-size="' + num(font) + '" text-anchor="middle">' + text + "</text></g>";
+  }
+
+  // Label placement, greedy: each label (in the order given) takes the first of its candidate positions, nearest
+  // to its anchor first, whose box overlaps no box placed before it and no anchor disc; when every candidate
+  // overlaps, the one that overlaps least. items: [{ax, ay, r, w, h}] (SVG units, y downwards); the anchor discs of
+  // the other labels are kept clear too, and so is the outside of `field` ({x, y, w, h}) when given. Returns
+  // [{x, y, w, h, moved}]: each box's top left corner, and whether it is off its first place (then the map draws
+  // a leader line to the anchor).
+  function placeLabels(items, field) {
+    const placed = [];
+    const discs = items.map((it) => ({ x: it.ax - it.r, y: it.ay - it.r, w: 2 * it.r, h: 2 * it.r }));
+    const DIRS = [[1, -1], [1, 0], [1, 1], [0, -1], [0, 1], [-1, -1], [-1, 0], [-1, 1]];
+    const overlap = (a, b) => Math.max(0, Math.min(a.x + a.w, b.x + b.w) - Math.max(a.x, b.x)) * Math.max(0, Math.min(a.y + a.h, b.y + b.h) - Math.max(a.y, b.y));
+    const out = [];
+    items.forEach((it, index) => {
+      const gap = Math.max(it.h * 0.15, it.r * 0.3);
+      let best = null, bestCost = Infinity;
+      search:
+      for (const level of [1, 2, 3, 4.5, 6.5, 9]) {
+        const d = it.r + gap * level + (level > 1 ? it.h * (level - 1) * 0.5 : 0);
+        for (const [dx, dy] of DIRS) {
+          const box = {
+            x: it.ax + dx * d * (dy === 0 ? 1 : 0.7) - (dx < 0 ? it.w : dx === 0 ? it.w / 2 : 0),
+            y: it.ay + dy * d * (dx === 0 ? 1 : 0.7) - (dy < 0 ? it.h : dy === 0 ? it.h / 2 : 0),
+            w: it.w, h: it.h, moved: level > 1,
+          };
+          let cost = 0;
+          for (const other of placed) { cost += overlap(box, other); }
+          discs.forEach((disc, k) => { if (k !== index) { cost += overlap(box, disc); } });
+          if (field) { cost += box.w * box.h - overlap(box, field); }
+          if (cost < bestCost) { best = box; bestCost = cost; }
+          if (cost <= 1e-9) { break search; }
+        }
+      }
+      placed.push(best);
+      out.push(best);
+    });
+    return out;
+  }
+
+  // Moves the map's labels (text.label, drawn at their anchors) apart with placeLabels; a moved label gets a leader line.
+  function arrange(svg, unit, field) {
+    if (!svg) { return; }
+    const texts = [...svg.querySelectorAll("text.label")];
+    texts.sort((a, b) => Number(a.dataset.priority) - Number(b.dataset.priority));
+    const items = texts.map((t) => {
+      const ax = Number(t.dataset.ax), ay = Number(t.dataset.ay), r = Number(t.dataset.r);
+      let bbox = null;
+      try { bbox = t.getBBox(); } catch (err) { bbox = null; }
+      const font = Number(t.getAttribute("font-size"));
+      const w = bbox && bbox.width > 0 ? bbox.width : 0.6 * font * t.textContent.length;
+      const h = bbox && bbox.height > 0 ? bbox.height : 1.2 * font;
+      const dy = bbox && bbox.height > 0 ? bbox.y - ay : -0.95 * font;  // the box's top above the baseline
+      return { ax, ay, r, w, h, dy };
+    });
+    const boxes = placeLabels(items, field);
+    const leaders = svg.querySelector("g.leaders");
+    let lines = "";
+    boxes.forEach((b, i) => {
+      const t = texts[i], it = items[i];
+      t.setAttribute("x", num(b.x));
+      t.setAttribute("y", num(b.y - it.dy));
+      t.dataset.moved = b.moved ? "yes" : "no";
+      if (b.moved) {
+        const px = Math.min(Math.max(it.ax, b.x), b.x + b.w), py = Math.min(Math.max(it.ay, b.y), b.y + b.h);
+        lines += '<line class="leader" x1="' + num(it.ax) + '" y1="' + num(it.ay) + '" x2="' + num(px) + '" y2="' + num(py) + '" stroke="#666" stroke-width="' + num(unit / 600) + '"/>';
+      }
+    });
+    if (leaders) { leaders.innerHTML = lines; }
   }
 
   function blocks(box, snapshot, meta) {
@@ -239,10 +355,76 @@
     return out + "</ul></li>";
   }
 
-  function fields(e) {
-    const rest = {};
-    for (const k of Object.keys(e)) { if (k !== "t" && k !== "agent" && k !== "event") { rest[k] = e[k]; } }
-    return JSON.stringify(rest);
+  // -- the event log: one line of text an event --------------------------------------------------------------
+
+  const SHORT = 60;  // characters of one field's value in a line (all of it with raw)
+  const SKIP = new Set(["t", "agent", "event"]);
+
+  function value(v, raw) {
+    const text = typeof v === "string" ? v : JSON.stringify(v);
+    return raw || text.length <= SHORT ? text : text.slice(0, SHORT - 1) + "\u2026";
+  }
+
+  // The fields of e but those named, as "k=v k=v" (each value cut to SHORT characters unless raw).
+  function rest(e, named, raw) {
+    const out = [];
+    for (const k of Object.keys(e)) {
+      if (SKIP.has(k) || named.includes(k) || e[k] === null || e[k] === undefined || e[k] === "") { continue; }
+      out.push(k + "=" + value(e[k], raw));
+    }
+    return out.length ? " " + out.join(" ") : "";
+  }
+
+  function at(e) { return typeof e.x === "number" && typeof e.y === "number" ? " at (" + num(e.x) + ", " + num(e.y) + ")" : ""; }
+  function why(text) { return text ? ": " + text : ""; }
+  function where(e) { return e.plan ? " in " + e.plan : e.key ? " in " + e.key : ""; }
+
+  // What each kind of event says, without its time and agent (the fields it leaves out follow as k=v unless noted).
+  const TEXTS = {
+    transition: (e) => "transition " + e.source + " -> " + e.target + where(e),
+    allocation: (e) => "allocation " + (e.plan || e.key) + ": " +
+      Object.entries(e.entries || {}).map(([a, ep]) => a + " " + ep).join(", ") + (e.reason ? " (" + e.reason + ")" : "") +
+      (e.outcome ? " " + e.outcome + why(e.why) : ""),
+    behaviour: (e) => "behaviour " + e.behaviour + " " + e.status + why(e.reason),
+    success: (e) => "success " + (e.plan || e.key),
+    failure: (e) => "failure " + (e.plan || e.child || e.key) + why(e.reason),
+    repair: (e) => "repair " + e.stage + " " + (e.plan || e.key) + why(e.reason),
+    replan: (e) => "replan " + e.key + why(e.reason),
+    fault: (e, raw) => "fault " + e.fault + rest(e, ["fault"], raw),
+    team: (e) => "team " + e.change + " " + e.who,
+    note: (e) => "note " + e.message,
+    pose: (e) => "pose" + at(e) + (typeof e.yaw === "number" ? " yaw " + num(e.yaw) : "") + (e.alive === false ? " (down)" : ""),
+    object: (e) => "object " + e.name + " " + (e.sample_kind || e.kind || "") + at(e),
+    found: (e) => "found " + e.name + " " + (e.kind || "(kind not known yet)") + at(e),
+    map: (e, raw) => "map " + e.width + " x " + e.height + " cells of " + e.resolution + " m" +
+      (Array.isArray(e.origin) ? " from (" + e.origin.map(num).join(", ") + ")" : "") + (raw ? rest(e, ["width", "height", "resolution", "origin"], true) : ""),
+    operator: (e, raw) => "operator " + (e.what || "facts") + rest(e, ["what"], raw),
+    planner: (e, raw) => "planner " + e.what + " " + e.key + rest(e, ["what", "key"], raw),
+  };
+
+  // One event as one line of text: "12.30 s  scout  transition Explore -> Return in Mission".
+  function eventText(e, raw) {
+    const say = TEXTS[e.event];
+    let text;
+    try { text = say ? say(e, raw) : e.event + rest(e, [], raw); } catch (err) { text = e.event + rest(e, [], raw); }
+    return Number(e.t).toFixed(2).padStart(7) + " s  " + String(e.agent).padEnd(8) + "  " + text;
+  }
+
+  // Pose rows are left out of the log unless raw.
+  function logged(e, raw) { return raw || e.event !== "pose"; }
+
+  // A row of the log: the event's line, its kind and agent as data, the whole event (without a map's cells unless raw)
+  // as the row's tooltip.
+  function logRow(e, raw) {
+    const tr = document.createElement("tr");
+    tr.dataset.kind = e.event;
+    tr.dataset.agent = e.agent;
+    const td = document.createElement("td");
+    td.className = "line";
+    td.textContent = eventText(e, raw);
+    tr.title = JSON.stringify(raw || e.event !== "map" ? e : Object.assign({}, e, { cells: "(" + String(e.cells || "").length + " characters)" }));
+    tr.appendChild(td);
+    return tr;
   }
 
   const LOG_ROWS = 500;  // the log draws the newest rows up to the time; a long trace has tens of thousands
@@ -257,17 +439,16 @@
     return lo;
   }
 
-  function log(tbody, events, filter, t) {
+  function log(tbody, events, filter, t, raw) {
     const text = (filter || "").trim().toLowerCase();
     const fragment = document.createDocumentFragment();
     let shown = 0, i = t == null ? events.length : after(events, t);
     while (i > 0 && shown < LOG_ROWS) {
       const e = events[--i];
-      const rest = fields(e);
-      if (text && !(e.event + " " + e.agent + " " + rest).toLowerCase().includes(text)) { continue; }
-      const tr = document.createElement("tr");
+      if (!logged(e, raw)) { continue; }
+      if (text && !(e.event + " " + eventText(e, raw)).toLowerCase().includes(text)) { continue; }
+      const tr = logRow(e, raw);
       tr.className = "past";
-      for (const v of [Number(e.t).toFixed(3), e.agent, e.event, rest]) { tr.appendChild(cell(v)); }
       fragment.appendChild(tr);
       shown += 1;
     }
@@ -275,7 +456,6 @@
       const tr = document.createElement("tr");
       tr.className = "more";
       const td = cell("the newest " + LOG_ROWS + " rows are shown; narrow the filter to see older events");
-      td.colSpan = 4;
       tr.appendChild(td);
       fragment.appendChild(tr);
     }
@@ -306,5 +486,5 @@
     box.hidden = html === "";
   }
 
-  window.AlicaViews = { agents, tracks, map, blocks, trees, log, operator };
+  window.AlicaViews = { agents, tracks, map, blocks, trees, log, operator, eventText, logged, logRow, placeLabels, scaleLength };
 })();
