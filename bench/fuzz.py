@@ -1,9 +1,10 @@
 """Fuzzing the readers: seeded mutants of the shipped plans and the benchmark PDDL, each in a bounded worker.
 
 Corpora: ``yaml`` and ``xml`` (the shipped plan files, :func:`alica.io.loader.plans_dir`),
-``pddl-domain`` and ``pddl-problem`` (``../shared/benchmarks/pddl/*/``). Mutant ``i`` of a corpus
-is made by ``random.Random(f"{seed}:{corpus}:{i}")`` from one of its files with one to
-three mutations: byte flips, token swaps, deletions, duplications, deep nesting,
+``pddl-domain`` and ``pddl-problem`` (``pddl/*/`` of the benchmark sets, read in place from
+``--benchmarks DIR``, else the environment variable ``ALICA_BENCHMARKS``, else ``../shared/benchmarks``
+beside the checkout). Mutant ``i`` of a corpus is made by ``random.Random(f"{seed}:{corpus}:{i}")``
+from one of its files with one to three mutations: byte flips, token swaps, deletions, duplications, deep nesting,
 huge numbers and control characters.
 
 Each mutant runs in a worker process (``--workers`` of them, each with an address
@@ -20,7 +21,7 @@ convert`` exiting 70), ``hang`` (no answer within ``--timeout`` seconds: the wor
 killed and replaced), ``memory`` (``MemoryError`` or a worker that died). A table per
 corpus is printed, then the first few tracebacks with the mutant's recipe.
 
-Run: ``.venv/bin/python bench/fuzz.py [--mutants 10000] [--seed 0] [--workers 2]``
+Run: ``.venv/bin/python bench/fuzz.py [--mutants 10000] [--seed 0] [--workers 2] [--benchmarks DIR]``
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ import os
 import random
 import re
 import shutil
+import sys
 import tempfile
 import threading
 import time
@@ -45,6 +47,11 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from bench.benchmark_sets import add_benchmarks_option, benchmark_set, default_benchmarks
+
 CORPORA = ("yaml", "xml", "pddl-domain", "pddl-problem")
 OUTCOMES = ("ok", "rejected", "traceback", "hang", "memory")
 
@@ -52,19 +59,19 @@ OUTCOMES = ("ok", "rejected", "traceback", "hang", "memory")
 # --------------------------------------------------------------------------- corpora and mutations
 
 
-def pddl_folder() -> Path:
-    """The benchmark PDDL: ``../shared/benchmarks/pddl`` beside the checkout."""
-    return ROOT / ".." / "shared" / "benchmarks" / "pddl"
+def pddl_folder(benchmarks: Path | None = None) -> Path:
+    """The benchmark PDDL: ``pddl/`` of the benchmark sets ``benchmarks`` (default: ``default_benchmarks()``)."""
+    return benchmark_set(benchmarks or default_benchmarks(), "pddl")
 
 
-def corpus_files(corpus: str) -> list[Path]:
-    """The seed files of one corpus, sorted."""
+def corpus_files(corpus: str, benchmarks: Path | None = None) -> list[Path]:
+    """The seed files of one corpus, sorted (the PDDL ones from the benchmark sets ``benchmarks``)."""
     if corpus in ("yaml", "xml"):
         from alica.io.loader import plans_dir
 
         endings = (".yaml", ".yml") if corpus == "yaml" else (".xml",)
         return sorted(p for p in plans_dir().rglob("*") if p.suffix in endings)
-    files = sorted(pddl_folder().glob("*/*.pddl"))
+    files = sorted(pddl_folder(benchmarks).glob("*/*.pddl"))
     if corpus == "pddl-domain":
         return [p for p in files if p.name == "domain.pddl"]
     return [p for p in files if p.name != "domain.pddl"][::4]  # every fourth problem: the small and the big
@@ -279,9 +286,9 @@ class Pool:
             thread.join()
 
 
-def jobs_of(corpus: str, count: int, seed: int) -> Iterator[Job]:
+def jobs_of(corpus: str, count: int, seed: int, benchmarks: Path | None = None) -> Iterator[Job]:
     """The ``count`` seeded mutants of one corpus."""
-    files = corpus_files(corpus)
+    files = corpus_files(corpus, benchmarks)
     contents = {path: path.read_bytes() for path in files}
     kind = "pddl" if corpus.startswith("pddl") else corpus
     for i in range(count):
@@ -292,7 +299,13 @@ def jobs_of(corpus: str, count: int, seed: int) -> Iterator[Job]:
 
 
 def fuzz(
-    corpora: tuple[str, ...], count: int, seed: int, workers: int = 2, timeout: float = 10.0, memory_mb: int = 2048
+    corpora: tuple[str, ...],
+    count: int,
+    seed: int,
+    workers: int = 2,
+    timeout: float = 10.0,
+    memory_mb: int = 2048,
+    benchmarks: Path | None = None,
 ) -> dict[str, Counter[str]]:
     """Outcome counts per corpus; the tracebacks' details are counted under ``traceback: ...`` keys."""
     results: dict[str, Counter[str]] = {c: Counter() for c in corpora}
@@ -306,7 +319,7 @@ def fuzz(
 
     pool = Pool(workers, timeout, memory_mb)
     for corpus in corpora:
-        pool.run(jobs_of(corpus, count, seed), report)
+        pool.run(jobs_of(corpus, count, seed, benchmarks), report)
     return results
 
 
@@ -318,10 +331,13 @@ def main() -> None:
     parser.add_argument("--timeout", type=float, default=10.0, help="seconds before a mutant counts as a hang")
     parser.add_argument("--memory", type=int, default=2048, help="address space limit of a worker, MB")
     parser.add_argument("--corpus", choices=CORPORA, action="append", help="only these corpora (repeatable)")
+    add_benchmarks_option(parser)
     args = parser.parse_args()
     corpora = tuple(args.corpus or CORPORA)
     start = time.perf_counter()
-    results = fuzz(corpora, args.mutants, args.seed, args.workers, args.timeout, args.memory)
+    if any(c.startswith("pddl") for c in corpora):
+        benchmark_set(args.benchmarks, "pddl")  # before the workers start: a missing folder ends here, with a message
+    results = fuzz(corpora, args.mutants, args.seed, args.workers, args.timeout, args.memory, args.benchmarks)
     seconds = time.perf_counter() - start
     print(f"{'corpus':<14} {'mutants':>8} " + " ".join(f"{o:>10}" for o in OUTCOMES))
     for corpus, counts in results.items():

@@ -15,8 +15,11 @@ With ``--processes`` the rounds run over agent processes instead
 teammate, zenoh on loopback); the time to the first plan is then in wall seconds from the round's
 start (the processes already up).
 
-Run: ``.venv/bin/python bench/magic.py [--problems p01,p05] [--agents 1,2,3,4] [--seed 0] [--processes]``;
-prints a markdown table.
+The Rovers problems are read in place from ``pddl/rovers`` of the benchmark sets: ``--benchmarks DIR``, else the
+environment variable ``ALICA_BENCHMARKS``, else ``../shared/benchmarks`` beside the checkout.
+
+Run: ``.venv/bin/python bench/magic.py [--problems p01,p05] [--agents 1,2,3,4] [--seed 0] [--processes]
+[--benchmarks DIR]``; prints a markdown table.
 """
 
 from __future__ import annotations
@@ -27,11 +30,14 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+ROOT = Path(__file__).resolve().parent.parent
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
 from alica.app.magic import run_lockstep
 from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.search import BuiltinPlanner
-
-ROVERS = Path(__file__).resolve().parent.parent / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
+from bench.benchmark_sets import add_benchmarks_option, benchmark_set, default_benchmarks
 
 FDP_COST = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """IMPERA Table 1: the cost FDP found on Rovers1-20."""
@@ -47,10 +53,21 @@ def _number(value: float | None) -> str:
     return str(int(value)) if float(value).is_integer() else f"{value:.1f}"
 
 
-def row(name: str, agents: Sequence[int], seed: int, progress_every: int, processes: bool = False) -> str:
-    """One table row: IMPERA's FDP, the builtin planner alone, then MAGiC per team size."""
+def row(
+    name: str,
+    agents: Sequence[int],
+    seed: int,
+    progress_every: int,
+    processes: bool = False,
+    benchmarks: Path | None = None,
+) -> str:
+    """One table row: IMPERA's FDP, the builtin planner alone, then MAGiC per team size.
+
+    ``benchmarks`` is the folder of the benchmark sets (default: ``default_benchmarks()``).
+    """
     number = int(name[1:])
-    domain_text, problem_text = (ROVERS / "domain.pddl").read_text(), (ROVERS / f"{name}.pddl").read_text()
+    rovers = benchmark_set(benchmarks or default_benchmarks(), "pddl") / "rovers"
+    domain_text, problem_text = (rovers / "domain.pddl").read_text(), (rovers / f"{name}.pddl").read_text()
     domain = parse_domain(domain_text)
     problem = parse_problem(problem_text, name, domain)
     start = time.perf_counter()
@@ -84,7 +101,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, default=0, help="the network's and the shares' seed")
     parser.add_argument("--progress-every", type=int, default=10, help="expansions per planner step (one per tick)")
     parser.add_argument("--processes", action="store_true", help="agent processes over zenoh instead of lock step")
+    add_benchmarks_option(parser)
     args = parser.parse_args(argv)
+    benchmark_set(args.benchmarks, "pddl")  # before the first line of the table
     agents = [int(a) for a in args.agents.split(",")]
     if args.processes:
         print(
@@ -104,7 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print("| " + " | ".join(head) + " |")
     print("|" + "---|" * len(head))
     for name in args.problems.split(","):
-        print(row(name.strip(), agents, args.seed, args.progress_every, args.processes), flush=True)
+        print(row(name.strip(), agents, args.seed, args.progress_every, args.processes, args.benchmarks), flush=True)
     return 0
 
 

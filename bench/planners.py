@@ -1,4 +1,4 @@
-"""Our planner (``alica plan``) beside Fast Downward lama-first and pyperplan gbf-hff on the standard PDDL benchmarks (read in place from ../shared/benchmarks).
+"""Our planner (``alica plan``) beside Fast Downward lama-first and pyperplan gbf-hff on the standard PDDL benchmarks (read in place from ../shared/benchmarks, or ``--benchmarks DIR``).
 
 Every problem runs as a whole process, one at a time by default (the machine has 2
 cores; timings must not compete), with a wall limit (60 s):
@@ -21,7 +21,11 @@ p01-p20 vs the IMPERA paper's Table 1, our first plan and ours after the anytime
 ours at most that on each); blocks after the anytime budget vs the optimum (goal: total at
 most 1.15x); the grounding time of Rovers p18-p20 (goal: at most 0.1 s each).
 
-With ``--suite ipc`` (issue 22) the 175 problems of the 26 domains in ``../shared/benchmarks/ipc/`` instead (airport
+The benchmark sets are read in place from the folder holding ``pddl/`` and ``ipc/``: ``--benchmarks DIR``, else the
+environment variable ``ALICA_BENCHMARKS``, else ``../shared/benchmarks`` beside the checkout
+(:mod:`bench.benchmark_sets`).
+
+With ``--suite ipc`` (issue 22) the 175 problems of the 26 domains in ``ipc/`` of that folder instead (airport
 and psr-small: each problem ``pNN-*.pddl`` with its own ``pNN-domain.pddl``), 30 s each: ours (first plan),
 Fast Downward lama-first, then ours with ``--anytime --time-limit 10`` on every problem. Each run is appended
 to ``build/bench/ipc_runs.tsv`` as it completes; at the end three markdown tables: per domain (solved, invalid,
@@ -29,10 +33,10 @@ errors, total time and first-plan cost on the problems both solve, anytime cost 
 (met or missed) and the problems ours fails with the reason. ``--report-only`` prints the tables from that
 TSV (of a run stopped early, say).
 
-Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick]``
+Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick] [--benchmarks DIR]``
 
 or: ``.venv/bin/python bench/planners.py --suite ipc [--domains a,b] [--limit N] [--time-limit 30]
-[--anytime-budget 10] [--skip-anytime] [--skip-fd] [--report-only]``
+[--anytime-budget 10] [--skip-anytime] [--skip-fd] [--report-only] [--benchmarks DIR]``
 """
 
 from __future__ import annotations
@@ -64,9 +68,11 @@ from alica.prophet.planner import PlanStep
 from alica.prophet.planners.fd import find_driver
 from alica.prophet.planners.planfile import parse_plan
 from alica.prophet.validate import validate_plan
+from bench.benchmark_sets import add_benchmarks_option, benchmark_set, default_benchmarks
 
-BENCHMARKS = ROOT / ".." / "shared" / "benchmarks" / "pddl"
-IPC = ROOT / ".." / "shared" / "benchmarks" / "ipc"
+BENCHMARKS = default_benchmarks() / "pddl"
+"""The classic sets (blocks, rovers); :func:`use_benchmarks` moves it and :data:`IPC`."""
+IPC = default_benchmarks() / "ipc"
 OUT = ROOT / "build" / "bench"
 IMPERA_TABLE1 = (10, 8, 13, 10, 22, 38, 18, 28, 34, 36, 38, 22, 46, 32, 44, 43, 52, 48, 74, 87)
 """Fast Downward (FDP) costs of Rovers1-20 in the IMPERA paper's Table 1."""
@@ -286,6 +292,12 @@ def _last_line(text: str) -> str:
 
 def _order(name: str) -> tuple[int, ...]:
     return tuple(int(n) for n in re.findall(r"\d+", name))
+
+
+def use_benchmarks(folder: Path) -> None:
+    """Read the benchmark sets from ``folder`` (``--benchmarks``): its ``pddl/`` and ``ipc/``."""
+    global BENCHMARKS, IPC
+    BENCHMARKS, IPC = folder / "pddl", folder / "ipc"
 
 
 def problems(domain: str, limit: int | None, quick: bool) -> list[Job]:
@@ -533,7 +545,7 @@ GOAL_TIME, GOAL_ANYTIME, GOAL_FIRST = 1.0, 0.8, 1.1
 
 
 def ipc_problems(domain: str, limit: int | None) -> list[Job]:
-    """The problems of ``../shared/benchmarks/ipc/DOMAIN`` (natural order), each with its domain file, as planner-less jobs.
+    """The problems of ``IPC/DOMAIN`` (natural order), each with its domain file, as planner-less jobs.
 
     A folder holds ``domain.pddl``, or (airport, psr-small) one ``pNN-domain.pddl`` per problem ``pNN-*.pddl``.
     """
@@ -549,7 +561,7 @@ def ipc_problems(domain: str, limit: int | None) -> list[Job]:
 
 
 def ipc_domains() -> list[str]:
-    """Every domain folder of ``../shared/benchmarks/ipc``."""
+    """Every domain folder of ``IPC`` (``ipc/`` of the benchmark sets)."""
     return sorted(p.name for p in IPC.iterdir() if p.is_dir())
 
 
@@ -705,8 +717,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         "--suite",
         choices=("classic", "ipc"),
         default="classic",
-        help="classic: ../shared/benchmarks/pddl (blocks, rovers); ipc: the 26 domains of ../shared/benchmarks/ipc (default classic)",
+        help="classic: pddl/ of the benchmark sets (blocks, rovers); ipc: the 26 domains of their ipc/ (default classic)",
     )
+    add_benchmarks_option(parser)
     parser.add_argument(
         "--domains", help="comma-separated benchmark domains (default blocks,rovers; for ipc every domain)"
     )
@@ -733,6 +746,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     args = parser.parse_args(argv)
     if not args.report_only:
+        benchmark_set(args.benchmarks, "ipc" if args.suite == "ipc" else "pddl")
+        use_benchmarks(args.benchmarks)
         compile_bytecode()
     if args.time_limit is None:
         args.time_limit = 30.0 if args.suite == "ipc" else 60.0

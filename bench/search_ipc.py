@@ -1,4 +1,4 @@
-"""The builtin search's first plan on the IPC suite (``../shared/benchmarks/ipc``), beside Fast Downward lama-first.
+"""The builtin search's first plan on the IPC suite (``ipc/`` of the benchmark sets), beside Fast Downward lama-first.
 
 One problem at a time, each as a whole process with a wall limit (30 s): ours runs
 ``alica plan --json`` (the default first search), or ``search_task`` with another
@@ -9,7 +9,11 @@ Results go to ``build/bench/search_ipc-<tag>.tsv`` (one row per problem, appende
 come, so a later run with ``--resume`` skips the problems done) and a per-domain table to
 standard output, compared with another tag (``--against fd``) where both ran.
 
-Run: ``.venv/bin/python bench/search_ipc.py --planner ours --tag lama [--first lama] [--domains a,b] [--limit 30]``
+The benchmark sets are read in place from ``--benchmarks DIR`` (the folder holding ``pddl/`` and ``ipc/``), else
+the environment variable ``ALICA_BENCHMARKS``, else ``../shared/benchmarks`` beside the checkout.
+
+Run: ``.venv/bin/python bench/search_ipc.py --planner ours --tag lama [--first lama] [--domains a,b] [--limit 30]
+[--benchmarks DIR]``
 """
 
 from __future__ import annotations
@@ -26,10 +30,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from bench.benchmark_sets import add_benchmarks_option, benchmark_set, default_benchmarks
 from bench.planners import GRACE_S, Job, Outcome, Tasks, _validated, run_fd, run_process
 
-IPC = ROOT / ".." / "shared" / "benchmarks" / "ipc"
-PDDL = ROOT / ".." / "shared" / "benchmarks" / "pddl"
 OUT = ROOT / "build" / "bench"
 FIELDS = ("domain", "problem", "status", "wall_s", "cost", "first_s", "expansions", "evaluations")
 
@@ -38,17 +41,19 @@ def _order(name: str) -> tuple[int, ...]:
     return tuple(int(x) for x in re.findall(r"\d+", name))
 
 
-def jobs(domains: Sequence[str] | None) -> list[Job]:
-    """Every IPC problem (and blocks/rovers when named), in order."""
+def jobs(domains: Sequence[str] | None, benchmarks: Path | None = None) -> list[Job]:
+    """Every IPC problem (and blocks/rovers when named), in order, from the benchmark sets ``benchmarks`` (default: ``default_benchmarks()``)."""
+    benchmarks = benchmarks or default_benchmarks()
+    ipc, pddl = benchmark_set(benchmarks, "ipc"), benchmarks / "pddl"
     out: list[Job] = []
-    names = sorted(p.name for p in IPC.iterdir() if p.is_dir())
+    names = sorted(p.name for p in ipc.iterdir() if p.is_dir())
     for extra in ("blocks", "rovers"):
         if domains and extra in domains:
             names.append(extra)
     for name in names:
         if domains and name not in domains:
             continue
-        folder = (PDDL if name in ("blocks", "rovers") else IPC) / name
+        folder = (pddl if name in ("blocks", "rovers") else ipc) / name
         for prob in sorted(folder.glob("*.pddl"), key=lambda p: (_order(p.stem), p.stem)):
             if "domain" in prob.stem:
                 continue
@@ -171,6 +176,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--resume", action="store_true", help="skip problems the tag's file already has")
     parser.add_argument("--against", default="fd", help="compare with this tag's results")
     parser.add_argument("--table", action="store_true", help="print the table of the stored results only")
+    add_benchmarks_option(parser)
     args = parser.parse_args(argv)
     if args.child:
         child(args.child[0], args.child[1], args.first)
@@ -188,7 +194,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         elif not path.exists():
             path.write_text("\t".join(FIELDS) + "\n")
         tasks = Tasks()
-        for job in jobs(domains):
+        for job in jobs(domains, args.benchmarks):
             if problems and job.problem not in problems:
                 continue
             if (job.domain, job.problem) in done:

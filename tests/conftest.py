@@ -1,7 +1,8 @@
-"""Shared test set-up: deterministic hypothesis runs, OMPL seeded, paths to the shipped plans."""
+"""Shared test set-up: deterministic hypothesis runs, OMPL seeded, paths to the shipped plans and the benchmark sets."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import pytest
@@ -23,6 +24,34 @@ configure_ompl(0)
 
 ROOT = Path(__file__).resolve().parent.parent
 PLANS = ROOT / "plans"
+BENCHMARKS_VARIABLE = "ALICA_BENCHMARKS"
+
+
+def benchmarks_folder() -> Path:
+    """The folder holding the benchmark sets (``pddl/``, ``ipc/``): ``$ALICA_BENCHMARKS``, else ``../shared/benchmarks``.
+
+    The sets are read in place, never copied into the repository (``bench/benchmark_sets.py`` has the same rule).
+    """
+    value = os.environ.get(BENCHMARKS_VARIABLE, "")
+    return Path(value).expanduser() if value else ROOT / ".." / "shared" / "benchmarks"
+
+
+BENCHMARKS = benchmarks_folder()
+
+
+def benchmark_set(name: str) -> Path:
+    """``BENCHMARKS / name`` (``"pddl"`` or ``"ipc"``); a failed test naming the folder when it is missing.
+
+    Call it inside a test or fixture, not at import: a module that failed to import would stop the collection.
+    """
+    folder = BENCHMARKS / name
+    if not folder.is_dir():
+        pytest.fail(
+            f"the benchmark sets are read in place from {BENCHMARKS.resolve()} and {name}/ is not there: "
+            f"put ../shared beside the checkout or set {BENCHMARKS_VARIABLE} to the folder holding pddl/ and ipc/",
+            pytrace=False,
+        )
+    return folder
 
 
 @pytest.fixture

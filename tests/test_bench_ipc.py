@@ -7,6 +7,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+from tests.conftest import benchmark_set
+
 ROOT = Path(__file__).resolve().parent.parent
 
 
@@ -22,6 +24,7 @@ def _bench() -> ModuleType:
 
 
 def test_ipc_jobs_pair_every_problem_with_its_domain_file() -> None:
+    benchmark_set("ipc")  # the bench reads the same folder (bench/benchmark_sets.py)
     bench = _bench()
     jobs = bench.ipc_jobs(bench.ipc_domains(), None, [bench.OURS, bench.FD, bench.ANYTIME])
     assert len(bench.ipc_domains()) == 26

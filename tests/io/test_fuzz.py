@@ -10,6 +10,8 @@ from types import ModuleType
 
 import pytest
 
+from tests.conftest import benchmark_set
+
 BENCH = Path(__file__).resolve().parents[2] / "bench" / "fuzz.py"
 
 
@@ -30,6 +32,7 @@ def test_mutants_are_seeded(fuzz: ModuleType) -> None:
 
 
 def test_no_mutant_gives_a_traceback(fuzz: ModuleType) -> None:
+    benchmark_set("pddl")  # the PDDL corpora: the bench reads the same folder (bench/benchmark_sets.py)
     # 50 per corpus, 200 in all; a worker that does not answer within 30 s (a hang, not load) is counted.
     results = fuzz.fuzz(fuzz.CORPORA, 50, seed=14, workers=2, timeout=30.0, memory_mb=2048)
     for corpus, counts in results.items():

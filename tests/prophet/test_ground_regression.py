@@ -7,14 +7,12 @@ what the grounding produces (ids, order, operators, effects) shows up here.
 from __future__ import annotations
 
 import hashlib
-from pathlib import Path
 
 import pytest
 
 from alica.prophet.ground import GroundTask, ground
 from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
-
-BENCHMARKS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl"
+from tests.conftest import benchmark_set
 
 MIXED = """(define (domain mixed) (:requirements :typing :negative-preconditions :equality :conditional-effects)
   (:types item place)
@@ -49,8 +47,9 @@ PINNED = {
 
 @pytest.mark.parametrize(("domain", "problem"), sorted(PINNED))
 def test_benchmark_grounding_unchanged(domain: str, problem: str) -> None:
-    d = read_domain(BENCHMARKS / domain / "domain.pddl")
-    assert digest(ground(d, read_problem(BENCHMARKS / domain / f"{problem}.pddl", d))) == PINNED[(domain, problem)]
+    folder = benchmark_set("pddl") / domain
+    d = read_domain(folder / "domain.pddl")
+    assert digest(ground(d, read_problem(folder / f"{problem}.pddl", d))) == PINNED[(domain, problem)]
 
 
 def test_mixed_grounding_unchanged() -> None:

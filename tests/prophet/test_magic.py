@@ -10,7 +10,6 @@ from __future__ import annotations
 import io
 import pickle
 from functools import cache
-from pathlib import Path
 
 import pytest
 from hypothesis import given, settings
@@ -32,16 +31,15 @@ from alica.prophet.pddl import PddlError, parse_domain, parse_problem
 from alica.prophet.planner import PlanStatus, PlanStep
 from alica.prophet.search import BuiltinPlanner, FirstSearch
 from alica.prophet.validate import validate_plan
+from tests.conftest import benchmark_set
 from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
-
-ROVERS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
 
 
 @cache
 def rovers(name: str) -> tuple[str, str]:
     """The Rovers domain and problem ``name`` as text."""
-    assert ROVERS.is_dir(), f"the benchmark folder {ROVERS} is missing"
-    return (ROVERS / "domain.pddl").read_text(), (ROVERS / f"{name}.pddl").read_text()
+    rovers = benchmark_set("pddl") / "rovers"
+    return (rovers / "domain.pddl").read_text(), (rovers / f"{name}.pddl").read_text()
 
 
 def assert_valid(run: MagicRun, texts: tuple[str, str]) -> None:

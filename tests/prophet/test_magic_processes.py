@@ -2,18 +2,16 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from alica.app.magic_processes import run_processes
 from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.planner import PlanStatus
 from alica.prophet.validate import validate_plan
-
-ROVERS = Path(__file__).resolve().parents[2] / ".." / "shared" / "benchmarks" / "pddl" / "rovers"
+from tests.conftest import benchmark_set
 
 
 def test_three_agent_processes_give_a_valid_plan_within_the_message_bound() -> None:
-    domain, problem = (ROVERS / "domain.pddl").read_text(), (ROVERS / "p05.pddl").read_text()
+    rovers = benchmark_set("pddl") / "rovers"
+    domain, problem = (rovers / "domain.pddl").read_text(), (rovers / "p05.pddl").read_text()
     run = run_processes(domain, problem, 3, timeout=60)
     assert run.status is PlanStatus.SOLVED and run.plan is not None
     parsed = parse_domain(domain)
@@ -23,7 +21,8 @@ def test_three_agent_processes_give_a_valid_plan_within_the_message_bound() -> N
 
 
 def test_a_worker_process_killed_during_the_round_is_not_waited_for():
-    domain, problem = (ROVERS / "domain.pddl").read_text(), (ROVERS / "p10.pddl").read_text()
+    rovers = benchmark_set("pddl") / "rovers"
+    domain, problem = (rovers / "domain.pddl").read_text(), (rovers / "p10.pddl").read_text()
     run = run_processes(domain, problem, 3, timeout=60.0, kill_after={"agent2": 0.0})
     assert run.status is PlanStatus.SOLVED and run.plan is not None
     assert "agent2" in run.lost

@@ -9,7 +9,8 @@ from alica.prophet.search import search_task
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.windows import Windows
-from tests.prophet.search.helpers import BENCHMARKS, TaskBuilder, check_plan, optimal_cost
+from tests.conftest import benchmark_set
+from tests.prophet.search.helpers import TaskBuilder, check_plan, optimal_cost
 
 ROAD = [("p0", "p1"), ("p1", "p2"), ("p2", "p3"), ("p0", "p3"), ("p3", "p4")]
 """A chain p0-p1-p2-p3-p4 with a shortcut p0-p3."""
@@ -137,8 +138,9 @@ def test_when_effects_skip_the_regrouping_and_plans_stay_valid() -> None:
 
 
 def test_rovers_anytime_plans_valid_and_strictly_cheaper() -> None:
-    domain = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    task = ground(domain, pddl.read_problem(BENCHMARKS / "rovers" / "p07.pddl", domain))
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = pddl.read_domain(rovers / "domain.pddl")
+    task = ground(domain, pddl.read_problem(rovers / "p07.pddl", domain))
     found = []
     for event in search_task(task, progress_every=100):
         if isinstance(event, Improved):

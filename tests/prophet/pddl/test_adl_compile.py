@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 import time
 from contextlib import ExitStack
-from pathlib import Path
 from unittest import mock
 
 import pytest
@@ -21,8 +20,7 @@ from alica.prophet.planner import PlanStatus, PlanStep
 from alica.prophet.planners import get_planner
 from alica.prophet.search.encoding import compile_task
 from alica.prophet.validate import _Lifted, validate_plan
-
-IPC = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "ipc"
+from tests.conftest import benchmark_set
 
 # A tiny miconic-fulladl: the lift may stop at a floor only if every boarded passenger with the
 # non-stop flag gets off there, and no passenger of a conflicting group is waiting or riding.
@@ -178,7 +176,8 @@ CASES = [
 
 @pytest.mark.parametrize(("folder", "name"), CASES, ids=[c[0] for c in CASES])
 def test_alica_plan_solves_the_adl_benchmarks(folder: str, name: str, capsys: pytest.CaptureFixture[str]) -> None:
-    domain_path, problem_path = IPC / folder / "domain.pddl", IPC / folder / name
+    ipc = benchmark_set("ipc")
+    domain_path, problem_path = ipc / folder / "domain.pddl", ipc / folder / name
     started = time.monotonic()
     code = main(["plan", str(domain_path), str(problem_path), "--json", "--time-limit", "20"])
     answer = json.loads(capsys.readouterr().out)

@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from alica.prophet.ground import GroundTask, ground
 from alica.prophet.pddl import PddlError, parse_domain, parse_problem, read_domain, read_problem
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
+from tests.conftest import benchmark_set
 
 
 def _task(domain_text: str, problem_text: str) -> GroundTask:
@@ -18,9 +15,9 @@ def _task(domain_text: str, problem_text: str) -> GroundTask:
 
 
 def test_blocks_4_counts() -> None:
-    assert BENCHMARKS.is_dir(), f"benchmark folder {BENCHMARKS} is missing"
-    domain = read_domain(BENCHMARKS / "blocks" / "domain.pddl")
-    task = ground(domain, read_problem(BENCHMARKS / "blocks" / "probBLOCKS-4-0.pddl", domain))
+    blocks = benchmark_set("pddl") / "blocks"
+    domain = read_domain(blocks / "domain.pddl")
+    task = ground(domain, read_problem(blocks / "probBLOCKS-4-0.pddl", domain))
     assert len(domain.actions) == 4
     # 4 pick-up + 4 put-down + 16 stack + 16 unstack (stack a a is relaxed-reachable)
     assert len(task.operators) == 40
@@ -35,8 +32,9 @@ def test_blocks_4_counts() -> None:
 
 
 def test_rovers_static_facts_leave_preconditions() -> None:
-    domain = read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    task = ground(domain, read_problem(BENCHMARKS / "rovers" / "p01.pddl", domain))
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = read_domain(rovers / "domain.pddl")
+    task = ground(domain, read_problem(rovers / "p01.pddl", domain))
     assert not any("visible" in f or "can_traverse" in f for f in task.facts)
     nav = task.operator("(navigate rover0 waypoint3 waypoint0)")[0]
     assert sorted(task.facts[p] for p in nav.pre) == ["(at rover0 waypoint3)", "(available rover0)"]
@@ -50,9 +48,10 @@ def test_rovers_static_facts_leave_preconditions() -> None:
 @pytest.mark.parametrize("names", [[f"p{i:02d}" for i in range(1, 21)], ["p30", "p40"]])
 def test_rovers_ground(names: list[str]) -> None:
     # (how fast: bench/planners.py's grounding table; no wall-clock assertions in tests)
-    domain = read_domain(BENCHMARKS / "rovers" / "domain.pddl")
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = read_domain(rovers / "domain.pddl")
     for name in names:
-        problem = read_problem(BENCHMARKS / "rovers" / f"{name}.pddl", domain)
+        problem = read_problem(rovers / f"{name}.pddl", domain)
         task = ground(domain, problem)
         assert task.unsolvable_reason is None and task.operators
 
@@ -148,6 +147,7 @@ def test_unreachable_goal_marked() -> None:
 
 
 def test_deterministic() -> None:
-    domain = read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    problem = read_problem(BENCHMARKS / "rovers" / "p05.pddl", domain)
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = read_domain(rovers / "domain.pddl")
+    problem = read_problem(rovers / "p05.pddl", domain)
     assert ground(domain, problem) == ground(domain, problem)

@@ -16,15 +16,13 @@ from alica.prophet.pddl import (
     write_problem,
 )
 from alica.prophet.planner import Feature
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
+from tests.conftest import benchmark_set
 
 
 def benchmark_sets() -> list[tuple[Path, list[Path]]]:
     """Every benchmark folder with its problem files; fails loudly when the folder is missing."""
-    assert BENCHMARKS.is_dir(), f"benchmark folder {BENCHMARKS} is missing"
     out = []
-    for folder in sorted(p for p in BENCHMARKS.iterdir() if p.is_dir()):
+    for folder in sorted(p for p in benchmark_set("pddl").iterdir() if p.is_dir()):
         problems = sorted(p for p in folder.glob("*.pddl") if p.name != "domain.pddl")
         out.append((folder / "domain.pddl", problems))
     assert len(out) == 2 and sum(len(p) for _, p in out) == 75

@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 
 from alica.prophet.ground import ground
 from alica.prophet.pddl import parse_domain, parse_problem, read_domain, read_problem
 from alica.prophet.planner import Plan, PlanStep
 from alica.prophet.validate import validate_plan
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
+from tests.conftest import benchmark_set
 
 GOOD = [
     ("pick-up", "b"),
@@ -25,9 +22,9 @@ GOOD = [
 
 @pytest.fixture
 def blocks() -> tuple:
-    assert BENCHMARKS.is_dir(), f"benchmark folder {BENCHMARKS} is missing"
-    domain = read_domain(BENCHMARKS / "blocks" / "domain.pddl")
-    return domain, read_problem(BENCHMARKS / "blocks" / "probBLOCKS-4-0.pddl", domain)
+    blocks = benchmark_set("pddl") / "blocks"
+    domain = read_domain(blocks / "domain.pddl")
+    return domain, read_problem(blocks / "probBLOCKS-4-0.pddl", domain)
 
 
 def _steps(raw: list[tuple[str, ...]]) -> list[PlanStep]:

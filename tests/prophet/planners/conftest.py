@@ -9,9 +9,8 @@ from pathlib import Path
 import pytest
 
 from alica.app.cli import main
+from tests.conftest import benchmark_set
 from tests.prophet.planners.checks import UNSOLVABLE_DOMAIN, UNSOLVABLE_PROBLEM
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 @dataclass(frozen=True)
@@ -38,13 +37,19 @@ def alica(capsys: pytest.CaptureFixture[str]) -> Callable[..., Run]:
 @pytest.fixture
 def blocks() -> Callable[[str], tuple[Path, Path]]:
     """The blocks domain and a problem of it, e.g. ``blocks("4-0")``."""
-    return lambda name: (BENCHMARKS / "blocks" / "domain.pddl", BENCHMARKS / "blocks" / f"probBLOCKS-{name}.pddl")
+    return lambda name: (
+        benchmark_set("pddl") / "blocks" / "domain.pddl",
+        benchmark_set("pddl") / "blocks" / f"probBLOCKS-{name}.pddl",
+    )
 
 
 @pytest.fixture
 def rovers() -> Callable[[str], tuple[Path, Path]]:
     """The Rovers domain and a problem of it, e.g. ``rovers("p01")``."""
-    return lambda name: (BENCHMARKS / "rovers" / "domain.pddl", BENCHMARKS / "rovers" / f"{name}.pddl")
+    return lambda name: (
+        benchmark_set("pddl") / "rovers" / "domain.pddl",
+        benchmark_set("pddl") / "rovers" / f"{name}.pddl",
+    )
 
 
 @pytest.fixture

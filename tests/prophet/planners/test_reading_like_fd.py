@@ -9,6 +9,7 @@ from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.pddl.model import Atom
 from alica.prophet.planner import PlanStatus
 from alica.prophet.planners import get_planner
+from tests.conftest import benchmark_set
 
 TIGHT = """(define (domain tight)
   (:requirements :strips :typing)
@@ -90,7 +91,7 @@ def test_with_json_a_refused_input_prints_solved_false_with_the_place(alica, tmp
 
 def test_ipc_storage_reads_and_plans(alica) -> None:  # type: ignore[no-untyped-def]
     """Storage declares 'area' under two parents and types 'in' with (either storearea crate)."""
-    folder = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "ipc" / "storage"
+    folder = benchmark_set("ipc") / "storage"
     run = alica("plan", folder / "domain.pddl", folder / "p03.pddl", "--json")
     assert run.code == 0, run.err
     answer = json.loads(run.out)

@@ -6,11 +6,8 @@ import heapq
 import itertools
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from alica.prophet.planner import Plan
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "pddl"
 
 
 @dataclass(frozen=True, slots=True)

@@ -8,7 +8,8 @@ from alica.prophet import ground as grounding
 from alica.prophet import pddl
 from alica.prophet.planner import Done, Improved, PlanStatus
 from alica.prophet.search import BuiltinPlanner, search_task
-from tests.prophet.search.helpers import BENCHMARKS, check_plan
+from tests.conftest import benchmark_set
+from tests.prophet.search.helpers import check_plan
 
 CASES = [
     ("blocks", "probBLOCKS-4-0", 6),
@@ -19,9 +20,9 @@ CASES = [
 
 
 def load(domain: str, problem: str):
-    assert BENCHMARKS.is_dir(), f"the benchmark folder {BENCHMARKS} is missing"
-    d = pddl.read_domain(BENCHMARKS / domain / "domain.pddl")
-    return d, pddl.read_problem(BENCHMARKS / domain / f"{problem}.pddl", d)
+    folder = benchmark_set("pddl") / domain
+    d = pddl.read_domain(folder / "domain.pddl")
+    return d, pddl.read_problem(folder / f"{problem}.pddl", d)
 
 
 @pytest.mark.parametrize(("domain", "problem", "optimum"), CASES)

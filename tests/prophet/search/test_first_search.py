@@ -8,12 +8,14 @@ from alica.prophet import ground as grounding
 from alica.prophet import pddl
 from alica.prophet.planner import Improved
 from alica.prophet.search import FIRST_HEURISTICS, BuiltinPlanner, FirstSearch, search_task
-from tests.prophet.search.helpers import BENCHMARKS, check_plan
+from tests.conftest import benchmark_set
+from tests.prophet.search.helpers import check_plan
 
 
 def task(name: str):
-    domain = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    return grounding.ground(domain, pddl.read_problem(BENCHMARKS / "rovers" / f"{name}.pddl", domain))
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = pddl.read_domain(rovers / "domain.pddl")
+    return grounding.ground(domain, pddl.read_problem(rovers / f"{name}.pddl", domain))
 
 
 def test_the_default_first_search_is_lamas() -> None:
@@ -54,8 +56,9 @@ def test_other_first_searches_give_other_searches() -> None:
 
 
 def test_the_builtin_planner_takes_a_first_search() -> None:
-    domain = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    problem = pddl.read_problem(BENCHMARKS / "rovers" / "p05.pddl", domain)
+    rovers = benchmark_set("pddl") / "rovers"
+    domain = pddl.read_domain(rovers / "domain.pddl")
+    problem = pddl.read_problem(rovers / "p05.pddl", domain)
     result = BuiltinPlanner(first=FirstSearch("ff_add_unit")).solve(domain, problem, anytime=False)
     assert result.plan is not None and result.plan.cost == 22
 

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections import deque
-from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -18,9 +17,8 @@ from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.heuristics import Relaxed
 from alica.prophet.search.jit import CompiledFF, SwitchingFF, available
 from alica.prophet.search.landmarks import LandmarkCount, Landmarks
-from tests.prophet.search.helpers import BENCHMARKS, GroundTask, TaskBuilder, blocks_task, check_plan
-
-IPC = Path(__file__).resolve().parents[3] / ".." / "shared" / "benchmarks" / "ipc"
+from tests.conftest import benchmark_set
+from tests.prophet.search.helpers import GroundTask, TaskBuilder, blocks_task, check_plan
 
 
 def compiled(task: GroundTask) -> tuple[CompiledTask, Relaxed, LandmarkCount]:
@@ -208,18 +206,19 @@ needs_numba = pytest.mark.skipif(not available(), reason="numba is not installed
 
 @needs_numba
 @pytest.mark.parametrize(
-    ("domain", "problem"),
+    ("benchmarks", "domain", "problem"),
     [
-        (BENCHMARKS / "rovers" / "domain.pddl", BENCHMARKS / "rovers" / "p05.pddl"),
-        (IPC / "miconic-simpleadl" / "domain.pddl", IPC / "miconic-simpleadl" / "s1-2.pddl"),  # when-effects
-        (IPC / "elevators-sat08-strips" / "domain.pddl", IPC / "elevators-sat08-strips" / "p01.pddl"),  # costs
-        (IPC / "optical-telegraphs" / "domain.pddl", IPC / "optical-telegraphs" / "p01-opt2.pddl"),  # free rules
+        ("pddl", "rovers", "p05"),
+        ("ipc", "miconic-simpleadl", "s1-2"),  # when-effects
+        ("ipc", "elevators-sat08-strips", "p01"),  # costs
+        ("ipc", "optical-telegraphs", "p01-opt2"),  # free rules
     ],
     ids=["rovers", "miconic-simpleadl", "elevators", "optical-telegraphs"],
 )
-def test_the_compiled_ff_equals_the_pure_python_one(domain: Path, problem: Path) -> None:
-    d = pddl.read_domain(domain)
-    ct = compile_task(grounding.ground(d, pddl.read_problem(problem, d)))
+def test_the_compiled_ff_equals_the_pure_python_one(benchmarks: str, domain: str, problem: str) -> None:
+    folder = benchmark_set(benchmarks) / domain
+    d = pddl.read_domain(folder / "domain.pddl")
+    ct = compile_task(grounding.ground(d, pddl.read_problem(folder / f"{problem}.pddl", d)))
     relaxed = Relaxed(ct)
     unit = CompiledFF(relaxed)
     ones = CompiledFF(relaxed, relaxed.r_unit)  # 1 per operator, 0 per derived-predicate rule
@@ -234,8 +233,9 @@ def test_the_compiled_ff_equals_the_pure_python_one(domain: Path, problem: Path)
 
 @needs_numba
 def test_switching_to_the_compiled_ff_does_not_change_the_search() -> None:
-    d = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    ct = compile_task(grounding.ground(d, pddl.read_problem(BENCHMARKS / "rovers" / "p10.pddl", d)))
+    rovers = benchmark_set("pddl") / "rovers"
+    d = pddl.read_domain(rovers / "domain.pddl")
+    ct = compile_task(grounding.ground(d, pddl.read_problem(rovers / "p10.pddl", d)))
     relaxed = Relaxed(ct)
     switching = SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=-1.0)  # switches after the first evaluation
     python = SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=float("inf"))  # never switches
@@ -255,8 +255,9 @@ def test_switching_to_the_compiled_ff_does_not_change_the_search() -> None:
 
 
 def plan_ipc(domain: str, problem: str) -> None:
-    d = pddl.read_domain(IPC / domain / "domain.pddl")
-    task = grounding.ground(d, pddl.read_problem(IPC / domain / f"{problem}.pddl", d))
+    folder = benchmark_set("ipc") / domain
+    d = pddl.read_domain(folder / "domain.pddl")
+    task = grounding.ground(d, pddl.read_problem(folder / f"{problem}.pddl", d))
     events = list(search_task(task, anytime=False, first=FirstSearch("lama")))
     plans = [e.plan for e in events if isinstance(e, Improved)]
     assert len(plans) == 1
@@ -288,8 +289,9 @@ def test_a_failing_compilation_keeps_the_pure_python_ff(monkeypatch: pytest.Monk
 
     monkeypatch.setattr(jit, "CompiledFF", Broken)
     monkeypatch.setattr(jit, "available", lambda: True)
-    d = pddl.read_domain(BENCHMARKS / "rovers" / "domain.pddl")
-    ct = compile_task(grounding.ground(d, pddl.read_problem(BENCHMARKS / "rovers" / "p05.pddl", d)))
+    rovers = benchmark_set("pddl") / "rovers"
+    d = pddl.read_domain(rovers / "domain.pddl")
+    ct = compile_task(grounding.ground(d, pddl.read_problem(rovers / "p05.pddl", d)))
     relaxed = Relaxed(ct)
     ff = jit.SwitchingFF(relaxed, relaxed.ff_add_unit, load_s=-1.0)
     states = random_states(ct, 20)
