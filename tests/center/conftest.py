@@ -28,7 +28,7 @@ def recorded_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
             "--stand-ins",
             "--crash",
             "r2@1",
-            "--max-time",
+            "--time-limit",
             "5",
             "--trace",
             str(path),
@@ -70,7 +70,7 @@ def written_trace(tmp_path: Path) -> Path:
 def blocks_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The blocks world demo: two manipulators, four blocks (a generated plan, object events of the blocks)."""
     folder = tmp_path_factory.mktemp("blocks")
-    _demo("blocksworld", "--agents", "2", "--blocks", "4", "--seed", "3", "--out", str(folder))
+    _demo("blocksworld", "--robots", "2", "--blocks", "4", "--seed", "3", "--out", str(folder))
     return folder / "trace.jsonl"
 
 
@@ -92,7 +92,7 @@ def lunar_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("lunar")
     _demo(  # the mission need not finish in 12 s (exit 1): the trace is what counts
         "lunar",
-        "--robots",
+        "--agents",
         "scout,stummel",
         "--samples",
         "3",

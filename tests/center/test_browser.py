@@ -200,7 +200,7 @@ def test_a_lunar_replay_shows_the_team_map_objects_and_found_samples(lunar_url: 
 def live_blocks() -> Iterator[Any]:
     """A blocks-world team planning under --review, served live."""
     _browser_or_skip()
-    with live_run(*BLOCKS, "--review", "--speed", "2", "--max-time", "600") as live:
+    with live_run(*BLOCKS, "--review", "--speed", "2", "--time-limit", "600") as live:
         yield live
 
 
@@ -259,7 +259,7 @@ def test_the_live_page_shows_the_team_updates_within_a_second_and_the_operator_r
 def replan_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A blocks demo with an opponent that makes the team replan (in a process of its own: OMPL's seed is per process)."""
     folder = tmp_path_factory.mktemp("replan")
-    command = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--agents", "2", "--blocks", "4"]
+    command = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--robots", "2", "--blocks", "4"]
     command += ["--opponents", "1", "--seed", "4", "--out", str(folder)]
     subprocess.run(command, check=True, capture_output=True, timeout=300)
     return folder / "trace.jsonl"
@@ -288,7 +288,7 @@ def test_the_live_page_of_a_team_of_processes_shows_its_agents_and_accepts_its_p
     _browser_or_skip()
     facts = "on(a, b) and ontable(b) and ontable(c) and clear(a) and clear(c) and handempty(r1) and handempty(r2)@0"
     team = [str(plans_dir() / "blocksworld" / "mission.yaml"), "--agents", "r1:Manipulator,r2:Manipulator"]
-    team += ["--stand-ins", "--fact", facts, "--processes", "--review", "--max-time", "60"]
+    team += ["--stand-ins", "--fact", facts, "--processes", "--review", "--time-limit", "60"]
     with live_run(*team) as live, _page(live.url, 1400, 1000) as page:
         page.wait_for_selector('#agents-body tr[data-agent="r1"]', timeout=20_000)
         page.wait_for_selector('#agents-body tr[data-agent="r2"]', timeout=20_000)

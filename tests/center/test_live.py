@@ -16,7 +16,7 @@ def _proposal(generation: int, error: bool = False):  # type: ignore[no-untyped-
 
 
 def test_the_operator_declines_changes_pins_and_accepts_a_plan_then_sets_a_goal() -> None:
-    with live_run(*BLOCKS, "--review", "--speed", "8", "--max-time", "400") as live:
+    with live_run(*BLOCKS, "--review", "--speed", "8", "--time-limit", "400") as live:
         hello = live.connect()
         assert hello["type"] == "hello"
         assert hello["meta"]["mode"] == "live"
@@ -87,7 +87,7 @@ def test_the_live_api_refuses_bad_input_and_requests_without_the_token() -> None
     from websockets.exceptions import InvalidStatus
     from websockets.sync.client import connect
 
-    with live_run(*BLOCKS, "--review", "--max-time", "60") as live:
+    with live_run(*BLOCKS, "--review", "--time-limit", "60") as live:
         assert live.request("", token=None)[0] == 403
         assert live.request("api/state", token=None)[0] == 403
         assert live.request("api/goal", {"problem": "StackBlocks", "goal": "on(a, b)"}, token="wrong")[0] == 403
@@ -120,7 +120,7 @@ def test_the_live_api_refuses_bad_input_and_requests_without_the_token() -> None
 
 def test_a_demo_serves_its_run_live_and_the_page_shows_the_end() -> None:
     with live_run(
-        "blocksworld", "--agents", "1", "--blocks", "2", "--seed", "1", "--speed", "50", command="demo"
+        "blocksworld", "--robots", "1", "--blocks", "2", "--seed", "1", "--speed", "50", command="demo"
     ) as live:
         live.connect()
         over = live.until_state(lambda s: not s["status"]["running"], timeout=120)
@@ -135,7 +135,7 @@ def test_a_demo_serves_its_run_live_and_the_page_shows_the_end() -> None:
 def test_with_json_the_address_goes_to_standard_error_and_standard_output_stays_json() -> None:
     import json
 
-    argv = ["demo", "blocksworld", "--agents", "1", "--blocks", "2", "--seed", "1", "--speed", "50", "--json"]
+    argv = ["demo", "blocksworld", "--robots", "1", "--blocks", "2", "--seed", "1", "--speed", "50", "--json"]
     with serving([*argv, "--center", "--center-port", "0"], stream="stderr") as (_, process):
         assert process.stdout is not None
         summary = json.loads(process.stdout.readline())  # the run's JSON line, written when the run ends

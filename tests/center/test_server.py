@@ -167,7 +167,7 @@ def test_the_start_up_line_names_the_real_port_and_the_page_loads(recorded_trace
 def test_a_blocks_world_demo_trace_replays(tmp_path: Path) -> None:
     from alica.app.cli import main
 
-    assert main(["demo", "blocksworld", "--agents", "2", "--blocks", "3", "--seed", "1", "--out", str(tmp_path)]) == 0
+    assert main(["demo", "blocksworld", "--robots", "2", "--blocks", "3", "--seed", "1", "--out", str(tmp_path)]) == 0
     client = _client(tmp_path / "trace.jsonl")
     client.cookies.set(COOKIE, TOKEN)
     meta = client.get("/api/meta").json()

@@ -42,7 +42,7 @@ def _plan_shared(e: dict[str, Any]) -> bool:
 
 
 def test_a_team_of_processes_is_shown_live_until_it_ends() -> None:
-    with live_run(*TEAM, "--processes", "--crash", "r2@2.5", "--recover", "r2@3.5", "--max-time", "40") as live:
+    with live_run(*TEAM, "--processes", "--crash", "r2@2.5", "--recover", "r2@3.5", "--time-limit", "40") as live:
         hello = live.connect()
         assert hello["type"] == "hello" and hello["meta"]["mode"] == "live"
         assert hello["meta"]["agents"] == ["r1", "r2"]
@@ -68,7 +68,7 @@ def test_a_team_of_processes_is_shown_live_until_it_ends() -> None:
 
 
 def test_the_operator_reviews_the_plans_of_a_team_of_processes() -> None:
-    with live_run(*TEAM, "--processes", "--review", "--max-time", "40") as live:
+    with live_run(*TEAM, "--processes", "--review", "--time-limit", "40") as live:
         live.connect()
         first = live.until(_proposal, timeout=20)
         assert first["generation"] == 1 and first["steps"]
@@ -116,7 +116,7 @@ def _agents(*extra: str) -> Iterator[list[str]]:
     try:
         for index, name in enumerate(("r1", "r2")):
             argv = [sys.executable, "-m", "alica.app.cli", "agent", *TEAM, "--name", name, "--start-at", start]
-            argv += ["--listen", endpoints[index], "--max-time", "40", "--review", "--json", *extra]
+            argv += ["--listen", endpoints[index], "--time-limit", "40", "--review", "--json", *extra]
             if index:
                 argv += ["--connect", endpoints[0]]
             processes.append(

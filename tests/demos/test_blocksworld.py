@@ -31,7 +31,7 @@ def test_with_an_opponent_the_goal_is_still_reached_after_replanning():
             "alica.app.cli",
             "demo",
             "blocksworld",
-            "--agents",
+            "--robots",
             "2",
             "--opponents",
             "1",
@@ -110,7 +110,7 @@ def test_the_same_seed_gives_the_same_trace(hash_seed, tmp_path):
 def test_small_demo_reports_the_steps_each_agent_carried_out(capsys):
     from alica.app.cli import main
 
-    code = main(["demo", "blocksworld", "--agents", "2", "--blocks", "3", "--seed", "1", "--json", "--no-progress"])
+    code = main(["demo", "blocksworld", "--robots", "2", "--blocks", "3", "--seed", "1", "--json", "--no-progress"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["success"], summary
     # start [[a], [b, c]], goal [[a], [b], [c]]: one robot unstacks c and puts it down, as one task
@@ -178,7 +178,7 @@ def test_a_leader_restarted_while_the_team_plans_rejoins_and_the_goal_is_reached
     # the restarted r1 leads again before it knows the team's plans: it used to reuse a plan name
     # (KeyError: "plan 'StackBlocks_g2v1' has no state 'T1_S0_Unstack'") or plan for the mission's own goal
     run, summary = _demo_cli(
-        "--agents",
+        "--robots",
         "3",
         "--blocks",
         "5",
@@ -197,7 +197,7 @@ def test_a_leader_restarted_while_the_team_plans_rejoins_and_the_goal_is_reached
 
 
 def test_demo_fault_options_are_checked():
-    run, _ = _demo_cli("--agents", "2", "--crash", "r3@2")
+    run, _ = _demo_cli("--robots", "2", "--crash", "r3@2")
     assert run.returncode == 1 and "--crash: 'r3' is not a team robot; the team is r1, r2" in run.stderr
     run, _ = _demo_cli("--recover", "r1")
     assert run.returncode == 1 and "--recover: 'r1' is not of the form WHAT@T" in run.stderr

@@ -87,11 +87,11 @@ def test_goal_crash_and_kind_names():
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--robots", "scout,robby"], "name each of scout, stummel, amparo at most once"),
+        (["--agents", "scout,robby"], "name each of scout, stummel, amparo at most once"),
         (["--collect", "green-pink-red"], "unknown kind(s) green-pink-red"),
         (["--goal", "on(a, g)"], "at(sample, g)"),
         (["--crash", "amparo@soon"], "neither seconds nor 'grasp'"),
-        (["--robots", "scout,stummel", "--crash", "amparo@3"], "'amparo' is not in the team"),
+        (["--agents", "scout,stummel", "--crash", "amparo@3"], "'amparo' is not in the team"),
         (["--partition", "scout|robby@1-5"], "robby not in the team"),
         (["--loss", "1.5"], "--loss must be a probability"),
         (["--time-limit", "0"], "--time-limit must be a positive"),

@@ -84,7 +84,7 @@ def _disagreement(trace_path) -> str | None:
 
 def test_lunar_at_loss_0_5_with_a_crash_succeeds(tmp_path, capsys):
     trace = tmp_path / "run.jsonl"
-    args = [*LUNAR_RUN, "--crash", "scout@2", "--loss", "0.5", "--seed", "2", "--max-time", "120"]
+    args = [*LUNAR_RUN, "--crash", "scout@2", "--loss", "0.5", "--seed", "2", "--time-limit", "120"]
     code = main([*args, "--trace", str(trace), "--json"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0, summary
@@ -95,7 +95,7 @@ def test_lunar_at_loss_0_5_with_a_crash_succeeds(tmp_path, capsys):
 @pytest.mark.parametrize("seed", [2, 7, 9])
 def test_lunar_at_loss_0_8_ends_with_success_or_a_reason_and_no_disagreement(tmp_path, capsys, seed):
     trace = tmp_path / "run.jsonl"
-    args = [*LUNAR_RUN, "--crash", "scout@2", "--loss", "0.8", "--seed", str(seed), "--max-time", "150"]
+    args = [*LUNAR_RUN, "--crash", "scout@2", "--loss", "0.8", "--seed", str(seed), "--time-limit", "150"]
     code = main([*args, "--trace", str(trace), "--json"])
     summary = json.loads(capsys.readouterr().out)
     assert summary["done"], summary

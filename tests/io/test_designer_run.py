@@ -62,7 +62,7 @@ def test_alica_run_with_stand_ins_and_facts(out: Path, tmp_path: Path, capsys: p
     argv = ["run", str(mission), "--name", "AdjacentSuccessSubPlan", "--agents", "a:Attacker", "--stand-ins", "--json"]
     try:
         # without the conditions' facts the agent waits in its first state
-        assert main([*argv, "--max-time", "3"]) == 1
+        assert main([*argv, "--time-limit", "3"]) == 1
         waiting = json.loads(capsys.readouterr().out)
         assert waiting["agents"]["a"]["path"] == "AdjacentSuccessSubPlan:EntryState"
         # Entry2Wait at 1 s, Wait2Suc at 2 s: the plan reaches its success state

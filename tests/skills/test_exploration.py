@@ -346,7 +346,7 @@ def test_the_explore_plan_runs_from_the_command_line(capsys):
 
     argv = ["run", str(plans_dir() / "skills" / "explore.yaml"), "--agents", "scout:Scout,stummel:Stummel"]
     argv += ["--world", "lunar", "--size", "12", "--rocks", "4", "--samples", "0", "--seed", "1", "--json"]
-    code = main([*argv, "--max-time", "120"])
+    code = main([*argv, "--time-limit", "120"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["success"], summary
     assert {"BuildMap", "Localize", "ExploreFrontier"} <= set(summary["skills"]["real"])
@@ -361,7 +361,7 @@ def test_when_the_mapper_crashes_the_other_robot_finishes_the_exploration(capsys
 
     argv = ["run", str(plans_dir() / "skills" / "explore.yaml"), "--agents", "scout:Scout,stummel:Stummel"]
     argv += ["--world", "lunar", "--size", "12", "--rocks", "4", "--samples", "0", "--seed", "1", "--json"]
-    code = main([*argv, "--crash", "scout@3", "--loss", "0.1", "--max-time", "200"])
+    code = main([*argv, "--crash", "scout@3", "--loss", "0.1", "--time-limit", "200"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["success"], summary
     agents = summary["agents"]

@@ -238,7 +238,7 @@ def test_a_skill_that_acts_on_a_robot_needs_a_world(project: Path, capsys: pytes
 
 def test_alica_run_with_a_blocks_world_runs_a_real_skill(project: Path, capsys: pytest.CaptureFixture[str]) -> None:
     path = plan(project, "MoveToPosition", "{goal: [0.6, -1.6]}")
-    code, out, err = cli(capsys, "run", path, "--agents", "ann:Worker", "--world", "blocks", "--max-time", "20")
+    code, out, err = cli(capsys, "run", path, "--agents", "ann:Worker", "--world", "blocks", "--time-limit", "20")
     assert code == 0, out + err
     assert out.startswith("Job: success after") and "real skills in the blocks world: MoveToPosition" in out
     code, _, err = cli(capsys, "run", path, "--agents", "ann:Worker", "--world", "lunar", "--rocks", "0")

@@ -502,7 +502,7 @@ def test_the_semantic_perception_plan_runs_from_the_command_line(capfd, teams, s
         assert math.dist(world.robots["amparo"].pose[:2], xy) < 2.8  # within the 3 m of the cloud
     plan = Path(__file__).resolve().parents[2] / "plans" / "skills" / "semantic_perception.yaml"
     args = ["run", str(plan), "--agents", "amparo:Amparo", "--world", "lunar", "--size", "10", "--rocks", "2"]
-    code = main([*args, "--samples", "1", "--seed", str(seed), "--max-time", "30", "--json"])
+    code = main([*args, "--samples", "1", "--seed", str(seed), "--time-limit", "30", "--json"])
     summary = json.loads(capfd.readouterr().out)
     assert code == 0, summary
     agent = summary["agents"]["amparo"]

@@ -476,7 +476,7 @@ def test_the_verify_plan_runs_from_the_command_line(capfd, teams, agents, seed):
     robot = agents.split(":")[0]
     kind, xy = _sample_near(seed, robot)
     args = ["run", PLAN, "--agents", agents, "--world", "lunar", "--size", "10", "--rocks", "2", "--samples", "1"]
-    code = main([*args, "--seed", str(seed), "--max-time", "30", "--json"])
+    code = main([*args, "--seed", str(seed), "--time-limit", "30", "--json"])
     summary = json.loads(capfd.readouterr().out)
     assert code == 0, summary
     assert summary["agents"][robot]["path"] == "Verify2DObject:ValidCandidate"

@@ -146,7 +146,7 @@ def test_a_bad_world_file_names_its_line(capsys, tmp_path):
 def test_the_formation_runs_and_the_trace_shows_the_solved_spots(capsys, tmp_path):
     trace = tmp_path / "run.jsonl"
     args = ["run", str(PLANS / "examples" / "formation.yaml"), "--agents", "r1:Robot,r2:Robot,r3:Robot"]
-    code, out, _ = run(capsys, *args, "--stand-ins", "--trace", str(trace), "--max-time", "60")
+    code, out, _ = run(capsys, *args, "--stand-ins", "--trace", str(trace), "--time-limit", "60")
     assert code == 0, out
     events = [json.loads(line) for line in trace.read_text().splitlines()]
     solved = [e for e in events if e["event"] == "solve"]
