@@ -44,7 +44,7 @@ def demo_argv(agents: int, opponents: int, blocks: int, seed: int, time_limit: f
         "alica.app.cli",
         "demo",
         "blocksworld",
-        "--agents",
+        "--robots",
         str(agents),
         "--opponents",
         str(opponents),

@@ -454,7 +454,7 @@ class Replay:
 
 def make_demo_trace(path: Path, agents: int, timeout: float) -> None:
     with tempfile.TemporaryDirectory() as out:
-        args = ["demo", "blocksworld", "--agents", str(agents), "--opponents", "4", "--blocks", "8", "--seed", "0"]
+        args = ["demo", "blocksworld", "--robots", str(agents), "--opponents", "4", "--blocks", "8", "--seed", "0"]
         start = time.monotonic()
         result = run_bounded([*args, "--out", out, "--no-progress"], timeout)
         made = Path(out) / "trace.jsonl"

@@ -39,7 +39,7 @@ def one_run(variant: str, seconds: float) -> tuple[list[dict[str, Any]], int]:
     from alica.app.processes import ProcessTeam
     from alica.comm.center_feed import CenterLink
 
-    options = ["--stand-ins", "--fact", "found(a) and found(b)@3", "--max-time", str(seconds)]
+    options = ["--stand-ins", "--fact", "found(a) and found(b)@3", "--time-limit", str(seconds)]
     if variant == "off":
         options.append("--no-center-feed")
     received = [0]
@@ -62,7 +62,7 @@ def one_run(variant: str, seconds: float) -> tuple[list[dict[str, Any]], int]:
             team.run([], seconds + 5.0, on_started=connect)
             while team.now() < seconds + 5.0 and not team.all_down():
                 team.exited()
-                time.sleep(0.1)  # the agents stop by themselves at --max-time
+                time.sleep(0.1)  # the agents stop by themselves at --time-limit
         finally:
             team.stop()
             if link is not None:

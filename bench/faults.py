@@ -3,7 +3,7 @@
 Run with ``.venv/bin/python bench/faults.py [--seeds 10] [--jobs 2] [--case NAME]``.
 Every run is ``alica run plans/lunar/mission.yaml --agents scout,stummel,amparo
 --stand-ins --fact "found(a) and found(b)@5"`` plus the case's faults, in its
-own process (``python -m alica.app.cli``), up to ``--max-time`` simulated
+own process (``python -m alica.app.cli``), up to ``--time-limit`` simulated
 seconds (and a wall-clock guard). From its ``--json`` summary and its trace,
 each run is classified:
 
@@ -203,7 +203,7 @@ def run_one(case: str, seed: int, max_time: float, wall: float) -> Outcome:
     root, success_of, maxima, required = _plan_facts()
     with tempfile.TemporaryDirectory() as tmp:
         trace = os.path.join(tmp, "run.jsonl")
-        args = [*BASE, *CASES[case], "--seed", str(seed), "--max-time", str(max_time), "--json", "--trace", trace]
+        args = [*BASE, *CASES[case], "--seed", str(seed), "--time-limit", str(max_time), "--json", "--trace", trace]
         try:
             proc = subprocess.run(
                 [sys.executable, "-m", "alica.app.cli", *args],

@@ -38,7 +38,7 @@ seeds 0..N-1): there a teammate is lost when it has been silent for the team
 timeout (no liveliness tokens), and the world digests are taken after every
 tick.
 
-Each run is bounded (``--max-time`` wall seconds for the agents, plus a
+Each run is bounded (``--time-limit`` wall seconds for the agents, plus a
 guard); every process is stopped in ``finally``; a failed run is counted and
 its error printed under the tables. Progress lines go to standard error.
 """
@@ -101,7 +101,7 @@ def process_run(kind: str, victim: str | None, args: argparse.Namespace, keep: P
         workdir = Path(tmp)
         team = None
         try:
-            options = ["--stand-ins", "--max-time", str(args.max_time)]
+            options = ["--stand-ins", "--time-limit", str(args.max_time)]
             if kind == "crash":
                 options += ["--fact", COMMON_FACT]
                 own = None
@@ -577,7 +577,7 @@ def cpu_table(sizes: list[int], seconds: float) -> None:
         roster = ",".join(f"r{i}:{('Scout', 'Stummel', 'Amparo')[i % 3]}" for i in range(n))
         argv = [sys.executable, "-m", "alica.app.cli", "run", PLAN, "--stand-ins", "--agents", roster]
         out = subprocess.run(
-            [*argv, "--processes", "--max-time", str(seconds), "--json"], capture_output=True, text=True, check=False
+            [*argv, "--processes", "--time-limit", str(seconds), "--json"], capture_output=True, text=True, check=False
         ).stdout
         try:
             summary = json.loads(out)

@@ -145,6 +145,7 @@ def _plans_with(tmp_path: Path, condition: str) -> Path:
     """A copy of the shipped plans whose lunar mission has ``condition`` for SamplesFound."""
     root = tmp_path / "plans"
     shutil.copytree(PLANS, root)
+    (root / ".alica-project").write_text("", encoding="utf-8")  # the copy is a project: its files import each other
     mission = root / "lunar" / "mission.yaml"
     text = mission.read_text(encoding="utf-8")
     old = '{to: SamplesFound, condition: "found(a) and found(b)"}'
@@ -156,7 +157,7 @@ def _plans_with(tmp_path: Path, condition: str) -> Path:
 def test_a_long_chain_validates_and_runs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.chdir(tmp_path)  # the copied plans are the project: their imports reach its folder
+    monkeypatch.chdir(tmp_path)
     mission = _plans_with(tmp_path, "found(a) and found(b) and " + chain(" + ", "1", 5000) + " > 0")
     assert main(["validate", str(mission)]) == 0, capsys.readouterr().err
     argv = ["run", str(mission), "--stand-ins", "--agents", "scout,stummel,amparo", "--ticks", "3"]
