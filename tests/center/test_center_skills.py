@@ -17,35 +17,11 @@ from starlette.testclient import TestClient
 
 from alica.app.center.team_view import TeamView
 from alica.app.cli import main
+from tests.skills.test_plugins import COUNTER
 
 from .conftest import TOKEN
 
-SKILL_MODULE = """
-import py_trees
-from py_trees.common import Status
-
-from alica import ParamSpec
-
-
-class CountTicks(py_trees.behaviour.Behaviour):
-    def __init__(self, name, params, context):
-        super().__init__(name)
-        self.times = int(params.get("times", 3))
-        self.context = context
-        self.ticks = 0
-
-    def update(self):
-        self.ticks += 1
-        if self.ticks < self.times:
-            return Status.RUNNING
-        self.context.world_model.assert_fact("counted", self.context.agent)
-        return Status.SUCCESS
-
-
-def register(registry):
-    registry.declare_predicate("counted", 1, "the agent counted its ticks")
-    registry.declare("CountTicks", ParamSpec("times", "int", required=False, default=3), implementation=CountTicks)
-"""
+SKILL_MODULE = COUNTER  # a plug-in module: CountTicks, which writes counted(agent)
 
 TASKS = """
 alica: 1
