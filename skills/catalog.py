@@ -36,18 +36,25 @@ def _p(name: str, type: str, doc: str, *, default: object = None, required: bool
     return ParamSpec(name, type, required, None if required else default, doc)
 
 
-def _composite(registry: SkillRegistry) -> None:
-    registry.declare(
-        "MoveToPosition",
+def _drive_params() -> tuple[ParamSpec, ...]:
+    """The parameters of MoveToPosition and DriveTo: one implementation runs both."""
+    return (
         _p("goal", "position", "where to drive: [x, y], [x, y, z] or a term such as pos(a)"),
         _p("tolerance", "float", "distance in metres at which the goal counts as reached", default=0.3),
-        _p("timeout", "float", "seconds before the skill gives up", default=60.0),
+        _p("timeout", "float", "seconds from the start before the skill gives up", default=60.0),
         _p(
             "at",
             "object",
             "the object or place driven to: on arrival the skill writes at(robot, at) (a goal given as pos(x) does too)",
             required=False,
         ),
+    )
+
+
+def _composite(registry: SkillRegistry) -> None:
+    registry.declare(
+        "MoveToPosition",
+        *_drive_params(),
         doc="drive to a goal position, escaping into free space when stuck (Fig. 8)",
         capabilities=("base",),
         implementation="alica.skills.navigation:MoveToPosition",
@@ -115,15 +122,7 @@ def _free_space_params(keep_away: str) -> tuple[ParamSpec, ...]:
 def _navigation(registry: SkillRegistry) -> None:
     registry.declare(
         "DriveTo",
-        _p("goal", "position", "where to drive: [x, y], [x, y, z] or a term such as pos(a)"),
-        _p("tolerance", "float", "distance in metres at which the goal counts as reached", default=0.3),
-        _p("timeout", "float", "seconds without progress before the skill fails", default=60.0),
-        _p(
-            "at",
-            "object",
-            "the object or place driven to: on arrival the skill writes at(robot, at) (a goal given as pos(x) does too)",
-            required=False,
-        ),
+        *_drive_params(),
         doc="follow a collision-free path to a goal; fails when stuck",
         capabilities=("base",),
         implementation="alica.skills.navigation:MoveToPosition",
