@@ -12,7 +12,7 @@ from heapq import heappop, heappush
 
 from alica.prophet.planner import Progress
 from alica.prophet.search.encoding import CompiledTask
-from alica.prophet.search.gbfs import Stats, trace
+from alica.prophet.search.gbfs import Stats, loop_setup, trace
 from alica.prophet.search.heuristics import INF, Evaluator
 
 
@@ -38,10 +38,8 @@ def astar(
         operator ids) or ``None``; ``exhausted`` when none exists (not when the
         budget ran out).
     """
-    successor = ct.successor
-    applicable = ct.applicable
-    op_cost = ct.cost
-    gm = ct.goal_mask
+    setup = loop_setup(ct)
+    successor, applicable, op_cost, gm = setup.successor, setup.applicable, setup.op_cost, setup.goal_mask
     init = ct.init
     h0 = evaluate(init)[0]
     stats.evaluations += 1

@@ -19,7 +19,7 @@ ids) or ``None``, and whether the open lists ran dry; use
 from __future__ import annotations
 
 import random
-from collections.abc import Generator
+from collections.abc import Callable, Generator, Sequence
 from dataclasses import dataclass
 from heapq import heappop, heappush
 
@@ -81,6 +81,34 @@ class Stats:
         return False
 
 
+@dataclass(frozen=True, slots=True)
+class LoopSetup:
+    """What every search loop reads before it starts: the task's hot members (the loop binds them
+    to locals), the weighting and the successor shuffle."""
+
+    successor: Callable[[int, int], int]
+    applicable: Callable[[int], list[int]]
+    op_cost: Sequence[int]
+    goal_mask: int
+    greedy: bool
+    w: float
+    shuffle: Callable[[list[int]], None] | None
+
+
+def loop_setup(ct: CompiledTask, weight: float | None = None, seed: int | None = None) -> LoopSetup:
+    """The shared preamble of :func:`lazy_search`, :func:`~alica.prophet.search.lama.lama_search`
+    and :func:`~alica.prophet.search.astar.astar`."""
+    return LoopSetup(
+        ct.successor,
+        ct.applicable,
+        ct.cost,
+        ct.goal_mask,
+        weight is None,
+        1.0 if weight is None else float(weight),
+        random.Random(seed).shuffle if seed is not None else None,
+    )
+
+
 def trace(parent: dict[int, tuple[int, int]], state: int) -> list[int]:
     """The operators leading to ``state`` through the ``parent`` links (op -1 marks the start)."""
     ops: list[int] = []
@@ -125,12 +153,9 @@ def lazy_search(
         that no plan cheaper than ``bound`` exists), not when the expansion
         budget did.
     """
-    successor = ct.successor
-    applicable = ct.applicable
-    op_cost = ct.cost
-    gm = ct.goal_mask
-    greedy = weight is None
-    w = 1.0 if weight is None else float(weight)
+    setup = loop_setup(ct, weight, seed)
+    successor, applicable, op_cost, gm = setup.successor, setup.applicable, setup.op_cost, setup.goal_mask
+    greedy, w, shuffle = setup.greedy, setup.w, setup.shuffle
     parent: dict[int, tuple[int, int]] = {}
     closed_g: dict[int, int] = {}
     cache: dict[int, tuple[float, list[int]]] = {}
@@ -140,7 +165,6 @@ def lazy_search(
     count = 0
     expanded = 0
     best_h = INF
-    shuffle = random.Random(seed).shuffle if seed is not None else None
     entry: tuple[float, int, int, int, int] | None = (0.0, 0, -1, -1, 0)
     while True:
         if entry is None:

@@ -21,13 +21,12 @@ the state is popped. Closed states are never reopened (greedy search).
 
 from __future__ import annotations
 
-import random
 from collections.abc import Generator
 from heapq import heappop, heappush
 
 from alica.prophet.planner import Progress
 from alica.prophet.search.encoding import CompiledTask
-from alica.prophet.search.gbfs import Stats, trace
+from alica.prophet.search.gbfs import Stats, loop_setup, trace
 from alica.prophet.search.heuristics import INF, Evaluator
 from alica.prophet.search.landmarks import LandmarkCount
 
@@ -59,12 +58,9 @@ def lama_search(
     Returns:
         ``(plan, exhausted)`` as :func:`~alica.prophet.search.gbfs.lazy_search` does.
     """
-    successor = ct.successor
-    applicable = ct.applicable
-    op_cost = ct.cost
-    gm = ct.goal_mask
-    greedy = weight is None
-    w = 1.0 if weight is None else float(weight)
+    setup = loop_setup(ct, weight, seed)
+    successor, applicable, op_cost, gm = setup.successor, setup.applicable, setup.op_cost, setup.goal_mask
+    greedy, w, shuffle = setup.greedy, setup.w, setup.shuffle
     progress = lmcount.progress
     needed_of = lmcount.needed
     lm_preferred = lmcount.preferred
@@ -79,7 +75,6 @@ def lama_search(
     expanded = 0
     best_ff = INF
     best_lm = INF
-    shuffle = random.Random(seed).shuffle if seed is not None else None
     entry: tuple[float, int, int, int, int] | None = (0.0, 0, -1, -1, 0)
     while True:
         if entry is None:
