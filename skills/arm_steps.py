@@ -52,7 +52,7 @@ ON_GROUND = 0.03
 
 def _scratch(skill: WorldSkill) -> dict[str, Any]:
     """The agent's scratch space (an own dict when the context has none)."""
-    scratch = getattr(skill.context, "scratch", None)
+    scratch = skill.context.scratch if skill.context is not None else None
     if scratch is None:
         scratch = skill.__dict__.setdefault("_own_scratch", {})
     return cast("dict[str, Any]", scratch)

@@ -65,7 +65,7 @@ def find_object(skill: WorldSkill, name: object) -> WorldThing:
         SkillError: no such object, and none where the world model puts ``name``.
     """
     objects = skill.world.objects
-    names = getattr(skill.context, "scratch", {}).get("names")  # what Grasp took under this name
+    names = (skill.context.scratch if skill.context is not None else {}).get("names")  # what Grasp took under this name
     if isinstance(name, str) and isinstance(names, dict) and names.get(name) in objects:
         return objects[names[name]]
     if isinstance(name, str) and name not in objects and skill.world_model is not None:

@@ -13,9 +13,25 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Protocol
 
+from alica.errors import AlicaError
+from alica.lang.belief import BeliefBase
 from alica.worldmodel.protocol import WorldModelLike
 
-__all__ = ["SkillContextLike", "SkillEnv"]
+__all__ = ["SkillContextLike", "SkillEnv", "SolveAnswer"]
+
+
+class SolveAnswer(Protocol):
+    """What a constraint query answers (the engine's :class:`~alica.engine.solving.SolveResult`)."""
+
+    @property
+    def ok(self) -> bool:
+        """Whether there are values."""
+        ...
+
+    @property
+    def values(self) -> Mapping[str, object]:
+        """This agent's values, by variable name."""
+        ...
 
 
 class SkillContextLike(Protocol):
@@ -52,6 +68,24 @@ class SkillContextLike(Protocol):
         ...
 
     @property
+    def belief(self) -> BeliefBase | None:
+        """The agent's whole belief base (the engine's: teammates' roles and liveness too), or None alone."""
+        ...
+
+    @property
+    def solver(self) -> Callable[[tuple[str, ...]], SolveAnswer] | None:
+        """The engine's constraint query for this behaviour; None outside an engine (see :meth:`solve`)."""
+        ...
+
+    def solve(self, *names: str) -> SolveAnswer:
+        """The values the constraint solver gives the behaviour's variables ``names`` now.
+
+        Raises:
+            AlicaError: the skill runs outside an engine (:attr:`solver` is None).
+        """
+        ...
+
+    @property
     def scratch(self) -> dict[str, object]:
         """The agent's own scratch space, shared by its behaviours and never sent to the team.
 
@@ -75,6 +109,8 @@ class SkillEnv:
         world_model: the world model, or None (what the skill writes goes nowhere).
         extra: run options.
         scratch: the agent's scratch space (see :attr:`SkillContextLike.scratch`).
+        belief: the agent's belief base, or None.
+        solver: a constraint query, or None (no engine: :meth:`solve` raises).
     """
 
     agent: str
@@ -84,8 +120,26 @@ class SkillEnv:
     world_model: WorldModelLike | None = None
     extra: Mapping[str, object] = field(default_factory=dict)
     scratch: dict[str, object] = field(default_factory=dict)
+    belief: BeliefBase | None = None
+    solver: Callable[[tuple[str, ...]], SolveAnswer] | None = None
+
+    def solve(self, *names: str) -> SolveAnswer:
+        """The solver's values for ``names`` (see :meth:`SkillContextLike.solve`)."""
+        if self.solver is None:
+            raise AlicaError(f"'{self.agent}' runs outside an engine: there are no constraints to solve")
+        return self.solver(tuple(names))
 
     @classmethod
     def without_world_model(cls, context: SkillContextLike) -> SkillEnv:
         """``context`` with the same agent, clock, generator, world, options and scratch space, but no world model."""
-        return cls(context.agent, context.now, context.rng, context.world, None, dict(context.extra), context.scratch)
+        return cls(
+            context.agent,
+            context.now,
+            context.rng,
+            context.world,
+            None,
+            dict(context.extra),
+            context.scratch,
+            context.belief,
+            context.solver,
+        )

@@ -57,7 +57,7 @@ class DriveToDroppedSample(MoveToPosition):
         self._look()
 
     def _look(self) -> bool:
-        belief = getattr(self.context, "belief", None)
+        belief = self.context.belief if self.context is not None else None
         dropped = dropped_samples(self.world_model, belief)
         self.next_look = self.now() + self.period
         if not dropped:
@@ -73,8 +73,10 @@ class DriveToDroppedSample(MoveToPosition):
     def _viewpoint(self, sample: str, holder: str, seen: tuple[float, float]) -> tuple[float, float]:
         """The next place to look from: ``distance`` from the sample, away from the holder first."""
         reach = float(self.param("distance", 1.5))  # type: ignore[arg-type]
-        views = getattr(self.context, "scratch", None)
-        tries = views.setdefault("dropped_views", {}) if views is not None else {}
+        views = self.context.scratch if self.context is not None else {}
+        tries = views.setdefault("dropped_views", {})
+        if not isinstance(tries, dict):  # another skill's data under this key: keep count here only
+            tries = {}
         turn = int(tries.get(sample, 0))
         tries[sample] = turn + 1
         wm = self.world_model

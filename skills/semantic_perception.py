@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import abc
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -545,10 +545,8 @@ class FuzzyDLClassify(PipelineSkill):
         wm = self.world_model
         if wm is None:
             return
-        add_object: Callable[[object, str], object] | None = getattr(wm, "add_object", None)
         for d in detections:
-            if add_object is not None:
-                add_object(d.sample, SAMPLE_TYPE)
+            wm.add_object(d.sample, SAMPLE_TYPE)
             wm.set("pos", d.sample, value=(round(d.position[0], 3), round(d.position[1], 3)))
             wm.set("confidence", d.sample, value=round(d.confidence, 3))
             wm.assert_fact("found", d.sample)

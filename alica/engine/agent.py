@@ -41,6 +41,7 @@ from alica.engine.team import (
 from alica.errors import AlicaError
 from alica.lang import FactBase, Registry
 from alica.model import Behaviour, ChildRef, Plan, PlanLibrary, RoleSet, Transition
+from alica.worldmodel import Delta, ReplicaLike
 
 Observer = Callable[[dict[str, Any]], None]
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
@@ -96,7 +97,7 @@ class AgentEngine:
         plan: str,
         roleset: RoleSet,
         transport: Transport,
-        world_model: Any,
+        world_model: ReplicaLike,
         clock: Clock,
         config: EngineConfig | None = None,
         skills: SkillBinder | None = None,
@@ -173,9 +174,7 @@ class AgentEngine:
         """The transport reports who is alive (liveliness tokens): a teammate gone is taken out at once."""
         self._peers: frozenset[str] = frozenset()
         self._greeted: set[str] = set()
-        self._refresh = getattr(world_model, "refresh", None)
-        if hasattr(world_model, "on_change"):
-            world_model.on_change(self._on_world_change)
+        world_model.on_change(self._on_world_change)
 
     def _on_world_change(self, keys: object) -> None:
         self._world_changed = True
@@ -224,7 +223,8 @@ class AgentEngine:
             if topic == SYNC_TOPIC and isinstance(payload, SyncTalk):
                 self._receive_sync(payload, now)
             elif topic == WORLD_TOPIC:
-                self.world_model.merge(payload)
+                if isinstance(payload, Delta):  # anything else is no world: dropped, never merged
+                    self.world_model.merge(payload)
             elif topic in self.children.routes:
                 self.children.routes[topic].receive(payload, now)
         if authority:
@@ -268,8 +268,7 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self._invalidate_all()
-        if self._refresh is not None:
-            self._refresh()  # values whose time to live ran out
+        self.world_model.refresh()  # values whose time to live ran out
         if self._world_changed:
             # utilities with summands read the world: allocate those plans again
             self._world_changed = False

@@ -22,10 +22,12 @@ import py_trees
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError, UnknownSkillError
 from alica.model import Behaviour
+from alica.worldmodel import WorldModelLike
 
 if TYPE_CHECKING:
     from alica.engine.belief import AgentBelief
     from alica.engine.conditions import Formulas
+    from alica.engine.solving import SolveResult
 
 logger = logging.getLogger(__name__)
 
@@ -57,17 +59,17 @@ class SkillContext:
 
     agent: str
     now: Callable[[], float]
-    world_model: Any
-    belief: AgentBelief
+    world_model: WorldModelLike | None
+    belief: AgentBelief | None
     rng: random.Random
     world: object | None = None
     behaviour: Behaviour | None = None
     path: str = ""
     extra: dict[str, object] = field(default_factory=dict)
-    solver: Callable[[tuple[str, ...]], Any] | None = None
+    solver: Callable[[tuple[str, ...]], SolveResult] | None = None
     scratch: dict[str, object] = field(default_factory=dict)
 
-    def solve(self, *names: str) -> Any:
+    def solve(self, *names: str) -> SolveResult:
         """The values the constraint solver gives the behaviour's variables ``names`` now.
 
         Returns:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from alica.worldmodel.delta import Add, Delta, Digest, Key, Write
 from alica.worldmodel.encoding import order_key
-from alica.worldmodel.protocol import WorldModelLike
+from alica.worldmodel.protocol import ReplicaLike, WorldModelLike
 from alica.worldmodel.replica import Replica
 from alica.worldmodel.stamp import LamportClock, Stamp
 from alica.worldmodel.state import ReplicaState
@@ -30,6 +30,7 @@ __all__ = [
     "Key",
     "LamportClock",
     "Replica",
+    "ReplicaLike",
     "ReplicaState",
     "Stamp",
     "WorldModel",

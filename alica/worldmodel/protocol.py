@@ -8,12 +8,14 @@ out as :class:`~alica.lang.fact.Fact`.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol, runtime_checkable
 
 from alica.lang.fact import Fact
+from alica.worldmodel.delta import Delta, Key
 from alica.worldmodel.stamp import Stamp
 
-__all__ = ["WorldModelLike"]
+__all__ = ["ReplicaLike", "WorldModelLike"]
 
 
 @runtime_checkable
@@ -48,6 +50,18 @@ class WorldModelLike(Protocol):
         """Add ``item`` to the set ``name``; whether it is new."""
         ...
 
+    def add_object(self, obj: object, type_name: str) -> bool:
+        """Make ``obj`` an object of ``type_name`` (for quantifiers); whether it is new."""
+        ...
+
+    def on_change(self, callback: Callable[[frozenset[Key]], None]) -> Callable[[], None]:
+        """Call ``callback(changed_keys)`` after every write or merge that changes something; returns the unsubscriber."""
+        ...
+
+    def refresh(self) -> frozenset[Key]:
+        """Drop values whose time to live ran out (once per engine tick); the registers that went stale."""
+        ...
+
     def members(self, name: str) -> frozenset[object]:
         """The members of the set ``name``."""
         ...
@@ -66,4 +80,21 @@ class WorldModelLike(Protocol):
 
     def values(self) -> list[tuple[str, tuple[object, ...], object]]:
         """Live function values (not truth values) as ``(name, args, value)``, sorted."""
+        ...
+
+
+@runtime_checkable
+class ReplicaLike(WorldModelLike, Protocol):
+    """A world model the engine replicates over the team: what it publishes and what it merges."""
+
+    def take_delta(self) -> Delta | None:
+        """What changed here since the last call (``None``: nothing)."""
+        ...
+
+    def snapshot(self) -> Delta:
+        """Everything this replica holds, for a teammate that joins or missed deltas."""
+        ...
+
+    def merge(self, delta: Delta) -> frozenset[Key]:
+        """Merge a delta or snapshot from any replica; the keys that changed."""
         ...

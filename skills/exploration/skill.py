@@ -30,7 +30,7 @@ never the true pose.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from py_trees.common import Status
@@ -40,6 +40,7 @@ from alica.skills.context import SkillContextLike
 from alica.skills.exploration.frontiers import FrontierCandidate, extract_frontiers
 from alica.skills.exploration.maps import current_map
 from alica.skills.world_skill import WorldSkill, distance
+from alica.worldmodel import WorldModelLike
 
 __all__ = ["HEADING", "ExploreFrontier", "headings", "publish_frontiers"]
 
@@ -60,7 +61,7 @@ HEADING = "heading"
 
 
 def publish_frontiers(
-    wm: Any,
+    wm: WorldModelLike,
     scratch: dict[str, object],
     candidates: list[FrontierCandidate],
     robot: str,
@@ -77,11 +78,9 @@ def publish_frontiers(
 
     put = _putter(wm)
     put("Pos", robot, (round(position[0], 3), round(position[1], 3)))
-    add_object = getattr(wm, "add_object", None)
     fresh = set()
     for cand in candidates:
-        if add_object is not None:
-            add_object(cand.name, "Frontier")
+        wm.add_object(cand.name, "Frontier")
         put("Pos", cand.name, (round(cand.position[0], 3), round(cand.position[1], 3)))
         put("gain", cand.name, cand.gain)
         fresh.add(cand.name)
@@ -93,7 +92,7 @@ def publish_frontiers(
     scratch[PUBLISHED_KEY] = fresh
 
 
-def _putter(wm: Any) -> Any:
+def _putter(wm: WorldModelLike) -> Callable[[str, str, object], None]:
     def put(name: str, arg: str, value: object) -> None:
         try:
             wm.set(name, arg, value=value, ttl=PUBLISH_TTL)
@@ -280,10 +279,10 @@ class ExploreFrontier(WorldSkill):
                 return usable[self.bound]
         # 2. the team's assignment (Eq. 7-8), unless another robot already heads there
         heading = headings(self.world_model, self.robot.name)
-        ask = getattr(self.context, "solve", None)
-        if callable(ask) and getattr(self.context, "solver", True) is not None:  # alone, no engine: no constraints
-            result = ask("frontier")
-            if getattr(result, "ok", False):
+        context = self.context
+        if context is not None and context.solver is not None:  # alone, no engine: no constraints
+            result = context.solve("frontier")
+            if result.ok:
                 mine = result.values.get("frontier")
                 if isinstance(mine, str) and mine in usable:
                     if all(distance(usable[mine].position, o) > self.spacing for o in heading):

@@ -276,3 +276,18 @@ def test_late_messages_from_before_a_departure_do_not_revive():
     assert view.heard("b", 2.2, 2.5) is True  # sent after: back
     assert view.is_alive("b")
     assert view.depart("nobody", 3.0) is False
+
+
+def test_a_world_frame_that_is_no_delta_is_dropped_not_fatal(tmp_path):
+    from alica.comm import QoS
+    from alica.engine.team import WORLD_TOPIC
+
+    lib = library(tmp_path, PLANS)
+    sim, _ = team(lib, "Shop", {"w": "Worker", "h": "Helper"}, SKILLS)
+    sim.run(ticks=3)
+    rogue = sim.network.attach("rogue")
+    for payload in ("found(a)", 42, None, ("a", "b")):
+        rogue.publish(WORLD_TOPIC, payload, QoS.RELIABLE)
+    sim.run(ticks=5)  # before: 'merge takes a Delta' ended every agent
+    assert where(sim, "w") == ("Work", "Working") and where(sim, "h") == ("Help", "Helping")
+    assert sim.engines["w"].world_model.facts() == []
