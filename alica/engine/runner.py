@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from alica.allocation import AgentSpec, assign_roles
-from alica.clock import ManualClock
+from alica.clock import Clock, ManualClock
 from alica.comm import Delay, SimNetwork
 from alica.comm.faults import describe_fault
 from alica.engine.agent import AgentEngine, Observer
 from alica.engine.behaviours import SkillBinder, SkillFactory
 from alica.engine.child import PlanDecision
 from alica.engine.config import EngineConfig
+from alica.engine.sim_world import SimWorld
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError
 from alica.lang import Registry, literal_text
@@ -123,7 +124,7 @@ class SimulatedTeam:
         registry: Registry | None = None,
         observers: Iterable[Observer] = (),
         trace_messages: bool = False,
-        world: Any = None,
+        world: SimWorld | None = None,
         perception: Callable[[SimulatedTeam], None] | None = None,
         step_world: bool = True,
     ) -> None:
@@ -140,10 +141,16 @@ class SimulatedTeam:
         self.config = config or EngineConfig()
         self.roleset = pick_roleset(library, (s.role for s in specs.values()), roleset)
         self.roles = assign_roles(specs, self.roleset)
-        self.world = world
+        self.world: Any = world
+        """The world as given: hooks such as a perception read their own world type from it (issue 36 leaves
+        making the team generic in its world for later); the team itself uses only :class:`SimWorld`."""
+        self._sim_world = world
         self.perception = perception
         self.step_world = step_world
-        self.clock = world.clock if world is not None and hasattr(world, "clock") else ManualClock()
+        manual = ManualClock()
+        self._manual: ManualClock | None = manual if world is None else None
+        """The team's own clock when it runs without a world (it advances it every tick)."""
+        self.clock: Clock = world.clock if world is not None else manual
         self.observers = list(observers)
         self.trace_messages = trace_messages
         self.network = SimNetwork(
@@ -195,11 +202,11 @@ class SimulatedTeam:
     def tick(self) -> None:
         """One lock-step tick of every running agent, then time moves one period on (the world steps)."""
         self.tick_agents()
-        if self.world is not None:
+        if self._sim_world is not None:
             if self.step_world:
-                self.world.step(self.config.period)
-        else:
-            self.clock.advance(self.config.period)
+                self._sim_world.step(self.config.period)
+        elif self._manual is not None:
+            self._manual.advance(self.config.period)
         for hook in self._after_tick:
             hook(self.now())
 
@@ -276,7 +283,7 @@ class SimulatedTeam:
             return
         self.crashed.add(name)
         self.network.crash(name)
-        robot = getattr(self.world, "robots", {}).get(name)
+        robot = self._sim_world.robots.get(name) if self._sim_world is not None else None
         if robot is not None:
             robot.crash()  # power loss: the robot stops where it is and drops what it holds
         self._fault("crash", agent=name)
@@ -291,8 +298,8 @@ class SimulatedTeam:
             return
         self.crashed.discard(name)
         self.network.recover(name)
-        robot = getattr(self.world, "robots", {}).get(name)
-        if robot is not None and hasattr(robot, "recover"):
+        robot = self._sim_world.robots.get(name) if self._sim_world is not None else None
+        if robot is not None:
             robot.recover()  # the body powers up again where it stopped
         old = self.engines[name]
         # a restarted agent listens for a broadcast interval before it allocates
