@@ -25,6 +25,7 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Protocol, runtime_checkable
 
 from alica.errors import PlannerError
 
@@ -247,6 +248,15 @@ class PlanResult:
         return self.plan.cost if self.plan is not None else None
 
 
+@runtime_checkable
+class _Requiring(Protocol):
+    """A task half that says which features it needs (a PDDL :class:`~alica.prophet.pddl.Domain` or
+    ``Problem``); other planners' tasks (RDDL) need none the planner checks here."""
+
+    @property
+    def requirements(self) -> frozenset[Feature]: ...
+
+
 class Planner(ABC):
     """A planner: ``name``, the features it supports, and an anytime search.
 
@@ -264,6 +274,12 @@ class Planner(ABC):
     reads_positions: bool = False
     """Whether its constructor takes ``positions`` (object -> position in metres, the world model's ``pos``)."""
 
+    @staticmethod
+    def unavailable() -> str:
+        """Why this back-end cannot run here (beyond its module: e.g. a planner binary that is not
+        installed), or ``""`` when it can; a back-end that needs more overrides it."""
+        return ""
+
     def missing(self, needed: Iterable[Feature]) -> frozenset[Feature]:
         """The needed features this planner lacks."""
         return frozenset(needed) - self.features
@@ -279,7 +295,7 @@ class Planner(ABC):
         Raises:
             PlannerError: the task needs features the planner lacks (named in the message).
         """
-        needed = getattr(domain, "requirements", frozenset()) | getattr(problem, "requirements", frozenset())
+        needed = frozenset[Feature]().union(*(t.requirements for t in (domain, problem) if isinstance(t, _Requiring)))
         lacking = self.missing(needed)
         if lacking:
             names = ", ".join(sorted(f.value for f in lacking))

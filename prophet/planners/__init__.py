@@ -73,8 +73,8 @@ def get_planner(name: str, **options: Any) -> Planner:
 def available() -> dict[str, str]:
     """Every back-end with the reason it cannot run here, or ``""`` when it can.
 
-    A back-end class may define a static or class method ``unavailable() -> str``
-    that checks what it needs beyond its module (Fast Downward checks that the
+    A back-end class overrides :meth:`~alica.prophet.planner.Planner.unavailable`
+    to check what it needs beyond its module (Fast Downward checks that the
     planner is installed).
     """
     reasons: dict[str, str] = {}
@@ -84,6 +84,5 @@ def available() -> dict[str, str]:
         except PlannerError as exc:
             reasons[name] = str(exc)
             continue
-        check = getattr(cls, "unavailable", None)
-        reasons[name] = check() if callable(check) else ""
+        reasons[name] = cls.unavailable()
     return reasons

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 from collections.abc import Generator, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.prophet.planner import Done, Improved, Limits, Plan, PlanStatus, PlanStep, SearchEvent
 from alica.prophet.search.astar import astar
@@ -44,6 +44,9 @@ from alica.prophet.search.landmarks import LandmarkCount
 from alica.prophet.search.neighbourhood import neighbourhood
 from alica.prophet.search.postprocess import improve
 from alica.prophet.search.windows import QUICK_WINDOW_STATES, WINDOW_STATES, Windows
+
+if TYPE_CHECKING:
+    from alica.prophet.ground import GroundTask
 
 DEFAULT_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1.5, 1)
 NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
@@ -118,7 +121,7 @@ def _portfolio(ct: CompiledTask, relaxed: Relaxed, weights: Sequence[float]) -> 
 
 
 def search_task(
-    task: Any,
+    task: GroundTask,
     *,
     anytime: bool = True,
     weights: Sequence[float] = DEFAULT_WEIGHTS,
@@ -150,7 +153,7 @@ def search_task(
         LimitReached: the deadline of ``limits`` passed (``Planner.search`` turns it into ``Done(TIMEOUT)``).
     """
     stats = Stats(progress_every, limits) if stats is None else stats
-    reason = getattr(task, "unsolvable_reason", None)
+    reason = task.unsolvable_reason
     if reason:
         yield Done(PlanStatus.UNSOLVABLE, 0, str(reason))
         return

@@ -21,7 +21,10 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from alica.prophet.ground import GroundTask
 
 CondEffect = tuple[int, int, int]
 """A compiled when-effect: (condition mask, add mask, delete mask)."""
@@ -290,7 +293,7 @@ def _keep_relevant(task: Any, cand: list[int], keep: list[bool], fluent: list[bo
         fluent[f] = fluent[f] and relevant[f]
 
 
-def compile_task(task: Any) -> CompiledTask:
+def compile_task(task: GroundTask) -> CompiledTask:
     """Compile a grounded task (``GroundTask`` shape) for search."""
     n = len(task.facts)
     init_set = set(task.init)
@@ -313,8 +316,8 @@ def compile_task(task: Any) -> CompiledTask:
                 if f not in init_set:
                     fluent[f] = True
 
-    task_axioms = getattr(task, "axioms", ())
-    derived: frozenset[int] = getattr(task, "derived", frozenset())
+    task_axioms = task.axioms
+    derived = task.derived
     for f in _changing_derived(task_axioms, derived, fluent):  # recomputed in every state
         fluent[f] = True
 
@@ -354,12 +357,12 @@ def compile_task(task: Any) -> CompiledTask:
     reached = _reachable(n, init_set, r_pre, r_add)
     keep_cand = [reached[a] for a in main]
     relaxed_facts = set(init_set)
-    for a, ok in enumerate(reached[:n_ops]):
-        if ok and keep_cand[r_of[a]]:
-            relaxed_facts.update(r_add[a])
-    for a, ok in enumerate(reached[n_ops:], n_ops):
+    for r, ok in enumerate(reached[:n_ops]):
+        if ok and keep_cand[r_of[r]]:
+            relaxed_facts.update(r_add[r])
+    for r, ok in enumerate(reached[n_ops:], n_ops):
         if ok:
-            relaxed_facts.update(r_add[a])
+            relaxed_facts.update(r_add[r])
     kept_axioms = [(a.head, r_pre[n_ops + k], a.neg, a.layer) for k, a in enumerate(ax_cand) if reached[n_ops + k]]
     if not task_axioms and not any(task.operators[i].conditional for i in cand):
         _keep_relevant(task, cand, keep_cand, fluent)
@@ -403,11 +406,11 @@ def compile_task(task: Any) -> CompiledTask:
             uses[f] += 1
     watch: list[list[int]] = [[] for _ in range(n)]
     always: list[int] = []
-    for op, p in enumerate(pre):
+    for op_id, p in enumerate(pre):
         if not p:
-            always.append(op)
+            always.append(op_id)
         else:
-            watch[min(p, key=lambda f: (uses[f], f))].append(op)
+            watch[min(p, key=lambda f: (uses[f], f))].append(op_id)
     watch_mask = mask([f for f in range(n) if watch[f]])
     goal = tuple(task.goal)
     kind = AxiomTask if task_axioms else CompiledTask
@@ -439,7 +442,7 @@ def compile_task(task: Any) -> CompiledTask:
         ct.ax_pre = [mask(p) for _, p, _, _ in kept_axioms]
         ct.ax_neg = [mask(g) for _, _, g, _ in kept_axioms]
         ct.ax_head = [1 << h for h, _, _, _ in kept_axioms]
-        relaxed = getattr(task, "relaxed_axioms", ())
+        relaxed = task.relaxed_axioms
         ct.relaxed_axioms = [(h, tuple(f for f in p if fluent[f])) for h, p in relaxed if fluent[h] and usable(p)]
         ct.init = ct.closure(ct.init & ~ct.derived_mask)
     return ct

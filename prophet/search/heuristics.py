@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from heapq import heappop, heappush
 
-from alica.prophet.search.encoding import CompiledTask, mask
+from alica.prophet.search.encoding import AxiomTask, CompiledTask, mask
 
 INF = float("inf")
 
@@ -47,7 +47,7 @@ class Relaxed:
                 r_add.append(cadd)
                 r_cost.append(ct.cost[op])
                 r_op.append(op)
-        for head, pos in getattr(ct, "relaxed_axioms", ()):  # derived facts: free, never preferred
+        for head, pos in ct.relaxed_axioms if isinstance(ct, AxiomTask) else ():  # derived facts: free, never preferred
             r_pre.append(pos)
             r_add.append((head,))
             r_cost.append(0)

@@ -21,7 +21,7 @@ from collections.abc import Generator, Sequence
 from heapq import heappop, heappush
 
 from alica.prophet.planner import Progress
-from alica.prophet.search.encoding import CompiledTask
+from alica.prophet.search.encoding import AxiomTask, CompiledTask
 from alica.prophet.search.gbfs import Stats, trace
 
 WINDOW_SIZES: tuple[int, ...] = (6, 10, 16, 24, 32)
@@ -52,7 +52,9 @@ class Windows:
                 by_object.setdefault(name, []).append(op)
         self.by_object = by_object
         self.no_args = no_args
-        self.exact = not any(ct.cond) and not getattr(ct, "axioms", None)  # derived facts: no swap analysis
+        self.exact = not any(ct.cond) and not (
+            isinstance(ct, AxiomTask) and ct.axioms
+        )  # derived facts: no swap analysis
         self.failed: dict[tuple[int, int, frozenset[str]], tuple[int, int]] = {}
         """Window searches that found nothing: (start, needed facts, objects) -> (bound, state limit)."""
 

@@ -35,6 +35,9 @@ class GroundTask:
     operators: tuple[GroundOperator, ...]
     has_costs: bool = False
     unsolvable_reason: str | None = field(default=None)
+    axioms: tuple[object, ...] = ()
+    derived: frozenset[int] = frozenset()
+    relaxed_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
 
 
 class TaskBuilder:
