@@ -20,9 +20,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Protocol
+from typing import Any
 
-from alica.engine.child import ChildHost, ChildSlot, PlanKey
+from alica.engine.child import ChildHost, ChildKinds, ChildSlot, PlanKey
 from alica.engine.config import EngineConfig
 from alica.model import PlanningProblem
 from alica.prophet.board import PLAN_TOPIC, PlanBoard
@@ -109,30 +109,21 @@ def engine_config(
     return replace(base, children={**base.children, PlanningProblem: planning}, **settings)
 
 
-class _Children(Protocol):
-    def factory(self, element_type: type) -> object | None: ...
-
-
-class _Engine(Protocol):
-    @property
-    def children(self) -> _Children: ...
-
-
-def latest_plans(engine: _Engine) -> Mapping[PlanKey, CreatedTasks]:
+def latest_plans(engine: ChildKinds) -> Mapping[PlanKey, CreatedTasks]:
     """The latest plan generated for each planning problem an agent's engine ran (kept after it ended).
 
     Args:
         engine: an agent's engine (:class:`alica.engine.AgentEngine`).
     """
-    agent = engine.children.factory(PlanningProblem)
+    agent = engine.child_kind(PlanningProblem)
     return agent.board.latest if isinstance(agent, PlanningAgent) else {}
 
 
-def made_plans(engine: _Engine) -> Sequence[tuple[int, int, CreatedTasks]]:
+def made_plans(engine: ChildKinds) -> Sequence[tuple[int, int, CreatedTasks]]:
     """``(generation, version, plan)`` of every plan generated for the problems an agent's engine ran, in the order it took them up.
 
     Args:
         engine: an agent's engine (:class:`alica.engine.AgentEngine`).
     """
-    agent = engine.children.factory(PlanningProblem)
+    agent = engine.child_kind(PlanningProblem)
     return tuple(agent.board.made) if isinstance(agent, PlanningAgent) else ()

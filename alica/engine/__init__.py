@@ -13,7 +13,16 @@
 
 from alica.engine.agent import AgentEngine
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext, SkillFactory
-from alica.engine.child import ChildFactory, ChildHost, ChildKind, ChildRuntime, ChildSlot, PlanDecision, RunningPlan
+from alica.engine.child import (
+    ChildFactory,
+    ChildHost,
+    ChildKind,
+    ChildKinds,
+    ChildRuntime,
+    ChildSlot,
+    PlanDecision,
+    RunningPlan,
+)
 from alica.engine.config import EngineConfig
 from alica.engine.runner import SimulatedTeam, pick_roleset
 from alica.engine.show import running_tree
@@ -27,6 +36,7 @@ __all__ = [
     "ChildFactory",
     "ChildHost",
     "ChildKind",
+    "ChildKinds",
     "ChildRuntime",
     "ChildSlot",
     "ChildStatus",

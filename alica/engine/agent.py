@@ -18,7 +18,7 @@ from alica.comm import QoS, Transport
 from alica.engine.allocate import Allocator
 from alica.engine.behaviours import BehaviourRunner, SkillBinder, SkillContext
 from alica.engine.belief import AgentBelief
-from alica.engine.child import PlanDecision
+from alica.engine.child import ChildFactory, PlanDecision
 from alica.engine.conditions import Formulas
 from alica.engine.config import EngineConfig
 from alica.engine.generated import GeneratedPlans
@@ -175,6 +175,11 @@ class AgentEngine:
         self._peers: frozenset[str] = frozenset()
         self._greeted: set[str] = set()
         world_model.on_change(self._on_world_change)
+
+    def child_kind(self, element_type: type) -> ChildFactory | None:
+        """This agent's factory of child runtimes for elements of ``element_type`` (``None``: none configured);
+        see :class:`~alica.engine.child.ChildKinds`."""
+        return self.children.factory(element_type)
 
     def _on_world_change(self, keys: object) -> None:
         self._world_changed = True

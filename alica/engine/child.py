@@ -355,6 +355,18 @@ class ChildKind(Protocol):
         """Attach to one agent's engine: its factory of runtimes."""
 
 
+class ChildKinds(Protocol):
+    """An agent's engine as a plug-in sees it from outside: the child runtime kinds it was configured with.
+
+    :class:`~alica.engine.AgentEngine` satisfies it; a plug-in reads its own state through the factory
+    it made for the agent (pRoPhEt MAS: the plans it generated).
+    """
+
+    def child_kind(self, element_type: type) -> ChildFactory | None:
+        """The agent's factory of child runtimes for elements of ``element_type`` (``None``: none configured)."""
+        ...
+
+
 def missing_kind_message(element: AbstractPlan, where: str) -> str:
     """The error for a child whose element type has no :class:`ChildKind` configured; ``where`` holds it."""
     kind = type(element).__name__
