@@ -122,9 +122,20 @@ class MobileRobot(Protocol):
         """One 2-D lidar scan: ``n_rays`` ranges (m) over the full circle from the heading on; no hit reads ``max_range``."""
         ...
 
+    def lidar_angles(self, n_rays: int) -> np.ndarray:
+        """The angles of a scan's ``n_rays`` rays relative to the heading, in the order :meth:`lidar` gives them."""
+        ...
+
     @property
     def lidar_noise(self) -> float:
         """Standard deviation in metres of the lidar's range noise."""
+        ...
+
+    def camera_pose(
+        self, pose: tuple[float, float, float] | None = None, pan: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Where the camera is and how it is turned, ``(position, rotation world-from-camera)``, with the base
+        at ``pose`` (default the true pose; pass :attr:`estimate` for what the robot believes), panned ``pan``."""
         ...
 
     def camera(

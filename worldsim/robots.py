@@ -245,10 +245,26 @@ class Robot:
 
         return lidar_scan(self, n_rays, max_range)
 
+    @staticmethod
+    def lidar_angles(n_rays: int) -> np.ndarray:
+        """The angles of a scan's ``n_rays`` rays relative to the heading (:func:`alica.worldsim.sensors.lidar_angles`)."""
+        from alica.worldsim.sensors import lidar_angles
+
+        return lidar_angles(n_rays)
+
     @property
     def lidar_noise(self) -> float:
         """Standard deviation in metres of the lidar's range noise (the world's seeded sensor noise)."""
         return float(self.world.noise.lidar_sigma)
+
+    def camera_pose(
+        self, pose: tuple[float, float, float] | None = None, pan: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Where the camera is and how it is turned, ``(position, rotation world-from-camera)``, for the base
+        at ``pose`` (default the true pose) panned ``pan`` radians left (:func:`alica.worldsim.robot_camera.camera_pose`)."""
+        from alica.worldsim.robot_camera import camera_pose
+
+        return camera_pose(self, pose, pan)
 
     def camera(
         self,

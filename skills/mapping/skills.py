@@ -60,10 +60,8 @@ def rays_for(radius: float, resolution: float) -> int:
 
 def lidar(robot: MobileRobot, n_rays: int, max_range: float) -> tuple[np.ndarray, np.ndarray]:
     """One scan of ``robot``'s lidar: ``(ranges, angles)``, angles relative to the heading."""
-    from alica.worldsim.sensors import lidar_angles
-
     rng = min(float(max_range), float(robot.spec.lidar_range))
-    return robot.lidar(n_rays, rng), lidar_angles(n_rays)
+    return robot.lidar(n_rays, rng), robot.lidar_angles(n_rays)
 
 
 def robot_mapper(
