@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from alica import __version__
+from alica.app.plan_entry import EXIT_INVALID, EXIT_OK, EXIT_USAGE, load_entry, root_plans
 from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError, PlanFormatError
 from alica.source import Diagnostic
@@ -22,7 +23,6 @@ from alica.source import Diagnostic
 if TYPE_CHECKING:
     from alica.model.library import Document
 
-EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
 #: A command whose reader closed the pipe: 128 + SIGPIPE, the status a shell shows for it.
 EXIT_BROKEN_PIPE = 141
 
@@ -58,34 +58,12 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _load(path: str | Path, loader=None):  # type: ignore[no-untyped-def]
-    """The library of a plan file's set and the file's own document, each file read once."""
-    from alica.io import Loader
-
-    loader = loader or Loader()
-    return loader.load(path), loader.document(path)
-
-
-def _roots(library, entry, name: str | None) -> list[str]:  # type: ignore[no-untyped-def]
-    if name is not None:
-        library.abstract(name)
-        return [name]
-    own = (
-        [p.name for p in entry.plans]
-        + [p.name for p in entry.problems]
-        + [b.name for b in entry.behaviours if not entry.plans]
-    )
-    used = {c for e in (*entry.plans, *entry.plantypes, *entry.problems) for c in library.children(e)}
-    roots = [n for n in own if n not in used]
-    return roots or own
-
-
 def _cmd_show(args: argparse.Namespace) -> int:
     from alica.app.render import dot_graph, svg, text_tree
 
-    library, entry = _load(args.plan)
+    library, entry = load_entry(args.plan)
     try:
-        roots = _roots(library, entry, args.name)
+        roots = root_plans(library, entry, args.name)
     except KeyError as exc:
         raise AlicaError(str(exc.args[0])) from None
     if not roots:
@@ -133,8 +111,8 @@ def _cmd_render(args: argparse.Namespace) -> int:
     has_dot = shutil.which("dot") is not None
     count = 0
     for path in files:
-        library, entry = _load(path, loader)
-        for root in _roots(library, entry, None):
+        library, entry = load_entry(path, loader)
+        for root in root_plans(library, entry, None):
             stem = out / f"{names[path]}.{root}"
             stem.parent.mkdir(parents=True, exist_ok=True)
             Path(f"{stem}.txt").write_text(text_tree(library, root) + "\n", encoding="utf-8")

@@ -164,8 +164,8 @@ def _zenoh_settings(items: list[str]) -> dict[str, object]:
 
 def cmd_agent(args: argparse.Namespace) -> int:
     """Run ``alica agent``; returns the exit code."""
-    from alica.app.cli import _load, _roots
-    from alica.app.cli_run import _agents, _roles
+    from alica.app.options import parse_roster
+    from alica.app.plan_entry import agent_roles, load_entry, root_plans
     from alica.app.run_skills import plan_skills, skill_wiring
     from alica.app.skill_options import skill_registry
     from alica.io import Loader
@@ -174,19 +174,19 @@ def cmd_agent(args: argparse.Namespace) -> int:
         raise AlicaError(f"--frequency must be > 0, got {args.frequency}")
     time_limit(args)
     registry = skill_registry(args)
-    library, entry = _load(args.plan, Loader(skills=registry))
+    library, entry = load_entry(args.plan, Loader(skills=registry))
     plan = args.root
     if plan is None:
-        roots = [r for r in _roots(library, entry, None) if r in library.plans]
+        roots = [r for r in root_plans(library, entry, None) if r in library.plans]
         if not roots:
             raise AlicaError(f"{args.plan} defines no plan to run; give one with --root")
         plan = roots[0]
-    agents = _agents(args.agents) if args.agents else {args.name: args.role}
+    agents = parse_roster(args.agents) if args.agents else {args.name: args.role}
     if args.name not in agents:
         raise AlicaError(f"--name {args.name} is not in --agents ({', '.join(agents)}); the roster names every agent")
     if args.role is not None:
         agents[args.name] = args.role
-    roles = _roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
+    roles = agent_roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
     wiring = skill_wiring(registry, plan_skills(library, plan), world=False, stand_ins=args.stand_ins, plan=plan)
     settings = _zenoh_settings(args.zenoh)

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from alica.app.cli import EXIT_INVALID, EXIT_OK, EXIT_USAGE
+from alica.app.plan_entry import EXIT_INVALID, EXIT_OK, EXIT_USAGE
 
 if TYPE_CHECKING:
     from alica.io.designer import ImportResult, Note

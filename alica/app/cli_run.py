@@ -16,7 +16,7 @@ from typing import Any
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
-from alica.app.options import add_time_limit, did_you_mean, parse_roster, time_limit
+from alica.app.options import add_time_limit, parse_roster, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
@@ -127,55 +127,9 @@ def add_parser(sub: Any) -> None:
     p.set_defaults(run=cmd_run)
 
 
-def _agents(text: str) -> dict[str, str | frozenset[str] | None]:
-    """The roster of ``--agents NAME[:ROLE],...`` (:func:`alica.app.options.parse_roster`)."""
-    return parse_roster(text, "--agents")
-
-
-def _roles(
-    library: Any,
-    agents: dict[str, str | frozenset[str] | None],
-    roleset: str | None,
-    options: dict[str, str] | None = None,
-) -> dict[str, Any]:
-    """Each agent's role (or capabilities); ``options`` names the option that gave an agent its role (``--agents``).
-
-    Raises:
-        AlicaError: a role no role set has (with the closest role's name), or no role set holding them all.
-    """
-    from alica.allocation import AgentSpec
-    from alica.engine import pick_roleset
-
-    sets = [library.rolesets[roleset]] if roleset in library.rolesets else list(library.rolesets.values())
-    known = sorted({r.name for rs in sets for r in rs.roles})
-    names = {r.name.lower(): r.name for rs in library.rolesets.values() for r in rs.roles}
-    out: dict[str, Any] = {}
-    for name, role in agents.items():
-        option = (options or {}).get(name, "--agents")
-        if isinstance(role, frozenset):
-            out[name] = AgentSpec(capabilities=role)
-            continue
-        if role is None:
-            if name.lower() not in names:
-                raise AlicaError(
-                    f"{option}: agent '{name}' has no role and no role is called like it{did_you_mean(name, known)}; "
-                    f"write {name}:ROLE (roles: {', '.join(known) or 'none'})"
-                )
-            role = names[name.lower()]
-        elif role not in known:
-            where = f"role set '{roleset}' does not have" if roleset in library.rolesets else "no role set has"
-            raise AlicaError(
-                f"{option}: agent '{name}' has role '{role}', which {where}{did_you_mean(role, known)}; "
-                f"roles: {', '.join(known) or 'none'}"
-            )
-        out[name] = role
-    pick_roleset(library, [r for r in out.values() if isinstance(r, str)], roleset)
-    return out
-
-
 def cmd_run(args: argparse.Namespace) -> int:
     """Run the ``run`` subcommand; returns the exit code."""
-    from alica.app.cli import _load, _roots
+    from alica.app.plan_entry import agent_roles, load_entry, root_plans
     from alica.app.run_skills import plan_skills, run_world, skill_wiring
     from alica.app.skill_options import skill_registry
     from alica.io import Loader
@@ -191,16 +145,16 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.center and args.show_tree:
         raise AlicaError("--center shows the team in a web page; it does not go with --show-tree")
     registry = skill_registry(args)
-    library, entry = _load(args.plan, Loader(skills=registry))
+    library, entry = load_entry(args.plan, Loader(skills=registry))
     if args.name is None:
-        roots = [r for r in _roots(library, entry, None) if r in library.plans]
+        roots = [r for r in root_plans(library, entry, None) if r in library.plans]
         if not roots:
             raise AlicaError(f"{args.plan} defines no plan to run; give one with --name")
         plan = roots[0]
     else:
         plan = args.name
-    agents = _agents(args.agents)
-    roles = _roles(library, agents, args.roleset)
+    agents = parse_roster(args.agents)
+    roles = agent_roles(library, agents, args.roleset)
     skills = plan_skills(library, plan)
     try:
         wiring = skill_wiring(registry, skills, world=args.world is not None, stand_ins=args.stand_ins, plan=plan)

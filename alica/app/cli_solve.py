@@ -76,16 +76,16 @@ def add_parser(sub: Any) -> None:
 
 def cmd_solve(args: argparse.Namespace) -> int:
     """Run the ``solve`` subcommand; returns the exit code."""
-    from alica.app.cli import _load
-    from alica.app.cli_run import _agents, _roles
+    from alica.app.options import parse_roster
+    from alica.app.plan_entry import agent_roles, load_entry
     from alica.app.skill_options import skill_registry
     from alica.io import Loader
     from alica.solver import solve
     from alica.solver.query import Level, collect
 
-    library, entry = _load(args.plan, Loader(skills=skill_registry(args)))
+    library, entry = load_entry(args.plan, Loader(skills=skill_registry(args)))
     plan = _pick_plan(library, entry, args.name, args.plan)
-    roles = _roles(library, _agents(args.agents), args.roleset)
+    roles = agent_roles(library, parse_roster(args.agents), args.roleset)
     places = _allocate(library, plan, roles, args.roleset)
     _place(plan, places, args.at)
     belief = _world(args.world, args.fact)

@@ -83,11 +83,11 @@ def plan_views(path: str, registry: Any = None) -> tuple[dict[str, dict[str, Any
         AlicaError: it defines nothing to draw.
     """
     from alica.app.center.plan_view import plan_svg, plan_tree
-    from alica.app.cli import _load, _roots
+    from alica.app.plan_entry import load_entry, root_plans
     from alica.io import Loader
 
-    library, entry = _load(path, Loader(skills=registry) if registry is not None else None)
-    roots = _roots(library, entry, None)
+    library, entry = load_entry(path, Loader(skills=registry) if registry is not None else None)
+    roots = root_plans(library, entry, None)
     if not roots:
         raise AlicaError(f"{path} defines no plan, planning problem or behaviour to draw")
     return {r: plan_tree(library, r) for r in roots}, {r: plan_svg(library, r) for r in roots}
