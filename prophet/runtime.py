@@ -77,6 +77,7 @@ from alica.prophet.planner import Plan as StepPlan
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
 from alica.prophet.review import PROPOSAL_PLAN, apply_pins, proposal_fields, reordered, resolve_pins
+from alica.prophet.runtime_states import LeaderPhase, child_phase, leader_phase
 from alica.prophet.tasks import (
     STEP_DONE,
     CreatedTasks,
@@ -235,13 +236,24 @@ class ProblemRuntime:
     def phase(self) -> str:
         """``wait``, ``plan``, ``alternative``, ``done`` or ``failed``."""
         share = self.share
-        if share is None or share.status == SEARCHING or share.generation <= self.failed_generation:
-            return "wait"
-        if share.status == PLAN:
-            return "plan"
-        if share.status == DONE:
-            return "done"
-        return "alternative" if self.model.alternative_plan else "failed"
+        status, generation = (share.status, share.generation) if share is not None else (None, 0)
+        return child_phase(status, generation, self.failed_generation, bool(self.model.alternative_plan)).value
+
+    def leader_phase(self) -> LeaderPhase:
+        """What this agent does for the problem now (:mod:`alica.prophet.runtime_states`)."""
+        return self._leader_phase(self._is_leader())
+
+    def _leader_phase(self, leader: bool) -> LeaderPhase:
+        share = self.share
+        return leader_phase(
+            leader=leader,
+            proposal=self.proposal is not None,
+            pending=self.pending is not None,
+            search=self.search is not None,
+            blocked=self.blocked is not None,
+            share=share.status if share is not None else None,
+            share_failed=share is not None and share.generation <= self.failed_generation,
+        )
 
     def wanted(self) -> tuple[Plan, ...]:
         """The plan the child runs now (none when done or failed)."""
@@ -508,28 +520,27 @@ class ProblemRuntime:
         if requests and share is not None and share.status == PLAN:
             self._replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
             return
-        if self.proposal is not None:
+        phase = self._leader_phase(True)
+        if phase is LeaderPhase.REVIEWING:
+            assert self.proposal is not None
             self._review(now, self.proposal)
-        elif self.pending is not None:
+        elif phase is LeaderPhase.SETTLING:
+            assert self.pending is not None
             if now + 1e-9 < self.pending[0]:
                 return
             reason = self.pending[1]
             self.pending = None
             self._start_search(now, reason, self.share.generation if self.share is not None else None)
-        elif self.search is not None:
+        elif phase is LeaderPhase.SEARCHING:
             self._step_search(now)
-        elif self.blocked is not None:
+        elif phase is LeaderPhase.WAITING:
             if now >= self.next_update and set(self._read_world(self.problem).facts) != self.blocked:
                 self.blocked = None
                 self._start_search(now, "the world changed while planning was blocked")
             elif self.team_wait_until is not None and now >= self.team_wait_until:
                 self.blocked = None
                 self._start_search(now, f"waited {TEAM_WAIT:g} s for the robots outside the team")
-        elif (
-            share is None
-            or share.status == SEARCHING
-            or (share.status == PLAN and share.generation <= self.failed_generation)
-        ):
+        elif phase is LeaderPhase.STARTING:
             self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
         if now < self.next_update:
             return
