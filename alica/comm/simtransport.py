@@ -3,12 +3,9 @@
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from alica.comm.transport import Envelope, QoS, Transport
-
-if TYPE_CHECKING:
-    from alica.comm.simnet import SimNetwork
 
 
 class Reliable:
@@ -122,6 +119,20 @@ class AgentState:
         return lost
 
 
+class _Network(Protocol):
+    """What an agent's transport asks of the simulated network (:class:`~alica.comm.simnet.SimNetwork`)."""
+
+    def _publish(self, state: AgentState, topic: str, payload: object, qos: QoS) -> None: ...
+
+    def _subscribe(self, state: AgentState, topic: str) -> None: ...
+
+    def _poll(self, state: AgentState) -> list[Envelope]: ...
+
+    def _peers(self, state: AgentState) -> frozenset[str]: ...
+
+    def _close(self, state: AgentState) -> None: ...
+
+
 class SimTransport(Transport):
     """The :class:`Transport` of one agent on a :class:`~alica.comm.simnet.SimNetwork`.
 
@@ -130,7 +141,7 @@ class SimTransport(Transport):
 
     __slots__ = ("_network", "_state")
 
-    def __init__(self, network: SimNetwork, state: AgentState) -> None:
+    def __init__(self, network: _Network, state: AgentState) -> None:
         self._network = network
         self._state = state
 
