@@ -68,6 +68,8 @@ from alica.errors import AlicaError, PlannerError
 from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
+from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER, GiveUp
+from alica.prophet.leadership import is_leader, next_generation
 from alica.prophet.magic.leader import MagicLeader
 from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
 from alica.prophet.pddl.writer import write_domain, write_problem
@@ -90,6 +92,7 @@ from alica.prophet.tasks import (
     holds,
     step_token,
 )
+from alica.prophet.waiting import TEAM_WAIT, Waiting
 from alica.prophet.world import (
     PlanningWorld,
     TaskProgress,
@@ -101,16 +104,13 @@ from alica.prophet.world import (
 
 SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareStatus.FAILED, ShareStatus.DONE
 
-#: A step that fails this many times for the same reason while the world stays the same fails the problem
-#: (the team runs the AlternativePlan): planning the same plan again would fail the same way for ever.
-GIVE_UP_AFTER = 3
-#: A step that fails this many times for the same reason, with no step of the team carried out in between,
-#: fails the problem whatever the world does meanwhile (a robot that moves a little on every new plan
-#: changes the world, but not what makes the step fail).
-GIVE_UP_ANYWAY_AFTER = 2 * GIVE_UP_AFTER
-#: Simulated seconds the leader waits, when no plan exists with the robots in the team while robots outside
-#: it are named in the world (teammates cut off by a partition, or crashed), before the problem fails.
-TEAM_WAIT = 30.0
+__all__ = [
+    "GIVE_UP_AFTER",
+    "GIVE_UP_ANYWAY_AFTER",
+    "TEAM_WAIT",
+    "ProblemRuntime",
+    "SearchBudget",
+]
 
 
 @dataclass(frozen=True, slots=True)
@@ -196,17 +196,15 @@ class ProblemRuntime:
         self.effected: set[str] = set()
         """Steps under way whose effect was written early (their skills had written its positive part)."""
         self.pending: tuple[float, str] | None = None
-        self.blocked: set[Fact] | None = None
+        self.waiting = Waiting()
+        """What the leader waits for: the world to change, the robots outside the team to come back."""
         self.predicates: dict[str, tuple[str, ...]] | None = None
-        self.step_failures: dict[tuple[str, frozenset[Fact]], int] = {}
-        self.step_failures_any: dict[str, int] = {}
-        self.steps_done = 0
+        self.give_up = GiveUp()
+        """The leader's count of failed steps: when to stop replanning."""
         self.stepwise = _planner_trait(element.planner, "stepwise")
         """Whether the problem's planner plans one step at a time (the operator changes goal and world, not planner)."""
         self.step_over: float | None = None
         """When a stepwise plan's step was seen over while its effects had not all arrived yet."""
-        self.team_wait_until: float | None = None
-        """While no plan exists without robots outside the team: when the leader stops waiting for them."""
         self.overrides = dict(host.override(self.model.name))
         self.proposal: _Proposal | None = None
         """The plan proposed to the operator, while the leader waits for a decision (review on)."""
@@ -250,7 +248,7 @@ class ProblemRuntime:
             proposal=self.proposal is not None,
             pending=self.pending is not None,
             search=self.search is not None,
-            blocked=self.blocked is not None,
+            blocked=self.waiting.blocked is not None,
             share=share.status if share is not None else None,
             share_failed=share is not None and share.generation <= self.failed_generation,
         )
@@ -415,8 +413,7 @@ class ProblemRuntime:
             self.host.unregister_plan(self.created.plan.name)
 
     def _is_leader(self) -> bool:
-        members = self.slot.members()
-        return bool(members) and members[0] == self.host.name
+        return is_leader(self.slot.members(), self.host.name)
 
     # -- shares ---------------------------------------------------------------
 
@@ -534,11 +531,11 @@ class ProblemRuntime:
         elif phase is LeaderPhase.SEARCHING:
             self._step_search(now)
         elif phase is LeaderPhase.WAITING:
-            if now >= self.next_update and set(self._read_world(self.problem).facts) != self.blocked:
-                self.blocked = None
+            if now >= self.next_update and self.waiting.changed(self._read_world(self.problem).facts):
+                self.waiting.unblock()
                 self._start_search(now, "the world changed while planning was blocked")
-            elif self.team_wait_until is not None and now >= self.team_wait_until:
-                self.blocked = None
+            elif self.waiting.team_wait_over(now):
+                self.waiting.unblock()
                 self._start_search(now, f"waited {TEAM_WAIT:g} s for the robots outside the team")
         elif phase is LeaderPhase.STARTING:
             self._start_search(now, "start" if share is None else f"taking over from {share.leader}")
@@ -568,21 +565,10 @@ class ProblemRuntime:
             self._start_search(now, reason)
             return
         generation = self._next_generation()
-        same = (reason.split(": ", 1)[-1], frozenset(self._read_world(self.problem).facts))
-        self.step_failures[same] = count = self.step_failures.get(same, 0) + 1
+        world = frozenset(self._read_world(self.problem).facts)
         done = sum(1 for fact in self.host.world.facts() if fact.predicate == STEP_DONE)
-        if done != self.steps_done:  # a step was carried out since the last failure: count afresh
-            self.steps_done = done
-            self.step_failures_any.clear()
-        self.step_failures_any[same[0]] = total = self.step_failures_any.get(same[0], 0) + 1
-        if count >= GIVE_UP_AFTER or total >= GIVE_UP_ANYWAY_AFTER:
-            self.step_failures.clear()
-            self.step_failures_any.clear()
-            message = (
-                f"gave up: the same step failed {count} times while the world stayed the same: {same[0]}"
-                if count >= GIVE_UP_AFTER
-                else f"gave up: the same step failed {total} times: {same[0]}"
-            )
+        message = self.give_up.step_failed(reason.split(": ", 1)[-1], world, done)
+        if message is not None:
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=message)
             self._publish_failure(now, generation, message)
             return
@@ -594,10 +580,8 @@ class ProblemRuntime:
 
     def _next_generation(self) -> int:
         """One more than any generation this agent has seen for the problem."""
-        board = self.board
-        return (
-            max(board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0)
-            + 1
+        return next_generation(
+            self.board.generations.get(self.key, 0), self.failed_generation, self.share.generation if self.share else 0
         )
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
@@ -722,27 +706,10 @@ class ProblemRuntime:
             yield Done(PlanStatus.SOLVED, outcome.expansions, "MAGiC: the first valid plan wins")
             return
 
-    def _wait_for_team(self, now: float, world: PlanningWorld, status: PlanStatus) -> bool:
-        """Whether to wait for robots outside the team (a partition heals, a crashed robot restarts) before failing.
-
-        The wait starts with the first unsolvable search while the world names robots outside the
-        team, lasts :data:`TEAM_WAIT` seconds, and ends early when the world changes (the leader
-        plans again); a plan found ends it.
-        """
-        if status is not PlanStatus.UNSOLVABLE or not world.others:
-            self.team_wait_until = None
-            return False
-        if self.team_wait_until is None:
-            self.team_wait_until = now + TEAM_WAIT
-        if now < self.team_wait_until:
-            return True
-        self.team_wait_until = None  # waited long enough: the problem fails
-        return False
-
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
         """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
         self.host.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
-        self.blocked = set(world.facts)
+        self.waiting.block(world.facts)
         if self.share is None or self.share.status != SEARCHING:
             self._publish(
                 PlanShare(
@@ -854,7 +821,8 @@ class ProblemRuntime:
                     )
                     self._wait_for_world(now, search.world, search.generation, reason)
                     return
-                if self._wait_for_team(now, search.world, finished.status):
+                unsolvable = finished.status is PlanStatus.UNSOLVABLE
+                if self.waiting.wait_for_team(now, unsolvable, bool(search.world.others)):
                     reason = (
                         f"{message} with the robots in the team ({', '.join(search.world.robots)}); waiting up to "
                         f"{TEAM_WAIT:g} s for those outside it ({', '.join(search.world.others)}): they may be back"
@@ -922,7 +890,7 @@ class ProblemRuntime:
 
     def _share_plan(self, now: float, search: _Search, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()) -> None:
         steps = plan.steps
-        self.team_wait_until = None
+        self.waiting.end_team_wait()
         search.version += 1
         search.shared_cost = plan.plan.cost  # the cost as the planner gave it (the trace shows it)
         self.host.emit(
@@ -958,7 +926,7 @@ class ProblemRuntime:
     def _propose(self, search: _Search, plan: ValidPlan) -> None:
         """Stop searching and propose the generation's first valid plan to the operator (the team keeps waiting)."""
         self.search = None
-        self.team_wait_until = None
+        self.waiting.end_team_wait()
         name = PROPOSAL_PLAN.format(problem=self.model.name, generation=search.generation)
         error = None
         try:
