@@ -1,31 +1,36 @@
 """Verify2DObject (IMPERA Section 6.4.3, Figs. 12-13): sample detection with a 2D laser and a directed colour camera.
 
 Four skills in consecutive states of ``plans/skills/verify_2d_object.yaml``
-hand their data on through the agent's scratch space (``context.scratch``):
+hand their data on through the agent's scratch space (``context.scratch``),
+as frozen dataclasses in typed slots (:mod:`alica.skills.vision2d_data`):
 
 1. :class:`DetectCircles` segments a 2D lidar scan into clusters and keeps
    those whose circle has the sample radius (silhouette width and a robust
-   RANSAC + least-squares circle fit): ``scratch["circles"]``, and
+   RANSAC + least-squares circle fit): :class:`Candidates` in
+   :data:`~alica.skills.vision2d_data.CANDIDATES`, and
    ``candidate(c)`` / ``candidate_pos(c)`` in the world model.
 2. :class:`CropCandidate` renders the robot's camera, projects the nearest
    candidate in view (its footprint and height) into the image and crops it:
-   ``scratch["candidate"]``, ``scratch["crop"]``.
+   a :class:`Crop` (with its :class:`Candidate`) in :data:`~alica.skills.vision2d_data.CROP`.
 3. :class:`BlobDetect` finds green and red blobs in the crop (HSV thresholds,
-   connected components; OpenCV): ``scratch["blobs"]``.
+   connected components; OpenCV): :class:`Blobs` in :data:`~alica.skills.vision2d_data.BLOBS`.
 4. :class:`ClassifySample` decodes the kind from the upper and lower blobs and
    the middle section's brightness, and writes ``found(s)``, ``sample_kind(s)``,
    ``pos(s)`` and ``confidence(s)``; a candidate the closer look
    disagrees with is retracted and recorded as ``invalid(c)``.
 
 The skills read lidar ranges and rendered pixels only (never the simulator's
-object names or poses); the pure functions below (:func:`detect_circles`,
-:func:`find_blobs`, :func:`decode_sections`) do the work and are tested alone.
+object names or poses); pure functions do the work and are tested alone:
+:func:`detect_circles` in :mod:`alica.skills.vision2d_geometry`,
+:func:`find_blobs` and :func:`decode_sections` in :mod:`alica.skills.vision2d_image`
+(all importable from here too). A step whose predecessor did not run fails
+saying which step to run first.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING
 
 import numpy as np
 from py_trees.common import Status
@@ -33,21 +38,42 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.jobs import Job
 from alica.skills.sample_facts import seen_on_the_ground, stale_verdicts
+from alica.skills.vision2d_data import (
+    BLOBS,
+    CANDIDATES,
+    CROP,
+    MEMORY,
+    VERDICT,
+    Blobs,
+    Candidate,
+    Candidates,
+    Crop,
+    Memory,
+    Verdict,
+)
 from alica.skills.vision2d_geometry import Circle, detect_circles, fit_circle, segment_scan
-from alica.skills.vision2d_image import HSV_RANGES, WHITE_VALUE, decode_sections, find_blobs
+from alica.skills.vision2d_image import HSV_RANGES, WHITE_VALUE, Blob, decode_sections, find_blobs
 from alica.skills.world_skill import WorldSkill, number_param
 
 if TYPE_CHECKING:
+    from alica.worldmodel.protocol import WorldModelLike
     from alica.worldsim.robot_camera import CameraImage
 
 __all__ = [
     "HSV_RANGES",
     "WHITE_VALUE",
+    "Blob",
     "BlobDetect",
+    "Blobs",
+    "Candidate",
+    "Candidates",
     "Circle",
     "ClassifySample",
+    "Crop",
     "CropCandidate",
     "DetectCircles",
+    "Memory",
+    "Verdict",
     "decode_sections",
     "detect_circles",
     "find_blobs",
@@ -76,11 +102,16 @@ class _Pipeline(WorldSkill):
 
     @property
     def scratch(self) -> dict[str, object]:
-        """The agent's scratch space (an own dict when the context has none)."""
-        scratch = getattr(self.context, "scratch", None)
-        if scratch is None:
-            scratch = self.__dict__.setdefault("_own_scratch", {})
-        return cast("dict[str, object]", scratch)
+        """The agent's scratch space (an own dict when the skill has no context)."""
+        if self.context is not None:
+            return self.context.scratch
+        own: dict[str, object] = self.__dict__.setdefault("_own_scratch", {})
+        return own
+
+    @property
+    def memory(self) -> Memory:
+        """What the steps remember across rounds (:data:`~alica.skills.vision2d_data.MEMORY`)."""
+        return MEMORY.setdefault(self.scratch, Memory)
 
     def verdicts(self) -> dict[str, str]:
         """Candidate -> verdict (a sample's name, or ``invalid``), less the stale ones, which are forgotten.
@@ -88,28 +119,28 @@ class _Pipeline(WorldSkill):
         A verdict is stale when the sample it named was held by a teammate now
         lost: the sample fell where it was, and its candidate is looked at again.
         """
-        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
-        for cid in stale_verdicts(verdicts, self.world_model, getattr(self.context, "belief", None)):
+        verdicts = self.memory.verdicts
+        belief = self.context.belief if self.context is not None else None
+        for cid in stale_verdicts(verdicts, self.world_model, belief):
             del verdicts[cid]
         return verdicts
 
-    def reject_candidate(self, candidate: dict[str, Any], reason: str) -> None:
+    def reject_candidate(self, candidate: Candidate, reason: str) -> None:
         """A closer look disagrees: retract the candidate (and a sample found there), record it as invalid."""
-        cid = str(candidate["id"])
+        cid = candidate.id
         wm = self.world_model
         if wm is not None:
             wm.retract_fact("candidate", cid)
             wm.assert_fact("invalid", cid)
             for name, at in _found_samples(wm):
-                if math.hypot(at[0] - candidate["x"], at[1] - candidate["y"]) <= ASSOCIATION_RADIUS:
+                if math.hypot(at[0] - candidate.x, at[1] - candidate.y) <= ASSOCIATION_RADIUS:
                     wm.retract_fact("found", name)
                     wm.retract_fact("onground", name)
-        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
-        verdicts[cid] = "invalid"
-        self.scratch["last_verdict"] = {"candidate": cid, "valid": False, "reason": reason}
+        self.memory.verdicts[cid] = "invalid"
+        VERDICT.put(self.scratch, Verdict(cid, valid=False, reason=reason))
 
 
-def _found_samples(wm: Any) -> list[tuple[str, tuple[float, float]]]:
+def _found_samples(wm: WorldModelLike) -> list[tuple[str, tuple[float, float]]]:
     """``(name, pos)`` of the samples found so far."""
     out = []
     for name, args, value in wm.values():
@@ -128,8 +159,8 @@ class DetectCircles(_Pipeline):
     :data:`SCAN_MARGIN` metres beyond ``max_range`` (within the lidar's range):
     nothing farther can make a candidate, and the rays cost less.
 
-    Succeeds with ``scratch["circles"]`` (a list of candidate dicts ``{"id", "x", "y", "radius",
-    "range", "bearing", "points"}``, nearest first) and ``candidate(c)``, ``candidate_pos(c)``
+    Succeeds with :class:`Candidates` (each a :class:`Candidate`, nearest first) in the
+    ``CANDIDATES`` slot and ``candidate(c)``, ``candidate_pos(c)``
     in the world model. With ``wait`` 0 (the default) it fails at once when the
     scan has no circle. With ``wait`` > 0 it waits for work: it scans every
     ``period`` seconds while no candidate without a verdict yet (an
@@ -203,7 +234,7 @@ class DetectCircles(_Pipeline):
         self.scans += 1
         verdicts = self.verdicts()
         out = self._candidates(circles, verdicts)
-        fresh = [c for c in out if c["id"] not in verdicts]
+        fresh = [c for c in out if c.id not in verdicts]
         if self.wait > 0.0 and not fresh:
             waited = self.now() - self.started
             seen = f"{len(out)} verified candidate(s)" if out else "no circle of the sample radius"
@@ -221,13 +252,13 @@ class DetectCircles(_Pipeline):
             return self.fail("no circle of the sample radius in the scan")
         near = (fresh or out)[0]
         return self.succeed(
-            f"{len(out)} candidate(s), {len(fresh)} unverified; nearest {near['id']} at "
-            f"({near['x']:.2f}, {near['y']:.2f}), {near['range']:.2f} m"
+            f"{len(out)} candidate(s), {len(fresh)} unverified; nearest {near.id} at "
+            f"({near.x:.2f}, {near.y:.2f}), {near.range:.2f} m"
         )
 
-    def _candidates(self, circles: list[Circle], verdicts: dict[str, str]) -> list[dict[str, Any]]:
+    def _candidates(self, circles: list[Circle], verdicts: dict[str, str]) -> tuple[Candidate, ...]:
         """Name the circles (a known candidate nearby keeps its id), write them to the scratch space and world model."""
-        known = cast("dict[str, tuple[float, float]]", self.scratch.setdefault("candidate_ids", {}))
+        known = self.memory.known
         out = []
         wm = self.world_model
         for c in circles:
@@ -235,29 +266,18 @@ class DetectCircles(_Pipeline):
             if cid is None:
                 cid = f"{self.robot.name}_c{len(known) + 1}"
             known[cid] = (c.x, c.y)
-            out.append(
-                {
-                    "id": cid,
-                    "x": c.x,
-                    "y": c.y,
-                    "radius": c.radius,
-                    "range": c.range,
-                    "bearing": c.bearing,
-                    "points": c.points,
-                }
-            )
+            out.append(Candidate(cid, c.x, c.y, c.radius, c.range, c.bearing, c.points))
             if wm is not None and cid not in verdicts:  # verified ones stay found (or invalid) until a new look
                 wm.assert_fact("candidate", cid)
                 wm.set("candidate_pos", cid, value=(round(c.x, 3), round(c.y, 3)))
-        self.scratch["circles"] = out
-        self.scratch["circle_radius"] = self.radius
-        return out
+        CANDIDATES.put(self.scratch, Candidates(tuple(out), self.radius))
+        return tuple(out)
 
 
 class CropCandidate(_Pipeline):
     """Turn the camera to the nearest unverified candidate, render it, project the candidate into it and crop it.
 
-    Candidates come from ``scratch["circles"]`` (DetectCircles). The target
+    Candidates come from the ``CANDIDATES`` slot (DetectCircles). The target
     is the nearest candidate within ``max_range`` without a verdict, one the
     camera could not see in the last ``retry`` seconds coming after the others;
     a camera with a pan unit (``spec.camera_pan_limit``) is turned toward it.
@@ -266,8 +286,8 @@ class CropCandidate(_Pipeline):
     the picture may be cropped, the target first. The crop is the
     candidate's cylinder (footprint of the sample radius,
     :data:`SAMPLE_HEIGHT` high) grown by ``margin`` metres;
-    ``scratch["candidate"]`` and ``scratch["crop"]`` (``{"rgb", "depth",
-    "box", "expected", "range", "pan"}``) go on to BlobDetect and
+    a :class:`Crop` (the candidate, ``rgb``, ``depth``, ``box``, ``expected``,
+    ``range``, ``time``, ``pan``) in the ``CROP`` slot goes on to BlobDetect and
     ClassifySample. Fails when no candidate is within ``max_range``, within
     the pan unit's reach and in clear view.
     """
@@ -281,7 +301,7 @@ class CropCandidate(_Pipeline):
         self.height = self._pixels("height", 480)
         if not ({"camera", "stereo_camera"} & self.robot.spec.capabilities):
             raise SkillError(f"skill '{self.name}': robot '{self.robot.name}' has no camera")
-        self.target: dict[str, Any] | None = None
+        self.target: Candidate | None = None
         self.reasons: list[str] = []
         self.pan = self._aim()
         self.job: Job | None = self.jobs.submit(self._render) if self.target is not None else None
@@ -298,9 +318,9 @@ class CropCandidate(_Pipeline):
         """Choose the target (``self.target``) and the pan angle that centres it; reasons for the others."""
         from alica.worldsim.robot_camera import camera_pose
 
-        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
+        circles = CANDIDATES.get(self.scratch) or ()
         verdicts = self.verdicts()
-        unseen = cast("dict[str, float]", self.scratch.get("unseen") or {})
+        unseen = self.memory.unseen
         robot = self.robot
         spec = robot.spec
         estimate = robot.estimate
@@ -311,22 +331,20 @@ class CropCandidate(_Pipeline):
         now = self.now()
         options = []
         for c in circles:
-            dx, dy = float(c["x"]) - estimate[0], float(c["y"]) - estimate[1]
+            dx, dy = c.x - estimate[0], c.y - estimate[1]
             if math.hypot(dx, dy) > self.max_range:
                 self.reasons.append(
-                    f"{c['id']}: {math.hypot(dx, dy):.1f} m away, beyond the {self.max_range:g} m of a closer look"
+                    f"{c.id}: {math.hypot(dx, dy):.1f} m away, beyond the {self.max_range:g} m of a closer look"
                 )
                 continue
-            bearing = math.remainder(
-                math.atan2(float(c["y"]) - camera[1], float(c["x"]) - camera[0]) - estimate[2], math.tau
-            )
+            bearing = math.remainder(math.atan2(c.y - camera[1], c.x - camera[0]) - estimate[2], math.tau)
             if abs(bearing) > reach:
                 self.reasons.append(
-                    f"{c['id']}: at {math.degrees(bearing):.0f} deg, out of the camera's reach (pan +-{math.degrees(limit):.0f} deg)"
+                    f"{c.id}: at {math.degrees(bearing):.0f} deg, out of the camera's reach (pan +-{math.degrees(limit):.0f} deg)"
                 )
                 continue
-            recent = now - unseen.get(str(c["id"]), -math.inf) < self.retry
-            options.append(((c["id"] in verdicts, recent, math.hypot(dx, dy)), bearing, c))
+            recent = now - unseen.get(c.id, -math.inf) < self.retry
+            options.append(((c.id in verdicts, recent, math.hypot(dx, dy)), bearing, c))
         if not options:
             return 0.0
         options.sort(key=lambda t: t[0])
@@ -350,9 +368,8 @@ class CropCandidate(_Pipeline):
             self.pan,
             frame=(self.width, self.height),
         )
-        radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
-        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
-        boxes = [g[0] for g in (self._geometry(probe, c, radius) for c in circles) if not isinstance(g, str)]
+        circles = CANDIDATES.get(self.scratch) or Candidates((), 0.03)
+        boxes = [g[0] for g in (self._geometry(probe, c, circles.radius) for c in circles) if not isinstance(g, str)]
         window = None
         if boxes:
             u0, v0 = min(b[0] for b in boxes), min(b[1] for b in boxes)
@@ -367,54 +384,53 @@ class CropCandidate(_Pipeline):
 
     def update(self) -> Status:
         """Poll the rendering; crop the candidate."""
-        circles = cast("list[dict[str, Any]]", self.scratch.get("circles") or [])
+        circles = CANDIDATES.get(self.scratch)
         if not circles:
             return self.fail("no candidate to look at: run DetectCircles first")
         if self.job is None or self.target is None:
             return self.fail("no candidate in reach: " + "; ".join(self.reasons[:3]))
         if not self.job.done():
             return self.running(
-                f"turning the camera to {self.target['id']} ({math.degrees(self.pan):.0f} deg) and taking a picture"
+                f"turning the camera to {self.target.id} ({math.degrees(self.pan):.0f} deg) and taking a picture"
             )
         image: CameraImage = self.job.result()
         verdicts = self.verdicts()
-        radius = float(cast("float", self.scratch.get("circle_radius", 0.03)))
         views = []
         reasons: list[str] = []
         for c in circles:
-            view = self._view(image, c, radius)
+            view = self._view(image, c, circles.radius)
             if isinstance(view, str):
-                if c["id"] == self.target["id"]:
-                    reasons.insert(0, f"{c['id']}: {view}")
-                    unseen = cast("dict[str, float]", self.scratch.setdefault("unseen", {}))
-                    unseen[str(c["id"])] = self.now()
+                if c.id == self.target.id:
+                    reasons.insert(0, f"{c.id}: {view}")
+                    self.memory.unseen[c.id] = self.now()
                 else:
-                    reasons.append(f"{c['id']}: {view}")
+                    reasons.append(f"{c.id}: {view}")
             else:
-                views.append((c["id"] in verdicts, c["id"] != self.target["id"], c["range"], c, view))
+                views.append((c.id in verdicts, c.id != self.target.id, c.range, c, view))
         if not views:
             return self.fail("no candidate in view: " + "; ".join((reasons + self.reasons)[:3]))
         views.sort(key=lambda t: (t[0], t[1], t[2]))
         *_, candidate, (box, expected) = views[0]
         u0, v0, u1, v1 = box
         ou, ov = image.offset
-        self.scratch["candidate"] = dict(candidate)
-        self.scratch["crop"] = {
-            "rgb": image.rgb[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
-            "depth": image.depth[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
-            "box": box,
-            "expected": (expected[0] - u0, expected[1] - v0, expected[2] - u0, expected[3] - v0),
-            "range": candidate["range"],
-            "time": image.time,
-            "pan": image.pan,
-        }
+        crop = Crop(
+            candidate,
+            rgb=image.rgb[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
+            depth=image.depth[v0 - ov : v1 - ov, u0 - ou : u1 - ou].copy(),
+            box=box,
+            expected=(expected[0] - u0, expected[1] - v0, expected[2] - u0, expected[3] - v0),
+            range=candidate.range,
+            time=image.time,
+            pan=image.pan,
+        )
+        CROP.put(self.scratch, crop)
         return self.succeed(
-            f"cropped {candidate['id']} ({u1 - u0}x{v1 - v0} px at {candidate['range']:.2f} m, "
+            f"cropped {candidate.id} ({u1 - u0}x{v1 - v0} px at {candidate.range:.2f} m, "
             f"camera at {math.degrees(image.pan):.0f} deg)"
         )
 
     def _view(
-        self, image: CameraImage, c: dict[str, Any], radius: float
+        self, image: CameraImage, c: Candidate, radius: float
     ) -> tuple[tuple[int, int, int, int], tuple[float, float, float, float]] | str:
         """The crop box and the sample's expected box in frame pixels, or why the candidate cannot be seen."""
         geometry = self._geometry(image, c, radius)
@@ -431,15 +447,15 @@ class CropCandidate(_Pipeline):
         return box, expected
 
     def _geometry(
-        self, image: CameraImage, c: dict[str, Any], radius: float
+        self, image: CameraImage, c: Candidate, radius: float
     ) -> tuple[tuple[int, int, int, int], tuple[float, float, float, float], float] | str:
         """Where the candidate lies in the camera's frame: crop box, expected box, depth (pixels of the whole
         frame, from the picture's pose and intrinsics); or why it cannot be seen there."""
-        if c["range"] > self.max_range:
-            return f"{c['range']:.1f} m away, beyond the {self.max_range:.1f} m of a closer look"
+        if c.range > self.max_range:
+            return f"{c.range:.1f} m away, beyond the {self.max_range:.1f} m of a closer look"
         w, h = image.frame_size
         ou, ov = image.offset
-        x, y = float(c["x"]), float(c["y"])
+        x, y = c.x, c.y
         # the sample's cylinder: its silhouette's left/right edges at the bottom and the top
         to = np.array([x, y, 0.0]) - image.position
         side = np.array([-to[1], to[0], 0.0]) / max(math.hypot(to[0], to[1]), 1e-9)
@@ -481,7 +497,7 @@ def _span(a: int, b: int, size: int) -> tuple[int, int]:
 class BlobDetect(_Pipeline):
     """Find coloured blobs in the crop (HSV thresholds, connected components of at least ``min_area`` pixels).
 
-    Reads ``scratch["crop"]`` (CropCandidate), writes ``scratch["blobs"]`` (see
+    Reads the :class:`Crop` (CropCandidate), writes :class:`Blobs` (see
     :func:`find_blobs`). Fails, retracting the candidate, when no blob of the
     colours is near the candidate: a closer look disagrees.
     """
@@ -494,7 +510,7 @@ class BlobDetect(_Pipeline):
             raise SkillError(
                 f"skill '{self.name}': parameter 'colours' must list colours of {', '.join(sorted(HSV_RANGES))}, got {raw!r}"
             )
-        self.colours = cast("tuple[str, ...]", colours)
+        self.colours: tuple[str, ...] = tuple(str(c) for c in colours)
         area = self.param("min_area", 12)
         if not isinstance(area, int) or isinstance(area, bool) or area < 1:
             raise SkillError(
@@ -504,20 +520,20 @@ class BlobDetect(_Pipeline):
 
     def update(self) -> Status:
         """Detect the blobs (cheap: the crop is small)."""
-        crop = cast("dict[str, Any] | None", self.scratch.get("crop"))
-        candidate = cast("dict[str, Any] | None", self.scratch.get("candidate"))
-        if crop is None or candidate is None:
+        crop = CROP.get(self.scratch)
+        if crop is None:
             return self.fail("no cropped candidate: run CropCandidate first")
-        u0, v0, u1, v1 = crop["expected"]
+        candidate = crop.candidate
+        u0, v0, u1, v1 = crop.expected
         pad = max(2.0, WINDOW_PAD * (v1 - v0) / 3.0)
-        blobs = find_blobs(crop["rgb"], self.colours, self.min_area, (u0 - pad, v0 - pad, u1 + pad, v1 + pad))
-        self.scratch["blobs"] = blobs
+        blobs = find_blobs(crop.rgb, self.colours, self.min_area, (u0 - pad, v0 - pad, u1 + pad, v1 + pad))
+        BLOBS.put(self.scratch, Blobs(tuple(blobs)))
         if not blobs:
-            reason = f"no {' or '.join(self.colours)} blob of {self.min_area} px or more at {candidate['id']}"
+            reason = f"no {' or '.join(self.colours)} blob of {self.min_area} px or more at {candidate.id}"
             self.reject_candidate(candidate, reason)
             return self.fail(reason)
-        summary = ", ".join(f"{b['colour']} {b['area']} px" for b in blobs[:4])
-        return self.succeed(f"{len(blobs)} blob(s) at {candidate['id']}: {summary}")
+        summary = ", ".join(f"{b.colour} {b.area} px" for b in blobs[:4])
+        return self.succeed(f"{len(blobs)} blob(s) at {candidate.id}: {summary}")
 
 
 class ClassifySample(_Pipeline):
@@ -541,22 +557,22 @@ class ClassifySample(_Pipeline):
 
     def update(self) -> Status:
         """Classify and write the result."""
-        crop = cast("dict[str, Any] | None", self.scratch.get("crop"))
-        candidate = cast("dict[str, Any] | None", self.scratch.get("candidate"))
-        blobs = cast("list[dict[str, Any]] | None", self.scratch.get("blobs"))
-        if crop is None or candidate is None or blobs is None:
+        crop = CROP.get(self.scratch)
+        blobs = BLOBS.get(self.scratch)
+        if crop is None or blobs is None:
             return self.fail("nothing to classify: run CropCandidate and BlobDetect first")
-        result = decode_sections(crop["rgb"], blobs, crop["expected"])
+        candidate = crop.candidate
+        result = decode_sections(crop.rgb, blobs.items, crop.expected)
         if isinstance(result, str):
             self.reject_candidate(candidate, result)
-            return self.fail(f"{candidate['id']} is no sample: {result}")
+            return self.fail(f"{candidate.id} is no sample: {result}")
         kind, confidence = result
         if confidence < self.min_confidence:
             reason = f"{kind} with confidence {confidence:.2f} below {self.min_confidence:.2f}"
             self.reject_candidate(candidate, reason)
-            return self.fail(f"{candidate['id']} is no sample: {reason}")
+            return self.fail(f"{candidate.id} is no sample: {reason}")
         name = self._name(kind, candidate)
-        position = (round(float(candidate["x"]), 3), round(float(candidate["y"]), 3))
+        position = (round(candidate.x, 3), round(candidate.y, 3))
         wm = self.world_model
         if wm is not None:
             wm.set("sample_kind", name, value=kind)
@@ -565,28 +581,21 @@ class ClassifySample(_Pipeline):
             wm.assert_fact("found", name)
             wm.assert_fact("onground", name)  # seen standing on the ground (the planning domain's fact)
             seen_on_the_ground(wm, name)
-            wm.retract_fact("candidate", str(candidate["id"]))
-            add_object = getattr(wm, "add_object", None)
-            if callable(add_object):
-                add_object(name, "Sample")
-        verdicts = cast("dict[str, str]", self.scratch.setdefault("verdicts", {}))
-        verdicts[str(candidate["id"])] = name
-        self.scratch["last_verdict"] = {
-            "candidate": candidate["id"],
-            "valid": True,
-            "sample": name,
-            "kind": kind,
-            "position": position,
-            "confidence": confidence,
-        }
+            wm.retract_fact("candidate", candidate.id)
+            wm.add_object(name, "Sample")
+        self.memory.verdicts[candidate.id] = name
+        VERDICT.put(
+            self.scratch,
+            Verdict(candidate.id, valid=True, sample=name, kind=kind, position=position, confidence=confidence),
+        )
         return self.succeed(
             f"found {name}: {kind} at ({position[0]:.2f}, {position[1]:.2f}), confidence {confidence:.2f}"
         )
 
-    def _name(self, kind: str, candidate: dict[str, Any]) -> str:
+    def _name(self, kind: str, candidate: Candidate) -> str:
         """The sample's name: the known sample of this kind nearby or without a position, else a new one."""
         wm = self.world_model
-        here = (float(candidate["x"]), float(candidate["y"]))
+        here = (candidate.x, candidate.y)
         base = kind.replace("-", "_")
         if wm is None:
             return base

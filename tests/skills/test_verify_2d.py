@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 from alica.errors import SkillError
+from alica.skills.vision2d_data import CANDIDATES, CROP, MEMORY, Candidate, Candidates, Memory
 from alica.worldmodel import WorldModel
 from alica.worldsim.objects import SAMPLE_KINDS
 
@@ -74,16 +75,16 @@ def test_detect_circles_reports_samples_not_rocks_or_robots(skill_run):
         wm = WorldModel("scout", clock=world.clock)
         run = skill_run("DetectCircles", world, "scout", {}, scratch=scratch, world_model=wm)
         assert run.ok, run.reason
-        circles = scratch["circles"]
-        found = [(c["x"], c["y"]) for c in circles]
+        circles = CANDIDATES.require(scratch, "test").items
+        found = [(c.x, c.y) for c in circles]
         for xy in samples:
             assert min(math.dist(xy, f) for f in found) < 0.03, (xy, found)
         assert len(circles) == len(samples), circles
         for c in circles:
-            assert abs(c["radius"] - 0.03) < 0.02
-            assert run.holds("candidate", c["id"])
-            assert wm.get("candidate_pos", c["id"]) is not None
-        assert [c["range"] for c in circles] == sorted(c["range"] for c in circles)
+            assert abs(c.radius - 0.03) < 0.02
+            assert run.holds("candidate", c.id)
+            assert wm.get("candidate_pos", c.id) is not None
+        assert [c.range for c in circles] == sorted(c.range for c in circles)
     finally:
         world.close()
 
@@ -104,10 +105,10 @@ def test_detect_circles_waits_for_an_unverified_candidate(skill_run):
         run = skill_run("DetectCircles", world, "scout", {"wait": 5.0}, scratch=scratch, on_tick=drop_a_sample)
         assert run.ok, run.reason
         assert world.now() - started >= 1.0  # it kept scanning until the sample was there
-        (c,) = scratch["circles"]
-        assert math.dist((c["x"], c["y"]), xy) < 0.03
+        (c,) = CANDIDATES.require(scratch, "test")
+        assert math.dist((c.x, c.y), xy) < 0.03
         # verified: the next look waits for another one and gives up after the wait
-        scratch["verdicts"] = {c["id"]: "green_black_red"}
+        MEMORY.setdefault(scratch, Memory).verdicts[c.id] = "green_black_red"
         run = skill_run("DetectCircles", world, "scout", {"wait": 2.0, "period": 0.5}, scratch=scratch)
         assert run.status == "failure", run.reason
         assert "no unverified candidate within 8 m in 2." in run.reason and "1 verified" in run.reason
@@ -173,7 +174,7 @@ def test_each_kind_is_found_and_classified(skill_run, kind):
         assert wm.get("sample_kind", "a") == kind
         assert math.dist(wm.get("pos", "a"), xy) < 0.05
         assert 0.5 <= wm.get("confidence", "a") <= 1.0
-        assert not wm.holds("candidate", scratch["candidate"]["id"])
+        assert not wm.holds("candidate", CROP.require(scratch, "test").candidate.id)
     finally:
         world.close()
 
@@ -191,10 +192,10 @@ def test_crop_candidate_renders_only_the_crops_part_of_the_frame_with_its_pixels
         assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
         crop_run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
         assert crop_run.ok, crop_run.reason
-        crop = scratch["crop"]
-        whole = robot_camera(world.robots["scout"], width=752, height=480, pan=crop["pan"], believed=True)
-        u0, v0, u1, v1 = crop["box"]
-        assert np.array_equal(crop["rgb"], whole.rgb[v0:v1, u0:u1])
+        crop = CROP.require(scratch, "test")
+        whole = robot_camera(world.robots["scout"], width=752, height=480, pan=crop.pan, believed=True)
+        u0, v0, u1, v1 = crop.box
+        assert np.array_equal(crop.rgb, whole.rgb[v0:v1, u0:u1])
         assert (u1 - u0) * (v1 - v0) < 752 * 480 // 10
     finally:
         world.close()
@@ -220,17 +221,8 @@ def test_an_unknown_sample_is_named_after_its_kind(skill_run):
 
 def _false_candidate(world, scratch, xy, cid="scout_c9"):
     x, y, _ = world.robots["scout"].pose
-    scratch["circles"] = [
-        {
-            "id": cid,
-            "x": xy[0],
-            "y": xy[1],
-            "radius": 0.03,
-            "range": math.dist((x, y), xy),
-            "bearing": 0.0,
-            "points": 3,
-        }
-    ]
+    candidate = Candidate(cid, xy[0], xy[1], radius=0.03, range=math.dist((x, y), xy), bearing=0.0, points=3)
+    CANDIDATES.put(scratch, Candidates((candidate,), radius=0.03))
 
 
 def test_a_rock_candidate_is_retracted_and_recorded_invalid(skill_run):
@@ -304,7 +296,7 @@ def test_the_camera_pans_to_a_candidate_behind_the_robot(skill_run):
         wm = WorldModel("scout", clock=world.clock)
         runs = _pipeline(skill_run, world, scratch, wm, rounds=1)
         assert [r.status for r in runs] == ["success"] * 4, [r.reason for r in runs]
-        assert abs(scratch["crop"]["pan"]) > math.radians(150)  # turned round (pan limit 160 deg)
+        assert abs(CROP.require(scratch, "test").pan) > math.radians(150)  # turned round (pan limit 160 deg)
         assert wm.holds("found", "green_black_red")
         assert math.dist(wm.get("pos", "green_black_red"), xy) < 0.05
     finally:
@@ -324,8 +316,10 @@ def test_crop_fails_clearly_when_no_candidate_is_in_reach(skill_run):
         assert none.status == "failure" and "DetectCircles first" in none.reason
         # Amparo's stereo camera has no pan unit: a candidate behind it is out of reach
         x, y, yaw = world.robots["amparo"].pose
-        behind = {"id": "c1", "x": x - 2.0 * math.cos(yaw), "y": y - 2.0 * math.sin(yaw), "range": 2.0}
-        run = skill_run("CropCandidate", world, "amparo", {}, scratch={"circles": [behind]})
+        behind = Candidate("c1", x - 2.0 * math.cos(yaw), y - 2.0 * math.sin(yaw), 0.03, 2.0, math.pi, 3)
+        scratch = {}
+        CANDIDATES.put(scratch, Candidates((behind,), radius=0.03))
+        run = skill_run("CropCandidate", world, "amparo", {}, scratch=scratch)
         assert run.status == "failure" and "out of the camera's reach (pan +-0 deg)" in run.reason
     finally:
         world.close()
@@ -339,13 +333,13 @@ def test_a_candidate_the_camera_cannot_see_goes_last(skill_run):
         world.step(0.2)
         scratch: dict[str, object] = {}
         assert skill_run("DetectCircles", world, "scout", {}, scratch=scratch).ok
-        (seen,) = scratch["circles"]
-        ghost = dict(seen, id="ghost", x=seen["x"] + 0.5, y=seen["y"] + 0.3)  # no sample there: a hole in the view
-        ghost["range"] = math.dist(world.robots["scout"].estimate[:2], (ghost["x"], ghost["y"]))
-        scratch["circles"] = sorted([seen, ghost], key=lambda c: c["range"])
-        scratch["unseen"] = {"ghost": world.now()}
+        (seen,) = CANDIDATES.require(scratch, "test")
+        ghost = replace(seen, id="ghost", x=seen.x + 0.5, y=seen.y + 0.3)  # no sample there: a hole in the view
+        ghost = replace(ghost, range=math.dist(world.robots["scout"].estimate[:2], (ghost.x, ghost.y)))
+        CANDIDATES.put(scratch, Candidates(tuple(sorted([seen, ghost], key=lambda c: c.range)), radius=0.03))
+        MEMORY.setdefault(scratch, Memory).unseen["ghost"] = world.now()
         run = skill_run("CropCandidate", world, "scout", {}, scratch=scratch)
-        assert run.ok and scratch["candidate"]["id"] == seen["id"], run.reason
+        assert run.ok and CROP.require(scratch, "test").candidate.id == seen.id, run.reason
     finally:
         world.close()
 
