@@ -59,7 +59,6 @@ is read from the plan's :attr:`~alica.prophet.tasks.CreatedTasks.places`
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
@@ -68,6 +67,7 @@ from alica.errors import AlicaError, PlannerError
 from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
+from alica.prophet.budget import LeaderSearch, SearchBudget, advance
 from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER, GiveUp
 from alica.prophet.leadership import is_leader, next_generation
 from alica.prophet.magic.leader import MagicLeader
@@ -113,45 +113,11 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True, slots=True)
-class SearchBudget:
-    """How much the leader searches per tick.
-
-    Attributes:
-        expansions: the search budget per tick, in expansions (deterministic: the same run plans the same way).
-        seconds: a wall-time budget per tick instead (for real robots); ``None`` uses ``expansions``.
-    """
-
-    expansions: int = 1000
-    seconds: float | None = None
-
-    def __post_init__(self) -> None:
-        if self.expansions < 1 or (self.seconds is not None and self.seconds <= 0):
-            raise ValueError("the planner's budget needs expansions >= 1 and seconds > 0 (or None)")
-
-
-@dataclass
-class _Search:
-    """The leader's running search."""
-
-    generation: int
-    world: PlanningWorld
-    events: Iterator[ProblemEvent]
-    started: float
-    expansions: int = 0
-    best: ValidPlan | None = None
-    shared_cost: float | None = None
-    version: int = 0
-    goal: tuple[Literal, ...] = ()
-    planning: ProblemPlanning | None = None
-    """What the search plans (its PDDL): an operator's change of the plan is validated against it."""
-
-
 @dataclass
 class _Proposal:
     """A plan the leader proposed to the operator (review on), waiting for a decision."""
 
-    search: _Search
+    search: LeaderSearch
     plan: ValidPlan
     created: CreatedTasks | None
 
@@ -188,7 +154,7 @@ class ProblemRuntime:
         self.revision = 0
         self.reason = ""
         self.failed_generation = -1
-        self.search: _Search | None = None
+        self.search: LeaderSearch | None = None
         self.next_update = -1.0
         self.invalid_once = False
         self.request: ReplanRequest | None = None
@@ -631,7 +597,7 @@ class ProblemRuntime:
             host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self._publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
             return
-        self.search = _Search(
+        self.search = LeaderSearch(
             generation, world, events, now, goal=partial if partial != goal else (), planning=planning
         )
         extra = {"goal": conjunction(partial), "outside": list(world.outside)} if partial != goal else {}
@@ -737,11 +703,8 @@ class ProblemRuntime:
     def _step_search(self, now: float) -> None:
         search = self.search
         assert search is not None
-        budget = self.budget
-        start_expansions = search.expansions
-        deadline = time.perf_counter() + budget.seconds if budget.seconds is not None else None
         try:
-            finished = self._run_search(search, budget, start_expansions, deadline)
+            finished = advance(search, self.budget, self._warn)
         except (PlannerError, AlicaError) as exc:  # grounding runs inside the search: a domain it cannot read
             self.search = None
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
@@ -752,36 +715,10 @@ class ProblemRuntime:
             return
         self._after_search(now, search, finished)
 
-    def _run_search(
-        self, search: _Search, budget: SearchBudget, start_expansions: int, deadline: float | None
-    ) -> Done | None:
-        """Advance the search within this tick's budget; the Done event when it ended."""
-        finished: Done | None = None
-        for event in search.events:
-            search.expansions = event.expansions
-            if isinstance(event, Found):
-                search.best = event.plan
-                if search.shared_cost is None:
-                    break  # share the first plan at once
-            elif isinstance(event, Rejected):
-                self.host.emit(
-                    "warning",
-                    key=key_text(self.key),
-                    message=f"the planner's plan is invalid and not shared: {event.reason}",
-                )
-            elif isinstance(event, Done):
-                finished = event
-                break
-            if deadline is not None:
-                if time.perf_counter() >= deadline:
-                    break
-            elif search.expansions - start_expansions >= budget.expansions:
-                break
-        else:
-            finished = Done(PlanStatus.SOLVED if search.best is not None else PlanStatus.UNSOLVABLE, search.expansions)
-        return finished
+    def _warn(self, message: str) -> None:
+        self.host.emit("warning", key=key_text(self.key), message=message)
 
-    def _after_search(self, now: float, search: _Search, finished: Done | None) -> None:
+    def _after_search(self, now: float, search: LeaderSearch, finished: Done | None) -> None:
         """Share what the search found; end it when it is done."""
         best = search.best
         if best is not None and search.shared_cost is None:
@@ -888,7 +825,9 @@ class ProblemRuntime:
             for _, state in node.believed.values()
         )
 
-    def _share_plan(self, now: float, search: _Search, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()) -> None:
+    def _share_plan(
+        self, now: float, search: LeaderSearch, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
+    ) -> None:
         steps = plan.steps
         self.waiting.end_team_wait()
         search.version += 1
@@ -923,7 +862,7 @@ class ProblemRuntime:
 
     # -- the operator's review (EngineConfig.review) -------------------------------
 
-    def _propose(self, search: _Search, plan: ValidPlan) -> None:
+    def _propose(self, search: LeaderSearch, plan: ValidPlan) -> None:
         """Stop searching and propose the generation's first valid plan to the operator (the team keeps waiting)."""
         self.search = None
         self.waiting.end_team_wait()
