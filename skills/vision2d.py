@@ -176,8 +176,8 @@ class DetectCircles(_Pipeline):
         self.period = number_param(self, "period", 0.5)
         raw_wait = self.param("wait", 0.0)
         try:
-            self.wait = float(raw_wait)  # type: ignore[arg-type]
-        except (TypeError, ValueError):
+            self.wait = float(raw_wait) if isinstance(raw_wait, (int, float, str)) else math.nan
+        except ValueError:
             self.wait = math.nan
         if not self.wait >= 0.0:  # NaN too; inf is allowed: wait until a candidate comes
             raise SkillError(
