@@ -60,9 +60,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
-from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanDecision, PlanKey, RunningPlan, key_text
+from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanKey, RunningPlan, key_text
 from alica.errors import AlicaError, PlannerError
 from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
@@ -75,10 +75,10 @@ from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
 from alica.prophet.pddl.writer import write_domain, write_problem
 from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
 from alica.prophet.planner import Done, PlanStatus, PlanStep, Progress
-from alica.prophet.planner import Plan as StepPlan
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
-from alica.prophet.review import PROPOSAL_PLAN, apply_pins, proposal_fields, reordered, resolve_pins
+from alica.prophet.review import apply_pins
+from alica.prophet.reviewing import Pins, Reviewing
 from alica.prophet.runtime_states import LeaderPhase, child_phase, leader_phase
 from alica.prophet.tasks import (
     STEP_DONE,
@@ -111,15 +111,6 @@ __all__ = [
     "ProblemRuntime",
     "SearchBudget",
 ]
-
-
-@dataclass
-class _Proposal:
-    """A plan the leader proposed to the operator (review on), waiting for a decision."""
-
-    search: LeaderSearch
-    plan: ValidPlan
-    created: CreatedTasks | None
 
 
 class ProblemRuntime:
@@ -172,10 +163,16 @@ class ProblemRuntime:
         self.step_over: float | None = None
         """When a stepwise plan's step was seen over while its effects had not all arrived yet."""
         self.overrides = dict(host.override(self.model.name))
-        self.proposal: _Proposal | None = None
-        """The plan proposed to the operator, while the leader waits for a decision (review on)."""
-        self.decided = len(host.decisions(self.model.name))
-        """How many of the operator's decisions on the problem this runtime has read (older ones are not for it)."""
+        self.reviewing = Reviewing(
+            element.name,
+            key_text(self.key),
+            host.name,
+            host.emit,
+            lambda: host.decisions(element.name),
+            lambda name, steps, world, robots: self._tasks_for(name, steps, world, robots, self._entry_task()),
+            lambda: self.problem.goal.text,
+        )
+        """The operator's review (review on): the plan proposed, and the decisions read."""
         now = host.now()
         # a share received lately is current (the leader repeats it every UpdateTime); an older one is stale
         fresh = board.fresh(self.key, now, 2 * self.model.update_time)
@@ -211,7 +208,7 @@ class ProblemRuntime:
         share = self.share
         return leader_phase(
             leader=leader,
-            proposal=self.proposal is not None,
+            proposal=self.reviewing.proposal is not None,
             pending=self.pending is not None,
             search=self.search is not None,
             blocked=self.waiting.blocked is not None,
@@ -317,11 +314,11 @@ class ProblemRuntime:
                 self._replan(now, "the operator changed the planning problem")
             self._lead(now)
         else:
-            if self.search is not None or self.proposal is not None:
+            if self.search is not None or self.reviewing.proposal is not None:
                 self.search = None
-                self.proposal = None
+                self.reviewing.drop()
                 host.emit("planner", key=key_text(self.key), what="handed over")
-            self.decided = len(host.decisions(self.model.name))  # whoever leads decides on its own proposals
+            self.reviewing.catch_up()  # whoever leads decides on its own proposals
             if self.request is not None and now >= self.next_update:
                 host.publish(self.request)
                 self.next_update = now + self.model.update_time
@@ -395,9 +392,9 @@ class ProblemRuntime:
             self.search = None
             self.pending = None
             host.emit("planner", key=key_text(self.key), what="superseded", generation=search.generation)
-        proposal = self.proposal
+        proposal = self.reviewing.proposal
         if proposal is not None and share.leader != host.name and share.generation >= proposal.search.generation:
-            self.proposal = None  # another leader is ahead: its plan wins over the one waiting for the operator
+            self.reviewing.drop()  # another leader is ahead: its plan wins over the one waiting for the operator
             host.emit("planner", key=key_text(self.key), what="superseded", generation=proposal.search.generation)
         created = None
         if share.status == PLAN:
@@ -485,8 +482,7 @@ class ProblemRuntime:
             return
         phase = self._leader_phase(True)
         if phase is LeaderPhase.REVIEWING:
-            assert self.proposal is not None
-            self._review(now, self.proposal)
+            self.reviewing.read(now, self._share_plan, self._replan)
         elif phase is LeaderPhase.SETTLING:
             assert self.pending is not None
             if now + 1e-9 < self.pending[0]:
@@ -552,7 +548,7 @@ class ProblemRuntime:
 
     def _start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         host = self.host
-        self.proposal = None
+        self.reviewing.drop()
         if generation is None:
             generation = self._next_generation()
         me = host.name
@@ -723,7 +719,9 @@ class ProblemRuntime:
         best = search.best
         if best is not None and search.shared_cost is None:
             if self.host.review:
-                self._propose(search, best)
+                self.search = None
+                self.waiting.end_team_wait()
+                self.reviewing.propose(search, best)
                 return
             self._share_plan(now, search, best)
         elif search.shared_cost is not None and self._executing():
@@ -825,9 +823,7 @@ class ProblemRuntime:
             for _, state in node.believed.values()
         )
 
-    def _share_plan(
-        self, now: float, search: LeaderSearch, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()
-    ) -> None:
+    def _share_plan(self, now: float, search: LeaderSearch, plan: ValidPlan, pins: Pins = ()) -> None:
         steps = plan.steps
         self.waiting.end_team_wait()
         search.version += 1
@@ -859,86 +855,6 @@ class ProblemRuntime:
             pins=pins,
         )
         self._publish(share, now)
-
-    # -- the operator's review (EngineConfig.review) -------------------------------
-
-    def _propose(self, search: LeaderSearch, plan: ValidPlan) -> None:
-        """Stop searching and propose the generation's first valid plan to the operator (the team keeps waiting)."""
-        self.search = None
-        self.waiting.end_team_wait()
-        name = PROPOSAL_PLAN.format(problem=self.model.name, generation=search.generation)
-        error = None
-        try:
-            created: CreatedTasks | None = self._tasks_for(
-                name, plan.steps, search.world.facts, search.world.robots, self._entry_task()
-            )
-        except (PlannerError, AlicaError) as exc:
-            created, error = None, f"the plan cannot be turned into tasks: {exc}"
-        self.proposal = _Proposal(search, plan, created)
-        self._emit_proposal(self.proposal, error)
-
-    def _emit_proposal(
-        self, proposal: _Proposal, error: str | None = None, decision: PlanDecision | None = None
-    ) -> None:
-        search = proposal.search
-        self.host.emit(
-            "proposal",
-            **proposal_fields(
-                key=key_text(self.key),
-                problem=self.model.name,
-                generation=search.generation,
-                leader=self.host.name,
-                cost=proposal.plan.plan.cost,
-                goal=conjunction(search.goal) if search.goal else self.problem.goal.text,
-                steps=proposal.plan.steps,
-                created=proposal.created,
-                error=error,
-                decision=decision.describe() if decision is not None else None,
-            ),
-        )
-
-    def _review(self, now: float, proposal: _Proposal) -> None:
-        """Read the operator's new decisions, in order, until one settles the proposal."""
-        decisions = self.host.decisions(self.model.name)
-        generation = proposal.search.generation
-        while self.decided < len(decisions) and self.proposal is proposal:
-            decided_for, decision = decisions[self.decided]
-            self.decided += 1
-            if decided_for != generation:
-                self.host.emit(
-                    "note",
-                    key=key_text(self.key),
-                    message=f"the operator's '{decision.action}' for generation {decided_for} is ignored: "
-                    f"the plan proposed is of generation {generation}",
-                )
-            elif decision.action == "accept":
-                self._accept(now, proposal, proposal.plan)
-            elif decision.action == "decline":
-                self._replan(now, f"the operator declined the plan of generation {generation}")
-            else:
-                self._modify(now, proposal, decision)
-
-    def _accept(self, now: float, proposal: _Proposal, plan: ValidPlan, pins: tuple[tuple[int, str], ...] = ()) -> None:
-        self.proposal = None
-        self._share_plan(now, proposal.search, plan, pins)
-
-    def _modify(self, now: float, proposal: _Proposal, decision: PlanDecision) -> None:
-        """Run the plan as the operator changed it if it is valid; else propose it again with the error."""
-        search = proposal.search
-        try:
-            steps = reordered(proposal.plan.steps, decision.order)
-            if search.planning is None:
-                raise PlannerError("the plan was not made by a search this agent can validate against")
-            check = search.planning.check(steps)
-            if not check.valid:
-                raise PlannerError(f"the modified plan is invalid: {check.reason}")
-            name = PROPOSAL_PLAN.format(problem=self.model.name, generation=search.generation)
-            created = self._tasks_for(name, steps, search.world.facts, search.world.robots, self._entry_task())
-            pins = resolve_pins(created, decision.pins, search.world.robots)
-        except (PlannerError, AlicaError) as exc:
-            self._emit_proposal(proposal, str(exc), decision)
-            return
-        self._accept(now, proposal, ValidPlan(steps, check.cost, StepPlan(steps, check.cost)), pins)
 
     # -- execution monitoring --------------------------------------------------
 
