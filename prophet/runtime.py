@@ -58,7 +58,6 @@ is read from the plan's :attr:`~alica.prophet.tasks.CreatedTasks.places`
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import replace
 
@@ -72,6 +71,7 @@ from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER, GiveUp
 from alica.prophet.leadership import is_leader, next_generation
 from alica.prophet.magic.leader import MagicLeader
 from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
+from alica.prophet.monitoring import StepMarks, executing, stalled, task_progress
 from alica.prophet.pddl.writer import write_domain, write_problem
 from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
 from alica.prophet.planner import Done, PlanStatus, PlanStep, Progress
@@ -84,18 +84,13 @@ from alica.prophet.tasks import (
     STEP_DONE,
     CreatedTasks,
     Literal,
-    Step,
-    StepKind,
     conjunction,
     create_tasks,
-    for_robot,
     holds,
-    step_token,
 )
 from alica.prophet.waiting import TEAM_WAIT, Waiting
 from alica.prophet.world import (
     PlanningWorld,
-    TaskProgress,
     goal_literals,
     reachable_goal,
     read_world,
@@ -110,7 +105,10 @@ __all__ = [
     "TEAM_WAIT",
     "ProblemRuntime",
     "SearchBudget",
+    "_stalled",
 ]
+
+_stalled = stalled  # the name the tests of the runtime knew it by
 
 
 class ProblemRuntime:
@@ -149,9 +147,8 @@ class ProblemRuntime:
         self.next_update = -1.0
         self.invalid_once = False
         self.request: ReplanRequest | None = None
-        self.marked: set[str] = set()
-        self.effected: set[str] = set()
-        """Steps under way whose effect was written early (their skills had written its positive part)."""
+        self.marks = StepMarks(host.world, host.name)
+        """The steps this agent finished in the generated plan (``step_done``, with their effects)."""
         self.pending: tuple[float, str] | None = None
         self.waiting = Waiting()
         """What the leader waits for: the world to change, the robots outside the team to come back."""
@@ -324,50 +321,7 @@ class ProblemRuntime:
                 self.next_update = now + self.model.update_time
         if self.request is not None and self.share is not None and self.share.generation > self.request.generation:
             self.request = None
-        self._mark_done()
-
-    def _mark_done(self) -> None:
-        """Write ``step_done`` for the steps this agent finished in the generated plan (later steps wait for them).
-
-        The finished step's effect (its skill plan's signature, for this agent) is written too, as a
-        plan executor applies an action's effects when it completes: the skills write what they sense
-        (``holding``, ``onground``), but a fact of the planning domain that no skill writes (the robot's
-        ``at`` a sample it has picked up, deleted by Pickup) would otherwise keep a stale value.
-        A step under way whose effect's positive part holds already is treated alike, once.
-        """
-        node, created = self.slot.node, self.created
-        if node is None or created is None or node.plan is not created.plan or node.ep is None:
-            return
-        place = created.place(node.state)
-        if place is None:
-            return  # standing by
-        world = self.host.world
-        me = self.host.name
-        for step in created.tasks[place.task][: place.step]:
-            token = step_token(created.plan.name, step.index)
-            if token not in self.marked:
-                self.marked.add(token)
-                if token not in self.effected:
-                    self._write_effect(step, me)
-                world.assert_fact(STEP_DONE, token)
-        if place.kind is StepKind.RUN and place.step < len(created.tasks[place.task]):
-            # a step under way whose effects the skills wrote already (the grasp is done, the lift is not)
-            # has done its work: its whole effect is written now, so that a replan before it ends (a
-            # teammate's step failed) does not plan from a robot still 'at' the sample it holds
-            step = created.tasks[place.task][place.step]
-            token = step_token(created.plan.name, step.index)
-            if token not in self.effected:
-                effect = for_robot(step.effect, step.robot, me)
-                if all(world.holds(fact.predicate, *fact.args) for positive, fact in effect if positive):
-                    self.effected.add(token)
-                    self._write_effect(step, me)
-
-    def _write_effect(self, step: Step, me: str) -> None:
-        """Write a step's effect for this agent to the world model (deletes first)."""
-        world = self.host.world
-        effect = for_robot(step.effect, step.robot, me)
-        for positive, fact in sorted(effect, key=lambda literal: literal[0]):
-            (world.assert_fact if positive else world.retract_fact)(fact.predicate, *fact.args)
+        self.marks.mark_done(self.slot.node, self.created)
 
     def stop(self) -> None:
         """The agent leaves the state: stop planning, forget the generated plan."""
@@ -724,7 +678,7 @@ class ProblemRuntime:
                 self.reviewing.propose(search, best)
                 return
             self._share_plan(now, search, best)
-        elif search.shared_cost is not None and self._executing():
+        elif search.shared_cost is not None and executing(self.slot.node, self.created):
             finished = finished or Done(PlanStatus.SOLVED, search.expansions, "execution has begun")
         elif search.shared_cost is not None and now >= self.next_update:
             if set(self._read_world(self.problem).facts) != set(search.world.facts):
@@ -788,7 +742,7 @@ class ProblemRuntime:
         runtime wrote arrive), for at most two UpdateTimes: planning from a world that lags behind would
         repeat a step that is done.
         """
-        self._mark_done()  # this agent's own last step first
+        self.marks.mark_done(self.slot.node, self.created)  # this agent's own last step first
         believed = {Fact(f.predicate, tuple(str(a) for a in f.args)) for f in self.host.world.facts()}
         if holds(goal, believed):
             return  # the child succeeds with the generated plan (child_status)
@@ -812,16 +766,6 @@ class ProblemRuntime:
                 except (TypeError, ValueError):
                     continue
         return out
-
-    def _executing(self) -> bool:
-        """Whether an agent runs a step of the shared plan (a better plan then no longer replaces it)."""
-        node, created = self.slot.node, self.created
-        if node is None or created is None or node.plan is not created.plan:
-            return False
-        return any(
-            (place := created.place(state)) is not None and place.kind is StepKind.RUN
-            for _, state in node.believed.values()
-        )
 
     def _share_plan(self, now: float, search: LeaderSearch, plan: ValidPlan, pins: Pins = ()) -> None:
         steps = plan.steps
@@ -863,22 +807,7 @@ class ProblemRuntime:
         created = self.created
         if node is None or created is None or node.plan is not created.plan:
             return
-        progress = []
-        for ep, steps in zip(created.task_entry_points, created.tasks, strict=True):
-            if node.succeeded.get(ep.name):
-                progress.append(TaskProgress(None, len(steps), done=True))
-                continue
-            holders = sorted(
-                (place.step if place is not None else 0, agent, place is not None and place.kind is StepKind.RUN)
-                for agent, (entry, state) in node.believed.items()
-                if entry == ep.name and state
-                for place in (created.place(state),)
-            )
-            if holders:
-                k, agent, running = holders[0]
-                progress.append(TaskProgress(agent, k, running=running))
-            else:
-                progress.append(TaskProgress(None, 0))
+        progress = task_progress(node, created)
         predicates = self._predicates()
         believed = self.host.world.facts()
         facts = [
@@ -894,7 +823,7 @@ class ProblemRuntime:
         stepwise = self.stepwise
         if stepwise:
             target = ()  # a step of a policy is not meant to reach the goal: only its actions must still fit
-        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or _stalled(
+        reason = remaining_fits(created.tasks, progress, facts, share.world, target, share.robots) or stalled(
             progress, order, created.allowed, members
         )
         if reason is None and stepwise and all(p.done for p in progress):
@@ -925,49 +854,3 @@ def _planner_trait(name: str, trait: str) -> bool:
 
 def _rest_holds(world: PlanningWorld) -> str:
     return f"robots outside the team hold, or nobody sees, {', '.join(world.outside)}; the rest of the goal holds"
-
-
-def _stalled(
-    progress: list[TaskProgress],
-    order: Sequence[Sequence[int]],
-    allowed: tuple[tuple[str, ...] | None, ...] = (),
-    members: tuple[str, ...] = (),
-) -> str | None:
-    """A task nobody holds while an agent waits in a step that comes after it in the plan: replan.
-
-    ``order[i]`` holds the plan positions of task ``i``'s steps. A step waits
-    only for steps before it in the plan, so an agent whose next step comes
-    after the free task's first step may wait for the free task; that is not
-    stuck while an alive agent that may take the free task will be free for
-    it: one that runs a step now, or whose next step comes before the free
-    task's (its task does not wait for the free one; it finishes it and then
-    takes the free task by the engine's reuse rule, as a team smaller than
-    its tasks works). An agent that may take the free task but waits in a
-    step after it never will: with the free task pinned to it alone, that is
-    a deadlock. So is a free task pinned only to agents that left the team.
-    """
-
-    def position(i: int) -> float:  # where the task's next step is in the plan (its last steps finished: after all)
-        steps, k = order[i], progress[i].next_step
-        return steps[k] if k < len(steps) else math.inf
-
-    free = [i for i, p in enumerate(progress) if p.agent is None and not p.done]
-    if not free:
-        return None
-    first = min(free, key=position)
-    start = position(first)
-    pinned = allowed[first] if first < len(allowed) else None
-    may = set(pinned if pinned is not None else members) & set(members)
-    if not may and pinned is not None:
-        # only robots that left the team (crashed, say, holding the block the task starts with) may start it
-        return f"task T{first} has nobody, and only {', '.join(sorted(pinned))} may start it, who is not in the team"
-    waiting = [
-        i
-        for i, p in enumerate(progress)
-        if p.agent is not None and not p.running and not p.done and position(i) > start
-    ]
-    if not waiting:
-        return None
-    if any(p.agent in may and not p.done and (p.running or position(i) < start) for i, p in enumerate(progress)):
-        return None
-    return f"task T{first} has nobody, and the agent of task T{max(waiting)} waits for it"
