@@ -164,6 +164,7 @@ def costs(world: Any, params: dict[str, dict[str, Any]]) -> tuple[float, float]:
 def run_seed(seed: int, lidar_sigma: float, params: dict[str, dict[str, Any]], max_rounds: int = 30) -> dict[str, Any]:
     """Run the steps as the plan does until no unverified candidate is left within reach; score the result."""
     from alica.skills.testing import run_skill
+    from alica.skills.vision2d_data import CANDIDATES
     from alica.worldmodel import WorldModel
 
     world, truth = build_scene(seed, lidar_sigma)
@@ -180,7 +181,7 @@ def run_seed(seed: int, lidar_sigma: float, params: dict[str, dict[str, Any]], m
                 break
             if name == "CropCandidate" and not run.ok:
                 world.step(1.0)  # the plan's LookAgain state
-        circles = scratch.get("circles") or []
+        circles = CANDIDATES.get(scratch) or ()
         ms_scan, ms_image = costs(world, params)
         robots = {n: r.pose[:2] for n, r in world.robots.items() if n != "scout"}
     finally:
@@ -200,11 +201,7 @@ def run_seed(seed: int, lidar_sigma: float, params: dict[str, dict[str, Any]], m
         else:
             near_robot = any(math.dist(p, pos) < 0.6 for p in robots.values())
             false.append((kind, "robot" if near_robot else "rock"))
-    lidar_true = sum(
-        1
-        for c in circles  # type: ignore[attr-defined]
-        if min(math.dist(p, (c["x"], c["y"])) for _, p in truth.values()) <= 0.1
-    )
+    lidar_true = sum(1 for c in circles if min(math.dist(p, (c.x, c.y)) for _, p in truth.values()) <= 0.1)
     return {
         "seed": seed,
         "samples": len(truth),
@@ -213,7 +210,7 @@ def run_seed(seed: int, lidar_sigma: float, params: dict[str, dict[str, Any]], m
         "false": false,
         "missed": [k for k, _ in free.values()],
         "pairs": pairs,
-        "candidates": len(circles),  # type: ignore[arg-type]
+        "candidates": len(circles),
         "candidates_true": lidar_true,
         "invalid": sum(1 for f in wm.facts() if f.predicate == "invalid"),
         "rounds": rounds,

@@ -202,8 +202,6 @@ class DetectCircles(_Pipeline):
         self.job: Job | None = self.jobs.submit(self._scan)
 
     def _scan(self) -> list[Circle]:
-        from alica.worldsim.sensors import lidar_angles
-
         robot = self.robot
         # the scan reaches a little beyond max_range only: farther hits make no candidate
         scan_range = min(robot.spec.lidar_range, self.max_range + SCAN_MARGIN)
@@ -211,7 +209,7 @@ class DetectCircles(_Pipeline):
         sigma = robot.lidar_noise
         return detect_circles(
             ranges,
-            lidar_angles(self.n_rays),
+            robot.lidar_angles(self.n_rays),
             robot.estimate,  # placed where the robot believes it is
             radius=self.radius,
             tolerance=self.tolerance,
@@ -316,15 +314,13 @@ class CropCandidate(_Pipeline):
 
     def _aim(self) -> float:
         """Choose the target (``self.target``) and the pan angle that centres it; reasons for the others."""
-        from alica.worldsim.robot_camera import camera_pose
-
         circles = CANDIDATES.get(self.scratch) or ()
         verdicts = self.verdicts()
         unseen = self.memory.unseen
         robot = self.robot
         spec = robot.spec
         estimate = robot.estimate
-        camera, _ = camera_pose(robot, estimate)
+        camera, _ = robot.camera_pose(estimate)
         limit = spec.camera_pan_limit
         # the candidate's middle must be this far inside the picture's edge
         reach = limit + 0.5 * spec.camera_fov - math.radians(3.0)
@@ -353,10 +349,10 @@ class CropCandidate(_Pipeline):
 
     def _render(self) -> CameraImage:
         """Render the part of the frame the candidates' crops can come from (the same pixels, far cheaper)."""
-        from alica.worldsim.robot_camera import CameraImage, camera_pose
+        from alica.worldsim.robot_camera import CameraImage
 
         robot = self.robot
-        position, rotation = camera_pose(robot, robot.estimate, self.pan)
+        position, rotation = robot.camera_pose(robot.estimate, self.pan)
         fx = (self.width / 2.0) / math.tan(robot.spec.camera_fov / 2.0)
         probe = CameraImage(
             np.zeros((1, 1, 3), dtype=np.uint8),
