@@ -58,7 +58,7 @@ is read from the plan's :attr:`~alica.prophet.tasks.CreatedTasks.places`
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 
 from alica.engine.child import ChildHost, ChildSlot, ChildStatus, PlanKey, RunningPlan, key_text
@@ -68,13 +68,12 @@ from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
 from alica.prophet.budget import LeaderSearch, SearchBudget, advance
 from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER, GiveUp
+from alica.prophet.leader_search import magic_events, positions
 from alica.prophet.leadership import is_leader, next_generation
-from alica.prophet.magic.leader import MagicLeader
-from alica.prophet.magic.team import STEP_EXPANSIONS, TeamMagic
+from alica.prophet.magic.team import TeamMagic
 from alica.prophet.monitoring import StepMarks, executing, stalled, task_progress
-from alica.prophet.pddl.writer import write_domain, write_problem
-from alica.prophet.pipeline import Found, ProblemEvent, ProblemPlanning, Rejected, ValidPlan, plan_problem
-from alica.prophet.planner import Done, PlanStatus, PlanStep, Progress
+from alica.prophet.pipeline import ValidPlan, plan_problem
+from alica.prophet.planner import Done, PlanStatus, PlanStep
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
 from alica.prophet.review import apply_pins
@@ -166,7 +165,7 @@ class ProblemRuntime:
             host.name,
             host.emit,
             lambda: host.decisions(element.name),
-            lambda name, steps, world, robots: self._tasks_for(name, steps, world, robots, self._entry_task()),
+            lambda name, steps, world, robots: self._tasks_for(name, steps, world, robots, self.slot.entry_task),
             lambda: self.problem.goal.text,
         )
         """The operator's review (review on): the plan proposed, and the decisions read."""
@@ -270,15 +269,12 @@ class ProblemRuntime:
         """The child's status from its running plan: the WaitPlan never ends it; the generated plan only with the goal."""
         plan = node.plan
         if self.is_generated(plan):
-            if node.status is ChildStatus.SUCCESS and not self._goal_believed(node):
+            if node.status is ChildStatus.SUCCESS and not self.host.holds(self.problem.goal.text, node):
                 return ChildStatus.RUNNING  # the leader's check replans
             return node.status
         if plan.name == self.model.wait_plan and self.phase() == "wait":
             return ChildStatus.RUNNING
         return node.status
-
-    def _goal_believed(self, node: RunningPlan) -> bool:
-        return self.host.holds(self.problem.goal.text, node)
 
     # -- the tick --------------------------------------------------------------
 
@@ -397,7 +393,9 @@ class ProblemRuntime:
 
     def _publish_failure(self, now: float, generation: int, reason: str) -> None:
         """Tell the team that planning ``generation`` failed: it runs the AlternativePlan."""
-        share = PlanShare(self.key, generation, 1, self.host.name, FAILED, entry_task=self._entry_task(), reason=reason)
+        share = PlanShare(
+            self.key, generation, 1, self.host.name, FAILED, entry_task=self.slot.entry_task, reason=reason
+        )
         self._publish(share, now)
 
     def _publish(self, share: PlanShare, now: float) -> None:
@@ -405,9 +403,6 @@ class ProblemRuntime:
         self.host.publish(share)
         if share is not self.share and (self.share is None or share.supersedes(self.share)):
             self._adopt(share, now)
-
-    def _entry_task(self) -> str:
-        return self.slot.entry_task
 
     # -- failures --------------------------------------------------------------
 
@@ -490,7 +485,9 @@ class ProblemRuntime:
             return
         self.pending = (now + self.model.update_time, reason)
         self._publish(
-            PlanShare(self.key, generation, 0, self.host.name, SEARCHING, entry_task=self._entry_task(), reason=reason),
+            PlanShare(
+                self.key, generation, 0, self.host.name, SEARCHING, entry_task=self.slot.entry_task, reason=reason
+            ),
             now,
         )
 
@@ -506,7 +503,7 @@ class ProblemRuntime:
         if generation is None:
             generation = self._next_generation()
         me = host.name
-        task = self._entry_task()
+        task = self.slot.entry_task
         problem = self.problem
         try:
             world = self._read_world(problem)
@@ -536,11 +533,21 @@ class ProblemRuntime:
                 problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
             options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
             if _planner_trait(problem.planner, "reads_positions"):
-                options.update(positions=self._positions(), seed=generation)
+                options.update(positions=positions(host.world.values()), seed=generation)
             planning = plan_problem(problem, host.library, world, options=options)
             team = [a for a in self.slot.members() if a != me]
             if self.magic is not None and problem.planner == "builtin" and team:
-                events = self._magic_events(planning, generation, self.magic)
+                events = magic_events(
+                    planning,
+                    generation,
+                    self.magic,
+                    me=me,
+                    members=self.slot.members,
+                    emit=host.emit,
+                    key=key_text(self.key),
+                    seconds=self.model.timeout,
+                    clock=host.now,
+                )
             else:
                 events = planning.search(anytime=True)
         except (PlannerError, AlicaError) as exc:
@@ -577,51 +584,6 @@ class ProblemRuntime:
         )
         self.next_update = now + self.model.update_time
 
-    def _magic_events(self, planning: ProblemPlanning, generation: int, magic: TeamMagic) -> Iterator[ProblemEvent]:
-        """A MAGiC round over the agents in the state as the leader's search events; its first valid plan wins."""
-        host = self.host
-        members = self.slot.members
-        leader = MagicLeader(
-            magic.leader_link(members),
-            write_domain(planning.domain),
-            write_problem(planning.pddl),
-            seed=generation,
-            seconds=self.model.timeout,
-            clock=host.now,
-            progress_every=STEP_EXPANSIONS,
-            first_round=generation,
-        )
-        agents = (host.name, *sorted(a for a in members() if a != host.name))
-        leader.start(agents)
-        host.emit("planner", key=key_text(self.key), what="magic", round=generation, agents=list(agents))
-        expansions = 0
-        while True:
-            outcome = leader.step(1)
-            if outcome is None:
-                expansions += STEP_EXPANSIONS
-                yield Progress(expansions)
-                continue
-            host.emit(
-                "planner",
-                key=key_text(self.key),
-                what="magic done",
-                round=generation,
-                status=outcome.status.value,
-                solver=outcome.solver,
-                messages=outcome.messages,
-                lost=list(outcome.lost),
-                seconds=round(outcome.seconds, 6),
-            )
-            if outcome.plan is None:
-                yield Done(outcome.status, outcome.expansions, outcome.message)
-                return
-            try:
-                yield Found(planning.validated(outcome.plan), outcome.expansions)
-            except PlannerError as exc:
-                yield Rejected(str(exc), outcome.expansions)
-            yield Done(PlanStatus.SOLVED, outcome.expansions, "MAGiC: the first valid plan wins")
-            return
-
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
         """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
         self.host.emit("planner", key=key_text(self.key), what="waiting", reason=reason)
@@ -636,7 +598,7 @@ class ProblemRuntime:
                     SEARCHING,
                     world=world.facts,
                     robots=world.robots,
-                    entry_task=self._entry_task(),
+                    entry_task=self.slot.entry_task,
                     reason=reason,
                 ),
                 now,
@@ -654,19 +616,20 @@ class ProblemRuntime:
         search = self.search
         assert search is not None
         try:
-            finished = advance(search, self.budget, self._warn)
+            finished = advance(
+                search,
+                self.budget,
+                lambda message: self.host.emit("warning", key=key_text(self.key), message=message),
+            )
         except (PlannerError, AlicaError) as exc:  # grounding runs inside the search: a domain it cannot read
             self.search = None
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             failed = PlanShare(
-                self.key, search.generation, 0, self.host.name, FAILED, entry_task=self._entry_task(), reason=str(exc)
+                self.key, search.generation, 0, self.host.name, FAILED, entry_task=self.slot.entry_task, reason=str(exc)
             )
             self._publish(failed, now)
             return
         self._after_search(now, search, finished)
-
-    def _warn(self, message: str) -> None:
-        self.host.emit("warning", key=key_text(self.key), message=message)
 
     def _after_search(self, now: float, search: LeaderSearch, finished: Done | None) -> None:
         """Share what the search found; end it when it is done."""
@@ -729,12 +692,6 @@ class ProblemRuntime:
             elif now >= self.next_update and set(self._read_world(self.problem).facts) != set(search.world.facts):
                 self._replan(now, "the world changed while planning")
 
-    def _predicates(self) -> dict[str, tuple[str, ...]]:
-        """The domain's predicates (they depend on the problem's elements only), worked out once."""
-        if self.predicates is None:
-            self.predicates = predicate_types(self.model, self.host.library)
-        return self.predicates
-
     def _next_step(self, now: float, created: CreatedTasks, goal: Sequence[Literal]) -> None:
         """A stepwise plan's step is over: plan the next one from the world as it is now (nothing when the goal holds).
 
@@ -755,17 +712,6 @@ class ProblemRuntime:
         self.step_over = None
         self.search = None
         self._start_search(now, "the step is done: planning the next one")
-
-    def _positions(self) -> dict[str, tuple[float, ...]]:
-        """Object -> its position from the world model's ``pos`` values (for planners that read positions)."""
-        out: dict[str, tuple[float, ...]] = {}
-        for name, args, value in self.host.world.values():
-            if name == "pos" and len(args) == 1 and isinstance(value, (tuple, list)) and len(value) >= 2:
-                try:
-                    out[str(args[0])] = tuple(float(v) for v in value)
-                except (TypeError, ValueError):
-                    continue
-        return out
 
     def _share_plan(self, now: float, search: LeaderSearch, plan: ValidPlan, pins: Pins = ()) -> None:
         steps = plan.steps
@@ -793,7 +739,7 @@ class ProblemRuntime:
             plan.plan.cost,
             search.world.facts,
             search.world.robots,
-            self._entry_task(),
+            self.slot.entry_task,
             goal=search.goal,
             origin=self.host.name,
             pins=pins,
@@ -808,7 +754,9 @@ class ProblemRuntime:
         if node is None or created is None or node.plan is not created.plan:
             return
         progress = task_progress(node, created)
-        predicates = self._predicates()
+        if self.predicates is None:  # the domain's predicates depend on the problem's elements only
+            self.predicates = predicate_types(self.model, self.host.library)
+        predicates = self.predicates
         believed = self.host.world.facts()
         facts = [
             Fact(f.predicate, tuple(str(a) for a in f.args)) for f in believed if f.predicate.lower() in predicates
