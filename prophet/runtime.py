@@ -54,6 +54,18 @@ its :class:`~alica.engine.child.ChildSlot` and the
 :class:`~alica.engine.child.RunningPlan` there. Progress in a generated plan
 is read from the plan's :attr:`~alica.prophet.tasks.CreatedTasks.places`
 (state -> task, step, kind), never from state names.
+
+Where each part lives: this module keeps the child-runtime seam and what the
+agent follows (the adopted share, the generated plan, a teammate's replan
+request). The phases and their moves are in :mod:`alica.prophet.runtime_states`;
+the leader's side in :mod:`alica.prophet.leader`, with its collaborators
+:mod:`~alica.prophet.leadership` (who leads, generations),
+:mod:`~alica.prophet.budget` (the search and its budget per tick),
+:mod:`~alica.prophet.leader_search` (MAGiC as a search, positions),
+:mod:`~alica.prophet.reviewing` (the operator's review),
+:mod:`~alica.prophet.waiting` (waits for the world and the team),
+:mod:`~alica.prophet.giving_up` (when failed steps fail the problem) and
+:mod:`~alica.prophet.monitoring` (steps done, the team's progress, stalls).
 """
 
 from __future__ import annotations
@@ -88,7 +100,7 @@ from alica.prophet.world import (
     read_world,
 )
 
-SEARCHING, PLAN, FAILED, DONE = ShareStatus.SEARCHING, ShareStatus.PLAN, ShareStatus.FAILED, ShareStatus.DONE
+PLAN = ShareStatus.PLAN
 
 __all__ = [
     "GIVE_UP_AFTER",
