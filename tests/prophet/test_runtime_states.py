@@ -106,3 +106,46 @@ def test_a_team_run_only_makes_moves_of_the_table():
         mp.undo()
     assert LeaderPhase.EXECUTING in seen
     assert all(allowed(a, b) for a, b in itertools.pairwise(seen)), seen
+
+
+_SCENARIOS = [
+    ("tests.prophet.test_runtime", "test_a_failed_step_sends_the_team_back_to_the_wait_plan_and_the_leader_replans"),
+    ("tests.prophet.test_runtime", "test_the_world_changing_under_the_plan_makes_the_leader_replan"),
+    ("tests.prophet.test_runtime", "test_the_leader_crashes_while_planning_and_the_next_lowest_id_takes_over"),
+    ("tests.prophet.test_runtime", "test_the_operator_sets_a_new_goal_and_the_leader_replans"),
+    ("tests.prophet.test_runtime", "test_a_block_held_by_a_robot_outside_the_team_the_team_does_the_rest_then_waits"),
+    ("tests.prophet.test_runtime", "test_a_plan_for_part_of_the_goal_runs_to_its_end_then_the_rest_is_planned"),
+    ("tests.prophet.test_review", "test_a_declined_plan_is_planned_again_and_the_new_generation_is_proposed"),
+    (
+        "tests.prophet.test_review",
+        "test_dropping_a_needed_step_is_refused_with_the_validators_reason_then_accept_runs_the_plan",
+    ),
+    ("tests.prophet.test_review", "test_the_leader_crashing_while_a_proposal_waits_the_next_leader_proposes"),
+]
+
+
+@pytest.mark.parametrize(("module", "name"), _SCENARIOS)
+def test_the_runtime_scenarios_move_only_along_the_table(module: str, name: str):
+    # every agent's leader phase, tick by tick, in scenarios of the runtime's own tests
+    import importlib
+
+    from alica.prophet.runtime import ProblemRuntime
+
+    seen: dict[int, list[LeaderPhase]] = {}
+    update = ProblemRuntime.update
+
+    def recording(self: ProblemRuntime, now: float) -> None:
+        update(self, now)
+        seen.setdefault(id(self), []).append(self.leader_phase())
+
+    mp = pytest.MonkeyPatch()
+    mp.setattr(ProblemRuntime, "update", recording)
+    try:
+        getattr(importlib.import_module(module), name)()
+    finally:
+        mp.undo()
+    moves = {(a, b) for phases in seen.values() for a, b in itertools.pairwise(phases) if a is not b}
+    assert moves
+    assert {(a, b) for a, b in moves if not allowed(a, b)} == set(), sorted(
+        (a.value, b.value) for a, b in moves if not allowed(a, b)
+    )
