@@ -217,9 +217,10 @@ class Leader:
     def replan(self, now: float, reason: str, settle: bool = False) -> None:
         """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step).
 
-        A failed step (``settle``) that failed :data:`GIVE_UP_AFTER` times for the same reason in the
-        same world, or :data:`GIVE_UP_ANYWAY_AFTER` times with no step carried out in between, fails
-        the problem instead: the team runs the AlternativePlan.
+        A failed step (``settle``) that failed :data:`~alica.prophet.giving_up.GIVE_UP_AFTER` times for the
+        same reason in the same world, or :data:`~alica.prophet.giving_up.GIVE_UP_ANYWAY_AFTER` times with no
+        step carried out in between, fails the problem instead (:class:`~alica.prophet.giving_up.GiveUp`):
+        the team runs the AlternativePlan.
         """
         self.host.counters["replans"] += 1
         self.host.emit("replan", key=key_text(self.key), reason=reason)
@@ -244,6 +245,12 @@ class Leader:
         )
 
     def start_search(self, now: float, reason: str, generation: int | None = None) -> None:
+        """Read World and start a search of ``generation`` (default: a new one), sharing ``searching``.
+
+        The goal holding already shares ``done``; with robots outside the team holding part of the
+        goal the search plans for the rest, or, with nothing left to plan for, the team waits; a
+        planner that cannot start shares ``failed``.
+        """
         host = self.host
         self.reviewing.drop()
         if generation is None:
