@@ -35,7 +35,7 @@ from alica.prophet.budget import LeaderSearch, SearchBudget, advance
 from alica.prophet.giving_up import GiveUp
 from alica.prophet.leader_search import magic_events, positions
 from alica.prophet.magic.team import TeamMagic
-from alica.prophet.monitoring import StepMarks, executing, stalled, task_progress
+from alica.prophet.monitoring import PlanCheck, StepMarks, executing, stalled, task_progress
 from alica.prophet.pipeline import ProblemPlanning, ValidPlan
 from alica.prophet.planner import Done, PlanStatus
 from alica.prophet.planners import planner_class
@@ -128,8 +128,8 @@ class Leader:
         """A replan waiting for the team to settle in the WaitPlan: (when, why)."""
         self.next_update = -1.0
         """When the agent next repeats its share (or its replan request) and checks the plan."""
-        self.invalid_once = False
-        """Whether the last check found that the rest of the plan no longer fits (twice in a row: replan)."""
+        self.check = PlanCheck()
+        """The check of the rest of the plan (twice in a row not fitting: replan)."""
         self.waiting = Waiting()
         """What the leader waits for: the world to change, the robots outside the team to come back."""
         self.give_up = GiveUp()
@@ -529,14 +529,9 @@ class Leader:
                 self._wait_for_world(now, world, self.team.next_generation(), _rest_holds(world))
                 return
             reason = "the plan is done, but the goal does not hold: the part that robots outside the team held can be planned now"
-        if reason is None:
-            self.invalid_once = False
-        elif not self.invalid_once:
-            self.invalid_once = True
-        elif reason.startswith("task T"):
-            self.replan(now, f"the plan is stuck: {reason}")
-        else:
-            self.replan(now, f"the world changed under the plan: {reason}")
+        replan = self.check.replan_reason(reason)
+        if replan is not None:
+            self.replan(now, replan)
 
     def _publish_failure(self, now: float, generation: int, reason: str) -> None:
         """Tell the team that planning ``generation`` failed: it runs the AlternativePlan."""

@@ -8,6 +8,8 @@
   never state names), and :func:`executing` whether an agent runs a step.
 * :func:`stalled` tells a plan that cannot go on (a task nobody holds while an
   agent waits for it).
+* :class:`PlanCheck` replans only when the check fails twice in a row (a
+  teammate's message may lag behind the world).
 
 The leader's check of the plan against the world uses these with
 :func:`alica.prophet.world.remaining_fits`.
@@ -83,6 +85,34 @@ class StepMarks:
         effect = for_robot(step.effect, step.robot, self.me)
         for positive, fact in sorted(effect, key=lambda literal: literal[0]):
             (world.assert_fact if positive else world.retract_fact)(fact.predicate, *fact.args)
+
+
+class PlanCheck:
+    """The leader's check of the rest of the plan: it replans only after two failed checks in a row."""
+
+    def __init__(self) -> None:
+        self.invalid_once = False
+        """Whether the last check failed."""
+
+    def reset(self) -> None:
+        """A new share is followed: its plan has not failed a check."""
+        self.invalid_once = False
+
+    def replan_reason(self, fault: str | None) -> str | None:
+        """The reason to replan after a check that found ``fault`` (``None``: the plan fits), or ``None``.
+
+        The first failed check is remembered; the second in a row replans (a stuck plan, or a world that
+        changed under it). A check that passes forgets the failed one.
+        """
+        if fault is None:
+            self.invalid_once = False
+            return None
+        if not self.invalid_once:
+            self.invalid_once = True
+            return None
+        if fault.startswith("task T"):
+            return f"the plan is stuck: {fault}"
+        return f"the world changed under the plan: {fault}"
 
 
 def executing(node: RunningPlan | None, created: CreatedTasks | None) -> bool:

@@ -339,7 +339,7 @@ class ProblemRuntime:
         self.share = share
         self.revision += 1
         self.reason = share.reason
-        self.leader.invalid_once = False
+        self.leader.check.reset()
         fields = {"generation": share.generation, "version": share.version, "leader": share.leader}
         if created is not None:
             fields.update(plan=created.plan.name, steps=len(share.steps), tasks=len(created.tasks), cost=share.cost)

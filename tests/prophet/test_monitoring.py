@@ -6,7 +6,7 @@ from types import SimpleNamespace
 from typing import Any
 
 from alica.lang.fact import Fact
-from alica.prophet.monitoring import StepMarks, executing, task_progress
+from alica.prophet.monitoring import PlanCheck, StepMarks, executing, task_progress
 from alica.prophet.tasks import STEP_DONE, Place, Step, StepKind
 from alica.prophet.world import TaskProgress
 
@@ -100,3 +100,16 @@ def test_executing_and_task_progress_read_the_believed_states():
     done = _node(created, "End")
     done.succeeded["G1_T0"] = True
     assert task_progress(done, created) == [TaskProgress(None, 2, done=True)]
+
+
+def test_the_plan_is_replanned_only_after_two_failed_checks_in_a_row():
+    check = PlanCheck()
+    assert check.replan_reason("on(a, b) no longer holds") is None
+    assert check.replan_reason(None) is None  # a check that passes forgets the failed one
+    assert check.replan_reason("on(a, b) no longer holds") is None
+    assert (
+        check.replan_reason("on(a, b) no longer holds") == "the world changed under the plan: on(a, b) no longer holds"
+    )
+    check.reset()
+    assert check.replan_reason("task T1 has nobody") is None
+    assert check.replan_reason("task T1 has nobody") == "the plan is stuck: task T1 has nobody"
