@@ -22,7 +22,7 @@ the agent follows, its generated plan, publishing a share, reading World.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import replace
 from typing import Protocol
 
@@ -36,7 +36,7 @@ from alica.prophet.giving_up import GiveUp
 from alica.prophet.leader_search import magic_events, positions
 from alica.prophet.magic.team import TeamMagic
 from alica.prophet.monitoring import PlanCheck, StepMarks, executing, stalled, task_progress
-from alica.prophet.pipeline import ProblemPlanning, ValidPlan
+from alica.prophet.pipeline import ProblemEvent, ProblemPlanning, ValidPlan
 from alica.prophet.planner import Done, PlanStatus
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
@@ -284,25 +284,7 @@ class Leader:
                     self.next_update = now + self.model.update_time
                     return
                 problem = replace(problem, goal=Condition(ConditionKind.POST, conjunction(partial)))
-            options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
-            if _planner_trait(problem.planner, "reads_positions"):
-                options.update(positions=positions(host.world.values()), seed=generation)
-            planning = self.plan(problem, host.library, world, options=options)
-            team = [a for a in self.slot.members() if a != me]
-            if self.magic is not None and problem.planner == "builtin" and team:
-                events = magic_events(
-                    planning,
-                    generation,
-                    self.magic,
-                    me=me,
-                    members=self.slot.members,
-                    emit=host.emit,
-                    key=key_text(self.key),
-                    seconds=self.model.timeout,
-                    clock=host.now,
-                )
-            else:
-                events = planning.search(anytime=True)
+            planning, events = self._plan(problem, world, generation)
         except (PlannerError, AlicaError) as exc:
             host.emit("planner", key=key_text(self.key), what="failed", reason=str(exc))
             self.team.publish(PlanShare(self.key, generation, 0, me, FAILED, entry_task=task, reason=str(exc)), now)
@@ -336,6 +318,37 @@ class Leader:
             now,
         )
         self.next_update = now + self.model.update_time
+
+    def _plan(
+        self, problem: PlanningProblem, world: PlanningWorld, generation: int
+    ) -> tuple[ProblemPlanning, Iterator[ProblemEvent]]:
+        """What the search plans, and its events: the planner's anytime search, or a MAGiC round over the team.
+
+        Raises:
+            PlannerError: the problem cannot be planned (an unknown planner, a domain it cannot read).
+            AlicaError: the problem's elements cannot be read.
+        """
+        host, me = self.host, self.host.name
+        options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
+        if _planner_trait(problem.planner, "reads_positions"):
+            options.update(positions=positions(host.world.values()), seed=generation)
+        planning = self.plan(problem, host.library, world, options=options)
+        team = [a for a in self.slot.members() if a != me]
+        if self.magic is not None and problem.planner == "builtin" and team:
+            events = magic_events(
+                planning,
+                generation,
+                self.magic,
+                me=me,
+                members=self.slot.members,
+                emit=host.emit,
+                key=key_text(self.key),
+                seconds=self.model.timeout,
+                clock=host.now,
+            )
+        else:
+            events = planning.search(anytime=True)
+        return planning, events
 
     def _wait_for_world(self, now: float, world: PlanningWorld, generation: int, reason: str) -> None:
         """Nothing the team can plan for now: it waits in the WaitPlan, and the leader plans again when the world changes."""
