@@ -37,7 +37,7 @@ from alica.prophet.leader_search import magic_events, positions
 from alica.prophet.magic.team import TeamMagic
 from alica.prophet.monitoring import PlanCheck, StepMarks, executing, stalled, task_progress
 from alica.prophet.pipeline import ProblemEvent, ProblemPlanning, ValidPlan
-from alica.prophet.planner import Done, PlanStatus
+from alica.prophet.planner import Done, Planner, PlanStatus
 from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
 from alica.prophet.reviewing import Pins, Reviewing
@@ -330,7 +330,7 @@ class Leader:
         """
         host, me = self.host, self.host.name
         options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
-        if _planner_trait(problem.planner, "reads_positions"):
+        if (traits := planner_traits(problem.planner)) is not None and traits.reads_positions:
             options.update(positions=positions(host.world.values()), seed=generation)
         planning = self.plan(problem, host.library, world, options=options)
         team = [a for a in self.slot.members() if a != me]
@@ -554,12 +554,13 @@ class Leader:
         self.team.publish(share, now)
 
 
-def _planner_trait(name: str, trait: str) -> bool:
-    """A class attribute of the planner called ``name`` (``False`` for an unknown planner: planning fails later)."""
+def planner_traits(name: str) -> type[Planner] | None:
+    """The class of the planner called ``name``, whose declared traits (``stepwise``, ``reads_positions``)
+    a runtime reads; ``None`` for an unknown planner (planning fails later, with the reason)."""
     try:
-        return bool(getattr(planner_class(name), trait, False))
+        return planner_class(name)
     except PlannerError:
-        return False
+        return None
 
 
 def _rest_holds(world: PlanningWorld) -> str:

@@ -80,7 +80,7 @@ from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
 from alica.prophet.budget import SearchBudget
 from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER
-from alica.prophet.leader import Leader, _planner_trait
+from alica.prophet.leader import Leader, planner_traits
 from alica.prophet.leadership import is_leader, next_generation
 from alica.prophet.magic.team import TeamMagic
 from alica.prophet.monitoring import StepMarks, stalled
@@ -149,7 +149,7 @@ class ProblemRuntime:
         self.request: ReplanRequest | None = None
         self.marks = StepMarks(host.world, host.name)
         """The steps this agent finished in the generated plan (``step_done``, with their effects)."""
-        self.stepwise = _planner_trait(element.planner, "stepwise")
+        self.stepwise = (traits := planner_traits(element.planner)) is not None and traits.stepwise
         """Whether the problem's planner plans one step at a time (the operator changes goal and world, not planner)."""
         self.overrides = dict(host.override(self.model.name))
         reviewing = Reviewing(
