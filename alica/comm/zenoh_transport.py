@@ -213,7 +213,7 @@ class ZenohTransport(Transport):
         self._history_bytes = float(history_mb) * 1024 * 1024
         self._gseq = 0
         self._history: dict[str, deque[tuple[int, float, bytes]]] = {}
-        self._publishers: dict[tuple[str, QoS], Any] = {}
+        self._publishers: dict[tuple[str, QoS], zenoh.Publisher] = {}
         # receiving
         self._subscribed: dict[str, float] = {}
         self._senders: dict[str, _Sender] = {}
@@ -223,7 +223,7 @@ class ZenohTransport(Transport):
         self._counts = dict.fromkeys(ZenohStats.__slots__, 0)
         self.errors: dict[str, int] = {}
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
-        self._subscribers: list[Any] = []
+        self._subscribers: list[zenoh.Subscriber[None] | zenoh.LivelinessToken | zenoh.Queryable[None]] = []
         connect, listen = tuple(connect), tuple(listen)
         try:
             self._session = zenoh.open(self._config(connect, listen, mode, lease, config))
@@ -423,7 +423,7 @@ class ZenohTransport(Transport):
 
     # ------------------------------------------------------------------ receiving (zenoh threads)
 
-    def _on_liveliness(self, sample: Any) -> None:
+    def _on_liveliness(self, sample: zenoh.Sample) -> None:
         name = str(sample.key_expr).rsplit("/", 1)[-1]
         if name == self._id:
             return
@@ -444,7 +444,7 @@ class ZenohTransport(Transport):
             return None
         return value
 
-    def _on_message(self, sample: Any) -> None:
+    def _on_message(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
         with self._lock:
             if self._closed:
@@ -551,7 +551,7 @@ class ZenohTransport(Transport):
         state.asked_at = self._clock.now()
         return sender
 
-    def _on_heartbeat(self, sample: Any) -> None:
+    def _on_heartbeat(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
         with self._lock:
             if self._closed:
@@ -594,7 +594,7 @@ class ZenohTransport(Transport):
         except Exception:  # (closed meanwhile, or the sender gone: the time-out asks again)
             return
 
-    def _on_query(self, query: Any) -> None:
+    def _on_query(self, query: zenoh.Query) -> None:
         """Answer a receiver's history query: the kept reliable messages it lacks, in send order."""
         payload = query.payload
         data = payload.to_bytes() if payload is not None else b""
@@ -630,8 +630,8 @@ class ZenohTransport(Transport):
         except Exception:  # (the asker left)
             return
 
-    def _on_reply(self, reply: Any) -> None:
-        sample = getattr(reply, "ok", None)
+    def _on_reply(self, reply: zenoh.Reply) -> None:
+        sample = reply.ok
         if sample is None:
             return
         data = sample.payload.to_bytes()
