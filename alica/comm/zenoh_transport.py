@@ -35,7 +35,6 @@ import json
 import re
 import threading
 import time
-from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -44,6 +43,7 @@ import zenoh
 
 from alica.clock import Clock, SystemClock
 from alica.comm.codec import CodecError, decode, encode
+from alica.comm.reliable import History
 from alica.comm.transport import Envelope, QoS, Transport
 
 _CHUNK = re.compile(r"[^/*$?#\s]+")
@@ -207,12 +207,7 @@ class ZenohTransport(Transport):
         self._closed = False
         # sending
         self._seq: dict[str, int] = {}
-        self._rseq: dict[str, int] = {}
-        self._put_rseq: dict[str, int] = {}
-        self._kept_bytes = 0
-        self._history_bytes = float(history_mb) * 1024 * 1024
-        self._gseq = 0
-        self._history: dict[str, deque[tuple[int, float, bytes]]] = {}
+        self._history = History(self._incarnation, seconds=self._history_s, max_bytes=float(history_mb) * 1024 * 1024)
         self._publishers: dict[tuple[str, QoS], zenoh.Publisher] = {}
         # receiving
         self._subscribed: dict[str, float] = {}
@@ -294,16 +289,9 @@ class ZenohTransport(Transport):
         if reliable:
             inner = encode(payload)
             with self._lock:
-                rseq = self._rseq[topic] = self._rseq.get(topic, 0) + 1
-                self._gseq += 1
-                data = encode((self._incarnation, self._id, topic, seq, rseq, self._gseq, now, inner))
-                kept = self._history.get(topic)
-                if kept is None:
-                    kept = self._history[topic] = deque()
-                kept.append((rseq, now, data))
-                self._kept_bytes += len(data)
-                while len(kept) > 1 and (self._kept_bytes > self._history_bytes or kept[0][1] < now - self._history_s):
-                    self._kept_bytes -= len(kept.popleft()[2])  # too old, or the flooding topic gives way first
+                rseq, gseq = self._history.next_numbers(topic)
+                data = encode((self._incarnation, self._id, topic, seq, rseq, gseq, now, inner))
+                self._history.keep(topic, rseq, now, data)
         else:
             data = encode((self._incarnation, self._id, topic, seq, 0, 0, now, encode(payload)))
         publisher = self._publishers.get((topic, qos))
@@ -316,7 +304,7 @@ class ZenohTransport(Transport):
         publisher.put(data)
         if reliable:
             with self._lock:
-                self._put_rseq[topic] = rseq  # the heartbeat announces only what is on its way
+                self._history.put(topic, rseq)  # the heartbeat announces only what is on its way
         self._counts["sent"] += 1
 
     def subscribe(self, topic: str) -> None:
@@ -403,15 +391,12 @@ class ZenohTransport(Transport):
 
     def _beat(self) -> None:
         now = self._clock.now()
-        horizon = now - self._history_s
         with self._lock:
             if self._closed:
                 return
-            for kept in self._history.values():
-                while kept and kept[0][1] < horizon:
-                    self._kept_bytes -= len(kept.popleft()[2])
+            self._history.trim(now)
             # every reliable counter, also of topics whose history is trimmed: a receiver learns what it lost
-            beat = dict(self._put_rseq)
+            beat = self._history.announced()
             retry = []
             for sender, state in self._senders.items():
                 if state.asked_at is not None and now - state.asked_at > self._query_timeout:
@@ -611,20 +596,8 @@ class ZenohTransport(Transport):
             if request is None or not isinstance(request[2], dict):
                 return
             _who, incarnation, wanted = request
-            frames: list[tuple[int, bytes]] = []
-            start: dict[str, int] = {}
-            oldest: dict[str, int] = {}
-            for topic, (first, since) in wanted.items():
-                kept = self._history.get(topic, deque())
-                last = self._rseq.get(topic, 0)
-                if first is None or incarnation != self._incarnation:
-                    # its first question (or about an earlier life of this agent): all since it subscribed
-                    frames += [(number, data) for number, at, data in kept if at >= since]
-                else:
-                    frames += [(number, data) for number, _, data in kept if number >= first]
-                start[topic] = last + 1
-                oldest[topic] = kept[0][0] if kept else last + 1
-        answer = encode((self._incarnation, self._id, tuple(data for _, data in frames), start, oldest))
+            frames, start, oldest = self._history.answer(incarnation, wanted)
+        answer = encode((self._incarnation, self._id, frames, start, oldest))
         try:
             query.reply(f"{self._team}/hist/{self._id}", answer)
         except Exception:  # (the asker left)
