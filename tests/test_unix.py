@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -56,7 +55,6 @@ def test_python_dash_m_alica_is_the_alica_command(tmp_path: Path) -> None:
     assert bad.returncode == 1 and "nowhere.yaml:1:1: error: no such file or folder" in bad.stderr
 
 
-@pytest.mark.skipif(shutil.which("make") is None, reason="make is not installed")
 def test_make_setup_and_test_install_nothing_outside_the_venv() -> None:
     for target in ("setup", "test", "demo", "test-fast"):
         plan = subprocess.run(

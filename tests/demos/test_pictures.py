@@ -28,7 +28,6 @@ from alica.app.demos.blocks_pictures import (
 from alica.app.demos.labels import Label, overlap, place_labels, text_extent
 from alica.app.demos.lunar import LunarConfig, Operator
 from alica.app.demos.lunar_map import BASE_COLOUR, map_figure, map_labels
-from alica.worldsim.camera import render
 from alica.worldsim.scenarios import blocksworld, lunar
 
 TOWER = [["a", "b", "c", "d", "e"]]
@@ -88,15 +87,7 @@ def test_the_scene_is_framed_tightly_on_the_robots_and_blocks(tower):
 def test_the_projection_is_the_renderers(tower):
     """A block's face seen by the camera is where the camera model puts it: not the ground's colour there."""
     camera = stacks_camera(tower)
-    image = render(
-        tower,
-        width=camera.width,
-        height=camera.height,
-        target=camera.target,
-        distance=camera.distance,
-        yaw=camera.yaw,
-        pitch=camera.pitch,
-    )
+    image = camera.render(tower)
     faces = camera.project([(b.x, b.y - 0.5 * b.size, b.z) for b in block_poses(tower)])
     ground = camera.project([(camera.target[0] + 0.2, camera.target[1] + 0.1, 0.0)])[0]
     floor = image[int(ground[1]), int(ground[0])].astype(int)

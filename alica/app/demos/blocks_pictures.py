@@ -92,6 +92,20 @@ class Camera:
     width: int = WIDTH
     height: int = HEIGHT
 
+    def render(self, world: Any) -> np.ndarray:
+        """The world's picture through this camera (pybullet's renderer)."""
+        from alica.worldsim.camera import render
+
+        return render(
+            world,
+            width=self.width,
+            height=self.height,
+            target=self.target,
+            distance=self.distance,
+            yaw=self.yaw,
+            pitch=self.pitch,
+        )
+
     def project(self, points: Points) -> np.ndarray:
         """Image pixels ``(n, 2)`` (column right, row down) of world points ``(n, 3)``, by pybullet's own matrices."""
         import pybullet
@@ -369,22 +383,12 @@ def picture_figure(world: Any, *, goal: Sequence[Sequence[str]] | None = None, t
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from alica.worldsim.camera import render
-
     scene, close = scene_camera(world), stacks_camera(world)
     fig = plt.figure(figsize=(18, 13), dpi=100)
     grid = fig.add_gridspec(2, 2, width_ratios=[4, 3], height_ratios=[3, 2])
     left, right, middle = fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]), fig.add_subplot(grid[1, :])
     for ax, camera, what in ((left, scene, "robots and blocks"), (middle, close, "close-up of the stacks")):
-        pixels = render(
-            world,
-            width=camera.width,
-            height=camera.height,
-            target=camera.target,
-            distance=camera.distance,
-            yaw=camera.yaw,
-            pitch=camera.pitch,
-        )
+        pixels = camera.render(world)
         ax.imshow(pixels)
         ax.set_xlim(0, camera.width)
         ax.set_ylim(camera.height, 0)
