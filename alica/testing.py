@@ -11,7 +11,7 @@ Example::
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import Any, Protocol
 
 import py_trees
 from py_trees.common import Status
@@ -21,6 +21,7 @@ from alica.errors import AlicaError
 from alica.lang import literals
 from alica.lang.skills import SkillRegistry
 from alica.model import Behaviour
+from alica.worldmodel import WorldModelLike
 
 __all__ = ["ManualClock", "ScriptedSkill", "TimedSkill", "default_fallback", "scripted"]
 
@@ -38,11 +39,23 @@ def _status(value: str | Status) -> Status:
         raise ValueError(f"unknown status '{value}' in a script (use running, success or failure)") from None
 
 
-def _write(context: Any, facts: Sequence[FactChange]) -> None:
-    world = getattr(context, "world_model", None)
-    if world is None:
+class _Context(Protocol):
+    """What the stand-ins use of the engine's skill context (:class:`alica.engine.behaviours.SkillContext`)."""
+
+    @property
+    def agent(self) -> str: ...
+
+    @property
+    def world_model(self) -> WorldModelLike | None: ...
+
+    def now(self) -> float: ...
+
+
+def _write(context: _Context | None, facts: Sequence[FactChange]) -> None:
+    world = context.world_model if context is not None else None
+    if world is None or context is None:
         return
-    me = getattr(context, "agent", None)
+    me = context.agent
     for positive, name, args in facts:
         args = tuple(me if a == "self" else a for a in args)
         if positive:
@@ -73,7 +86,7 @@ class ScriptedSkill(py_trees.behaviour.Behaviour):
             raise ValueError("a script needs at least one status")
         self.script = [_status(s) for s in script]
         self.facts = tuple(facts)
-        self.context: Any = None
+        self.context: _Context | None = None
         self.starts = 0
         self.stops = 0
         self.ticks = 0
@@ -117,7 +130,7 @@ class TimedSkill(py_trees.behaviour.Behaviour):
         self.duration = duration
         self.outcome = _status(outcome)
         self.facts = tuple(facts)
-        self.context: Any = None
+        self.context: _Context | None = None
         self.started = 0.0
 
     def setup(self, **kwargs: Any) -> None:

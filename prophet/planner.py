@@ -273,6 +273,9 @@ class Planner(ABC):
     names, and once the step is over the runtime plans the next one from the world as it is then."""
     reads_positions: bool = False
     """Whether its constructor takes ``positions`` (object -> position in metres, the world model's ``pos``)."""
+    reads_files: bool = False
+    """Whether :meth:`solve` takes the PDDL files' paths rather than the parsed domain and problem
+    (a back-end that runs an outside planner on the files, such as Fast Downward)."""
 
     @staticmethod
     def unavailable() -> str:

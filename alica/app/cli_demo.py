@@ -11,7 +11,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, Protocol, TextIO
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.options import (
@@ -344,27 +344,39 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
     return 0 if result.success else 1
 
 
+class Faultable(Protocol):
+    """A team whose robots can be crashed and recovered by name (a simulated team, a team of processes)."""
+
+    def crash(self, name: str) -> None: ...
+
+    def recover(self, name: str) -> None: ...
+
+
 def fault_actions(
     crashes: Sequence[str], recoveries: Sequence[str], agents: int
-) -> list[tuple[float, Callable[[Any], None]]]:
+) -> list[tuple[float, Callable[[Faultable], None]]]:
     """The demo's timed faults from ``--crash NAME@T`` and ``--recover NAME@T``, in the order given.
 
     Raises:
         AlicaError: a value is not NAME@T, or NAME is not a team robot.
     """
     team = [f"r{i + 1}" for i in range(agents)]
-    actions: list[tuple[float, Callable[[Any], None]]] = []
-    for option, texts, method in (("--crash", crashes, "crash"), ("--recover", recoveries, "recover")):
+    actions: list[tuple[float, Callable[[Faultable], None]]] = []
+    for option, texts, fault in (("--crash", crashes, _crash), ("--recover", recoveries, _recover)):
         for text in texts:
             who, at, _ = timed(option, text)
             if who not in team:
                 raise AlicaError(f"{option}: '{who}' is not a team robot; the team is {', '.join(team)}")
-            actions.append((at, functools.partial(_fault, method, who)))
+            actions.append((at, functools.partial(fault, who)))
     return actions
 
 
-def _fault(method: str, who: str, team: Any) -> None:
-    getattr(team, method)(who)
+def _crash(who: str, team: Faultable) -> None:
+    team.crash(who)
+
+
+def _recover(who: str, team: Faultable) -> None:
+    team.recover(who)
 
 
 def _print_summary(result: Any) -> None:

@@ -182,7 +182,7 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
     except PddlError as exc:
         return _refuse(args, exc)
     planner = get_planner(args.planner)
-    if getattr(planner, "reads_files", False):
+    if planner.reads_files:
         _check_features(planner, domain, problem)
         result = planner.solve(args.domain, args.problem, anytime=args.anytime, limits=limits)
     else:

@@ -371,13 +371,10 @@ class Validator:
         for state in plan.states:
             for child in state.children:
                 target = self._ref(child.name, child.span, f"state '{state.name}' of {what}")
-                variables = {v.name for v in getattr(target, "variables", ())}
+                binds = isinstance(target, (Plan, Behaviour))  # a plan type's plans each declare their own
+                variables = {v.name for v in target.variables} if isinstance(target, (Plan, Behaviour)) else set()
                 for binding in child.bindings:
-                    if (
-                        target is not None
-                        and isinstance(target, (Plan, Behaviour))
-                        and binding.variable not in variables
-                    ):
+                    if binds and binding.variable not in variables:
                         self.problems.add(
                             binding.span,
                             f"'{child.name}' has no variable '{binding.variable}' to bind",

@@ -10,7 +10,7 @@ search.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Generator, Iterator
 
 from alica.errors import PlannerError
 from alica.prophet.planner import Done, Improved, LimitReached, Limits, Plan, PlanStatus, SearchEvent
@@ -137,9 +137,8 @@ class ShareSearch:
 
     def _close(self) -> None:
         if self._events is not None:
-            close = getattr(self._events, "close", None)
-            if close is not None:
-                close()
+            if isinstance(self._events, Generator):  # a generator holds its grounding until closed
+                self._events.close()
             self._events = None
 
     def __repr__(self) -> str:

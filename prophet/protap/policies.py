@@ -20,9 +20,12 @@ import statistics
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.prophet.protap.model import IDLE, NOOP, JointAction, ProtapModel, RobotAction, State
+
+if TYPE_CHECKING:
+    from alica.prophet.protap.planner import ProtapPlanner
 
 Policy = Callable[[ProtapModel, State, random.Random], JointAction]
 
@@ -139,7 +142,7 @@ class Recorder:
     """
 
     policy: Policy
-    planner: Any = None
+    planner: ProtapPlanner | None = None
     breaks: int = 0
     seconds: list[float] = field(default_factory=list)
     trials: list[int] = field(default_factory=list)
@@ -149,7 +152,7 @@ class Recorder:
         start = time.perf_counter()
         joint = self.policy(model, state, rng)
         elapsed = time.perf_counter() - start
-        searched = getattr(self.planner, "last_trials", 0) if self.planner is not None else None
+        searched = self.planner.last_trials if self.planner is not None else None
         if searched is None or searched:
             self.seconds.append(elapsed)
         if searched:
