@@ -14,16 +14,23 @@
 
 Every agent computes the same result from the same view, so the team agrees
 without a central controller (:mod:`alica.allocation` solves the problems).
+
+The allocator reads the agent's shared context (:class:`~alica.engine.parts.AgentContext`:
+team view, formulas, belief, settings) and the generated plans' priorities and
+pins; of the plan tree it needs only :class:`Nodes` (make and find plan nodes,
+say the tree changed). It keeps, itself, what succeeded in plan instances
+restarted for want of agents (:meth:`Allocator.carry`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 from alica.allocation import AllocationProblem, Assignment, allocate, utility
-from alica.engine.node import PlanNode
+from alica.engine.generated import GeneratedPlans
+from alica.engine.parts import AgentContext
 from alica.engine.status import ChildStatus
 from alica.engine.team import PlanKey
 from alica.errors import AlicaError
@@ -31,36 +38,66 @@ from alica.model import Plan, StateKind, Summand
 from alica.model.plan import EntryPoint
 
 if TYPE_CHECKING:
-    from alica.engine.agent import AgentEngine
+    from alica.engine.node import PlanNode
     from alica.engine.slot import Slot
+
+
+class Nodes(Protocol):
+    """The plan tree as allocation uses it (:class:`~alica.engine.tree.PlanTree`)."""
+
+    def new_node(self, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float) -> PlanNode:
+        """A new plan node, indexed by ``key``."""
+        ...
+
+    def get(self, key: PlanKey) -> PlanNode | None:
+        """The running plan node of instance ``key``, if any."""
+        ...
+
+    def plan(self, name: str) -> Plan:
+        """A plan of the library, or one a child runtime generated."""
+        ...
+
+    def changed(self) -> None:
+        """The plan tree changed: tell the team soon."""
+        ...
 
 
 class Allocator:
     """The allocation rules of one agent's engine (see the module docstring).
 
     Args:
-        engine: the agent's engine (its team view, belief, formulas, plans and trace).
+        ctx: the agent's name, team view, formulas, belief, settings and trace.
+        nodes: makes and finds the plan tree's nodes.
+        generated: the plans child runtimes generated, with their tasks' priorities and pins.
     """
 
-    def __init__(self, engine: AgentEngine) -> None:
-        self.engine = engine
+    def __init__(self, ctx: AgentContext, nodes: Nodes, generated: GeneratedPlans) -> None:
+        self.ctx = ctx
+        self.nodes = nodes
+        self.generated = generated
         self._unallocated: dict[PlanKey, str] = {}
         """Plan instance -> why its last allocation found no assignment (reported once while it stays the same)."""
+        self.carried: dict[PlanKey, tuple[str, dict[str, set[str]]]] = {}
+        """Plan instances restarted for want of agents: the plan and who succeeded in which entry point."""
+
+    def carry(self, node: PlanNode) -> None:
+        """``node`` restarts for want of agents: the new instance starts with what succeeded in it."""
+        self.carried[node.key] = (node.plan.name, {ep: set(agents) for ep, agents in node.succeeded.items()})
 
     def members(self, parent: PlanNode | None) -> tuple[str, ...]:
         """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""
-        engine = self.engine
-        alive = engine.team.alive()
+        me = self.ctx.name
+        alive = self.ctx.team.alive()
         if parent is None:
             return alive
         believed, state = parent.believed, parent.state
-        return tuple(a for a in alive if a == engine.name or (believed.get(a) or (None, None))[1] == state)
+        return tuple(a for a in alive if a == me or (believed.get(a) or (None, None))[1] == state)
 
     def _summand_fn(
         self, node_env: Mapping[str, object], context: PlanNode | None
     ) -> Callable[[Plan, Summand, str, EntryPoint], float]:
-        engine = self.engine
-        pins = engine.generated.pins
+        ctx = self.ctx
+        pins = self.generated.pins
 
         def summand(plan: Plan, term: Summand, agent: str, ep: EntryPoint) -> float:
             pinned = pins.get(plan.name)
@@ -68,12 +105,11 @@ class Allocator:
                 return -1.0  # a generated task only some robots can start
             env = dict(node_env)
             env.update({"self": agent, "task": ep.task, "entry": ep.name})
-            if context is not None:
-                engine.belief.node = context
+            belief = ctx.belief.at(context) if context is not None else ctx.belief
             try:
-                value = engine.formulas.value(term.expression, engine.belief, env)
+                value = ctx.formulas.value(term.expression, belief, env)
             except AlicaError as exc:
-                engine.formula_error(term.expression, str(exc))
+                ctx.emit("warning", formula=term.expression, message=str(exc))
                 return 0.0
             return float(value)  # type: ignore[arg-type]
 
@@ -88,18 +124,17 @@ class Allocator:
         env: Mapping[str, object],
         context: PlanNode | None,
     ) -> AllocationProblem:
-        engine = self.engine
-        roles = engine.team.roles
+        roles = self.ctx.team.roles
         needs_summands = any(p.utility.summands for p in plans)
         return AllocationProblem(
             agents=agents,
             roles={a: roles[a] for a in agents},
-            roleset=engine.roleset,
+            roleset=self.generated.roleset,
             plans=plans,
             successes=successes,
             old=old,
             summand=self._summand_fn(env, context) if needs_summands else None,
-            allow_idle=engine.config.allow_idle,
+            allow_idle=self.ctx.config.allow_idle,
         )
 
     def start(self, slot: Slot | None, plans: tuple[Plan, ...], env: dict[str, object], now: float) -> PlanNode | None:
@@ -108,7 +143,8 @@ class Allocator:
         Returns:
             The new plan node, or ``None`` when there is no valid assignment (``slot.reason`` says why).
         """
-        engine = self.engine
+        ctx = self.ctx
+        me = ctx.name
         parent = slot.parent if slot is not None else None
         key: PlanKey = (*slot.parent.key, slot.parent.state or "", slot.name) if slot is not None else (plans[0].name,)
         members = self.members(parent)
@@ -118,7 +154,7 @@ class Allocator:
         names = {p.name for p in plans}
         chosen: str | None = None
         for agent in members:
-            claim = engine.team.claim(agent, key) if agent != engine.name else None
+            claim = ctx.team.claim(agent, key) if agent != me else None
             if claim is not None and claim.plan in names and (chosen is None or claim.plan == chosen):
                 chosen = claim.plan
                 fixed[agent] = (claim.entry, claim.state)
@@ -130,38 +166,37 @@ class Allocator:
         if chosen is not None:
             plans = tuple(p for p in plans if p.name == chosen)
         # what this agent knew had succeeded in the instance before it restarted for want of agents
-        carried = engine.carried.get(key)
+        carried = self.carried.get(key)
         if carried is not None and carried[0] in {p.name for p in plans}:
             counts = successes.setdefault(carried[0], {})
             for ep, done in sorted(carried[1].items()):
-                if engine.name in done:
+                if me in done:
                     counts[ep] = counts.get(ep, 0) + 1
         agents = tuple(a for a in members if a not in fixed)
         result = allocate(self._problem(agents, plans, successes, None, env, parent))
-        engine.stats["allocations"] += 1
+        ctx.count("allocations")
         assignment = result.assignment
         if assignment is None:
             if self._unallocated.get(key) != result.why:
                 self._unallocated[key] = result.why
-                engine.emit("allocation", key="/".join(key), outcome="none", why=result.why)
+                ctx.emit("allocation", key="/".join(key), outcome="none", why=result.why)
             if slot is not None:
                 slot.reason = f"no valid assignment: {result.why}"
             return None
         self._unallocated.pop(key, None)
-        plan = engine.plan_named(assignment.plan)
-        node = PlanNode(engine, key, slot, plan, env, now)
-        engine.index[key] = node
-        carried = engine.carried.pop(key, None)
+        plan = self.nodes.plan(assignment.plan)
+        node = self.nodes.new_node(key, slot, plan, env, now)
+        carried = self.carried.pop(key, None)
         if carried is not None and carried[0] == plan.name:
             for ep, done in carried[1].items():
                 node.succeeded.setdefault(ep, set()).update(done)
         for agent, entry in fixed.items():
             node.believed[agent] = entry
         for agent, ep in assignment.entries:
-            if agent != engine.name:
+            if agent != me:
                 node.believed[agent] = (ep, plan.entry_point(ep).state if ep is not None else None)
                 node.predicted_at[agent] = now
-        engine.emit(
+        ctx.emit(
             "allocation",
             key=node.key_text,
             plan=plan.name,
@@ -169,7 +204,7 @@ class Allocator:
             utility=round(assignment.utility, 9),
             entries=assignment.as_dict(),
         )
-        node.set_entry(assignment.entry_of(engine.name), now)
+        node.set_entry(assignment.entry_of(me), now)
         return node
 
     def reallocate(self, node: PlanNode, now: float) -> None:
@@ -234,7 +269,7 @@ class Allocator:
         if not moves:
             return
         moves = tuple(sorted(moves))
-        self.engine.emit("allocation", key=node.key_text, plan=plan.name, reason="reuse", entries=dict(moves))
+        self.ctx.emit("allocation", key=node.key_text, plan=plan.name, reason="reuse", entries=dict(moves))
         node.apply(Assignment(plan.name, moves, 0.0), now, "reuse")
 
     def _place(
@@ -251,7 +286,7 @@ class Allocator:
         return tuple((a, ep) for a, ep in best.entries if ep is not None)
 
     def _reallocate(self, node: PlanNode, now: float) -> None:
-        engine = self.engine
+        ctx = self.ctx
         plan = node.plan
         members = node.members()
         current: dict[str, str | None] = {}
@@ -265,7 +300,7 @@ class Allocator:
         agents_t = tuple(agents)
         # a plan whose run-time condition fails scores -1: the child takes an alternative of its
         # plan type whose conditions hold, if any (else the abort rule fails the plan)
-        runs = plan.run is None or engine.formulas.holds(plan.run.text, engine.belief_for(node), node.env)
+        runs = plan.run is None or ctx.formulas.holds(plan.run.text, ctx.belief.at(node), node.env)
         plans: tuple[Plan, ...] = (
             (plan,) if node.slot is None else node.slot.startable(node.slot.candidates(), keep=plan if runs else None)
         )
@@ -278,7 +313,7 @@ class Allocator:
         problem = self._problem(agents_t, plans, successes, old, node.env, node.slot.parent if node.slot else None)
         now_utility = (utility(problem, plan, current) if agents_t else 0.0) if runs else -1.0
         result = allocate(problem)
-        engine.stats["allocations"] += 1
+        ctx.count("allocations")
         best = result.assignment
         if best is None:
             if runs and now_utility <= -1:
@@ -291,7 +326,7 @@ class Allocator:
         same = best.plan == plan.name and all(best.entry_of(a) == current[a] for a in agents_t)
         if same:
             return
-        engine.emit(
+        ctx.emit(
             "allocation",
             key=node.key_text,
             plan=best.plan,
@@ -304,24 +339,22 @@ class Allocator:
             slot = node.slot
             node.stop()
             slot.node = None
-            slot.start(now, only=engine.plan_named(best.plan))
+            slot.start(now, only=self.nodes.plan(best.plan))
             return
         node.apply(best, now, "utility")
         self._check_conflicts(node, now)
 
     def _check_conflicts(self, node: PlanNode, now: float) -> None:
-        engine = self.engine
-        config = engine.config
+        ctx = self.ctx
+        config = ctx.config
         contested = node.conflicts(now, config.cycle_window) >= config.cycle_count
         if not contested:
             contested = any(
-                (c := engine.team.claim(a, node.key)) is not None and c.contested
-                for a in node.members()
-                if a != engine.name
+                (c := ctx.team.claim(a, node.key)) is not None and c.contested for a in node.members() if a != ctx.name
             )
         if not contested or now < node.authority_until:
             return
-        if node.members()[0] == engine.name:
+        if node.members()[0] == ctx.name:
             window = (
                 config.authority_min
                 if node.authority_window == 0
@@ -330,33 +363,31 @@ class Allocator:
             node.authority_window = window
             node.authority_until = now + window
             node.history.clear()
-            engine.emit(
+            ctx.emit(
                 "authority",
                 key=node.key_text,
                 window=window,
                 entries=dict(sorted((a, e[0]) for a, e in node.believed.items())),
             )
-            engine.tree_changed()
+            self.nodes.changed()
         else:
             node.contested_until = now + config.authority_min
-            engine.tree_changed()
+            self.nodes.changed()
 
     def apply_authority(self, now: float) -> None:
         """Adopt the assignments that lower agents impose by authority on plans this agent runs."""
-        engine = self.engine
-        for sender, claim in engine.team.authority_claims():
-            if sender >= engine.name or claim.until <= now:
+        ctx = self.ctx
+        for sender, claim in ctx.team.authority_claims():
+            if sender >= ctx.name or claim.until <= now:
                 continue
-            node = engine.index.get(claim.key)
+            node = self.nodes.get(claim.key)
             if node is None or node.plan.name != claim.plan or node.status is not ChildStatus.RUNNING:
                 continue
             node.overridden_until = claim.until
             entries = dict(claim.entries)
-            if engine.name not in entries:
+            if ctx.name not in entries:
                 continue
             if all(node.believed.get(a, (None, None))[0] == ep for a, ep in entries.items()):
                 continue
-            engine.emit(
-                "allocation", key=node.key_text, plan=claim.plan, reason="authority", by=sender, entries=entries
-            )
+            ctx.emit("allocation", key=node.key_text, plan=claim.plan, reason="authority", by=sender, entries=entries)
             node.apply(Assignment(claim.plan, tuple(sorted(entries.items())), 0.0), now, "authority")

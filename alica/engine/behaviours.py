@@ -15,19 +15,21 @@ import logging
 import random
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import py_trees
 
 from alica.engine.status import ChildStatus
 from alica.errors import AlicaError, UnknownSkillError
+from alica.lang import BeliefBase
 from alica.model import Behaviour
 from alica.worldmodel import WorldModelLike
 
 if TYPE_CHECKING:
     from alica.engine.belief import AgentBelief
     from alica.engine.conditions import Formulas
-    from alica.engine.solving import SolveResult
+    from alica.engine.parts import SolveResult
+    from alica.lang.skills import SkillRegistry
 
 logger = logging.getLogger(__name__)
 
@@ -73,7 +75,7 @@ class SkillContext:
         """The values the constraint solver gives the behaviour's variables ``names`` now.
 
         Returns:
-            A :class:`alica.engine.solving.SolveResult`: ``status`` (``solved``,
+            A :class:`alica.engine.parts.SolveResult`: ``status`` (``solved``,
             ``infeasible``, ``timeout``), ``values`` (this agent's, by variable
             name), ``team`` (every agent's), ``utility`` and ``reason``. No
             solution is a status, never an exception.
@@ -109,7 +111,7 @@ class SkillBinder:
     def __init__(
         self,
         overrides: Mapping[str, SkillFactory] | None = None,
-        registry: Any = None,
+        registry: SkillRegistry | None = None,
         fallback: Callable[[Behaviour], SkillFactory] | None = None,
     ) -> None:
         self.overrides = dict(overrides or {})
@@ -171,7 +173,7 @@ class BehaviourRunner:
         self._next_tick = 0.0
         self._period = 1.0 / model.frequency if model.frequency > 0 else 0.0
 
-    def tick(self, belief: AgentBelief, formulas: Formulas, env: Mapping[str, object], now: float) -> ChildStatus:
+    def tick(self, belief: BeliefBase, formulas: Formulas, env: Mapping[str, object], now: float) -> ChildStatus:
         """Start the behaviour when its pre-condition holds, then tick it; returns its status."""
         if self.status.done:
             return self.status

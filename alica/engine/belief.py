@@ -15,21 +15,49 @@ It combines, in this order:
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from typing import TYPE_CHECKING
+from collections.abc import Callable, Iterable, Mapping
+from typing import TYPE_CHECKING, Protocol
 
 from alica.lang import BeliefBase, FactBase
+from alica.model import Plan
 
 if TYPE_CHECKING:
-    from alica.engine.node import PlanNode
     from alica.engine.team import TeamView
+
+
+class PlanContext(Protocol):
+    """A running plan as the belief base reads it (the engine's :class:`~alica.engine.node.PlanNode`)."""
+
+    @property
+    def plan(self) -> Plan:
+        """The plan."""
+        ...
+
+    @property
+    def believed(self) -> Mapping[str, tuple[str | None, str | None]]:
+        """Every agent in the plan -> its entry point and state, as this agent believes them."""
+        ...
+
+    @property
+    def state_entered_at(self) -> float:
+        """When this agent entered its current state."""
+        ...
+
+    def children_status(self, want: str) -> bool:
+        """``success``: every child of the current state succeeded; ``failure``: some child failed."""
+        ...
+
+    def child_status(self, name: str, want: str) -> bool:
+        """Whether the child ``name`` of the current state succeeded / failed."""
+        ...
+
 
 _CONTEXT = frozenset({"succeeded", "failed", "elapsed"})
 _TEAM = frozenset({"role", "alive", "in_task", "in_state"})
 
 
 class AgentBelief:
-    """An agent's belief base; the engine sets :attr:`node` before evaluating a plan's formulas.
+    """An agent's belief base; :meth:`at` sets the plan whose context formulas read (:attr:`node`).
 
     Args:
         agent: the agent's name (bound to ``self`` in formulas).
@@ -41,13 +69,20 @@ class AgentBelief:
 
     __slots__ = ("_now", "agent", "node", "own", "team", "world")
 
-    def __init__(self, agent: str, world: BeliefBase, team: TeamView, own: FactBase, clock_now) -> None:  # type: ignore[no-untyped-def]
+    def __init__(
+        self, agent: str, world: BeliefBase, team: TeamView, own: FactBase, clock_now: Callable[[], float]
+    ) -> None:
         self.agent = agent
         self.world = world
         self.team = team
         self.own = own
-        self.node: PlanNode | None = None
+        self.node: PlanContext | None = None
         self._now = clock_now
+
+    def at(self, node: PlanContext | None) -> AgentBelief:
+        """This belief base, looking at ``node``'s context (``None``: no plan's)."""
+        self.node = node
+        return self
 
     def lookup(self, name: str, args: tuple[object, ...]) -> object | None:
         """See the module docstring for the order of sources."""

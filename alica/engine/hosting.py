@@ -5,12 +5,18 @@ when the engine is built, each with its own :class:`EngineHost` bound to the
 topic the kind owns: the host is all a child runtime sees of the engine.
 :class:`Children` then makes the runtime of every child of a configured type
 and routes the messages of each kind's topic to its factory.
+
+Neither holds the engine: they read the agent's shared context
+(:class:`~alica.engine.parts.AgentContext`) and, for what a child runtime may
+see beyond it, :class:`Operated` (the library, the generated plans, the world
+model, the operator's settings and decisions, publishing on a topic), which
+:class:`~alica.engine.agent.AgentEngine` satisfies.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, MutableMapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Protocol
 
 from alica.engine.child import (
     ChildFactory,
@@ -21,16 +27,51 @@ from alica.engine.child import (
     missing_kind_message,
     reachable_elements,
 )
+from alica.engine.generated import GeneratedPlans
 from alica.engine.node import PlanNode
+from alica.engine.parts import AgentContext
 from alica.errors import AlicaError
 from alica.lang.fact import Fact
 from alica.model import Behaviour, Plan, PlanLibrary, PlanType, Priority, RoleSet
+from alica.worldmodel import WorldModelLike
 
 if TYPE_CHECKING:
-    from alica.engine.agent import AgentEngine
     from alica.engine.slot import Slot
 
 _NONE: Mapping[str, str] = {}
+
+
+class Operated(Protocol):
+    """What a child runtime's host reads of the agent beyond the shared context (the engine satisfies it)."""
+
+    @property
+    def library(self) -> PlanLibrary:
+        """The plan library."""
+        ...
+
+    @property
+    def generated(self) -> GeneratedPlans:
+        """The plans child runtimes generated, with the team's base role set."""
+        ...
+
+    @property
+    def world_model(self) -> WorldModelLike:
+        """The agent's world model."""
+        ...
+
+    @property
+    def overrides(self) -> Mapping[str, Mapping[str, str]]:
+        """Element -> what the operator set for it (``goal``, ``world``)."""
+        ...
+
+    @property
+    def decisions(self) -> Mapping[str, Sequence[tuple[int, PlanDecision]]]:
+        """Element -> the operator's decisions on its proposed plans, ``(generation, decision)``, oldest first."""
+        ...
+
+    def publish(self, topic: str, payload: object) -> None:
+        """Send a message to the team on ``topic`` (reliably)."""
+        ...
 
 
 class _World:
@@ -38,7 +79,7 @@ class _World:
 
     __slots__ = ("_model",)
 
-    def __init__(self, model: Any) -> None:
+    def __init__(self, model: WorldModelLike) -> None:
         self._model = model
 
     def facts(self) -> list[Fact]:
@@ -67,29 +108,31 @@ class EngineHost:
     """An agent's engine as the host of one kind of child runtime (a :class:`~alica.engine.child.ChildHost`).
 
     Args:
-        engine: the agent's engine.
+        ctx: the agent's name, clock, settings, formulas, belief, counters and trace.
+        agent: the rest of what a child runtime may see of the agent.
         topic: the team topic the kind owns (``None``: it may not publish).
     """
 
-    def __init__(self, engine: AgentEngine, topic: str | None) -> None:
-        self._engine = engine
+    def __init__(self, ctx: AgentContext, agent: Operated, topic: str | None) -> None:
+        self._ctx = ctx
+        self._agent = agent
         self._topic = topic
-        self._world = _World(engine.world_model)
+        self._world = _World(agent.world_model)
 
     @property
     def name(self) -> str:
-        return self._engine.name
+        return self._ctx.name
 
     def now(self) -> float:
-        return self._engine.now()
+        return self._ctx.now()
 
     @property
     def library(self) -> PlanLibrary:
-        return self._engine.library
+        return self._agent.library
 
     @property
     def roleset(self) -> RoleSet:
-        return self._engine.base_roleset
+        return self._agent.generated.base
 
     @property
     def world(self) -> WorldFacts:
@@ -97,31 +140,31 @@ class EngineHost:
 
     @property
     def counters(self) -> MutableMapping[str, int]:
-        return self._engine.stats
+        return self._ctx.stats
 
     def holds(self, formula: str, plan: RunningPlan) -> bool:
         if not isinstance(plan, PlanNode):
             raise TypeError(f"not a plan this engine runs: {plan!r}")
-        engine = self._engine
-        return engine.formulas.holds(formula, engine.belief_for(plan), plan.env)
+        ctx = self._ctx
+        return ctx.formulas.holds(formula, ctx.belief.at(plan), plan.env)
 
     def override(self, element: str) -> Mapping[str, str]:
-        return self._engine.overrides.get(element, _NONE)
+        return self._agent.overrides.get(element, _NONE)
 
     @property
     def review(self) -> bool:
-        return self._engine.config.review
+        return self._ctx.config.review
 
     def decisions(self, element: str) -> Sequence[tuple[int, PlanDecision]]:
-        return self._engine.decisions.get(element, ())
+        return self._agent.decisions.get(element, ())
 
-    def emit(self, event: str, **fields: Any) -> None:
-        self._engine.emit(event, **fields)
+    def emit(self, event: str, **fields: object) -> None:
+        self._ctx.emit(event, **fields)
 
     def publish(self, payload: object) -> None:
         if self._topic is None:
             raise AlicaError("this child kind owns no topic to publish on: give it a 'topic'")
-        self._engine.publish(self._topic, payload)
+        self._agent.publish(self._topic, payload)
 
     def register_plan(
         self,
@@ -129,33 +172,35 @@ class EngineHost:
         priorities: Mapping[str, tuple[Priority, ...]],
         pins: Mapping[str, tuple[str, ...]],
     ) -> None:
-        self._engine.generated.register(plan, priorities, pins)
+        self._agent.generated.register(plan, priorities, pins)
 
     def unregister_plan(self, name: str) -> None:
-        self._engine.generated.unregister(name)
+        self._agent.generated.unregister(name)
 
 
 class Children:
     """The child kinds attached to one agent's engine: per configured element type a factory with its host.
 
     Args:
-        engine: the agent's engine; its configuration names the kinds (``EngineConfig.children``).
+        ctx: the agent's shared context; its configuration names the kinds (``EngineConfig.children``).
+        agent: what the kinds' hosts read of the agent beyond ``ctx``.
+        root: the name of the agent's root plan.
 
     Raises:
-        AlicaError: the engine's plan tree reaches an element no kind is configured for.
+        AlicaError: the agent's plan tree reaches an element no kind is configured for.
     """
 
-    def __init__(self, engine: AgentEngine) -> None:
+    def __init__(self, ctx: AgentContext, agent: Operated, root: str) -> None:
         self._factories: list[tuple[type, ChildFactory]] = []
         self.routes: dict[str, ChildFactory] = {}
         """Topic -> the factory its messages go to."""
-        for element_type, kind in engine.config.children.items():
+        for element_type, kind in ctx.config.children.items():
             topic = kind.topic
-            factory = kind(EngineHost(engine, topic))
+            factory = kind(EngineHost(ctx, agent, topic))
             self._factories.append((element_type, factory))
             if topic is not None:
                 self.routes[topic] = factory
-        for where, element in reachable_elements(engine.library, engine.root_plan.name):
+        for where, element in reachable_elements(agent.library, root):
             if not isinstance(element, (Behaviour, Plan, PlanType)) and self.factory(type(element)) is None:
                 raise AlicaError(missing_kind_message(element, where))
 

@@ -21,31 +21,152 @@ Each tick the engine visits the tree top-down. For one plan node:
    every success-required entry point has enough agents in success states.
 
 Behaviours are ticked after the rules (see :meth:`AgentEngine.tick`).
+
+A node does not hold the engine: it is given :class:`NodeParts`, the shared
+context and the small interfaces declared here (the plan tree, allocation,
+the start of children, child runtimes, solved values, synchronisations), each
+satisfied by one of the engine's collaborators.
 """
 
 from __future__ import annotations
 
 from collections import deque
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol
 
+from alica.engine.parts import AgentContext, NoSolution
 from alica.engine.slot import Slot
-from alica.engine.solving import NoSolution
 from alica.engine.status import ChildStatus
+from alica.engine.sync import SyncTable
 from alica.engine.team import Claim, PlanKey, key_text
-from alica.model import Plan, StateKind, Transition
+from alica.model import ChildRef, Plan, PlanLibrary, StateKind, Transition
 
 if TYPE_CHECKING:
     from alica.allocation import Assignment
-    from alica.engine.agent import AgentEngine
+    from alica.engine.behaviours import BehaviourRunner
+    from alica.engine.child import ChildRuntime
 
 Entry = tuple[str | None, str | None]
+
+
+class Tree(Protocol):
+    """The agent's plan tree as its nodes and slots see it (:class:`~alica.engine.tree.PlanTree`)."""
+
+    @property
+    def library(self) -> PlanLibrary:
+        """The plan library."""
+        ...
+
+    @property
+    def inputs(self) -> int:
+        """Moves on whenever something an allocation reads may have changed."""
+        ...
+
+    def plan(self, name: str) -> Plan:
+        """A plan of the library, or one a child runtime generated."""
+        ...
+
+    def changed(self) -> None:
+        """The plan tree changed: tell the team soon."""
+        ...
+
+    def forget(self, node: PlanNode) -> None:
+        """``node`` stopped."""
+        ...
+
+    def left_with_success(self, node: PlanNode) -> None:
+        """``node`` stops after this agent's task succeeded in it: keep claiming the success."""
+        ...
+
+    def out_transitions(self, plan: Plan, state: str) -> tuple[Transition, ...]:
+        """The transitions leaving ``state``."""
+        ...
+
+
+class Allocation(Protocol):
+    """The allocation rules as plan nodes and slots call them (:class:`~alica.engine.allocate.Allocator`)."""
+
+    def members(self, parent: PlanNode | None) -> tuple[str, ...]:
+        """Alive agents believed to be in ``parent``'s state (all alive agents for the root), sorted."""
+        ...
+
+    def start(self, slot: Slot | None, plans: tuple[Plan, ...], env: dict[str, object], now: float) -> PlanNode | None:
+        """Allocate the agents of ``slot``'s state to one of ``plans`` and start it (``None``: no assignment)."""
+        ...
+
+    def reallocate(self, node: PlanNode, now: float) -> None:
+        """The dynamic allocation rule for a running plan."""
+        ...
+
+    def carry(self, node: PlanNode) -> None:
+        """``node`` restarts for want of agents: keep what succeeded in it for the new instance."""
+        ...
+
+
+class Launch(Protocol):
+    """What a state's children get when the agent enters the state (:class:`~alica.engine.launch.Launcher`)."""
+
+    def bind(self, node: PlanNode, ref: ChildRef) -> dict[str, object]:
+        """The variables of child ``ref`` of ``node``'s state.
+
+        Raises:
+            NoSolution: a binding reads a solved variable and the constraints have no solution now.
+        """
+        ...
+
+    def runner(self, slot: Slot) -> BehaviourRunner:
+        """The runner of a behaviour child, with its parameters bound."""
+        ...
+
+
+class Runtimes(Protocol):
+    """The child runtimes the engine was configured with (:class:`~alica.engine.hosting.Children`)."""
+
+    def runtime(self, slot: Slot) -> ChildRuntime:
+        """The runtime of a child that is neither a behaviour, a plan nor a plan type."""
+        ...
+
+
+class Watch(Protocol):
+    """Behaviours started with solved values, watched for new ones (:class:`~alica.engine.solving.Solving`)."""
+
+    def track(self, slot: Slot) -> None:
+        """Restart ``slot``'s behaviour when the solved values it was started with change."""
+        ...
+
+    def unwatch(self, slot: Slot) -> None:
+        """The slot stopped."""
+        ...
+
+
+@dataclass(frozen=True, slots=True)
+class NodeParts:
+    """Everything a plan node and its slots work with: made once by the engine, shared by every node.
+
+    Attributes:
+        ctx: the agent's name, clock, settings, team view, formulas, belief base and trace.
+        tree: the plan tree the node is part of.
+        allocation: the allocation rules.
+        launch: binds a child's variables and builds a behaviour's runner.
+        runtimes: makes the runtime of a planning problem's child.
+        solved: watches behaviours whose variables the constraint solver gives.
+        syncs: the agent's synchronisation processes.
+    """
+
+    ctx: AgentContext
+    tree: Tree
+    allocation: Allocation
+    launch: Launch
+    runtimes: Runtimes
+    solved: Watch
+    syncs: SyncTable
 
 
 class PlanNode:
     """One plan instance as one agent runs it.
 
     Args:
-        engine: the agent's engine.
+        parts: what the node works with (the same for every node of the agent).
         key: the plan instance's key in the team.
         slot: the child of the parent state it runs in; ``None`` for the root.
         plan: the plan.
@@ -54,9 +175,9 @@ class PlanNode:
     """
 
     def __init__(
-        self, engine: AgentEngine, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float
+        self, parts: NodeParts, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float
     ) -> None:
-        self.engine = engine
+        self.parts = parts
         self.key = key
         self.key_text = key_text(key)
         self.slot = slot
@@ -99,7 +220,7 @@ class PlanNode:
     def members(self) -> tuple[str, ...]:
         """Alive agents believed to be in the parent state (all alive agents for the root), sorted."""
         if self._members is None:
-            self._members = self.engine.allocator.members(self.slot.parent if self.slot is not None else None)
+            self._members = self.parts.allocation.members(self.slot.parent if self.slot is not None else None)
         return self._members
 
     def invalidate(self) -> None:
@@ -113,7 +234,7 @@ class PlanNode:
 
     def own_successes(self) -> tuple[str, ...]:
         """Entry points in which this agent's task succeeded here."""
-        me = self.engine.name
+        me = self.parts.ctx.name
         return tuple(sorted(ep for ep, agents in self.succeeded.items() if me in agents))
 
     def claim(self) -> Claim:
@@ -124,7 +245,7 @@ class PlanNode:
             self.ep,
             self.state,
             self.own_successes(),
-            self.contested_until > self.engine.now(),
+            self.contested_until > self.parts.ctx.now(),
         )
 
     def integrate(self, now: float) -> bool:
@@ -133,16 +254,16 @@ class PlanNode:
         Returns:
             Whether anything changed.
         """
-        engine = self.engine
-        me = engine.name
-        team = engine.team
+        ctx = self.parts.ctx
+        me = ctx.name
+        team = ctx.team
         members = set(self.members())
         changed = False
         for agent in [a for a in self.believed if a != me and a not in members]:
             del self.believed[agent]
             self.former.add(agent)
             changed = True
-        protection = engine.config.assignment_protection
+        protection = ctx.config.assignment_protection
         for agent in sorted(self.former):
             if agent in members or not team.is_alive(agent):
                 continue
@@ -202,7 +323,7 @@ class PlanNode:
     def set_entry(self, ep: str | None, now: float) -> None:
         """Take entry point ``ep`` (``None``: idle) and enter its initial state."""
         self.ep = ep
-        me = self.engine.name
+        me = self.parts.ctx.name
         if ep is None:
             self._leave_state()
             self.state = None
@@ -215,28 +336,29 @@ class PlanNode:
     def enter_state(self, state: str, now: float) -> None:
         """Leave the current state (stopping its children) and enter ``state``."""
         self._leave_state()
-        engine = self.engine
+        parts = self.parts
+        me = parts.ctx.name
         self.state = state
         self.state_entered_at = now
-        self.believed[engine.name] = (self.ep, state)
+        self.believed[me] = (self.ep, state)
         model = self.plan.state(state)
         if model.kind is StateKind.SUCCESS and self.ep is not None:
-            self.succeeded.setdefault(self.ep, set()).add(engine.name)
+            self.succeeded.setdefault(self.ep, set()).add(me)
             self.dirty = True  # free now: maybe needed for another task
-        engine.tree_changed()
+        parts.tree.changed()
         for ref in model.children:
             try:
-                env, unsolved = engine.bind(self, ref), ""
+                env, unsolved = parts.launch.bind(self, ref), ""
             except NoSolution as exc:
-                env, unsolved = {"self": engine.name}, str(exc)
+                env, unsolved = {"self": me}, str(exc)
             slot = Slot(self, ref, env)
             self.slots.append(slot)
             if unsolved:
                 slot.fail_unsolved(unsolved)  # a status the plan reacts to ('failed'), not an exception
             elif slot.is_behaviour:
-                slot.runner = engine.make_runner(slot)
+                slot.runner = parts.launch.runner(slot)
                 slot.status = slot.runner.status
-                engine.solving.track(slot)
+                parts.solved.track(slot)
             else:
                 slot.start(now)
 
@@ -244,14 +366,14 @@ class PlanNode:
         for slot in self.slots:
             slot.stop()
         self.slots = []
-        self.engine.drop_syncs(self)
+        self.parts.syncs.drop(self.key)
 
     def stop(self) -> None:
         """Stop every child: the agent leaves this plan (what it succeeded in here is still claimed, see ``left``)."""
         self.stopped = True
-        self.engine.left_with_success(self)
+        self.parts.tree.left_with_success(self)
         self._leave_state()
-        self.engine.forget(self)
+        self.parts.tree.forget(self)
 
     # -- conditions ------------------------------------------------------
 
@@ -272,7 +394,8 @@ class PlanNode:
         """Apply the rules to this plan and its children (see the module docstring)."""
         if self.status is ChildStatus.FAILURE:
             return
-        engine = self.engine
+        parts = self.parts
+        config = parts.ctx.config
         if 0 <= self.overridden_until <= now:
             # an authority's window ended: look at the allocation again
             self.overridden_until = -1.0
@@ -281,7 +404,7 @@ class PlanNode:
         if (
             self.predicted_at
             and not self.dirty
-            and now - min(self.predicted_at.values()) > engine.config.assignment_protection
+            and now - min(self.predicted_at.values()) > config.assignment_protection
         ):
             self.dirty = True
         if self.slot is not None and self.slot.choice_changed():
@@ -289,7 +412,7 @@ class PlanNode:
         if self.dirty:
             self.dirty = False
             self.integrate(now)
-            engine.allocator.reallocate(self, now)
+            parts.allocation.reallocate(self, now)
             if self.failed or self.stopped:
                 return
         for slot in list(self.slots):
@@ -298,14 +421,14 @@ class PlanNode:
             self._check_success()
             return
         fired = False
-        for _ in range(engine.config.max_rule_applications):
+        for _ in range(config.max_rule_applications):
             if self.plan.state(self.state).terminal:
                 break
             transition = self._transition_rule(now)
             if transition is None:
                 break
             fired = True
-            engine.emit(
+            parts.ctx.emit(
                 "transition",
                 key=self.key_text,
                 plan=self.plan.name,
@@ -324,23 +447,22 @@ class PlanNode:
             self._check_success()
 
     def _transition_rule(self, now: float) -> Transition | None:
-        engine = self.engine
+        parts = self.parts
+        ctx = parts.ctx
         state = self.state
         assert state is not None  # the rules run in a state
-        belief = engine.belief_for(self)
-        for transition in engine.out_transitions(self.plan, state):
+        belief = ctx.belief.at(self)
+        for transition in parts.tree.out_transitions(self.plan, state):
             condition = transition.condition.text if transition.condition else None
-            holds = engine.formulas.holds(condition, belief, self.env)
+            holds = ctx.formulas.holds(condition, belief, self.env)
             if transition.synchronisation is None:
                 if holds:
                     return transition
                 continue
-            process = engine.sync_process(self, transition.synchronisation)
+            process = parts.syncs.process(self.key, self.plan, transition.synchronisation)
             process.update_mine(transition.name, holds, now)
             if holds and process.complete():
-                engine.emit(
-                    "sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="fired"
-                )
+                ctx.emit("sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="fired")
                 process.reset()
                 return transition
             if process.timed_out(now):
@@ -348,7 +470,7 @@ class PlanNode:
                 if process.sync.fail_on_timeout:
                     self.fail(f"synchronisation '{process.sync.name}' timed out after {process.sync.sync_timeout} s")
                     return None
-                engine.emit(
+                ctx.emit(
                     "sync", key=self.key_text, sync=process.sync.name, transition=transition.name, outcome="timeout"
                 )
         return None
@@ -359,11 +481,12 @@ class PlanNode:
         if state.kind is StateKind.FAILURE:
             self.fail(f"reached failure state '{state.name}'")
             return
+        ctx = self.parts.ctx
         run = self.plan.run
-        if run is not None and not self.engine.formulas.holds(run.text, self.engine.belief_for(self), self.env):
+        if run is not None and not ctx.formulas.holds(run.text, ctx.belief.at(self), self.env):
             self.fail(f"run-time condition '{run.text}' no longer holds")
             return
-        if not fired and self.engine.config.auto_failure_handling:
+        if not fired and ctx.config.auto_failure_handling:
             for slot in self.slots:
                 if slot.status is ChildStatus.FAILURE:
                     self.fail(
@@ -384,7 +507,7 @@ class PlanNode:
     def _check_success(self) -> None:
         if self.status is ChildStatus.RUNNING and self.plan_succeeded():
             self.status = ChildStatus.SUCCESS
-            self.engine.emit("success", key=self.key_text, plan=self.plan.name)
+            self.parts.ctx.emit("success", key=self.key_text, plan=self.plan.name)
 
     def fail(self, reason: str) -> None:
         """The plan failed for this agent; the parent repairs it."""
@@ -392,13 +515,13 @@ class PlanNode:
             return
         self.status = ChildStatus.FAILURE
         self.reason = reason
-        self.engine.emit("failure", key=self.key_text, plan=self.plan.name, reason=reason)
+        self.parts.ctx.emit("failure", key=self.key_text, plan=self.plan.name, reason=reason)
 
     # -- allocation results ---------------------------------------------
 
     def apply(self, assignment: Assignment, now: float, reason: str) -> None:
         """Adopt an assignment: predictions for teammates, a new entry point for this agent if it changed."""
-        me = self.engine.name
+        me = self.parts.ctx.name
         for agent, ep in assignment.entries:
             if agent == me:
                 continue
@@ -414,7 +537,7 @@ class PlanNode:
             if mine != self.ep or (self.state is None and mine is not None):
                 self.history.append((now, reason, me, self.ep, mine))
                 self.set_entry(mine, now)
-        self.engine.tree_changed()
+        self.parts.tree.changed()
 
     def conflicts(self, now: float, window: float) -> int:
         """Times, within ``window`` seconds, that a teammate's message undid a utility-driven change."""

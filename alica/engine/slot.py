@@ -75,34 +75,36 @@ class Repairs:
         Returns:
             ``False`` when the failure propagates (or, with ``auto`` off, stays).
         """
-        engine = node.engine
+        parts = node.parts
+        ctx = parts.ctx
+        rejoin_wait = ctx.config.rejoin_wait
         plan = node.plan
         node.stop()
-        now = engine.now()
-        if node.understaffed and not self.waited_out(now, engine.config.rejoin_wait):
+        now = ctx.now()
+        if node.understaffed and not self.waited_out(now, rejoin_wait):
             # a teammate is missing (lost messages, a partition, a crash): not the plan's fault. Restart it
             # when the team allows, keeping what succeeded, without using up a repair stage
             if self.waiting_since is None:
                 self.waiting_since = now
-            engine.carried[node.key] = (plan.name, {ep: set(agents) for ep, agents in node.succeeded.items()})
-            engine.emit("repair", key=node.key_text, stage="wait", plan=plan.name, reason=node.reason)
+            parts.allocation.carry(node)
+            ctx.emit("repair", key=node.key_text, stage="wait", plan=plan.name, reason=node.reason)
             start(plan)
             return True
         if node.understaffed:
-            node.reason += f" (no valid assignment for {engine.config.rejoin_wait:g} s)"
+            node.reason += f" (no valid assignment for {rejoin_wait:g} s)"
         if not auto:
             return False
         count = self.failures[plan.name] = self.failures.get(plan.name, 0) + 1
         if count == 1 and may_retry:
-            engine.emit("repair", key=node.key_text, stage="retry", plan=plan.name, reason=node.reason)
+            ctx.emit("repair", key=node.key_text, stage="retry", plan=plan.name, reason=node.reason)
             start(plan)
             return True
         self.dropped.append(plan.name)
         if alternatives():
-            engine.emit("repair", key=node.key_text, stage="replace", plan=plan.name, reason=node.reason)
+            ctx.emit("repair", key=node.key_text, stage="replace", plan=plan.name, reason=node.reason)
             if start(None):
                 return True
-        engine.emit("repair", key=node.key_text, stage="propagate", plan=plan.name, reason=node.reason)
+        ctx.emit("repair", key=node.key_text, stage="propagate", plan=plan.name, reason=node.reason)
         return False
 
 
@@ -138,10 +140,11 @@ class Slot:
     )
 
     def __init__(self, parent: PlanNode, ref: ChildRef, env: dict[str, object]) -> None:
-        engine = parent.engine
+        parts = parent.parts
+        tree = parts.tree
         self.parent = parent
         self.ref = ref
-        self.element = engine.library.abstract(ref.name)
+        self.element = tree.library.abstract(ref.name)
         self.env = env
         self.node: PlanNode | None = None
         self.runner: BehaviourRunner | None = None
@@ -150,16 +153,16 @@ class Slot:
         self.repairs = Repairs()
         self.next_try = 0.0
         self.tried = -1
-        """``engine.inputs`` at the last try that found nothing to start."""
+        """The plan tree's ``inputs`` at the last try that found nothing to start."""
         self.runtime: ChildRuntime | None = None
         if not isinstance(self.element, (Behaviour, Plan, PlanType)):
-            self.runtime = engine.children.runtime(self)
+            self.runtime = parts.runtimes.runtime(self)
         self.revision = self.runtime.revision if self.runtime is not None else 0
         self.failed_node: PlanNode | None = None
         """The plan node that failed in this step, shown to the parent's transitions before it is repaired."""
         element = self.element
         self.watch = isinstance(element, PlanType) and any(
-            engine.plan_named(n).pre is not None or engine.plan_named(n).run is not None for n in element.plans
+            tree.plan(n).pre is not None or tree.plan(n).run is not None for n in element.plans
         )
         """A plan type with conditioned plans: which plans may run is looked at every step."""
         self.seen: tuple[str, ...] | None = None
@@ -184,7 +187,7 @@ class Slot:
 
     def members(self) -> tuple[str, ...]:
         """Alive agents believed to be in the state that holds the child, sorted."""
-        return self.parent.engine.allocator.members(self.parent)
+        return self.parent.parts.allocation.members(self.parent)
 
     @property
     def feedback(self) -> str:
@@ -202,7 +205,7 @@ class Slot:
         A child with a runtime (a planning problem) runs what its runtime says:
         for pRoPhEt MAS the WaitPlan, the generated plan or the AlternativePlan.
         """
-        library = self.parent.engine.library
+        library = self.parent.parts.tree.library
         element = self.element
         dropped = self.repairs.dropped
         if self.runtime is not None:
@@ -217,9 +220,9 @@ class Slot:
 
     def startable(self, plans: tuple[Plan, ...], keep: Plan | None = None) -> tuple[Plan, ...]:
         """The plans whose pre-condition and run-time condition hold now (``keep`` is kept regardless: it runs)."""
-        engine = self.parent.engine
-        belief = engine.belief_for(self.parent)
-        holds = engine.formulas.holds
+        ctx = self.parent.parts.ctx
+        belief = ctx.belief.at(self.parent)
+        holds = ctx.formulas.holds
         return tuple(
             p
             for p in plans
@@ -248,14 +251,13 @@ class Slot:
 
     def start(self, now: float, only: Plan | None = None) -> None:
         """Allocate the agents of the parent state to this plan child and start it."""
-        engine = self.parent.engine
         candidates = (only,) if only is not None else self.candidates()
         usable = self.startable(candidates)
         if not usable:
             self._wait(now, "no plan whose pre-condition and run-time condition hold" if candidates else "no plan left")
             return
         env = self.env if self.runtime is None else {**self.env, **self.runtime.bindings()}
-        node = engine.allocator.start(self, usable, env, now)
+        node = self.parent.parts.allocation.start(self, usable, env, now)
         if node is None:
             self._wait(now, self.reason)
             return
@@ -270,11 +272,11 @@ class Slot:
         The C++ engine tries again in every step; trying when an allocation's inputs moved starts
         the child in the same step, without allocating again and again while nothing changed.
         """
-        engine = self.parent.engine
+        parts = self.parent.parts
         self.status = ChildStatus.WAITING
         self.reason = reason
-        self.next_try = now + engine.config.broadcast_interval
-        self.tried = engine.inputs
+        self.next_try = now + parts.ctx.config.broadcast_interval
+        self.tried = parts.tree.inputs
 
     def visit(self, now: float) -> None:
         """Run the rules of the child plan; a failed one waits for :meth:`repair_pending` (behaviours are ticked elsewhere)."""
@@ -288,10 +290,12 @@ class Slot:
         if self.status is ChildStatus.FAILURE:
             return
         if self.node is None:
-            if self.repairs.waited_out(now, self.parent.engine.config.rejoin_wait):
+            parts = self.parent.parts
+            rejoin_wait = parts.ctx.config.rejoin_wait
+            if self.repairs.waited_out(now, rejoin_wait):
                 self.status = ChildStatus.FAILURE
-                self.reason = f"no valid assignment for {self.parent.engine.config.rejoin_wait:g} s: {self.reason}"
-            elif now >= self.next_try or self.parent.engine.inputs != self.tried:
+                self.reason = f"no valid assignment for {rejoin_wait:g} s: {self.reason}"
+            elif now >= self.next_try or parts.tree.inputs != self.tried:
                 self.start(now)
             return
         node = self.node
@@ -348,15 +352,15 @@ class Slot:
             return self.node is not None
 
         self.node = None
-        auto = self.parent.engine.config.auto_failure_handling
+        auto = self.parent.parts.ctx.config.auto_failure_handling
         if not self.repairs.repair(node, start, lambda: bool(self.candidates()), may_retry=may_retry, auto=auto):
             self.status = ChildStatus.FAILURE
             self.reason = f"plan '{node.plan.name}' failed: {node.reason}"
 
     def fail_unsolved(self, reason: str) -> None:
         """The constraints that give the child its variables have no solution: the child fails with ``reason``."""
-        engine = self.parent.engine
-        engine.solving.unwatch(self)
+        parts = self.parent.parts
+        parts.solved.unwatch(self)
         if self.runner is not None:
             self.runner.stop()
             self.runner = None
@@ -365,21 +369,21 @@ class Slot:
             self.node = None
         self.status = ChildStatus.FAILURE
         self.reason = reason
-        engine.emit("failure", key=self.parent.key_text, child=self.name, reason=reason)
+        parts.ctx.emit("failure", key=self.parent.key_text, child=self.name, reason=reason)
 
     def restart_with(self, values: dict[str, object], now: float) -> None:
         """Solved variables of the child changed: a behaviour starts again with them (a plan reads them itself)."""
         self.env.update(values)
         if self.runner is not None:
-            engine = self.parent.engine
+            parts = self.parent.parts
             self.runner.stop()
-            self.runner = engine.make_runner(self)
+            self.runner = parts.launch.runner(self)
             self.status = self.runner.status
-            engine.emit("restart", key=self.parent.key_text, child=self.name, values=dict(sorted(values.items())))
+            parts.ctx.emit("restart", key=self.parent.key_text, child=self.name, values=dict(sorted(values.items())))
 
     def stop(self) -> None:
         """Stop the child and everything below it (the agent leaves the state)."""
-        self.parent.engine.solving.unwatch(self)
+        self.parent.parts.solved.unwatch(self)
         if self.runner is not None:
             self.runner.stop()
         if self.node is not None:

@@ -25,28 +25,35 @@ through its context (:meth:`SkillContext.solve`).
 
 Each solve is traced (event ``solve``: status, this plan's values of every
 agent, utility, time).
+
+:class:`Solving` reads the agent's shared context (:class:`~alica.engine.parts.AgentContext`)
+and its world model, nothing else of the engine. What a query returns
+(:class:`~alica.engine.parts.SolveResult`, :class:`~alica.engine.parts.NoSolution`)
+lives in :mod:`alica.engine.parts`, below the behaviours that see it; it is
+re-exported here.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from alica.engine.parts import AgentContext, NoSolution, SolveResult
 from alica.errors import AlicaError
 from alica.model import ChildRef
 from alica.solver import Solution, Var, check, solve
 from alica.solver.problem import Problem
 from alica.solver.query import Level, Query, QueryError, collect, digest
+from alica.worldmodel import WorldModelLike
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
-
-    from alica.engine.agent import AgentEngine
     from alica.engine.node import PlanNode
     from alica.engine.slot import Slot
+
+__all__ = ["RECHECK", "SHARE_TTL", "TIME_BUDGET", "NoSolution", "SolveResult", "Solving", "binding_names"]
 
 #: Seconds between two checks of a solution in use (problem changed? constraints still hold?).
 RECHECK = 0.5
@@ -56,34 +63,6 @@ SHARE_TTL = 10.0
 TIME_BUDGET = 1.0
 
 _IDENT = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*$")
-
-
-class NoSolution(AlicaError):
-    """The constraints of a query have no solution (or none was found in the time budget)."""
-
-
-@dataclass(frozen=True)
-class SolveResult:
-    """What a query returns.
-
-    Attributes:
-        status: ``solved``, ``infeasible`` or ``timeout``.
-        values: this agent's values, by the asking plan's variable names.
-        team: every agent's per-agent values and the static ones (under ``""``), by the same names.
-        utility: the utility of the solution (``nan`` when not solved).
-        reason: why there is no solution (empty when solved).
-    """
-
-    status: str
-    values: Mapping[str, object]
-    team: Mapping[str, Mapping[str, object]]
-    utility: float
-    reason: str = ""
-
-    @property
-    def ok(self) -> bool:
-        """Whether there are values."""
-        return self.status == "solved"
 
 
 @dataclass
@@ -110,11 +89,13 @@ class Solving:
     """The constraint queries of one engine (see the module docstring).
 
     Args:
-        engine: the agent's engine.
+        ctx: the agent's name, clock, team view, formulas, belief, counters and trace.
+        world_model: the agent's world model, which shares each solution with the team.
     """
 
-    def __init__(self, engine: AgentEngine) -> None:
-        self.engine = engine
+    def __init__(self, ctx: AgentContext, world_model: WorldModelLike) -> None:
+        self.ctx = ctx
+        self.world_model = world_model
         self.cache: dict[str, _Cached] = {}
         self.watched: dict[int, tuple[Slot, dict[str, object]]] = {}
         self.next_check = 0.0
@@ -124,26 +105,26 @@ class Solving:
 
     def levels(self, node: PlanNode) -> list[Level]:
         """The running plans from the root down to ``node``, as the query sees them."""
-        engine = self.engine
+        me = self.ctx.name
         chain: list[PlanNode] = []
         current: PlanNode | None = node
         while current is not None:
             chain.append(current)
             current = current.slot.parent if current.slot is not None else None
         chain.reverse()
-        alive = set(engine.team.alive())
+        alive = set(self.ctx.team.alive())
         levels = []
         for plan_node in chain:
-            places = {a: e for a, e in plan_node.believed.items() if a in alive and a != engine.name}
-            places[engine.name] = (plan_node.ep, plan_node.state)
+            places = {a: e for a, e in plan_node.believed.items() if a in alive and a != me}
+            places[me] = (plan_node.ep, plan_node.state)
             bindings = binding_names(plan_node.slot.ref) if plan_node.slot is not None else {}
             levels.append(Level(plan_node.key_text, plan_node.plan, places, bindings))
         return levels
 
     def _collect(self, node: PlanNode, names: tuple[str, ...]) -> Query:
         """The query of ``node`` now; collected once per plan node, moment and view (binding a child asks twice)."""
-        engine = self.engine
-        now = engine.now()
+        ctx = self.ctx
+        now = ctx.now()
         levels = self.levels(node)
         view = digest(levels)
         last = self._last
@@ -152,7 +133,7 @@ class Solving:
             depth = len(levels) - 1
             if all((depth, name) in query.names for name in names):
                 return query
-        query = collect(levels, engine.belief_for(node), registry=engine.formulas.registry, names=names)
+        query = collect(levels, ctx.belief.at(node), registry=ctx.formulas.registry, names=names)
         self._last = (node, now, query)
         return query
 
@@ -164,8 +145,7 @@ class Solving:
 
     def query(self, node: PlanNode, names: tuple[str, ...] = ()) -> SolveResult:
         """The solution of the constraints of the plan tree down to ``node``, by ``node``'s variable names."""
-        engine = self.engine
-        now = engine.now()
+        now = self.ctx.now()
         try:
             query = self._collect(node, names)
         except QueryError as exc:
@@ -210,7 +190,6 @@ class Solving:
         return checked is not None and all(checked[0].values())
 
     def _solve(self, node: PlanNode, query: Query, cached: _Cached | None) -> Solution:
-        engine = self.engine
         problem = query.problem
         shared = self._shared(node, query)
         checked = _checked(problem, shared) if shared is not None else None
@@ -225,9 +204,9 @@ class Solving:
             solution = solve(problem, time_limit=TIME_BUDGET, start=start or None)
         except AlicaError as exc:  # a formula that cannot be read here: no values, with the reason
             solution = Solution("infeasible", {}, math.nan, {}, False, 0.0, str(exc))
-        engine.stats["solves"] = engine.stats.get("solves", 0) + 1
+        self.ctx.count("solves")
         if solution.status == "solved":
-            engine.world_model.set(
+            self.world_model.set(
                 "solution", node.key_text, value=(query.digest, _encode(solution.values)), ttl=SHARE_TTL
             )
         self._trace(node, query, solution, "solved")
@@ -235,7 +214,7 @@ class Solving:
 
     def _adopt(self, node: PlanNode, query: Query, own: Solution) -> Solution | None:
         """The team's solution for the same view when it differs from ``own`` and satisfies the constraints."""
-        stored = self.engine.world_model.get("solution", node.key_text)
+        stored = self.world_model.get("solution", node.key_text)
         if not isinstance(stored, tuple) or len(stored) != 2 or stored[0] != query.digest:
             return None
         shared = self._shared(node, query)
@@ -250,7 +229,7 @@ class Solving:
 
     def _shared(self, node: PlanNode, query: Query) -> dict[Var, object] | None:
         """The team's solution of this plan instance from the world model, when it covers this problem's variables."""
-        stored = self.engine.world_model.get("solution", node.key_text)
+        stored = self.world_model.get("solution", node.key_text)
         if not isinstance(stored, tuple) or len(stored) != 2:
             return None
         _digest, entries = stored
@@ -264,7 +243,7 @@ class Solving:
         return values
 
     def _result(self, node: PlanNode, query: Query, solution: Solution) -> SolveResult:
-        me = self.engine.name
+        me = self.ctx.name
         local = query.local(_depth(node))
         team: dict[str, dict[str, object]] = {}
         for var, value in solution.values.items():
@@ -280,7 +259,7 @@ class Solving:
         values: dict[str, dict[str, object]] = {}
         for var, value in sorted(solution.values.items(), key=lambda item: (item[0].agent or "", item[0].name)):
             values.setdefault(var.agent or "", {})[var.name] = _plain(value)
-        self.engine.emit(
+        self.ctx.emit(
             "solve",
             key=node.key_text,
             status=solution.status,

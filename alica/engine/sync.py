@@ -10,6 +10,9 @@ them). Then each holder fires on its own next tick, so with the
 same messages all fire in the same tick. A synchronisation that is not
 complete ``sync_timeout`` seconds after the agent's condition began to hold
 fails the plan (``fail_on_timeout``) or starts over.
+
+:class:`SyncTable` keeps an agent's processes, one per plan instance and
+synchronisation, while the agent is in the state that holds them.
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from alica.engine.team import PlanKey
-from alica.model import Synchronisation
+from alica.model import Plan, Synchronisation
 
 
 @dataclass(frozen=True, slots=True)
@@ -127,3 +130,46 @@ class SyncProcess:
         self.rows.clear()
         self.holding_since = None
         self.last_sent = None
+
+
+class SyncTable:
+    """One agent's synchronisation processes, by plan instance and synchronisation name.
+
+    Args:
+        me: the agent.
+        period: seconds between two engine ticks (a process forgets silent rows after at least four).
+    """
+
+    def __init__(self, me: str, period: float) -> None:
+        self.me = me
+        self.period = period
+        self.processes: dict[tuple[PlanKey, str], SyncProcess] = {}
+
+    def process(self, key: PlanKey, plan: Plan, name: str) -> SyncProcess:
+        """This agent's process of synchronisation ``name`` of ``plan`` in the plan instance ``key``."""
+        process = self.processes.get((key, name))
+        if process is None:
+            sync = next(s for s in plan.synchronisations if s.name == name)
+            expiry = max(4 * sync.talk_timeout, 4 * self.period)
+            process = self.processes[(key, name)] = SyncProcess(self.me, key, sync, expiry)
+        return process
+
+    def drop(self, key: PlanKey) -> None:
+        """The agent left the state of plan instance ``key``: forget its synchronisations."""
+        for found in [k for k in self.processes if k[0] == key]:
+            del self.processes[found]
+
+    def receive(self, talk: SyncTalk, plan: Plan, now: float) -> None:
+        """A teammate's row for the instance of ``plan`` that this agent runs (ignored for no such synchronisation)."""
+        if any(s.name == talk.sync for s in plan.synchronisations):
+            self.process(talk.key, plan, talk.sync).receive(talk, now)
+
+    def talk(self, now: float) -> list[SyncTalk]:
+        """The rows to send now (teammates' stale rows dropped first)."""
+        out = []
+        for process in list(self.processes.values()):
+            process.expire(now)
+            talk = process.talk(now)
+            if talk is not None:
+                out.append(talk)
+        return out
