@@ -74,19 +74,30 @@ class EngineConfig:
     auto_failure_handling: bool = True
 
     def __post_init__(self) -> None:
-        positive = ("frequency", "broadcast_interval", "team_timeout", "cycle_window", "authority_min")
-        for name in positive:
-            if getattr(self, name) <= 0:
-                raise ValueError(f"EngineConfig.{name} must be > 0, got {getattr(self, name)}")
+        positive = {
+            "frequency": self.frequency,
+            "broadcast_interval": self.broadcast_interval,
+            "team_timeout": self.team_timeout,
+            "cycle_window": self.cycle_window,
+            "authority_min": self.authority_min,
+        }
+        for name, value in positive.items():
+            if value <= 0:
+                raise ValueError(f"EngineConfig.{name} must be > 0, got {value}")
         if self.team_timeout < 2 * self.broadcast_interval:
             raise ValueError(
                 f"EngineConfig.team_timeout ({self.team_timeout} s) must span at least two heartbeats "
                 f"(2 x broadcast_interval = {2 * self.broadcast_interval} s): a teammate would be taken out "
                 "for one lost message"
             )
-        for name in ("min_broadcast_gap", "assignment_protection", "rejoin_wait"):
-            if getattr(self, name) < 0:
-                raise ValueError(f"EngineConfig.{name} must be >= 0, got {getattr(self, name)}")
+        non_negative = {
+            "min_broadcast_gap": self.min_broadcast_gap,
+            "assignment_protection": self.assignment_protection,
+            "rejoin_wait": self.rejoin_wait,
+        }
+        for name, value in non_negative.items():
+            if value < 0:
+                raise ValueError(f"EngineConfig.{name} must be >= 0, got {value}")
         if self.max_rule_applications < 1 or self.cycle_count < 1:
             raise ValueError("EngineConfig.max_rule_applications and cycle_count must be at least 1")
         for element_type in self.children:

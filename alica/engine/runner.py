@@ -15,7 +15,7 @@ from typing import Any
 
 from alica.allocation import AgentSpec, assign_roles
 from alica.clock import Clock, ManualClock
-from alica.comm import Delay, SimNetwork
+from alica.comm import Delay, SimNetwork, Transport
 from alica.comm.faults import describe_fault
 from alica.engine.agent import AgentEngine, Observer
 from alica.engine.behaviours import SkillBinder, SkillFactory
@@ -26,7 +26,7 @@ from alica.engine.status import ChildStatus
 from alica.errors import AlicaError
 from alica.lang import Registry, literal_text
 from alica.lang.skills import SkillRegistry
-from alica.model import PlanLibrary, RoleSet
+from alica.model import Behaviour, PlanLibrary, RoleSet
 from alica.worldmodel import WorldModel
 
 
@@ -120,7 +120,7 @@ class SimulatedTeam:
         jitter: float = 0.0,
         skills: Mapping[str, SkillFactory] | None = None,
         skill_registry: SkillRegistry | None = None,
-        fallback: Callable[[Any], SkillFactory] | None = None,
+        fallback: Callable[[Behaviour], SkillFactory] | None = None,
         registry: Registry | None = None,
         observers: Iterable[Observer] = (),
         trace_messages: bool = False,
@@ -174,7 +174,7 @@ class SimulatedTeam:
         for name in self.roles:
             self.engines[name] = self._make_engine(name, self.network.attach(name))
 
-    def _make_engine(self, name: str, transport: Any, listen_first: float = 0.0) -> AgentEngine:
+    def _make_engine(self, name: str, transport: Transport, listen_first: float = 0.0) -> AgentEngine:
         return AgentEngine(
             name,
             self.roles,
@@ -372,7 +372,7 @@ class SimulatedTeam:
         details = decision.describe()
         self._operator(str(details.pop("action")), problem=problem, generation=generation, **details)
 
-    def _operator(self, what: str, **fields: Any) -> None:
+    def _operator(self, what: str, **fields: object) -> None:
         """An ``operator`` event: what the operator did."""
         record = {"t": round(self.now(), 6), "agent": "operator", "event": "operator", "what": what, **fields}
         for observer in self.observers:
@@ -384,7 +384,7 @@ class SimulatedTeam:
         except KeyError:
             raise AlicaError(f"no agent named '{name}' in the team; agents: {', '.join(self.engines)}") from None
 
-    def _fault(self, kind: str, **fields: Any) -> None:
+    def _fault(self, kind: str, **fields: object) -> None:
         record = {
             "t": round(self.now(), 6),
             "agent": fields.pop("agent", "-"),
