@@ -1,9 +1,13 @@
-"""The sender's side of reliable delivery, pure and synchronous: numbering and the history.
+"""Reliable delivery, pure and synchronous: the sender's history and the receiver's inbox.
 
 A sender numbers its reliable messages per topic (``rseq``) and across all its
 topics (``gseq``), keeps them for receivers that missed some, and answers
-their history questions. :class:`History` does this without threads, zenoh or
-a clock of its own: time comes in as ``now``. The caller (the zenoh shell,
+their history questions: :class:`History`. A receiver delivers each sender's
+reliable messages once and in the sender's order, holds back those that came
+after a gap, asks the sender's history for what it lacks, and keeps the
+latest best-effort value per sender and topic: :class:`Inbox`. Neither has
+threads, zenoh or a clock of its own: time comes in as ``now``, and what to
+send (a history question) comes back as a value. The caller (the zenoh shell,
 :mod:`alica.comm.zenoh_transport`) holds its lock around every call.
 
 Bounds: a kept message goes when it is older than ``seconds``, or, while the
@@ -14,7 +18,22 @@ published goes first; each topic keeps at least its newest message.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+
+from alica.comm.codec import CodecError, decode
+from alica.comm.transport import Envelope, QoS
+
+# A frame: (incarnation, sender, topic, seq, rseq, gseq, sent_at, payload bytes). ``seq`` counts the
+# sender's messages on the topic, ``rseq`` its reliable ones on the topic (0 for best-effort) and
+# ``gseq`` its reliable ones on every topic (0 for best-effort): receivers find gaps by ``rseq``
+# and deliver a sender's reliable messages in ``gseq`` order, whatever their topic. The payload
+# is encoded on its own: one a receiver cannot decode is counted and skipped, and its stream goes on.
+Frame = tuple[int, str, str, int, int, int, float, object]
+Question = tuple[int, dict[str, tuple[int | None, float]]]
+"""A history question to one sender: (the incarnation of it the receiver knows; per subscribed topic,
+(the next number the receiver lacks, ``None`` before the first answer; when it subscribed))."""
+_UNDECODABLE = object()
 
 
 class History:
@@ -99,3 +118,257 @@ class History:
             start[topic] = last + 1
             oldest[topic] = kept[0][0] if kept else last + 1
         return tuple(frames), start, oldest
+
+
+@dataclass(slots=True)
+class _Stream:
+    """What a receiver knows of one sender's reliable messages on one topic."""
+
+    next: int | None = None
+    """The next reliable number to deliver; ``None`` until the sender's history said where to start."""
+    held: dict[int, tuple[int, Envelope | None]] = field(default_factory=dict)
+    """Reliable messages not delivered yet, by number: (gseq, envelope; ``None`` when it cannot be decoded)."""
+    last_gseq: int = 0
+    """The sender-wide number of the last message delivered from this stream."""
+
+    def gapped(self) -> bool:
+        """Whether a message is known to be missing before the held ones (or where to start is unknown)."""
+        return self.next is None or (bool(self.held) and self.next not in self.held)
+
+
+@dataclass(slots=True)
+class _Sender:
+    """What a receiver knows of one sender (one incarnation of it)."""
+
+    incarnation: int
+    streams: dict[str, _Stream] = field(default_factory=dict)
+    offset: dict[str, int] = field(default_factory=dict)
+    """Per topic: added to the incarnation's numbers, so that numbers grow across restarts."""
+    last_seq: dict[str, int] = field(default_factory=dict)
+    """Per topic: the last number delivered from this sender (offset included)."""
+    asked_at: float | None = None
+    """When a history question to this sender went out (``None``: none outstanding)."""
+
+    def stream(self, topic: str) -> _Stream:
+        found = self.streams.get(topic)
+        if found is None:
+            found = self.streams[topic] = _Stream()
+        return found
+
+
+class Inbox:
+    """One receiver's side: what came from every sender, in the order to deliver it.
+
+    A reliable message is delivered once, in its sender's order across all
+    the sender's topics; one that comes after a gap is held until the gap is
+    filled from the sender's history (or the history says it no longer has
+    the missing ones). A best-effort message replaces the one of the same
+    sender and topic not taken yet, and one older than a delivered one is
+    dropped. A sender's new incarnation (a restart) starts over, with its
+    envelope numbers going on from the old ones; frames of an older
+    incarnation are ignored.
+
+    Methods that may need a history question return the sender to ask; the
+    caller then asks :meth:`question` and hands the answer to :meth:`answered`.
+
+    Args:
+        agent_id: the receiver's own id (its own frames are ignored).
+    """
+
+    def __init__(self, agent_id: str) -> None:
+        self._id = agent_id
+        self.subscribed: dict[str, float] = {}
+        """The topics subscribed to, and when."""
+        self._senders: dict[str, _Sender] = {}
+        self._out: list[Envelope | None] = []
+        self._pending: dict[tuple[str, str], int] = {}
+        self.counts = dict.fromkeys(("recovered", "duplicates", "superseded", "lost", "undecodable"), 0)
+        """What happened so far (the counters of the same names of :class:`~alica.comm.zenoh_transport.ZenohStats`)."""
+        self.errors: dict[str, int] = {}
+        """Why payloads could not be decoded (sender, topic, reason) and how often."""
+
+    def subscribe(self, topic: str, now: float) -> None:
+        """Take in ``topic`` from now on (a second call keeps the first time)."""
+        self.subscribed.setdefault(topic, now)
+
+    def take(self) -> list[Envelope]:
+        """The envelopes to deliver, in order, and forget them."""
+        out = self._out
+        if not out:
+            return []
+        self._out = []
+        self._pending.clear()
+        return [envelope for envelope in out if envelope is not None]
+
+    def receive(self, frame: Frame, now: float) -> str | None:
+        """Take in one frame; returns its sender when that sender's history must be asked now."""
+        incarnation, sender, topic, seq, rseq, gseq, sent_at, data = frame
+        if topic not in self.subscribed or sender == self._id:
+            return None
+        state = self._sender(sender, incarnation)
+        if state is None:
+            return None
+        shown = state.offset.get(topic, 0) + seq
+        payload = self._payload(data, sender, topic)
+        if rseq == 0:
+            if payload is _UNDECODABLE:
+                return None
+            if shown <= state.last_seq.get(topic, 0):
+                self.counts["superseded"] += 1
+                return None
+            state.last_seq[topic] = shown
+            key = (sender, topic)
+            old = self._pending.get(key)
+            if old is not None:
+                self._out[old] = None
+                self.counts["superseded"] += 1
+            self._pending[key] = len(self._out)
+            self._out.append(Envelope(topic, sender, shown, payload, sent_at, QoS.BEST_EFFORT))
+            return None
+        stream = state.stream(topic)
+        if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
+            self.counts["duplicates"] += 1
+            return None
+        stream.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
+        self._release(state)
+        return self._want(sender, state, now) if stream.gapped() else None
+
+    def heard(self, sender: str, incarnation: int, last: Mapping[str, int], now: float) -> str | None:
+        """Take in a heartbeat (per topic, the last reliable number sent); returns the sender when it must be asked."""
+        if sender == self._id:
+            return None
+        state = self._sender(sender, incarnation)
+        if state is None:
+            return None
+        behind = False
+        for topic, number in last.items():
+            if topic in self.subscribed:
+                stream = state.stream(topic)
+                behind = behind or stream.next is None or stream.next <= number
+        return self._want(sender, state, now) if behind else None
+
+    def overdue(self, now: float, timeout: float) -> list[str]:
+        """The senders asked more than ``timeout`` seconds ago and not answered: they count as asked again now."""
+        retry = []
+        for sender, state in self._senders.items():
+            if state.asked_at is not None and now - state.asked_at > timeout:
+                state.asked_at = now
+                retry.append(sender)
+        return retry
+
+    def question(self, sender: str) -> Question | None:
+        """What to ask ``sender``'s history (``None``: nothing heard of it)."""
+        state = self._senders.get(sender)
+        if state is None:
+            return None
+        return state.incarnation, {topic: (state.stream(topic).next, since) for topic, since in self.subscribed.items()}
+
+    def answered(
+        self,
+        incarnation: int,
+        sender: str,
+        frames: Iterable[Frame],
+        start: Mapping[str, int],
+        oldest: Mapping[str, int],
+    ) -> None:
+        """Take in a history answer (see :meth:`History.answer`).
+
+        Args:
+            incarnation: the answering sender's incarnation.
+            sender: the answering sender.
+            frames: the frames of the answer (read only when the answer is about the current incarnation).
+            start: per topic, the number of the sender's next reliable message.
+            oldest: per topic, the oldest number the sender still keeps.
+        """
+        state = self._sender(sender, incarnation)
+        if state is None:
+            return
+        state.asked_at = None
+        decoded = list(frames)
+        first_answer = {topic for topic in start if topic in self.subscribed and state.stream(topic).next is None}
+        for topic in first_answer:
+            stream = state.stream(topic)
+            numbers = [f[4] for f in decoded if f[2] == topic]
+            stream.next = min(numbers) if numbers else int(start[topic])
+            for number in [n for n in stream.held if n < stream.next]:
+                del stream.held[number]  # sent before this agent subscribed
+        for topic, first in oldest.items():
+            known = state.streams.get(topic)
+            if topic not in first_answer and known is not None and known.next is not None and first > known.next:
+                self.counts["lost"] += first - known.next
+                known.next = first
+        for frame in decoded:
+            _, _, topic, seq, rseq, gseq, sent_at, data = frame
+            known = state.streams.get(topic)
+            if known is None or known.next is None or rseq < known.next or rseq in known.held:
+                continue
+            shown = state.offset.get(topic, 0) + seq
+            payload = self._payload(data, sender, topic)
+            known.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
+            self.counts["recovered"] += topic not in first_answer
+        self._release(state)
+
+    def _payload(self, data: object, sender: str, topic: str) -> object:
+        """The decoded payload, or :data:`_UNDECODABLE` (counted, its reason kept)."""
+        if not isinstance(data, bytes):
+            self.counts["undecodable"] += 1
+            return _UNDECODABLE
+        try:
+            return decode(data)
+        except CodecError as exc:
+            self.counts["undecodable"] += 1
+            self.errors.setdefault(f"{sender} on {topic}: {exc}", 0)
+            self.errors[f"{sender} on {topic}: {exc}"] += 1
+            return _UNDECODABLE
+
+    def _sender(self, sender: str, incarnation: int) -> _Sender | None:
+        """The state of ``sender``, started over for a new incarnation; ``None`` for an old one."""
+        state = self._senders.get(sender)
+        if state is None:
+            state = self._senders[sender] = _Sender(incarnation)
+        elif incarnation > state.incarnation:
+            numbers = dict(state.last_seq)
+            state = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
+        elif incarnation < state.incarnation:
+            return None
+        return state
+
+    def _release(self, state: _Sender) -> None:
+        """Deliver the sender's held reliable messages that can go, in its send order.
+
+        A message goes when its topic has no gap before it and no other topic
+        of the sender has a gap that may hold an earlier message.
+        """
+        streams = state.streams
+        while True:
+            gate = min((s.last_gseq for s in streams.values() if s.gapped()), default=None)
+            best: _Stream | None = None
+            for stream in streams.values():
+                if stream.next is not None and stream.next in stream.held:
+                    if best is None or stream.held[stream.next][0] < best.held[best.next][0]:  # type: ignore[index]
+                        best = stream
+            if best is None or best.next is None:
+                return
+            gseq, envelope = best.held[best.next]
+            if gate is not None and gseq > gate:
+                return
+            del best.held[best.next]
+            best.next += 1
+            best.last_gseq = gseq
+            if envelope is None:
+                continue  # a payload this process cannot decode: counted, skipped
+            if envelope.seq > state.last_seq.get(envelope.topic, 0):
+                state.last_seq[envelope.topic] = envelope.seq
+            self._out.append(envelope)
+
+    @staticmethod
+    def _want(sender: str, state: _Sender, now: float) -> str | None:
+        """``sender`` when no history question to it is outstanding (then one counts as asked ``now``)."""
+        if state.asked_at is not None:
+            return None
+        state.asked_at = now
+        return sender
+
+
+def _envelope(topic: str, sender: str, seq: int, payload: object, sent_at: float) -> Envelope | None:
+    return None if payload is _UNDECODABLE else Envelope(topic, sender, seq, payload, sent_at, QoS.RELIABLE)

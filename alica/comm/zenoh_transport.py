@@ -36,28 +36,21 @@ import re
 import threading
 import time
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import zenoh
 
 from alica.clock import Clock, SystemClock
 from alica.comm.codec import CodecError, decode, encode
-from alica.comm.reliable import History
+from alica.comm.reliable import Frame, History, Inbox
 from alica.comm.transport import Envelope, QoS, Transport
 
 _CHUNK = re.compile(r"[^/*$?#\s]+")
 
-# A frame: (incarnation, sender, topic, seq, rseq, gseq, sent_at, payload bytes). ``seq`` counts the
-# sender's messages on the topic, ``rseq`` its reliable ones on the topic (0 for best-effort) and
-# ``gseq`` its reliable ones on every topic (0 for best-effort): receivers find gaps by ``rseq``
-# and deliver a sender's reliable messages in ``gseq`` order, whatever their topic. The payload
-# is encoded on its own: one a receiver cannot decode is counted and skipped, and its stream goes on.
-Frame = tuple[int, str, str, int, int, int, float, object]
-_FRAME_LEN = 8
 _SYNC = ("sync",)
-_UNDECODABLE = object()
 _SYNC_BYTES = encode(_SYNC)
+_FRAME_LEN = 8
 
 
 def _check_topic(topic: object) -> str:
@@ -74,42 +67,6 @@ def _check_name(what: str, name: object) -> str:
     if not isinstance(name, str) or not _CHUNK.fullmatch(name):
         raise ValueError(f"{what} must be a non-empty name without '/', '*', '$', '?', '#' or spaces, got {name!r}")
     return name
-
-
-@dataclass(slots=True)
-class _Stream:
-    """What a receiver knows of one sender's reliable messages on one topic."""
-
-    next: int | None = None
-    """The next reliable number to deliver; ``None`` until the sender's history said where to start."""
-    held: dict[int, tuple[int, Envelope | None]] = field(default_factory=dict)
-    """Reliable messages not delivered yet, by number: (gseq, envelope; ``None`` when it cannot be decoded)."""
-    last_gseq: int = 0
-    """The sender-wide number of the last message delivered from this stream."""
-
-    def gapped(self) -> bool:
-        """Whether a message is known to be missing before the held ones (or where to start is unknown)."""
-        return self.next is None or (bool(self.held) and self.next not in self.held)
-
-
-@dataclass(slots=True)
-class _Sender:
-    """What a receiver knows of one sender (one incarnation of it)."""
-
-    incarnation: int
-    streams: dict[str, _Stream] = field(default_factory=dict)
-    offset: dict[str, int] = field(default_factory=dict)
-    """Per topic: added to the incarnation's numbers, so that numbers grow across restarts."""
-    last_seq: dict[str, int] = field(default_factory=dict)
-    """Per topic: the last number delivered from this sender (offset included)."""
-    asked_at: float | None = None
-    """When a history query to this sender went out (``None``: none outstanding)."""
-
-    def stream(self, topic: str) -> _Stream:
-        found = self.streams.get(topic)
-        if found is None:
-            found = self.streams[topic] = _Stream()
-        return found
 
 
 @dataclass(frozen=True, slots=True)
@@ -210,18 +167,15 @@ class ZenohTransport(Transport):
         self._history = History(self._incarnation, seconds=self._history_s, max_bytes=float(history_mb) * 1024 * 1024)
         self._publishers: dict[tuple[str, QoS], zenoh.Publisher] = {}
         # receiving
-        self._subscribed: dict[str, float] = {}
-        self._senders: dict[str, _Sender] = {}
-        self._inbox: list[Envelope | None] = []
-        self._pending: dict[tuple[str, str], int] = {}
+        self._inbox = Inbox(self._id)
         self._alive: set[str] = set()
         self._counts = dict.fromkeys(ZenohStats.__slots__, 0)
-        self.errors: dict[str, int] = {}
+        self.errors = self._inbox.errors
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
         self._subscribers: list[zenoh.Subscriber[None] | zenoh.LivelinessToken | zenoh.Queryable[None]] = []
         connect, listen = tuple(connect), tuple(listen)
         try:
-            self._session = zenoh.open(self._config(connect, listen, mode, lease, config))
+            self._session = zenoh.open(zenoh_config(connect, listen, mode, lease, config))
         except zenoh.ZError as exc:
             raise ValueError(
                 f"zenoh could not open a session listening on {list(listen)} and connecting to {list(connect)}: {exc}"
@@ -249,14 +203,8 @@ class ZenohTransport(Transport):
         self._timer = threading.Thread(target=self._tick, name=f"zenoh-{self._id}", daemon=True)
         self._timer.start()
 
-    @staticmethod
-    def _config(
-        connect: tuple[str, ...], listen: tuple[str, ...], mode: str, lease: float, extra: Mapping[str, object] | None
-    ) -> zenoh.Config:
-        return zenoh_config(connect, listen, mode, lease, extra)
-
     @property
-    def session(self) -> Any:
+    def session(self) -> zenoh.Session:
         """The zenoh session, for more keys of this agent under :attr:`team` (e.g. :class:`~alica.comm.center_feed.CenterFeed`)."""
         return self._session
 
@@ -311,10 +259,9 @@ class ZenohTransport(Transport):
         """See :meth:`Transport.subscribe`."""
         self._check_open("subscribe")
         _check_topic(topic)
+        now = self._clock.now()
         with self._lock:
-            if topic in self._subscribed:
-                return
-            self._subscribed[topic] = self._clock.now()
+            self._inbox.subscribe(topic, now)
 
     def _sync(self) -> None:
         """Wait (a round trip, at most the query time-out) until every linked peer knows this session's subscriber.
@@ -338,12 +285,7 @@ class ZenohTransport(Transport):
         """See :meth:`Transport.poll`: what arrived, in arrival order (reliable ones in send order per sender)."""
         self._check_open("poll")
         with self._lock:
-            inbox = self._inbox
-            if not inbox:
-                return []
-            self._inbox = []
-            self._pending.clear()
-        out = [envelope for envelope in inbox if envelope is not None]
+            out = self._inbox.take()
         self._counts["delivered"] += len(out)
         return out
 
@@ -358,7 +300,7 @@ class ZenohTransport(Transport):
             if self._closed:
                 return
             self._closed = True
-            self._inbox = []
+            self._inbox.take()  # (dropped)
         self._stop.set()
         try:
             self._session.close()
@@ -369,7 +311,10 @@ class ZenohTransport(Transport):
     def stats(self) -> ZenohStats:
         """Counters of what this transport did (:class:`ZenohStats`)."""
         with self._lock:
-            return ZenohStats(**self._counts)
+            counts = dict(self._counts)
+            for name, count in self._inbox.counts.items():
+                counts[name] += count
+        return ZenohStats(**counts)
 
     @property
     def closed(self) -> bool:
@@ -397,11 +342,7 @@ class ZenohTransport(Transport):
             self._history.trim(now)
             # every reliable counter, also of topics whose history is trimmed: a receiver learns what it lost
             beat = self._history.announced()
-            retry = []
-            for sender, state in self._senders.items():
-                if state.asked_at is not None and now - state.asked_at > self._query_timeout:
-                    state.asked_at = now
-                    retry.append(sender)
+            retry = self._inbox.overdue(now, self._query_timeout)
         self._hb_publisher.put(encode((self._incarnation, self._id, beat)))
         for sender in retry:
             self._ask(sender)
@@ -418,7 +359,7 @@ class ZenohTransport(Transport):
             else:
                 self._alive.discard(name)
 
-    def _decode(self, data: bytes, size: int) -> Any:
+    def _decode(self, data: bytes, size: int) -> tuple[Any, ...] | None:
         """The tuple of ``size`` items in ``data``, or ``None`` (counted) when it is something else (lock held)."""
         try:
             value = decode(data)
@@ -441,100 +382,7 @@ class ZenohTransport(Transport):
 
     def _receive(self, frame: Frame) -> str | None:
         """Take in one frame (lock held); returns the sender when its history must be asked."""
-        incarnation, sender, topic, seq, rseq, gseq, sent_at, data = frame
-        if topic not in self._subscribed or sender == self._id:
-            return None
-        state = self._sender(sender, incarnation)
-        if state is None:
-            return None
-        shown = state.offset.get(topic, 0) + seq
-        payload = self._payload(data, sender, topic)
-        if rseq == 0:
-            if payload is _UNDECODABLE:
-                return None
-            if shown <= state.last_seq.get(topic, 0):
-                self._counts["superseded"] += 1
-                return None
-            state.last_seq[topic] = shown
-            key = (sender, topic)
-            old = self._pending.get(key)
-            if old is not None:
-                self._inbox[old] = None
-                self._counts["superseded"] += 1
-            self._pending[key] = len(self._inbox)
-            self._inbox.append(Envelope(topic, sender, shown, payload, sent_at, QoS.BEST_EFFORT))
-            return None
-        stream = state.stream(topic)
-        if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
-            self._counts["duplicates"] += 1
-            return None
-        stream.held[rseq] = (gseq, self._envelope(topic, sender, shown, payload, sent_at))
-        self._release(state)
-        return self._want(sender, state) if stream.gapped() else None
-
-    def _payload(self, data: object, sender: str, topic: str) -> object:
-        """The decoded payload, or :data:`_UNDECODABLE` (counted, its reason kept) (lock held)."""
-        if not isinstance(data, bytes):
-            self._counts["undecodable"] += 1
-            return _UNDECODABLE
-        try:
-            return decode(data)
-        except CodecError as exc:
-            self._counts["undecodable"] += 1
-            self.errors.setdefault(f"{sender} on {topic}: {exc}", 0)
-            self.errors[f"{sender} on {topic}: {exc}"] += 1
-            return _UNDECODABLE
-
-    @staticmethod
-    def _envelope(topic: str, sender: str, seq: int, payload: object, sent_at: float) -> Envelope | None:
-        return None if payload is _UNDECODABLE else Envelope(topic, sender, seq, payload, sent_at, QoS.RELIABLE)
-
-    def _sender(self, sender: str, incarnation: int) -> _Sender | None:
-        """The receiver's state of ``sender``, started over for a new incarnation; ``None`` for an old one."""
-        state = self._senders.get(sender)
-        if state is None:
-            state = self._senders[sender] = _Sender(incarnation)
-        elif incarnation > state.incarnation:
-            numbers = dict(state.last_seq)
-            state = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
-        elif incarnation < state.incarnation:
-            return None
-        return state
-
-    def _release(self, state: _Sender) -> None:
-        """Deliver the sender's held reliable messages that can go, in its send order (lock held).
-
-        A message goes when its topic has no gap before it and no other topic
-        of the sender has a gap that may hold an earlier message.
-        """
-        streams = state.streams
-        while True:
-            gate = min((s.last_gseq for s in streams.values() if s.gapped()), default=None)
-            best: _Stream | None = None
-            for stream in streams.values():
-                if stream.next is not None and stream.next in stream.held:
-                    if best is None or stream.held[stream.next][0] < best.held[best.next][0]:  # type: ignore[index]
-                        best = stream
-            if best is None or best.next is None:
-                return
-            gseq, envelope = best.held[best.next]
-            if gate is not None and gseq > gate:
-                return
-            del best.held[best.next]
-            best.next += 1
-            best.last_gseq = gseq
-            if envelope is None:
-                continue  # a payload this process cannot decode: counted, skipped
-            if envelope.seq > state.last_seq.get(envelope.topic, 0):
-                state.last_seq[envelope.topic] = envelope.seq
-            self._inbox.append(envelope)
-
-    def _want(self, sender: str, state: _Sender) -> str | None:
-        """``sender`` when no history query to it is outstanding (then one counts as sent now)."""
-        if state.asked_at is not None:
-            return None
-        state.asked_at = self._clock.now()
-        return sender
+        return self._inbox.receive(frame, self._clock.now())
 
     def _on_heartbeat(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
@@ -545,28 +393,19 @@ class ZenohTransport(Transport):
             if beat is None:
                 return
             incarnation, sender, last = beat
-            if sender == self._id or not isinstance(last, dict):
+            if not isinstance(last, dict):
                 return
-            state = self._sender(sender, incarnation)
-            if state is None:
-                return
-            behind = False
-            for topic, number in last.items():
-                if topic in self._subscribed:
-                    stream = state.stream(topic)
-                    behind = behind or stream.next is None or stream.next <= number
-            ask = self._want(sender, state) if behind else None
+            ask = self._inbox.heard(sender, incarnation, last, self._clock.now())
         if ask is not None:
             self._ask(ask)
 
     def _ask(self, sender: str) -> None:
         """Query ``sender``'s history for what this receiver lacks on every topic it subscribed to."""
         with self._lock:
-            state = self._senders.get(sender)
-            if self._closed or state is None:
+            question = None if self._closed else self._inbox.question(sender)
+            if question is None:
                 return
-            wanted = {topic: (state.stream(topic).next, since) for topic, since in self._subscribed.items()}
-            request = (self._id, state.incarnation, wanted)
+            request = (self._id, *question)
             self._counts["queries"] += 1
         try:
             self._session.get(
@@ -615,33 +454,9 @@ class ZenohTransport(Transport):
             if answer is None:
                 return
             incarnation, sender, frames, start, oldest = answer
-            state = self._sender(sender, incarnation)
-            if state is None:
-                return
-            state.asked_at = None
-            decoded = [frame for frame in (self._decode(d, _FRAME_LEN) for d in frames) if frame is not None]
-            first_answer = {topic for topic in start if topic in self._subscribed and state.stream(topic).next is None}
-            for topic in first_answer:
-                stream = state.stream(topic)
-                numbers = [f[4] for f in decoded if f[2] == topic]
-                stream.next = min(numbers) if numbers else int(start[topic])
-                for number in [n for n in stream.held if n < stream.next]:
-                    del stream.held[number]  # sent before this agent subscribed
-            for topic, first in oldest.items():
-                known = state.streams.get(topic)
-                if topic not in first_answer and known is not None and known.next is not None and first > known.next:
-                    self._counts["lost"] += first - known.next
-                    known.next = first
-            for frame in decoded:
-                _, _, topic, seq, rseq, gseq, sent_at, data = frame
-                known = state.streams.get(topic)
-                if known is None or known.next is None or rseq < known.next or rseq in known.held:
-                    continue
-                shown = state.offset.get(topic, 0) + seq
-                payload = self._payload(data, sender, topic)
-                known.held[rseq] = (gseq, self._envelope(topic, sender, shown, payload, sent_at))
-                self._counts["recovered"] += topic not in first_answer
-            self._release(state)
+            # decoded only once the inbox knows the answer is about the sender's current incarnation
+            decoded = (frame for frame in (self._decode(d, _FRAME_LEN) for d in frames) if frame is not None)
+            self._inbox.answered(incarnation, sender, decoded, start, oldest)
 
     def _check_open(self, what: str) -> None:
         if self._closed:
