@@ -31,7 +31,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
-from typing import Any, Self
+from typing import Any, Self, cast
 
 import zenoh
 
@@ -42,6 +42,9 @@ KEEP = 50_000
 EVENTS = "center/events"
 HISTORY = "center/history"
 OPERATOR = "center/operator"
+
+_Declared = zenoh.Publisher | zenoh.Subscriber[None] | zenoh.Queryable[None] | zenoh.MatchingListener[None]
+"""What a feed or a center declared on a session, undeclared when it closes."""
 
 
 class CenterFeed:
@@ -74,8 +77,10 @@ class CenterFeed:
         self._publisher = session.declare_publisher(
             f"{prefix}/{EVENTS}/{self.name}", congestion_control=zenoh.CongestionControl.DROP
         )
-        self._listened = bool(self._publisher.matching_status.matching)
-        self._declared: list[Any] = [
+        # zenoh's stubs (eclipse-zenoh 1.10) call matching_status a bool, but it is a MatchingStatus
+        # (whose truth is always True): its ``matching`` says whether a subscriber matches
+        self._listened = cast(zenoh.MatchingStatus, self._publisher.matching_status).matching
+        self._declared: list[_Declared] = [
             self._publisher.declare_matching_listener(self._on_matching),
             session.declare_queryable(f"{prefix}/{HISTORY}/{self.name}", self._on_query),
             session.declare_subscriber(f"{prefix}/{OPERATOR}", self._on_command),
@@ -130,10 +135,10 @@ class CenterFeed:
 
     # -- zenoh's threads ----------------------------------------------------------
 
-    def _on_matching(self, status: Any) -> None:
-        self._listened = bool(status.matching)
+    def _on_matching(self, status: zenoh.MatchingStatus) -> None:
+        self._listened = status.matching
 
-    def _on_query(self, query: Any) -> None:
+    def _on_query(self, query: zenoh.Query) -> None:
         with self._lock:
             events = list(self._kept)
             count = self._count
@@ -146,7 +151,7 @@ class CenterFeed:
         except Exception:  # (the asker left)
             return
 
-    def _on_command(self, sample: Any) -> None:
+    def _on_command(self, sample: zenoh.Sample) -> None:
         try:
             command = json.loads(sample.payload.to_bytes())
         except (ValueError, UnicodeDecodeError):
@@ -207,7 +212,7 @@ class CenterLink:
         except zenoh.ZError as exc:
             raise ValueError(f"zenoh could not open a session to {list(self.connect)}: {exc}") from None
         try:
-            self._declared: list[Any] = [
+            self._declared: list[_Declared] = [
                 self._session.declare_subscriber(f"{prefix}/{EVENTS}/*", self._on_sample),
                 self._session.liveliness().declare_subscriber(f"{prefix}/alive/*", self._on_alive, history=True),
             ]
@@ -250,7 +255,7 @@ class CenterLink:
 
     # -- zenoh's threads ----------------------------------------------------------
 
-    def _on_alive(self, sample: Any) -> None:
+    def _on_alive(self, sample: zenoh.Sample) -> None:
         name = str(sample.key_expr).rsplit("/", 1)[-1]
         if sample.kind == zenoh.SampleKind.PUT:
             with self._lock:
@@ -285,8 +290,8 @@ class CenterLink:
             for name in due:
                 self._ask(name)
 
-    def _on_reply(self, reply: Any) -> None:
-        sample = getattr(reply, "ok", None)
+    def _on_reply(self, reply: zenoh.Reply) -> None:
+        sample = reply.ok
         if sample is None:
             return
         try:
@@ -308,7 +313,7 @@ class CenterLink:
                 self._known[name] = (incarnation, number)
                 self._on_event(name, event)
 
-    def _on_sample(self, sample: Any) -> None:
+    def _on_sample(self, sample: zenoh.Sample) -> None:
         name = str(sample.key_expr).rsplit("/", 1)[-1]
         try:
             event = json.loads(sample.payload.to_bytes())

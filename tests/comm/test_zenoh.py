@@ -282,3 +282,14 @@ def test_a_busy_port_is_a_clear_error(endpoints):
     with ZenohTransport("a", listen=[endpoints[0]], team="unit"):
         with pytest.raises(ValueError, match="could not open a session listening on .* already in use"):
             ZenohTransport("b", listen=[endpoints[0]], team="unit")
+
+
+def test_a_publishers_matching_status_is_an_object_whose_matching_says_it(endpoints):
+    """zenoh's stubs call ``Publisher.matching_status`` a bool; CenterFeed reads ``.matching``, as the runtime has it."""
+    import zenoh
+
+    with ZenohTransport("a", listen=[endpoints[0]], team="unit") as a:
+        publisher = a.session.declare_publisher("unit/nobody/listens")
+        status = publisher.matching_status
+        assert isinstance(status, zenoh.MatchingStatus) and status.matching is False
+        publisher.undeclare()
