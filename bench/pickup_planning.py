@@ -37,8 +37,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from alica.skills.manipulation import ArmScene, Box, plan_arm, plan_pickup, solve_ik, top_down_quat, top_grasps
+from alica.skills.manipulation import Box, plan_arm, plan_pickup, solve_ik, top_down_quat, top_grasps
 from alica.skills.manipulation.geometry import quat_angle
+from alica.worldsim.arm_scene import ArmScene
 
 T = TypeVar("T")
 

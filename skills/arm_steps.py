@@ -31,20 +31,25 @@ rest on in the agent's scratch space (``context.scratch``):
 from __future__ import annotations
 
 import math
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from alica.skills.arm_world import find_object, place_area, write_held, write_placed, write_released
-from alica.skills.handling import PLACE_TOLERANCE, REACH, SETTLE, ArmSkill, Pickup, Putdown
+from alica.skills.arm_motion import ArmStep, arm_xy, held_object_box
+from alica.skills.arm_world import REACH, find_object, place_area, write_held, write_placed, write_released
+from alica.skills.handling import PLACE_TOLERANCE, SETTLE, ArmSkill, Phase, Pickup, Putdown
 from alica.skills.world_skill import WorldSkill, distance, number_param
+from alica.worldsim.arm_interface import ArmPlanningScene
 from alica.worldsim.interface import WorldThing
+
+if TYPE_CHECKING:
+    from alica.skills.manipulation import TransportPlan
 
 #: Grasp attempts after which crowding objects are pushed aside (the plans give up after three).
 GRASP_ATTEMPTS = 3
-#: How far beyond :data:`~alica.skills.handling.REACH` (m) an object may be from the arm's base for Grasp to try.
+#: How far beyond :data:`~alica.skills.arm_world.REACH` (m) an object may be from the arm's base for Grasp to try.
 REACH_SLACK = 0.25
 #: An object whose bottom is higher than this (m) does not lie on the ground.
 ON_GROUND = 0.03
@@ -95,7 +100,7 @@ class AlignWithObject(ArmSkill):
         self.drives = 0
         tried = _scratch(self).get("tried_sides")
         if isinstance(tried, dict) and tried.get("object") == self.object_label():
-            self.tried_sides = [tuple(side) for side in tried.get("sides", [])]
+            self.approach.tried_sides = [tuple(side) for side in tried.get("sides", [])]
 
     def site(self) -> tuple[float, float]:
         """Where the object is: the world model's estimate, else the world's."""
@@ -130,8 +135,8 @@ class AlignWithObject(ArmSkill):
                 f"cannot align with {self.object_label()}: {gap:.3f} m from it after {self.drives} drives, "
                 f"wanted {wanted:.2f} m within {self.tolerance:g} m"
             )
-        self.mover = None
-        self.phase = "approach"
+        self.approach.again()
+        self.phase = Phase.APPROACH
         return self.running(f"{gap:.3f} m from {self.object_label()}, wanted {wanted:.2f} m: driving again")
 
 
@@ -174,7 +179,7 @@ class Grasp(Pickup):
         if reason is not None:
             return reason
         obj = self.target_object()
-        gap = distance(self._arm_xy(), self.site())
+        gap = distance(arm_xy(self.arm), self.site())
         if gap > REACH + REACH_SLACK:
             return (
                 f"{obj.name} is {gap:.2f} m from the arm's base, beyond its reach ({REACH:g} m): "
@@ -190,7 +195,7 @@ class Grasp(Pickup):
         """The ``force`` parameter."""
         return self.force
 
-    def arm_steps(self, paths: list[np.ndarray]) -> list[Any]:
+    def arm_steps(self, paths: list[np.ndarray]) -> list[ArmStep]:
         """To the pre-grasp pose, down, grip; the lift is kept for MoveArmToTransport."""
         self._retreat = [np.asarray(p, dtype=float) for p in paths[2:]]
         return [*paths[:2], "grip"]
@@ -238,7 +243,7 @@ class MoveArmToTransport(ArmSkill):
         """Take the stored retreat when it starts at the arm's configuration."""
         super().initialise()
         self.retries = 1
-        self.released = True  # stopped midway, the arm goes on to the transport pose (never back)
+        self.motion.released = True  # stopped midway, the arm goes on to the transport pose (never back)
         self.stored: list[np.ndarray] | None = None
         record = _scratch(self).pop("arm_retreat", None)
         if isinstance(record, dict) and record.get("robot") == self.robot.name and record.get("paths"):
@@ -252,15 +257,15 @@ class MoveArmToTransport(ArmSkill):
         held = self.arm.held
         return {held.name} if held is not None else set()
 
-    def plan(self, scene: Any, q: np.ndarray, rng: np.random.Generator) -> Any:
+    def plan(self, scene: ArmPlanningScene, q: np.ndarray, rng: np.random.Generator) -> TransportPlan:
         """The stored retreat, or a new plan to the transport pose."""
         from alica.skills.manipulation import TransportPlan, plan_transport
 
         if self.stored is not None:
             return TransportPlan(True, self.stored, "ok")
-        return plan_transport(scene, q, rng=rng, held=self._held_box(scene, q))
+        return plan_transport(scene, q, rng=rng, held=held_object_box(self.arm, scene, q))
 
-    def arm_steps(self, paths: list[np.ndarray]) -> list[Any]:
+    def arm_steps(self, paths: list[np.ndarray]) -> list[ArmStep]:
         """Each path in turn."""
         return list(paths)
 
@@ -312,7 +317,7 @@ class MoveArmToPlace(Putdown):
             return "the hand is empty: there is nothing to place (run Pickup or Grasp first)"
         return None
 
-    def arm_steps(self, paths: list[np.ndarray]) -> list[Any]:
+    def arm_steps(self, paths: list[np.ndarray]) -> list[ArmStep]:
         """Above the place and down; the retreat is kept for MoveArmToTransport."""
         self._retreat = [np.asarray(p, dtype=float) for p in paths[2:]]
         return list(paths[:2])

@@ -1,7 +1,9 @@
-"""What the arm skills read and write about the world: objects by name, places, outcome facts.
+"""What the arm skills read and write about the world: objects by name, places, the field, outcome facts.
 
-Shared by the monolithic manipulation skills (:mod:`alica.skills.handling`) and
-the steps of the Pickup and Putdown plans (:mod:`alica.skills.arm_steps`).
+Shared by the monolithic manipulation skills (:mod:`alica.skills.handling`),
+the steps of the Pickup and Putdown plans (:mod:`alica.skills.arm_steps`) and
+the blocks-world rules (:mod:`alica.skills.blocks_rules`). They read the world
+through the robot interface only (:class:`~alica.worldsim.interface.RobotWorld`).
 """
 
 from __future__ import annotations
@@ -15,6 +17,19 @@ from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 #: An object name the world does not know stands for the sample or block nearest where the world
 #: model puts it (``pos(name)``, e.g. from perception), within this many metres.
 ASSOCIATION = 0.3
+#: Horizontal distance from the arm's base at which the arm works best.
+REACH = 0.55
+
+
+def mount_ahead(robot: MobileRobot) -> float:
+    """How far ahead of the base centre the arm is mounted (metres; 0 without an arm)."""
+    return float(robot.arm.mount_offset[0]) if robot.arm is not None else 0.0
+
+
+def inside_field(world: RobotWorld, xy: tuple[float, float], margin: float) -> bool:
+    """Whether ``xy`` lies at least ``margin`` metres inside the world's field."""
+    xmin, ymin, xmax, ymax = world.bounds
+    return xmin + margin <= xy[0] <= xmax - margin and ymin + margin <= xy[1] <= ymax - margin
 
 
 def place_area(skill: WorldSkill, target: object) -> tuple[float, float, float] | None:
@@ -40,8 +55,6 @@ def area_spots(
     The spots are the centre and two rings of eight, at a third and two thirds
     of the radius; on a ring the spots nearest to ``robot`` come first.
     """
-    from alica.worldsim.queries import blocker
-
     cx, cy, radius = area
     x, y, _ = robot.estimate
     spots = [(cx, cy)]
@@ -51,7 +64,7 @@ def area_spots(
             for k in range(8)
         ]
         spots += sorted(ring, key=lambda spot: distance(spot, (x, y)))
-    return [spot for spot in spots if blocker(world, spot[0], spot[1], room) is None]
+    return [spot for spot in spots if world.blocker(spot[0], spot[1], room) is None]
 
 
 def find_object(skill: WorldSkill, name: object) -> WorldThing:

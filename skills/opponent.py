@@ -1,7 +1,8 @@
 """The opponents' skill of the blocks-world demo (IMPERA Section 8.2, Fig. 22): disturb the stacks at random.
 
 :class:`RandomBlockSkill` runs forever. Whenever it is idle it reads the
-simulated state (:func:`alica.worldsim.scenarios.blocks_facts`), lists the IPC
+state (:func:`alica.skills.blocks_rules.blocks_state`, the robot interface's
+``blocks_facts``: the simulator's perfect perception), lists the IPC
 actions its robot could do now, drops those touching a stack that another
 robot stands near, draws one with the agent's seeded generator and runs the
 matching skill of :mod:`alica.skills.handling` as an inner behaviour, then pauses.
@@ -88,7 +89,7 @@ def applicable_actions(facts: Facts, robot: str) -> list[BlockAction]:
     clear block.
 
     Args:
-        facts: IPC facts as :func:`alica.worldsim.scenarios.blocks_facts` gives them.
+        facts: IPC facts as :func:`alica.skills.blocks_rules.blocks_state` gives them.
         robot: the robot's name.
     """
     clear = {f[1] for f in facts if f[0] == "clear"}
@@ -279,9 +280,9 @@ class RandomBlockSkill(WorldSkill):
         return sorted(a for a in candidates if not self._blocked(a, facts))
 
     def _facts(self) -> Facts:
-        from alica.worldsim.scenarios import blocks_facts
+        from alica.skills.blocks_rules import blocks_state
 
-        return set(blocks_facts(self.world))
+        return blocks_state(self.world)
 
     def _start(self, action: BlockAction) -> None:
         """Run ``action``: the inner skill built while checking it (Putdown), or a new one."""
@@ -372,11 +373,11 @@ class RandomBlockSkill(WorldSkill):
         return float(spot[0]), float(spot[1])
 
     def _free_spot(self) -> tuple[float, float] | None:
-        """The first spot Putdown could use (:func:`alica.skills.handling.putdown_spots`) that no other robot blocks.
+        """The first spot Putdown could use (:func:`alica.skills.blocks_rules.putdown_spots`) that no other robot blocks.
 
         ``None`` when there is none: Putdown then picks its own spot (and the action is blocked there).
         """
-        from alica.skills.handling import putdown_spots
+        from alica.skills.blocks_rules import putdown_spots
 
         return next((spot for spot in putdown_spots(self.world, self.robot) if not self._crowded(spot)), None)
 

@@ -26,6 +26,7 @@ from alica.worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, Gri
 from alica.worldsim.objects import ARM_GROUP, MOVABLE_GROUP
 
 if TYPE_CHECKING:
+    from alica.worldsim.arm_scene import ArmScene
     from alica.worldsim.robots import Robot
 
 __all__ = ["GRASP_TOLERANCE", "GRIP_FORCE", "PANDA_URDF", "Arm"]
@@ -67,6 +68,7 @@ class Arm(GripperMixin):
         "_q",
         "_reset_joints",
         "_reset_pose",
+        "_scene",
         "_seg",
         "_t",
         "_times",
@@ -140,6 +142,7 @@ class Arm(GripperMixin):
         self._base_dirty = True
         self._moved = True
         self._joints_dirty = True
+        self._scene: ArmScene | None = None
         self._sync()
 
     # ----------------------------------------------------------------- poses
@@ -149,6 +152,32 @@ class Arm(GripperMixin):
         ox, oy, oz = self.mount_offset
         c, s = math.cos(yaw), math.sin(yaw)
         return (x + c * ox - s * oy, y + s * ox + c * oy, oz), yaw_to_quat(yaw)
+
+    def planning_scene(self) -> ArmScene:
+        """The arm's planning scene (:class:`~alica.worldsim.arm_scene.ArmScene`), its base where the arm's is now.
+
+        Made on first use, seeded by the world's seed. The scenes of the arms of one
+        world share one planning model per URDF (the pybullet client with the arm,
+        about 40 MB): a scene of its own costs only its state.
+        """
+        from alica.worldsim.arm_scene import ArmPlanningModel, ArmScene  # pybullet, imported quietly by the world first
+
+        scene = self._scene
+        if scene is None:
+            world = self.robot.world
+            model = next(
+                (
+                    r.arm._scene.model
+                    for r in world.robots.values()
+                    if r.arm is not None and r.arm._scene is not None and r.arm.urdf_path == self.urdf_path
+                ),
+                None,
+            )
+            if model is None:
+                model = ArmPlanningModel(self.urdf_path)
+            scene = self._scene = ArmScene(self.urdf_path, self.base_pose(), seed=world.seed, model=model)
+        scene.set_base_pose(self.base_pose())
+        return scene
 
     def q(self) -> np.ndarray:
         """The seven joint positions (a copy)."""

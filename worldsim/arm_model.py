@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from pybullet_utils.bullet_client import BulletClient
 
-from alica.skills.manipulation.geometry import Pose, Vec3, pose_inverse, pose_multiply
+from alica.worldsim.geometry import Pose, Vec3, pose_inverse, pose_multiply
 
 #: Panda "ready" pose: the IK seed and rest configuration.
 PANDA_REST_Q = (0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785)
@@ -111,8 +111,8 @@ def read_arm_model(c: BulletClient, body: int) -> ArmModel:
     com_pos, com_quat = c.getBasePositionAndOrientation(body)
     dyn = c.getDynamicsInfo(body, -1)
     inertial: Pose = (tuple(dyn[3]), tuple(dyn[4]))
-    base_frame = pose_multiply((tuple(com_pos), tuple(com_quat)), pose_inverse(inertial))
-    shoulder = pose_multiply(pose_inverse(base_frame), (tuple(frames[arm[1]]), (0.0, 0.0, 0.0, 1.0)))[0]
+    base_frame = pose_multiply(tuple(com_pos), tuple(com_quat), *pose_inverse(*inertial))
+    shoulder = pose_multiply(*pose_inverse(*base_frame), tuple(frames[arm[1]]), (0.0, 0.0, 0.0, 1.0))[0]
 
     g_lo = [infos[j][8] for j in gripper]
     g_hi = [infos[j][9] for j in gripper]

@@ -25,7 +25,6 @@ import logging
 import math
 import os
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from typing import Self
 
 import numpy as np
@@ -33,19 +32,21 @@ import pybullet
 import pybullet_data
 from pybullet_utils.bullet_client import BulletClient
 
-from alica.skills.manipulation.geometry import (
+from alica.worldsim._quiet import quiet_stdout
+from alica.worldsim.arm_model import ArmModel, read_arm_model
+from alica.worldsim.geometry import (
     IDENTITY_QUAT,
+    Box,
     Pose,
     Vec3,
     as_configuration,
     as_pose,
-    as_vec3,
     pose_inverse,
     pose_multiply,
-    quat_from_yaw,
 )
-from alica.skills.manipulation.robot_model import ArmModel, read_arm_model
-from alica.worldsim._quiet import quiet_stdout
+from alica.worldsim.geometry import yaw_to_quat as quat_from_yaw
+
+__all__ = ["ArmPlanningModel", "ArmScene", "Box", "default_urdf"]
 
 log = logging.getLogger(__name__)
 
@@ -53,46 +54,6 @@ log = logging.getLogger(__name__)
 _PARK_Z = 1000.0
 #: Half size of the ground slab around the arm base, metres.
 _GROUND_HALF = 5.0
-
-
-@dataclass(frozen=True, slots=True)
-class Box:
-    """A box: world obstacle, object to pick, or (for a held object) a box in the tool frame.
-
-    Attributes:
-        name: unique name among a scene's obstacles.
-        center: centre (x, y, z) in metres.
-        half_extents: half sizes (hx, hy, hz) in metres, all > 0.
-        yaw: rotation about the z axis in radians.
-    """
-
-    name: str
-    center: Vec3
-    half_extents: Vec3
-    yaw: float = 0.0
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"Box name must be a non-empty string, got {self.name!r}")
-        object.__setattr__(self, "center", as_vec3(self.center, f"Box {self.name!r} center"))
-        half = as_vec3(self.half_extents, f"Box {self.name!r} half_extents")
-        if min(half) <= 0.0:
-            raise ValueError(f"Box {self.name!r} half_extents must be > 0, got {half}")
-        object.__setattr__(self, "half_extents", half)
-        yaw = float(self.yaw)
-        if not math.isfinite(yaw):
-            raise ValueError(f"Box {self.name!r} yaw must be finite, got {self.yaw!r}")
-        object.__setattr__(self, "yaw", yaw)
-
-    @property
-    def pose(self) -> Pose:
-        """The box's pose ``(center, quat_xyzw)``."""
-        return self.center, quat_from_yaw(self.yaw)
-
-    @property
-    def top(self) -> float:
-        """Height of the top face (for an upright box in the world)."""
-        return self.center[2] + self.half_extents[2]
 
 
 def default_urdf() -> str:
@@ -197,7 +158,7 @@ class ArmPlanningModel:
     def place_base(self, frame: Pose) -> None:
         """Put the arm's base link frame (and the ground under it) at ``frame``."""
         # pybullet places a body by its centre of mass; the caller gives the URDF frame.
-        position, orientation = pose_multiply(frame, self.model.base_inertial)
+        position, orientation = pose_multiply(*frame, *self.model.base_inertial)
         self.reset_base(self.robot, position, orientation)
         self.reset_base(self.ground, self.ground_center(frame[0]), IDENTITY_QUAT)
 
@@ -401,13 +362,13 @@ class ArmScene:
 
     def shoulder_position(self) -> Vec3:
         """World position of the shoulder (the second joint's axis), the centre of the reach sphere."""
-        return pose_multiply(self.base_pose(), (self._model.shoulder_offset, IDENTITY_QUAT))[0]
+        return pose_multiply(*self.base_pose(), self._model.shoulder_offset, IDENTITY_QUAT)[0]
 
     def base_pose(self) -> Pose:
         """Current world pose of the base link's URDF frame (as ``loadURDF``'s ``basePosition``)."""
         m = self._model_in_use()
         pos, quat = m.client.getBasePositionAndOrientation(m.robot)  # centre of mass frame
-        return pose_multiply((tuple(pos), tuple(quat)), pose_inverse(self._model.base_inertial))
+        return pose_multiply(tuple(pos), tuple(quat), *pose_inverse(*self._model.base_inertial))
 
     # ----------------------------------------------------------------- world edits
     def set_base_pose(self, pose: Pose) -> None:
@@ -492,7 +453,7 @@ class ArmScene:
             if m.held_grip != m.gripper_value:
                 m.set_gripper(m.held_grip)
             state = m.link_state(m.robot, self._model.ee_link, computeForwardKinematics=True)
-            pos, quat = pose_multiply((state[4], state[5]), m.held_local)
+            pos, quat = pose_multiply(state[4], state[5], *m.held_local)
             m.reset_base(body, pos, quat)
         m.detect()
         # Only pairs with a moving body (arm links, held object) are ever in contact: static boxes
@@ -511,6 +472,26 @@ class ArmScene:
         m = self._model_in_use()
         state = m.link_state(m.robot, self._model.ee_link, computeForwardKinematics=True)
         return tuple(state[4]), tuple(state[5])
+
+    def ik_round(
+        self, position: Vec3, orientation: tuple[float, float, float, float], *, damping: float, iterations: int
+    ) -> np.ndarray:
+        """A few iterations of pybullet's damped least squares IK from the joint values last set.
+
+        Returns the 7 arm joint values it reached (not clipped, not checked: see
+        :func:`alica.skills.manipulation.solve_ik`, which verifies them).
+        """
+        m = self._model_in_use()
+        solution = m.client.calculateInverseKinematics(
+            m.robot,
+            self._model.ee_link,
+            position,
+            orientation,
+            jointDamping=[damping] * len(self._model.movable_joints),
+            maxNumIterations=iterations,
+            residualThreshold=1e-7,
+        )
+        return np.array(solution[:7])
 
     def close(self) -> None:
         """Leave the shared model, or disconnect the scene's own one (idempotent)."""

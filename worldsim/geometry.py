@@ -1,7 +1,8 @@
-"""Small pose helpers and the 2-D footprint checks used to stop driving robots.
+"""Small pose helpers, the 2-D footprint checks used to stop driving robots, and the checked values of arm planning.
 
 Pure Python and numpy (no pybullet): quaternions are ``(x, y, z, w)`` as in
-pybullet. The footprint checks measure the *penetration depth* of a robot's
+pybullet. :class:`Box` and the ``as_*`` checks are the values the arm's
+planning scene takes (skills and the world's scene share them). The footprint checks measure the *penetration depth* of a robot's
 circle into obstacles: positive means overlap.
 """
 
@@ -9,13 +10,21 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 __all__ = [
+    "IDENTITY_QUAT",
+    "Box",
     "Footprints",
+    "Pose",
     "Quat",
     "Vec3",
+    "as_configuration",
+    "as_pose",
+    "as_quat",
+    "as_vec3",
     "circle_box_depth",
     "pose_inverse",
     "pose_multiply",
@@ -28,6 +37,9 @@ __all__ = [
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
+Pose = tuple[Vec3, Quat]
+
+IDENTITY_QUAT: Quat = (0.0, 0.0, 0.0, 1.0)
 
 
 def wrap_angle(angle: float) -> float:
@@ -184,3 +196,98 @@ class Footprints:
                 d = circle_box_depth(x, y, r, e[1], e[2], e[3], e[4], e[5], e[6])
             worst = max(worst, d)
         return worst
+
+
+# -- checked values for arm planning (the arm's planning scene takes and gives them) --------------
+
+
+def as_vec3(v: Sequence[float], name: str = "vector") -> Vec3:
+    """Return ``v`` as a float 3-tuple, or raise ``ValueError`` if it is not three finite numbers."""
+    try:
+        out = tuple(float(x) for x in v)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be three numbers, got {v!r}") from exc
+    if len(out) != 3 or not all(math.isfinite(x) for x in out):
+        raise ValueError(f"{name} must be three finite numbers, got {v!r}")
+    return out
+
+
+def as_quat(q: Sequence[float], name: str = "quaternion") -> Quat:
+    """Return ``q`` normalised as a float 4-tuple (x, y, z, w); ``ValueError`` if invalid."""
+    try:
+        out = tuple(float(x) for x in q)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be four numbers (x, y, z, w), got {q!r}") from exc
+    if len(out) != 4 or not all(math.isfinite(x) for x in out):
+        raise ValueError(f"{name} must be four finite numbers (x, y, z, w), got {q!r}")
+    n = math.sqrt(sum(x * x for x in out))
+    if n < 1e-9:
+        raise ValueError(f"{name} must not be zero")
+    return (out[0] / n, out[1] / n, out[2] / n, out[3] / n)
+
+
+def as_pose(pose: Sequence[Sequence[float]], name: str = "pose") -> Pose:
+    """Validate a ``((x, y, z), (qx, qy, qz, qw))`` pose."""
+    if len(pose) != 2:
+        raise ValueError(f"{name} must be ((x, y, z), (qx, qy, qz, qw)), got {pose!r}")
+    return as_vec3(pose[0], f"{name} position"), as_quat(pose[1], f"{name} orientation")
+
+
+def as_configuration(q: Sequence[float] | np.ndarray, dof: int, name: str = "q") -> np.ndarray:
+    """Return ``q`` as a float array of length ``dof``.
+
+    Raises:
+        ValueError: wrong length, not numeric, or NaN/inf entries.
+    """
+    try:
+        arr = np.asarray(q, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{name} must be {dof} joint values, got {q!r}") from exc
+    if arr.shape != (dof,):
+        raise ValueError(f"{name} must have {dof} joint values, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or infinite values: {arr.tolist()}")
+    return arr
+
+
+@dataclass(frozen=True, slots=True)
+class Box:
+    """A box: world obstacle, object to pick, or (for a held object) a box in the tool frame.
+
+    The value the arm's planning scene (:class:`~alica.worldsim.arm_interface.ArmPlanningScene`)
+    takes for obstacles and held objects.
+
+    Attributes:
+        name: unique name among a scene's obstacles.
+        center: centre (x, y, z) in metres.
+        half_extents: half sizes (hx, hy, hz) in metres, all > 0.
+        yaw: rotation about the z axis in radians.
+    """
+
+    name: str
+    center: Vec3
+    half_extents: Vec3
+    yaw: float = 0.0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"Box name must be a non-empty string, got {self.name!r}")
+        object.__setattr__(self, "center", as_vec3(self.center, f"Box {self.name!r} center"))
+        half = as_vec3(self.half_extents, f"Box {self.name!r} half_extents")
+        if min(half) <= 0.0:
+            raise ValueError(f"Box {self.name!r} half_extents must be > 0, got {half}")
+        object.__setattr__(self, "half_extents", half)
+        yaw = float(self.yaw)
+        if not math.isfinite(yaw):
+            raise ValueError(f"Box {self.name!r} yaw must be finite, got {self.yaw!r}")
+        object.__setattr__(self, "yaw", yaw)
+
+    @property
+    def pose(self) -> Pose:
+        """The box's pose ``(center, quat_xyzw)``."""
+        return self.center, yaw_to_quat(self.yaw)
+
+    @property
+    def top(self) -> float:
+        """Height of the top face (for an upright box in the world)."""
+        return self.center[2] + self.half_extents[2]

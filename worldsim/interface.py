@@ -8,8 +8,8 @@ driver satisfies them too by offering the same members.
 
 Every object has a ``kind`` (one of :data:`~alica.worldsim.objects.OBJECT_KINDS`),
 a ``radius`` and ``half_extents`` (zeros when they do not apply), so a skill
-reads ``obj.kind`` instead of probing for it. Arms are typed by
-:class:`~alica.worldsim.arm.Arm` itself for now.
+reads ``obj.kind`` instead of probing for it. Arms and their planning scenes
+have an interface of their own (:mod:`alica.worldsim.arm_interface`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     import numpy as np
     import trimesh
 
-    from alica.worldsim.arm import Arm
+    from alica.worldsim.arm_interface import RobotArm
     from alica.worldsim.grid import Obstacle2D
     from alica.worldsim.robot_camera import CameraImage
     from alica.worldsim.robots import RobotSpec
@@ -100,7 +100,7 @@ class MobileRobot(Protocol):
         ...
 
     @property
-    def arm(self) -> Arm | None:
+    def arm(self) -> RobotArm | None:
         """The arm, or ``None``."""
         ...
 
@@ -197,6 +197,22 @@ class RobotWorld(Protocol):
 
     def ground_truth_obstacles(self, *, include_samples: bool = False) -> list[Obstacle2D]:
         """Footprints of the obstacles lying in the world (held objects left out)."""
+        ...
+
+    def blocker(self, x: float, y: float, radius: float) -> str | None:
+        """What a circle at ``(x, y)`` would overlap (``"robot 'r2'"``, ``"block 'a'"``), or ``None``.
+
+        Robots, rocks, tables, blocks and samples count; held objects do not.
+        """
+        ...
+
+    def blocks_facts(self) -> set[tuple[str, ...]]:
+        """The IPC blocks-world facts now: ``on``, ``ontable``, ``clear``, ``holding``, ``handempty``.
+
+        The simulator's perfect perception stands in here for what a robot
+        would sense (an overhead camera, in effect); a real robot's driver
+        answers from its own perception.
+        """
         ...
 
 

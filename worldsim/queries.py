@@ -1,6 +1,8 @@
-"""Geometric questions about a world: obstacle footprints, free space, contacts.
+"""Geometric questions about a world: obstacle footprints, free space, contacts, the blocks' IPC facts.
 
-Used by :class:`~alica.worldsim.world.World` (call them through its methods).
+Used by :class:`~alica.worldsim.world.World` (call them through its methods:
+skills ask :meth:`~alica.worldsim.interface.RobotWorld.blocker` and
+:meth:`~alica.worldsim.interface.RobotWorld.blocks_facts` of the robot interface).
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ if TYPE_CHECKING:
     from alica.worldsim.robots import Robot
     from alica.worldsim.world import World
 
-__all__ = ["blocker", "body_names", "contacts", "obstacles"]
+__all__ = ["blocker", "blocks_facts", "body_names", "contacts", "obstacles"]
 
 
 def obstacles(world: World, *, include_samples: bool = False) -> list[Obstacle2D]:
@@ -49,6 +51,62 @@ def blocker(world: RobotWorld, x: float, y: float, radius: float) -> str | None:
             if fp is not None and float(fp.distance(np.array(x), np.array(y))) < radius:
                 return f"{obj.kind} '{obj.name}'"
     return None
+
+
+def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple[str, ...]]:
+    """The IPC blocks-world facts of the simulated state.
+
+    ``("on", x, y)``, ``("ontable", x)``, ``("clear", x)``, ``("holding", robot, x)``
+    and ``("handempty", robot)`` for every robot with an arm. A block is on another
+    when its bottom lies within ``tolerance`` of the other's top and its centre
+    over the other; on the table when its bottom is within ``tolerance`` of the
+    ground or a table top. A falling block is neither.
+
+    Args:
+        world: the world to read.
+        tolerance: vertical tolerance in metres (default 30 % of the smallest block).
+    """
+    blocks = {n: o for n, o in world.objects.items() if o.kind == "block"}
+    facts: set[tuple[str, ...]] = set()
+    held: dict[str, str] = {}
+    for rname, robot in world.robots.items():
+        if robot.arm is None:
+            continue
+        obj = robot.arm.held
+        if obj is not None and obj.kind == "block":
+            facts.add(("holding", rname, obj.name))
+            held[obj.name] = rname
+        elif obj is None:
+            facts.add(("handempty", rname))
+    if not blocks:
+        return facts
+    tol = 0.3 * min(o.size for o in blocks.values()) if tolerance is None else float(tolerance)
+    boxes = {n: o.aabb() for n, o in blocks.items() if n not in held}
+    tables = [o for o in world.objects.values() if o.kind == "table"]
+    covered: set[str] = set()
+    for x, (lo_x, hi_x) in boxes.items():
+        cx, cy = 0.5 * (lo_x[0] + hi_x[0]), 0.5 * (lo_x[1] + hi_x[1])
+        bottom = lo_x[2]
+        support = None
+        for y, (lo_y, hi_y) in boxes.items():
+            if y != x and abs(bottom - hi_y[2]) <= tol and lo_y[0] <= cx <= hi_y[0] and lo_y[1] <= cy <= hi_y[1]:
+                support = y
+                break
+        if support is not None:
+            facts.add(("on", x, support))
+            covered.add(support)
+            continue
+        floor = 0.0
+        for table in tables:
+            lo_t, hi_t = table.aabb()
+            if lo_t[0] <= cx <= hi_t[0] and lo_t[1] <= cy <= hi_t[1]:
+                floor = max(floor, hi_t[2])
+        if abs(bottom - floor) <= tol:
+            facts.add(("ontable", x))
+    for x in boxes:
+        if x not in covered:
+            facts.add(("clear", x))
+    return facts
 
 
 def body_names(world: World) -> dict[int, str]:

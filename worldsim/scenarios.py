@@ -19,6 +19,7 @@ from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import RobotWorld
 from alica.worldsim.objects import SAMPLE_KINDS
 from alica.worldsim.perception import FactPerception, Place
+from alica.worldsim.queries import blocks_facts
 from alica.worldsim.robots import ROBOT_KINDS
 from alica.worldsim.world import World
 
@@ -190,62 +191,6 @@ def _configuration_counts(n: int, height: int) -> list[int]:
             math.comb(m - 1, j - 1) * math.factorial(j) * counts[m - j] for j in range(1, min(height, m) + 1)
         )
     return counts
-
-
-def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple[str, ...]]:
-    """The IPC blocks-world facts of the simulated state.
-
-    ``("on", x, y)``, ``("ontable", x)``, ``("clear", x)``, ``("holding", robot, x)``
-    and ``("handempty", robot)`` for every robot with an arm. A block is on another
-    when its bottom lies within ``tolerance`` of the other's top and its centre
-    over the other; on the table when its bottom is within ``tolerance`` of the
-    ground or a table top. A falling block is neither.
-
-    Args:
-        world: the world to read.
-        tolerance: vertical tolerance in metres (default 30 % of the smallest block).
-    """
-    blocks = {n: o for n, o in world.objects.items() if o.kind == "block"}
-    facts: set[tuple[str, ...]] = set()
-    held: dict[str, str] = {}
-    for rname, robot in world.robots.items():
-        if robot.arm is None:
-            continue
-        obj = robot.arm.held
-        if obj is not None and obj.kind == "block":
-            facts.add(("holding", rname, obj.name))
-            held[obj.name] = rname
-        elif obj is None:
-            facts.add(("handempty", rname))
-    if not blocks:
-        return facts
-    tol = 0.3 * min(o.size for o in blocks.values()) if tolerance is None else float(tolerance)
-    boxes = {n: o.aabb() for n, o in blocks.items() if n not in held}
-    tables = [o for o in world.objects.values() if o.kind == "table"]
-    covered: set[str] = set()
-    for x, (lo_x, hi_x) in boxes.items():
-        cx, cy = 0.5 * (lo_x[0] + hi_x[0]), 0.5 * (lo_x[1] + hi_x[1])
-        bottom = lo_x[2]
-        support = None
-        for y, (lo_y, hi_y) in boxes.items():
-            if y != x and abs(bottom - hi_y[2]) <= tol and lo_y[0] <= cx <= hi_y[0] and lo_y[1] <= cy <= hi_y[1]:
-                support = y
-                break
-        if support is not None:
-            facts.add(("on", x, support))
-            covered.add(support)
-            continue
-        floor = 0.0
-        for table in tables:
-            lo_t, hi_t = table.aabb()
-            if lo_t[0] <= cx <= hi_t[0] and lo_t[1] <= cy <= hi_t[1]:
-                floor = max(floor, hi_t[2])
-        if abs(bottom - floor) <= tol:
-            facts.add(("ontable", x))
-    for x in boxes:
-        if x not in covered:
-            facts.add(("clear", x))
-    return facts
 
 
 #: The IPC facts the blocks world's perception writes into every agent's world model.

@@ -413,6 +413,14 @@ class World:
         """
         return _queries.obstacles(self, include_samples=include_samples)
 
+    def blocker(self, x: float, y: float, radius: float) -> str | None:
+        """What a circle at ``(x, y)`` would overlap (``"rock 'r3'"``), or ``None`` (held objects do not count)."""
+        return _queries.blocker(self, x, y, radius)
+
+    def blocks_facts(self) -> set[tuple[str, ...]]:
+        """The IPC blocks facts of the simulated state (:func:`~alica.worldsim.queries.blocks_facts`): perfect perception."""
+        return _queries.blocks_facts(self)
+
     def is_free(self, x: float, y: float, radius: float, *, margin: float = 0.0) -> bool:
         """Whether a circle fits in the field without touching obstacles, movable objects or robots."""
         return self._inside_field(x, y, radius + margin) and self._blocker(x, y, radius + margin) is None

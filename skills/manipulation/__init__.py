@@ -1,9 +1,11 @@
 """Arm motion planning for the manipulation skills (Pickup, Putdown, Stack, Unstack and their steps).
 
-Works from plain data (a URDF, the base pose, boxes), in a pybullet DIRECT
-client per :class:`ArmPlanningModel`, which the :class:`ArmScene` s of arms of
-the same kind may share; plans are returned as data (configurations
-and joint paths) for someone else to execute. See ``docs/manipulation.md``.
+Works on the arm's planning scene (:class:`~alica.worldsim.arm_interface.ArmPlanningScene`,
+which the world implements: :class:`alica.worldsim.arm_scene.ArmScene`, a pybullet
+DIRECT client, and a robot's arm gives by ``arm.planning_scene()``) with plain data
+(poses, :class:`~alica.worldsim.geometry.Box` es); plans are returned as data
+(configurations and joint paths) for someone else to execute. No pybullet here.
+See ``docs/manipulation.md``.
 """
 
 from __future__ import annotations
@@ -14,13 +16,13 @@ from alica.skills.manipulation.geometry import Pose, Quat, Vec3, top_down_quat
 from alica.skills.manipulation.grasps import Grasp, held_box, place_poses, placed_box, top_grasps
 from alica.skills.manipulation.ik import IKResult, solve_ik
 from alica.skills.manipulation.pickup import PickupPlan, PlacePlan, plan_pickup, plan_place
-from alica.skills.manipulation.scene import ArmPlanningModel, ArmScene, Box, default_urdf
 from alica.skills.manipulation.transport import TransportPlan, plan_transport
+from alica.worldsim.arm_interface import ArmPlanningScene
+from alica.worldsim.geometry import Box
 
 __all__ = [
     "ArmPath",
-    "ArmPlanningModel",
-    "ArmScene",
+    "ArmPlanningScene",
     "Box",
     "Grasp",
     "IKResult",
@@ -30,7 +32,6 @@ __all__ = [
     "Quat",
     "TransportPlan",
     "Vec3",
-    "default_urdf",
     "held_box",
     "interpolate_path",
     "path_is_free",

@@ -31,7 +31,8 @@ from ompl import geometric as og
 from ompl import util as ou
 
 from alica.skills.manipulation.geometry import as_configuration
-from alica.skills.manipulation.scene import ArmScene, Box
+from alica.worldsim.arm_interface import ArmPlanningScene
+from alica.worldsim.geometry import Box
 
 log = logging.getLogger(__name__)
 
@@ -108,17 +109,19 @@ def interpolate_path(path: np.ndarray, step: float = RECHECK_STEP) -> np.ndarray
     return np.concatenate(out)
 
 
-def path_is_free(scene: ArmScene, path: np.ndarray, held: Box | None = None, step: float = RECHECK_STEP) -> bool:
+def path_is_free(
+    scene: ArmPlanningScene, path: np.ndarray, held: Box | None = None, step: float = RECHECK_STEP
+) -> bool:
     """True if every sample of :func:`interpolate_path` ``(path, step)`` is collision free."""
     return _samples_free(scene, interpolate_path(path, step), held)
 
 
-def _samples_free(scene: ArmScene, samples: np.ndarray, held: Box | None) -> bool:
+def _samples_free(scene: ArmPlanningScene, samples: np.ndarray, held: Box | None) -> bool:
     collides = scene.collides
     return not any(collides(q, held) for q in samples.tolist())
 
 
-def _check_endpoint(scene: ArmScene, q: np.ndarray, held: Box | None, which: str) -> str | None:
+def _check_endpoint(scene: ArmPlanningScene, q: np.ndarray, held: Box | None, which: str) -> str | None:
     lower, upper = scene.joint_limits
     bad = [i for i in range(7) if not lower[i] <= q[i] <= upper[i]]
     if bad:
@@ -130,7 +133,7 @@ def _check_endpoint(scene: ArmScene, q: np.ndarray, held: Box | None, which: str
 
 
 def plan_arm(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     q_start: Sequence[float] | np.ndarray,
     q_goal: Sequence[float] | np.ndarray,
     *,
@@ -198,7 +201,7 @@ def plan_arm(
 
 
 def _rrt_connect(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     start: np.ndarray,
     goal: np.ndarray,
     held: Box | None,

@@ -15,7 +15,7 @@ import numpy as np
 
 from alica.skills.manipulation.geometry import Pose, Quat, as_configuration, as_pose, quat_angle
 from alica.skills.manipulation.ik import solve_ik
-from alica.skills.manipulation.scene import ArmScene
+from alica.worldsim.arm_interface import ArmPlanningScene
 
 #: Distance between waypoints along the line, metres.
 LINE_STEP = 0.05
@@ -31,7 +31,7 @@ def _nlerp(a: Quat, b: Quat, t: float) -> Quat:
 
 
 def straight_line(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     q_from: Sequence[float] | np.ndarray,
     pose_to: Pose,
     *,

@@ -9,47 +9,38 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-import numpy as np
+from alica.worldsim.geometry import (  # the same quaternion algebra and checked values as the world's
+    IDENTITY_QUAT,
+    Pose,
+    Quat,
+    Vec3,
+    as_configuration,
+    as_pose,
+    as_quat,
+    as_vec3,
+    quat_multiply,
+    quat_rotate,
+)
 
-from alica.worldsim.geometry import quat_multiply, quat_rotate  # the same quaternion algebra as the world's
-
-Vec3 = tuple[float, float, float]
-Quat = tuple[float, float, float, float]
-Pose = tuple[Vec3, Quat]
-
-IDENTITY_QUAT: Quat = (0.0, 0.0, 0.0, 1.0)
-
-
-def as_vec3(v: Sequence[float], name: str = "vector") -> Vec3:
-    """Return ``v`` as a float 3-tuple, or raise ``ValueError`` if it is not three finite numbers."""
-    try:
-        out = tuple(float(x) for x in v)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be three numbers, got {v!r}") from exc
-    if len(out) != 3 or not all(math.isfinite(x) for x in out):
-        raise ValueError(f"{name} must be three finite numbers, got {v!r}")
-    return out
-
-
-def as_quat(q: Sequence[float], name: str = "quaternion") -> Quat:
-    """Return ``q`` normalised as a float 4-tuple (x, y, z, w); ``ValueError`` if invalid."""
-    try:
-        out = tuple(float(x) for x in q)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be four numbers (x, y, z, w), got {q!r}") from exc
-    if len(out) != 4 or not all(math.isfinite(x) for x in out):
-        raise ValueError(f"{name} must be four finite numbers (x, y, z, w), got {q!r}")
-    n = math.sqrt(sum(x * x for x in out))
-    if n < 1e-9:
-        raise ValueError(f"{name} must not be zero")
-    return (out[0] / n, out[1] / n, out[2] / n, out[3] / n)
-
-
-def as_pose(pose: Sequence[Sequence[float]], name: str = "pose") -> Pose:
-    """Validate a ``((x, y, z), (qx, qy, qz, qw))`` pose."""
-    if len(pose) != 2:
-        raise ValueError(f"{name} must be ((x, y, z), (qx, qy, qz, qw)), got {pose!r}")
-    return as_vec3(pose[0], f"{name} position"), as_quat(pose[1], f"{name} orientation")
+__all__ = [
+    "IDENTITY_QUAT",
+    "Pose",
+    "Quat",
+    "Vec3",
+    "as_configuration",
+    "as_pose",
+    "as_quat",
+    "as_vec3",
+    "pose_inverse",
+    "pose_multiply",
+    "quat_angle",
+    "quat_conjugate",
+    "quat_from_yaw",
+    "top_down_quat",
+    "upright_box",
+    "vertical_yaw",
+    "wrap_angle",
+]
 
 
 def quat_conjugate(q: Quat) -> Quat:
@@ -131,20 +122,3 @@ def wrap_angle(a: float) -> float:
     if w <= 0.0:
         w += 2.0 * math.pi
     return w - math.pi
-
-
-def as_configuration(q: Sequence[float] | np.ndarray, dof: int, name: str = "q") -> np.ndarray:
-    """Return ``q`` as a float array of length ``dof``.
-
-    Raises:
-        ValueError: wrong length, not numeric, or NaN/inf entries.
-    """
-    try:
-        arr = np.asarray(q, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ValueError(f"{name} must be {dof} joint values, got {q!r}") from exc
-    if arr.shape != (dof,):
-        raise ValueError(f"{name} must have {dof} joint values, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name} contains NaN or infinite values: {arr.tolist()}")
-    return arr

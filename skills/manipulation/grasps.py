@@ -24,7 +24,7 @@ from alica.skills.manipulation.geometry import (
     vertical_yaw,
     wrap_angle,
 )
-from alica.skills.manipulation.scene import Box
+from alica.worldsim.geometry import Box
 
 #: Height of the approach (pre-grasp / above-place) pose over the grasp or place pose.
 APPROACH_HEIGHT = 0.10

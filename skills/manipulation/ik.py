@@ -23,7 +23,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from alica.skills.manipulation.geometry import as_configuration, as_quat, as_vec3, quat_angle
-from alica.skills.manipulation.scene import ArmScene, Box
+from alica.worldsim.arm_interface import ArmPlanningScene
+from alica.worldsim.geometry import Box
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +56,7 @@ class IKResult:
 
 
 def solve_ik(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     target_pos: Sequence[float],
     target_quat: Sequence[float],
     *,
@@ -146,7 +147,7 @@ def solve_ik(
 
 
 def _descend(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     pos: tuple[float, float, float],
     quat: tuple[float, float, float, float],
     start: np.ndarray,
@@ -157,24 +158,14 @@ def _descend(
     rounds: int,
 ) -> tuple[np.ndarray, float, float]:
     """One attempt: rounds of pybullet IK, each result projected into the limits; returns (q, pos err, ang err)."""
-    c, body, ee = scene.client, scene.robot_id, scene.ee_link
-    damping = [_DAMPING] * len(scene.movable_joints)
     target = np.array(pos)
     q = np.clip(np.asarray(start, dtype=float), lower, upper)
     pe = ae = math.inf
     stalled = 0
     for _ in range(rounds):
         scene.set_joints(q)
-        solution = c.calculateInverseKinematics(
-            body,
-            ee,
-            pos,
-            quat,
-            jointDamping=damping,
-            maxNumIterations=_ITERATIONS_PER_ROUND,
-            residualThreshold=1e-7,
-        )
-        q = np.clip(np.array(solution[:7]), lower, upper)
+        solution = scene.ik_round(pos, quat, damping=_DAMPING, iterations=_ITERATIONS_PER_ROUND)
+        q = np.clip(solution, lower, upper)
         scene.set_joints(q)
         p_now, q_now = scene.current_tool_pose()
         new_pe = float(np.linalg.norm(np.array(p_now) - target))

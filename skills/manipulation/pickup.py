@@ -41,7 +41,8 @@ from alica.skills.manipulation.grasps import (
     top_grasps,
 )
 from alica.skills.manipulation.ik import solve_ik
-from alica.skills.manipulation.scene import ArmScene, Box
+from alica.worldsim.arm_interface import ArmPlanningScene
+from alica.worldsim.geometry import Box
 
 log = logging.getLogger(__name__)
 
@@ -100,7 +101,7 @@ class PlacePlan:
 
 
 @contextmanager
-def _obstacles(scene: ArmScene) -> Iterator[tuple[Box, ...]]:
+def _obstacles(scene: ArmPlanningScene) -> Iterator[tuple[Box, ...]]:
     """Yield the scene's obstacles and restore them afterwards."""
     original = scene.obstacles
     try:
@@ -109,7 +110,7 @@ def _obstacles(scene: ArmScene) -> Iterator[tuple[Box, ...]]:
         scene.set_obstacles(original)
 
 
-def _natural_order(scene: ArmScene, xy: Sequence[float], yaws: Sequence[float]) -> list[int]:
+def _natural_order(scene: ArmPlanningScene, xy: Sequence[float], yaws: Sequence[float]) -> list[int]:
     """Indices of ``yaws`` sorted by how close each is to the tool yaw of a plain reach towards ``xy``."""
     base = scene.base_pose()[0]
     heading = math.atan2(xy[1] - base[1], xy[0] - base[0])
@@ -130,7 +131,7 @@ def _summary(failures: list[tuple[str, str]], what: str) -> str:
     return f"no {what} worked: " + "; ".join(parts[:4]) + more
 
 
-def _lift_is_free(scene: ArmScene, descent: np.ndarray, held: Box, z_grasp: float) -> bool:
+def _lift_is_free(scene: ArmPlanningScene, descent: np.ndarray, held: Box, z_grasp: float) -> bool:
     """Check the reversed descent holding ``held``, from ``LIFT_CLEARANCE`` above the grasp height ``z_grasp``.
 
     The lift retraces the descent, which was checked without the object; the
@@ -145,7 +146,7 @@ def _lift_is_free(scene: ArmScene, descent: np.ndarray, held: Box, z_grasp: floa
 
 
 def plan_pickup(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     object_box: Box,
     q_start: Sequence[float] | np.ndarray,
     *,
@@ -262,7 +263,7 @@ def plan_pickup(
 
 
 def plan_place(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     held: Box,
     target_top_center: Sequence[float],
     q_start: Sequence[float] | np.ndarray,

@@ -24,7 +24,8 @@ from alica.skills.manipulation.cartesian import straight_line
 from alica.skills.manipulation.geometry import as_configuration, quat_rotate
 from alica.skills.manipulation.grasps import APPROACH_HEIGHT
 from alica.skills.manipulation.pickup import _lift_is_free
-from alica.skills.manipulation.scene import ArmScene, Box
+from alica.worldsim.arm_interface import ArmPlanningScene
+from alica.worldsim.geometry import Box
 
 #: Joint distance (rad, largest joint) within which the arm counts as in the transport pose.
 AT_TRANSPORT = 1e-3
@@ -48,7 +49,7 @@ class TransportPlan:
 
 
 def plan_transport(
-    scene: ArmScene,
+    scene: ArmPlanningScene,
     q_start: Sequence[float] | np.ndarray,
     *,
     rng: np.random.Generator,

@@ -6,7 +6,7 @@ from collections.abc import Iterator
 
 import pytest
 
-from alica.skills.manipulation import ArmScene
+from alica.worldsim.arm_scene import ArmScene
 from tests.manipulation.helpers import BASE_HEIGHT, PLATFORM
 
 

@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 
-from alica.skills.manipulation import ArmScene, Box
+from alica.skills.manipulation import Box
+from alica.worldsim.arm_scene import ArmScene
 
 #: The arm base sits on a mobile base 0.3 m above the ground ...
 BASE_HEIGHT = 0.3

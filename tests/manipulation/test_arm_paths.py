@@ -11,7 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from alica.skills.manipulation import ArmScene, Box, interpolate_path, path_is_free, plan_arm, solve_ik, top_down_quat
+from alica.skills.manipulation import Box, interpolate_path, path_is_free, plan_arm, solve_ik, top_down_quat
+from alica.worldsim.arm_scene import ArmScene
 from tests.manipulation.helpers import assert_path_free, dense_states
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -107,7 +108,8 @@ def test_interpolation_and_bad_arguments(scene: ArmScene) -> None:
 _SCRIPT = """
 import json, sys
 import numpy as np
-from alica.skills.manipulation import ArmScene, Box, plan_arm, solve_ik, top_down_quat
+from alica.skills.manipulation import Box, plan_arm, solve_ik, top_down_quat
+from alica.worldsim.arm_scene import ArmScene
 scene = ArmScene(obstacles=[Box("wall", (0.5, 0.0, 0.25), (0.08, 0.03, 0.25))])
 rng = np.random.default_rng(0)
 a = solve_ik(scene, (0.5, 0.25, 0.15), top_down_quat(0.0), rng=rng)

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from alica.skills.manipulation import ArmScene, Box, solve_ik, top_down_quat
+from alica.skills.manipulation import Box, solve_ik, top_down_quat
 from alica.skills.manipulation.geometry import quat_angle
+from alica.worldsim.arm_scene import ArmScene
 
 
 @pytest.mark.parametrize(

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from alica.skills.manipulation import ArmScene, Box, PickupPlan, plan_pickup, plan_place
+from alica.skills.manipulation import Box, PickupPlan, plan_pickup, plan_place
 from alica.skills.manipulation.geometry import quat_angle
 from alica.skills.manipulation.pickup import LIFT_CLEARANCE
+from alica.worldsim.arm_scene import ArmScene
 from tests.manipulation.helpers import PLATFORM, assert_path_free, dense_states
 
 BLOCK = Box("block", (0.5, 0.0, 0.025), (0.025, 0.025, 0.025))

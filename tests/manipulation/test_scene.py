@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from alica.skills.manipulation import ArmScene, Box, default_urdf
+from alica.skills.manipulation import Box
 from alica.skills.manipulation.geometry import quat_angle
+from alica.worldsim.arm_scene import ArmScene, default_urdf
 
 
 def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:
@@ -139,7 +140,8 @@ def test_scenes_are_independent_and_close_is_idempotent() -> None:
 
 
 def test_scenes_sharing_a_model_answer_as_scenes_of_their_own() -> None:
-    from alica.skills.manipulation import ArmPlanningModel, solve_ik
+    from alica.skills.manipulation import solve_ik
+    from alica.worldsim.arm_scene import ArmPlanningModel
 
     poses = [((0.0, 0.0, 0.3), (0.0, 0.0, 0.0, 1.0)), ((2.0, 1.0, 0.3), (0.0, 0.0, 0.7071068, 0.7071068))]
     walls = [

@@ -1,4 +1,8 @@
-"""putdown_spots reads only the robot interface, so it works on any RobotWorld, not just the simulator."""
+"""putdown_spots reads only the robot interface, so it works on any RobotWorld, not just the simulator.
+
+The driver below answers the interface's ``blocker`` with :func:`alica.worldsim.queries.blocker`, which reads only
+the interface itself (as a real robot's driver may).
+"""
 
 from __future__ import annotations
 
@@ -8,10 +12,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from alica.skills.handling import PUTDOWN_TURNS, REACH, putdown_spots
-from alica.worldsim.arm import Arm
+from alica.skills.arm_world import REACH
+from alica.skills.blocks_rules import PUTDOWN_TURNS, putdown_spots
+from alica.worldsim.arm_interface import RobotArm
 from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.interface import Position, Quaternion, RobotWorld
+from alica.worldsim.queries import blocker
 from alica.worldsim.robots import ROBOT_KINDS, RobotSpec
 
 
@@ -20,7 +26,7 @@ class _Robot:
     name: str
     pose: Position
     spec: RobotSpec = ROBOT_KINDS["scout"]
-    arm: Arm | None = None
+    arm: RobotArm | None = None
     crashed: bool = False
     bumped: bool = False
 
@@ -72,6 +78,12 @@ class _Driver:
 
     def ground_truth_obstacles(self, *, include_samples: bool = False) -> list[Obstacle2D]:
         return [o.footprint() for o in self.objects.values()]
+
+    def blocker(self, x: float, y: float, radius: float) -> str | None:
+        return blocker(self, x, y, radius)
+
+    def blocks_facts(self) -> set[tuple[str, ...]]:
+        return set()
 
 
 def test_putdown_spots_on_a_robot_world_that_is_not_the_simulator() -> None:

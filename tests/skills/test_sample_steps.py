@@ -110,7 +110,7 @@ def test_move_arm_to_transport_plans_its_own_way_without_a_stored_one(skill_run,
     steps.scratch.pop("arm_retreat")
     run = steps("MoveArmToTransport")
     assert run.ok, (run.reason, run.trace[-5:])
-    from alica.skills.manipulation.robot_model import PANDA_HOME_Q
+    from alica.worldsim.arm_model import PANDA_HOME_Q
 
     arm = field.robots["stummel"].arm
     assert np.abs(np.asarray(arm.q()) - PANDA_HOME_Q).max() < 1e-3  # where the pick-up plans carry to
