@@ -3,6 +3,16 @@
 The engine never sleeps and never reads the wall clock: the caller ticks it
 (:meth:`AgentEngine.tick`, or :meth:`receive` then :meth:`step` when a team
 is ticked in lock step) and the injected clock says what time it is.
+
+The engine keeps the tick, the root plan's start and repair, the team's
+messages and the operator's settings. It builds its collaborators once and
+hands each only what it needs (:mod:`alica.engine.parts` says how): the plan
+tree (:mod:`alica.engine.tree`) whose nodes run the rules
+(:mod:`alica.engine.node`, :mod:`alica.engine.slot`), allocation
+(:mod:`alica.engine.allocate`), constraint queries (:mod:`alica.engine.solving`),
+the start of a state's children (:mod:`alica.engine.launch`), the child
+runtimes' host (:mod:`alica.engine.hosting`) and the synchronisations
+(:class:`~alica.engine.sync.SyncTable`).
 """
 
 from __future__ import annotations
