@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from typing import Any
 
 from alica.errors import AlicaError
-from alica.lang import Registry, compile_formula
+from alica.lang import BeliefBase, Registry, compile_formula
+
+#: A compiled formula: its value (or truth) for a belief base and the plan's variables.
+Compiled = Callable[[BeliefBase, Mapping[str, object]], object]
 
 
 class Formulas:
@@ -21,11 +23,11 @@ class Formulas:
     def __init__(self, registry: Registry | None = None, on_error: Callable[[str, str], None] | None = None) -> None:
         self.registry = registry
         self.on_error = on_error
-        self._truth: dict[str, Callable[..., Any]] = {}
-        self._value: dict[str, Callable[..., Any]] = {}
+        self._truth: dict[str, Compiled] = {}
+        self._value: dict[str, Compiled] = {}
         self._reported: set[tuple[str, str]] = set()
 
-    def holds(self, text: str | None, belief: object, env: Mapping[str, object]) -> bool:
+    def holds(self, text: str | None, belief: BeliefBase, env: Mapping[str, object]) -> bool:
         """Whether ``text`` holds (``None``: the empty condition, true)."""
         if text is None:
             return True
@@ -38,7 +40,7 @@ class Formulas:
             self._report(text, str(exc))
             return False
 
-    def value(self, text: str, belief: object, env: Mapping[str, object]) -> object:
+    def value(self, text: str, belief: BeliefBase, env: Mapping[str, object]) -> object:
         """The value of a term.
 
         Raises:
