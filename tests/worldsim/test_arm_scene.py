@@ -1,15 +1,38 @@
-"""ArmScene: the Panda's joints, limits and forward kinematics; collision checks."""
+"""The world's arm planning scene (alica.worldsim.arm_scene.ArmScene): the Panda's joints, limits and FK; collision checks.
+
+Also: an arm gives its scene (Arm.planning_scene), the arms of a world share one planning model.
+"""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 
 import numpy as np
 import pytest
 
-from alica.skills.manipulation import Box
 from alica.skills.manipulation.geometry import quat_angle
+from alica.worldsim.arm_interface import ArmPlanningScene
 from alica.worldsim.arm_scene import ArmScene, default_urdf
+from alica.worldsim.geometry import Box
+from alica.worldsim.world import World
+from tests.manipulation.helpers import BASE_HEIGHT, PLATFORM
+
+
+@pytest.fixture
+def scene() -> Iterator[ArmScene]:
+    """A Panda with its base at the origin on the ground, no obstacles."""
+    s = ArmScene()
+    yield s
+    s.close()
+
+
+@pytest.fixture
+def mobile_scene() -> Iterator[ArmScene]:
+    """A Panda on a 0.3 m high mobile base (the platform is an obstacle)."""
+    s = ArmScene(base_pose=((0.0, 0.0, BASE_HEIGHT), (0.0, 0.0, 0.0, 1.0)), obstacles=[PLATFORM])
+    yield s
+    s.close()
 
 
 def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:
@@ -180,3 +203,16 @@ def test_scenes_sharing_a_model_answer_as_scenes_of_their_own() -> None:
         for s in shared + alone:
             s.close()
         model.close()
+
+
+def test_an_arm_gives_its_planning_scene_and_the_arms_of_a_world_share_one_model(world: World) -> None:
+    one = world.add_robot("manipulator", "r1", (0.0, 0.0, 0.0))
+    two = world.add_robot("manipulator", "r2", (2.0, 0.0, 1.0))
+    assert one.arm is not None and two.arm is not None
+    scene_one, scene_two = one.arm.planning_scene(), two.arm.planning_scene()
+    assert isinstance(scene_one, ArmScene) and scene_one is one.arm.planning_scene()  # made once
+    assert scene_one is not scene_two and scene_one.model is scene_two.model
+    plain: ArmPlanningScene = scene_two  # what skills see of it
+    position, _ = plain.base_pose()
+    assert position == pytest.approx(two.arm.base_pose()[0], abs=1e-9)
+    assert scene_one.base_pose()[0] == pytest.approx(one.arm.base_pose()[0], abs=1e-9)
