@@ -85,13 +85,13 @@ def _row(s: Series) -> str:
 def _limit_variant_ik(scene: ArmScene, pos: tuple, quat: tuple) -> bool:
     """pybullet's null-space IK with the joint limits, checked like :func:`solve_ik` (5 mm, 0.02 rad)."""
     lower, upper = scene.joint_limits
-    extra = len(scene.movable_joints) - 7
+    extra = len(scene.arm_model.movable_joints) - 7
     lo = list(lower) + [0.0] * extra
     hi = list(upper) + [0.04] * extra
     scene.set_joints(scene.rest_q)
     sol = scene.client.calculateInverseKinematics(
         scene.robot_id,
-        scene.ee_link,
+        scene.arm_model.ee_link,
         pos,
         quat,
         lowerLimits=lo,

@@ -265,8 +265,8 @@ class ArmScene:
         try:
             m = self._model_in_use()
             self._model: ArmModel = m.model
-            self.rest_q = self._default_q(rest_q, self._model.rest_q, "rest_q")
-            self.home_q = self._default_q(home_q, self._model.home_q, "home_q")
+            self.rest_q = _default_q(self._model, rest_q, self._model.rest_q, "rest_q")
+            self.home_q = _default_q(self._model, home_q, self._model.home_q, "home_q")
             self.set_obstacles(obstacles)
         except BaseException:
             self.close()
@@ -316,29 +316,16 @@ class ArmScene:
         return self._model_in_use().robot
 
     @property
-    def joint_indices(self) -> tuple[int, ...]:
-        """pybullet joint indices of the 7 arm joints."""
-        return self._model.arm_joints
-
-    @property
-    def movable_joints(self) -> tuple[int, ...]:
-        """All non-fixed joints (arm then gripper), the order of pybullet's IK results."""
-        return self._model.movable_joints
+    def arm_model(self) -> ArmModel:
+        """The arm's joint and link facts in :attr:`client`: ``arm_joints`` (the 7 arm joints), ``movable_joints``
+        (arm then gripper, the order of pybullet's IK results), ``ee_link`` (the tool frame, ``panda_grasptarget``
+        if present, else ``panda_hand``), ``gripper_links`` (the fingers, which may touch a held object)."""
+        return self._model
 
     @property
     def joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
         """``(lower, upper)`` arrays of the arm joints' limits in radians (copies)."""
         return self._model.lower.copy(), self._model.upper.copy()
-
-    @property
-    def ee_link(self) -> int:
-        """Link index of the tool frame (``panda_grasptarget`` if present, else ``panda_hand``)."""
-        return self._model.ee_link
-
-    @property
-    def gripper_links(self) -> tuple[int, ...]:
-        """Links moved by the gripper joints (the fingers); they may touch a held object."""
-        return self._model.gripper_links
 
     @property
     def max_grasp_width(self) -> float:
@@ -449,7 +436,7 @@ class ArmScene:
             if held is not m.last_held:
                 m.last_held = held
                 m.held_local = (held.center, quat_from_yaw(held.yaw))
-                m.held_grip = self._grip_value(held)
+                m.held_grip = _grip_value(self._model, held)
             if m.held_grip != m.gripper_value:
                 m.set_gripper(m.held_grip)
             state = m.link_state(m.robot, self._model.ee_link, computeForwardKinematics=True)
@@ -509,15 +496,17 @@ class ArmScene:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    # ----------------------------------------------------------------- internals
-    def _default_q(self, given: Sequence[float] | None, model_q: np.ndarray, name: str) -> np.ndarray:
-        q = model_q.copy() if given is None else as_configuration(given, 7, name)
-        if not self.within_limits(q):
-            raise ValueError(f"{name} lies outside the joint limits: {q.tolist()}")
-        return q
 
-    def _grip_value(self, held: Box) -> float:
-        """Finger joint value closing the gripper on ``held`` (width across the tool y axis)."""
-        hx, hy, _ = held.half_extents
-        half_width = abs(math.sin(held.yaw)) * hx + abs(math.cos(held.yaw)) * hy
-        return float(min(self._model.gripper_open, max(self._model.gripper_closed, half_width)))
+def _default_q(model: ArmModel, given: Sequence[float] | None, model_q: np.ndarray, name: str) -> np.ndarray:
+    """``given`` (checked: 7 values inside the joint limits), else the model's ``model_q``."""
+    q = model_q.copy() if given is None else as_configuration(given, 7, name)
+    if not (np.all(q >= model.lower) and np.all(q <= model.upper)):
+        raise ValueError(f"{name} lies outside the joint limits: {q.tolist()}")
+    return q
+
+
+def _grip_value(model: ArmModel, held: Box) -> float:
+    """Finger joint value closing the gripper on ``held`` (width across the tool y axis)."""
+    hx, hy, _ = held.half_extents
+    half_width = abs(math.sin(held.yaw)) * hx + abs(math.cos(held.yaw)) * hy
+    return float(min(model.gripper_open, max(model.gripper_closed, half_width)))

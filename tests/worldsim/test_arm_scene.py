@@ -36,7 +36,7 @@ def mobile_scene() -> Iterator[ArmScene]:
 
 
 def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:
-    assert len(scene.joint_indices) == 7
+    assert len(scene.arm_model.arm_joints) == 7
     lower, upper = scene.joint_limits
     assert lower.shape == upper.shape == (7,)
     assert np.all(lower < upper)
@@ -44,7 +44,7 @@ def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:
     assert lower[0] == pytest.approx(-2.9671) and upper[0] == pytest.approx(2.9671)
     assert lower[3] == pytest.approx(-3.1416) and upper[3] == pytest.approx(0.0)
     assert lower[5] == pytest.approx(-0.0873) and upper[5] == pytest.approx(3.8223)
-    name = scene.client.getJointInfo(scene.robot_id, scene.ee_link)[12].decode()
+    name = scene.client.getJointInfo(scene.robot_id, scene.arm_model.ee_link)[12].decode()
     assert name == "panda_grasptarget"
     assert scene.within_limits(scene.rest_q) and scene.within_limits(scene.home_q)
     # joint_limits hands out copies
@@ -92,7 +92,9 @@ def test_margin_inflates_obstacles(scene: ArmScene) -> None:
     probe = c.createMultiBody(
         0.0, c.createCollisionShape(c.GEOM_BOX, halfExtents=(1, 1, 0.01)), basePosition=(0, 0, -1)
     )
-    lowest = min(c.getClosestPoints(scene.robot_id, probe, 5.0, link)[0][5][2] for link in scene.gripper_links)
+    lowest = min(
+        c.getClosestPoints(scene.robot_id, probe, 5.0, link)[0][5][2] for link in scene.arm_model.gripper_links
+    )
     c.removeBody(probe)
     assert scene.margin == pytest.approx(0.003)
 
