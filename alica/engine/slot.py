@@ -21,6 +21,10 @@ repair: the plan stays failed until a transition leaves the state.
 
 A child whose element is neither a behaviour, a plan nor a plan type (a
 planning problem) runs what its child runtime says (:mod:`alica.engine.child`).
+
+A slot reaches the rest of the agent only through its parent's
+:class:`~alica.engine.node.NodeParts` (allocation, the start of children,
+child runtimes, solved values), never through the engine.
 """
 
 from __future__ import annotations
