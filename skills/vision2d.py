@@ -54,10 +54,10 @@ from alica.skills.vision2d_data import (
 from alica.skills.vision2d_geometry import Circle, detect_circles, fit_circle, segment_scan
 from alica.skills.vision2d_image import HSV_RANGES, WHITE_VALUE, Blob, decode_sections, find_blobs
 from alica.skills.world_skill import WorldSkill, number_param
+from alica.worldsim.interface import CameraImage
 
 if TYPE_CHECKING:
     from alica.worldmodel.protocol import WorldModelLike
-    from alica.worldsim.robot_camera import CameraImage
 
 __all__ = [
     "HSV_RANGES",
@@ -349,8 +349,6 @@ class CropCandidate(_Pipeline):
 
     def _render(self) -> CameraImage:
         """Render the part of the frame the candidates' crops can come from (the same pixels, far cheaper)."""
-        from alica.worldsim.robot_camera import CameraImage
-
         robot = self.robot
         position, rotation = robot.camera_pose(robot.estimate, self.pan)
         fx = (self.width / 2.0) / math.tan(robot.spec.camera_fov / 2.0)

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.interface import SAMPLE_KINDS
 
 __all__ = ["HSV_RANGES", "WHITE_VALUE", "Blob", "decode_sections", "find_blobs"]
 

@@ -15,7 +15,7 @@ Example:
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 _EXPORTS = {
     "World": "alica.worldsim.world",
@@ -79,3 +79,15 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_EXPORTS))
+
+
+if TYPE_CHECKING:  # mypy proves that the simulator satisfies the interfaces it implements
+    from alica.engine.sim_world import SimWorld
+    from alica.worldsim.interface import RobotWorld
+    from alica.worldsim.world import World
+
+    def _world_is_a_robot_world(world: World) -> RobotWorld:
+        return world  # the skills' robot interface
+
+    def _world_is_a_sim_world(world: World) -> SimWorld:
+        return world  # what the runtime's simulated team uses: its clock, its step, its robots' crash and recover

@@ -2,7 +2,10 @@
 
 All settings are per world (``world.faults``, ``world.noise``) and every random
 draw comes from the world's seeded :attr:`~alica.worldsim.world.World.rng`, so a run
-with faults is as repeatable as one without.
+with faults is as repeatable as one without. A crash or a recovery reaches
+the robot through its declared ``crash()`` and ``recover()``
+(:class:`~alica.engine.sim_world.PoweredRobot`, the Protocol the team runner
+uses too); the settings see of the world only :class:`FaultedWorld`.
 """
 
 from __future__ import annotations
@@ -10,16 +13,18 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
-from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Protocol
 
 from alica.worldsim.errors import WorldError
+from alica.worldsim.noise import SensorNoise
 
 if TYPE_CHECKING:
-    from alica.worldsim.robots import Robot
-    from alica.worldsim.world import World
+    import numpy as np
 
-__all__ = ["Faults", "SensorNoise", "crash", "recover", "set_grasp_slip", "set_sensor_noise"]
+    from alica.engine.sim_world import PoweredRobot
+
+__all__ = ["FaultedWorld", "Faults", "SensorNoise", "crash", "recover", "set_grasp_slip", "set_sensor_noise"]
 
 logger = logging.getLogger(__name__)
 
@@ -27,32 +32,20 @@ logger = logging.getLogger(__name__)
 SLIP_DELAY = (0.1, 0.6)
 
 
-@dataclass(frozen=True, slots=True)
-class SensorNoise:
-    """Noise of the simulated sensors.
+class FaultedWorld(Protocol):
+    """What the fault settings use of a world: its robots to power down and up, its noise, its seeded draws."""
 
-    Attributes:
-        lidar_sigma: standard deviation (m) of the Gaussian noise added to lidar hits.
-        position_sigma: standard deviation (m) of a camera detection's position at close range;
-            it grows linearly to twice that at the perception range; 3-D perception has a quarter of it.
-        camera_misclassification: probability that a camera reports a wrong sample kind.
-        stereo_misclassification: the same for 3-D (stereo and 3-D lidar) perception.
-        pixel_sigma: standard deviation of the Gaussian noise on each colour channel of a robot
-            camera's pixels, in intensity levels (0-255).
-        depth_sigma: standard deviation (m) of a robot camera's depth at 1 m; it grows with the
-            square of the distance, as a stereo pair's does.
-        odometry_drift: relative error of the robots' odometry (0.02 = 2 %): each step's distance and
-            turn are scaled by ``1 + drift * (bias + noise)`` (see :mod:`alica.worldsim.odometry`);
-            0 keeps every robot's pose estimate equal to its true pose.
-    """
+    noise: SensorNoise
 
-    lidar_sigma: float = 0.0
-    position_sigma: float = 0.03
-    camera_misclassification: float = 0.1
-    stereo_misclassification: float = 0.01
-    pixel_sigma: float = 2.0
-    depth_sigma: float = 0.005
-    odometry_drift: float = 0.0
+    @property
+    def robots(self) -> Mapping[str, PoweredRobot]:
+        """Robots by name."""
+        ...
+
+    @property
+    def rng(self) -> np.random.Generator:
+        """The world's seeded generator (slips are drawn from it)."""
+        ...
 
 
 def _probability(value: float, what: str) -> float:
@@ -74,16 +67,16 @@ class Faults:
 
     __slots__ = ("_world", "grasp_slip")
 
-    def __init__(self, world: World) -> None:
+    def __init__(self, world: FaultedWorld) -> None:
         self._world = world
         #: Probability that a grasp slips (see :meth:`set_grasp_slip`).
         self.grasp_slip = 0.0
 
-    def crash(self, robot: Robot | str) -> None:
+    def crash(self, robot: PoweredRobot | str) -> None:
         """Crash a robot (power loss): it stops, drops what it holds and ignores every later command."""
         self._robot(robot).crash()
 
-    def recover(self, robot: Robot | str) -> None:
+    def recover(self, robot: PoweredRobot | str) -> None:
         """Power a crashed robot up again: it takes commands from where it stopped."""
         self._robot(robot).recover()
 
@@ -113,7 +106,7 @@ class Faults:
         self._world.noise = dataclasses.replace(noise, **changes)
         return self._world.noise
 
-    def _robot(self, robot: Robot | str) -> Robot:
+    def _robot(self, robot: PoweredRobot | str) -> PoweredRobot:
         if isinstance(robot, str):
             if robot not in self._world.robots:
                 raise WorldError(f"no robot named '{robot}' (robots: {', '.join(sorted(self._world.robots)) or '-'})")
@@ -132,23 +125,32 @@ class Faults:
         return at
 
 
-def crash(robot: Robot) -> None:
+class WorldWithFaults(Protocol):
+    """A world with fault settings (``world.faults``)."""
+
+    @property
+    def faults(self) -> Faults:
+        """The world's fault settings."""
+        ...
+
+
+def crash(robot: PoweredRobot) -> None:
     """Crash ``robot`` (it stops acting and drops what it holds; commands are ignored)."""
     robot.crash()
 
 
-def recover(robot: Robot) -> None:
+def recover(robot: PoweredRobot) -> None:
     """Power ``robot`` up again after a crash."""
     robot.recover()
 
 
-def set_grasp_slip(world: World, probability: float) -> None:
+def set_grasp_slip(world: WorldWithFaults, probability: float) -> None:
     """Set the probability that a grasp in ``world`` slips (see :meth:`Faults.set_grasp_slip`)."""
     world.faults.set_grasp_slip(probability)
 
 
 def set_sensor_noise(
-    world: World,
+    world: WorldWithFaults,
     lidar_sigma: float | None = None,
     position_sigma: float | None = None,
     *,

@@ -3,10 +3,15 @@
 Skills (:mod:`alica.skills`) act on a world through these Protocols, never on
 pybullet directly. :class:`~alica.worldsim.world.World` satisfies
 :class:`RobotWorld` (its robots :class:`MobileRobot`, its objects
-:class:`WorldThing`; checked by mypy below and by a test); a real robot's
-driver satisfies them too by offering the same members.
+:class:`WorldThing`; checked by mypy in :mod:`alica.worldsim` and by a test); a
+real robot's driver satisfies them too by offering the same members.
 
-Every object has a ``kind`` (one of :data:`~alica.worldsim.objects.OBJECT_KINDS`),
+The interface imports only plain data of the world and re-exports it, so a
+skill needs no other module of the world for it: :class:`CameraImage` (what
+``robot.camera()`` returns), :class:`RobotSpec` (``robot.spec``) and the
+vocabularies :data:`SAMPLE_KINDS` and :data:`OBJECT_KINDS`.
+
+Every object has a ``kind`` (one of :data:`OBJECT_KINDS`),
 a ``radius`` and ``half_extents`` (zeros when they do not apply), so a skill
 reads ``obj.kind`` instead of probing for it. Arms and their planning scenes
 have an interface of their own (:mod:`alica.worldsim.arm_interface`).
@@ -17,16 +22,18 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
+from alica.worldsim.camera_image import CameraImage
+from alica.worldsim.kinds import OBJECT_KINDS, SAMPLE_KINDS
+from alica.worldsim.robot_specs import RobotSpec
+
 if TYPE_CHECKING:
     import numpy as np
     import trimesh
 
     from alica.worldsim.arm_interface import RobotArm
     from alica.worldsim.grid import Obstacle2D
-    from alica.worldsim.robot_camera import CameraImage
-    from alica.worldsim.robots import RobotSpec
 
-__all__ = ["MobileRobot", "RobotWorld", "WorldThing"]
+__all__ = ["OBJECT_KINDS", "SAMPLE_KINDS", "CameraImage", "MobileRobot", "RobotSpec", "RobotWorld", "WorldThing"]
 
 Position = tuple[float, float, float]
 Quaternion = tuple[float, float, float, float]
@@ -214,10 +221,3 @@ class RobotWorld(Protocol):
         answers from its own perception.
         """
         ...
-
-
-if TYPE_CHECKING:
-    from alica.worldsim.world import World
-
-    def _world_is_a_robot_world(world: World) -> RobotWorld:
-        return world  # mypy proves that World satisfies the robot interface

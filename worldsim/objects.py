@@ -3,7 +3,8 @@
 Blocks and samples are *movable* (dynamic, graspable); rocks and tables are
 static obstacles; the collection point is a flat marker without collision.
 The bodies are built by :mod:`alica.worldsim.bodies` (through the world's ``add_*``
-methods); this module holds :class:`WorldObject` and the vocabularies.
+methods); this module holds :class:`WorldObject`, the colours and the collision groups;
+the kinds of objects and samples are data of :mod:`alica.worldsim.kinds` (re-exported here).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import trimesh
 from alica.worldsim.errors import WorldError
 from alica.worldsim.geometry import quat_rotate, quat_to_yaw
 from alica.worldsim.grid import Obstacle2D
+from alica.worldsim.kinds import OBJECT_KINDS, SAMPLE_KINDS
 
 __all__ = ["COLOURS", "OBJECT_KINDS", "SAMPLE_KINDS", "WorldObject", "parse_colour", "sample_sections"]
 
@@ -35,19 +37,6 @@ COLOURS: dict[str, tuple[float, float, float, float]] = {
     "brown": (0.5, 0.33, 0.18, 1.0),
 }
 BLOCK_PALETTE = ("red", "blue", "green", "yellow", "orange", "purple", "cyan", "white")
-
-#: The six IMPERA sample containers: upper and lower section green or red (unordered), middle black or white.
-SAMPLE_KINDS: tuple[str, ...] = (
-    "green-black-green",
-    "green-black-red",
-    "red-black-red",
-    "green-white-green",
-    "green-white-red",
-    "red-white-red",
-)
-
-#: The ``kind`` values of :class:`WorldObject`.
-OBJECT_KINDS: tuple[str, ...] = ("block", "sample", "rock", "table", "collection_point", "terrain")
 
 #: Collision filter bit of movable objects; robot arms collide only with these.
 MOVABLE_GROUP = 8

@@ -27,7 +27,7 @@ import numpy as np
 from alica.worldsim.geometry import wrap_angle
 
 if TYPE_CHECKING:
-    from alica.worldsim.robots import Robot
+    from alica.worldsim.sensing import SensingRobot
 
 __all__ = ["Odometry"]
 
@@ -47,7 +47,7 @@ class Odometry:
 
     __slots__ = ("_block", "_k", "_rng", "_robot", "_unit_bias", "_x", "_y", "_yaw", "distance", "following")
 
-    def __init__(self, robot: Robot, seed: int) -> None:
+    def __init__(self, robot: SensingRobot, seed: int) -> None:
         self._robot = robot
         self._rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, zlib.crc32(robot.name.encode()), 11])
         self._unit_bias = tuple(float(v) for v in self._rng.standard_normal(2))
@@ -109,7 +109,7 @@ class Odometry:
         self._yaw = wrap_angle(self._yaw + dyaw)
 
     def _drift(self) -> float:
-        return float(getattr(self._robot.world.noise, "odometry_drift", 0.0))
+        return float(self._robot.world.noise.odometry_drift)
 
     def _state(self) -> tuple[float, float, float, float, bool]:
         return (self._x, self._y, self._yaw, self.distance, self.following)

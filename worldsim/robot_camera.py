@@ -33,16 +33,15 @@ camera sees: perception skills get pixels and depths only.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from alica.worldsim.camera_image import CameraImage
 from alica.worldsim.errors import WorldError
 
 if TYPE_CHECKING:
-    from alica.worldsim.interface import MobileRobot
-    from alica.worldsim.robots import Robot
+    from alica.worldsim.sensing import SensingRobot
 
 #: The camera sits this fraction of the robot's radius ahead of its centre.
 MOUNT_FORWARD = 0.8
@@ -54,64 +53,8 @@ TILT = math.radians(15.0)
 NEAR = 0.05
 
 
-@dataclass(frozen=True)
-class CameraImage:
-    """One picture of a robot's camera (see the module docstring).
-
-    Attributes:
-        rgb: colour image, ``(height, width, 3)`` ``uint8``.
-        depth: metres along the optical axis, ``(height, width)``; ``inf`` where nothing was hit.
-        intrinsics: ``(fx, fy, cx, cy)`` in pixels.
-        position: the camera centre in the world, metres.
-        rotation: 3x3 rotation, world from camera (OpenCV axes: x right, y down, z forward).
-        time: the simulated time of the picture.
-        pan: the pan angle the picture was taken at, radians left of the heading.
-        offset: ``(u0, v0)``: where this picture lies in the camera's frame; a picture of a
-            ``window`` of the frame (see :func:`robot_camera`) is its pixels ``[v0:v0+height, u0:u0+width]``.
-            The intrinsics are this picture's (the principal point shifted by the offset).
-        frame: ``(width, height)`` of the whole frame; ``None``: the picture is the whole frame.
-    """
-
-    rgb: np.ndarray
-    depth: np.ndarray
-    intrinsics: tuple[float, float, float, float]
-    position: np.ndarray
-    rotation: np.ndarray
-    time: float
-    pan: float = 0.0
-    offset: tuple[int, int] = (0, 0)
-    frame: tuple[int, int] | None = None
-
-    @property
-    def frame_size(self) -> tuple[int, int]:
-        """``(width, height)`` of the camera's whole frame (this picture's size when it is the whole frame)."""
-        if self.frame is not None:
-            return self.frame
-        h, w = self.depth.shape
-        return w, h
-
-    def points(self, max_depth: float = math.inf) -> np.ndarray:
-        """World points of every pixel with a depth below ``max_depth``: ``(n, 3)``, row-major pixel order."""
-        fx, fy, cx, cy = self.intrinsics
-        h, w = self.depth.shape
-        v, u = np.mgrid[0:h, 0:w]
-        d = self.depth
-        keep = np.isfinite(d) & (d < max_depth)
-        z = d[keep]
-        cam = np.column_stack([(u[keep] - cx) * z / fx, (v[keep] - cy) * z / fy, z])
-        return cam @ self.rotation.T + self.position
-
-    def project(self, point: np.ndarray | tuple[float, float, float]) -> tuple[float, float, float]:
-        """Pixel ``(u, v)`` and depth of a world point (depth <= 0: behind the camera)."""
-        p = self.rotation.T @ (np.asarray(point, dtype=float) - self.position)
-        fx, fy, cx, cy = self.intrinsics
-        if p[2] <= 1e-9:
-            return math.nan, math.nan, float(p[2])
-        return float(fx * p[0] / p[2] + cx), float(fy * p[1] / p[2] + cy), float(p[2])
-
-
 def camera_pose(
-    robot: MobileRobot, pose: tuple[float, float, float] | None = None, pan: float = 0.0
+    robot: SensingRobot, pose: tuple[float, float, float] | None = None, pan: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """Where the robot's camera is and how it is turned: ``(position, rotation world-from-camera)``.
 
@@ -137,7 +80,7 @@ def camera_pose(
 
 
 def robot_camera(
-    robot: Robot,
+    robot: SensingRobot,
     *,
     width: int = 320,
     height: int = 240,
@@ -164,13 +107,11 @@ def robot_camera(
     Raises:
         WorldError: a robot without a camera, a closed world, a bad size, field of view, range, pan angle or window.
     """
-    from alica.worldsim.world import pybullet
-
     spec = robot.spec
     if not ({"camera", "stereo_camera"} & spec.capabilities):
         raise WorldError(f"robot '{robot.name}' ({spec.kind}) has no camera")
     world = robot.world
-    if getattr(world, "closed", False):
+    if world.closed:
         raise WorldError("robot_camera: the world is closed")
     if not (isinstance(width, int) and isinstance(height, int) and 8 <= width <= 4096 and 8 <= height <= 4096):
         raise WorldError(
@@ -212,7 +153,7 @@ def robot_camera(
         ]
     )
     w, h = u1 - u0, v1 - v0
-    _, _, rgba, zbuffer, _ = client.getCameraImage(w, h, view, projection, renderer=pybullet.ER_TINY_RENDERER, shadow=0)
+    _, _, rgba, zbuffer, _ = client.getCameraImage(w, h, view, projection, renderer=client.ER_TINY_RENDERER, shadow=0)
     rgb = np.asarray(rgba, dtype=np.uint8).reshape(h, w, 4)[:, :, :3].astype(float)
     z = np.asarray(zbuffer, dtype=float).reshape(h, w)
     depth = far_plane * NEAR / (far_plane - (far_plane - NEAR) * z)

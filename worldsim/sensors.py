@@ -23,11 +23,10 @@ import numpy as np
 
 from alica.worldsim.errors import WorldError
 from alica.worldsim.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
-from alica.worldsim.objects import SAMPLE_KINDS
+from alica.worldsim.kinds import SAMPLE_KINDS
 
 if TYPE_CHECKING:
-    from alica.worldsim.robots import Robot
-    from alica.worldsim.world import World
+    from alica.worldsim.sensing import SensingRobot, SensingWorld
 
 __all__ = ["Detection", "lidar_angles", "lidar_scan", "perceive", "scan_to_grid", "unknown_grid"]
 
@@ -66,7 +65,7 @@ def _level_at_zero(client: Any, body: int) -> bool:
     return abs(position[2]) < 1e-9 and abs(abs(orientation[3]) - 1.0) < 1e-9
 
 
-def _own_bodies(robot: Robot) -> set[int]:
+def _own_bodies(robot: SensingRobot) -> set[int]:
     own = {robot.body_id}
     if robot.arm is not None:
         own.add(robot.arm.body_id)
@@ -75,7 +74,7 @@ def _own_bodies(robot: Robot) -> set[int]:
     return own
 
 
-def _cast(world: World, starts: np.ndarray, ends: np.ndarray, skip: set[int]) -> tuple[np.ndarray, np.ndarray]:
+def _cast(world: SensingWorld, starts: np.ndarray, ends: np.ndarray, skip: set[int]) -> tuple[np.ndarray, np.ndarray]:
     """First hit fraction along each segment and its body id, passing through ``skip`` bodies."""
     c = world.client
     fractions = np.ones(len(starts))
@@ -105,7 +104,7 @@ def _cast(world: World, starts: np.ndarray, ends: np.ndarray, skip: set[int]) ->
 _BOX_PAD = 0.02
 
 
-def _boxes(world: World, own: set[int], z: float) -> np.ndarray | None:
+def _boxes(world: SensingWorld, own: set[int], z: float) -> np.ndarray | None:
     """The axis-aligned boxes ``(xmin, ymin, zmin, xmax, ymax, zmax)`` of every body and link but ``own``,
     grown by :data:`_BOX_PAD`; ``None`` when one is unbounded (other than a ground plane below ``z``).
 
@@ -144,7 +143,9 @@ def _boxes(world: World, own: set[int], z: float) -> np.ndarray | None:
 _STILL: weakref.WeakKeyDictionary[Any, tuple[int, dict[int, str], dict[int, Any]]] = weakref.WeakKeyDictionary()
 
 
-def _ray_reach(world: World, origin: np.ndarray, yaw: float, n_rays: int, rng_max: float, own: set[int]) -> np.ndarray:
+def _ray_reach(
+    world: SensingWorld, origin: np.ndarray, yaw: float, n_rays: int, rng_max: float, own: set[int]
+) -> np.ndarray:
     """How far each ray of a horizontal scan from ``origin`` must be cast: beyond the farthest box it meets.
 
     A ray meets a body's (or link's) axis-aligned box only if its angle lies
@@ -189,7 +190,7 @@ def _ray_reach(world: World, origin: np.ndarray, yaw: float, n_rays: int, rng_ma
 
 
 def lidar_scan(
-    robot: Robot, n_rays: int = 360, max_range: float | None = None, *, noise: float | None = None
+    robot: SensingRobot, n_rays: int = 360, max_range: float | None = None, *, noise: float | None = None
 ) -> np.ndarray:
     """One 2-D scan: ranges in metres from the robot centre, at the angles of :func:`lidar_angles`.
 
@@ -233,7 +234,7 @@ def lidar_scan(
     return ranges
 
 
-def perceive(robot: Robot, max_range: float | None = None, *, fov: float | None = None) -> list[Detection]:
+def perceive(robot: SensingRobot, max_range: float | None = None, *, fov: float | None = None) -> list[Detection]:
     """The samples and blocks the robot sees now, in name order.
 
     An object is seen when its centre is within ``max_range`` of the robot,
@@ -297,7 +298,7 @@ def unknown_grid(bounds: tuple[float, float, float, float], resolution: float = 
     return grid
 
 
-def scan_to_grid(grid: OccupancyGrid, robot: Robot, ranges: np.ndarray, max_range: float | None = None) -> int:
+def scan_to_grid(grid: OccupancyGrid, robot: SensingRobot, ranges: np.ndarray, max_range: float | None = None) -> int:
     """Mark a scan of :func:`lidar_scan` taken at the robot's current pose: rays free, hits occupied.
 
     Args:
