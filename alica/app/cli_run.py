@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
@@ -22,8 +22,24 @@ from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
-def add_parser(sub: Any) -> None:
+    import uvicorn
+
+    from alica.allocation import AgentSpec
+    from alica.app.center.live import LiveHub, LiveSession
+    from alica.app.center.team_feed import CommandLoop
+    from alica.app.processes import Fault, ProcessTeam
+    from alica.app.run_skills import SkillWiring
+    from alica.engine import AgentEngine, SimulatedTeam
+    from alica.engine.agent import Observer
+    from alica.lang.skills import SkillRegistry
+    from alica.model import PlanLibrary
+    from alica.worldsim.world import World
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``run`` subcommand to the ``alica`` parser."""
     p = sub.add_parser(
         "run",
@@ -167,7 +183,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         return _run_team(args, library, plan, roles, wiring, world, perception, session)
 
 
-def _declared_in_files(registry: Any, skills: list[str]) -> str:
+def _declared_in_files(registry: SkillRegistry, skills: list[str]) -> str:
     """A note on the skills a plan file declared (``skills:``): how to bind an implementation to them."""
     declared = [registry.get(name) for name in skills if name in registry]
     declared = [s for s in declared if s.declared_at is not None and s.implementation is None]
@@ -181,7 +197,11 @@ def _declared_in_files(registry: Any, skills: list[str]) -> str:
 
 
 def _trace_header(
-    args: argparse.Namespace, library: Any, plan: str, roles: dict[str, Any], world: Any
+    args: argparse.Namespace,
+    library: PlanLibrary,
+    plan: str,
+    roles: dict[str, str | AgentSpec],
+    world: World | None,
 ) -> dict[str, Any]:
     """The header of the run's trace: the plan file, the root plan, every agent's role, the seed, the world."""
     from alica.allocation import AgentSpec, assign_roles
@@ -207,13 +227,13 @@ def _trace_header(
 
 def _run_team(
     args: argparse.Namespace,
-    library: Any,
+    library: PlanLibrary,
     plan: str,
-    roles: dict[str, Any],
-    wiring: Any,
-    world: Any,
-    perception: Any,
-    session: Any = None,
+    roles: dict[str, str | AgentSpec],
+    wiring: SkillWiring,
+    world: World | None,
+    perception: Callable[[SimulatedTeam], None] | None,
+    session: LiveSession | None = None,
 ) -> int:
     from alica.app.trace_world import WorldTrace, team_grid, tee
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
@@ -224,7 +244,7 @@ def _run_team(
     if not (args.pose_rate > 0 and args.pose_rate < float("inf")):
         raise AlicaError(f"--pose-rate must be a positive number of poses per second, got {args.pose_rate}")
     reasons = _Reasons()
-    observers: list[Any] = [reasons]
+    observers: list[Observer] = [reasons]
     header = _trace_header(args, library, plan, roles, world) if args.trace or args.center else None
     trace = JsonlTrace(args.trace, header=header) if args.trace else None
     if trace is not None:
@@ -315,10 +335,10 @@ def _run_processes(
     args: argparse.Namespace,
     plan: str,
     names: list[str],
-    wiring: Any,
+    wiring: SkillWiring,
     header: dict[str, Any] | None = None,
-    library: Any = None,
-    session: Any = None,
+    library: PlanLibrary | None = None,
+    session: LiveSession | None = None,
 ) -> int:
     """``alica run --processes``: one ``alica agent`` per agent (:mod:`alica.app.processes`).
 
@@ -349,7 +369,7 @@ def _run_processes(
             f"--processes runs the agents on a real network and the wall clock: {', '.join(unsupported)} "
             "only work in the simulated run (leave out --processes)"
         )
-    faults: list[tuple[float, str, Any]] = []
+    faults: list[Fault] = []
     for text in args.crash:
         who, at, _ = _timed("--crash", text)
         faults.append((at, "crash", who))
@@ -416,15 +436,20 @@ def _run_processes(
 class _ProcessCenter:
     """``alica run --processes --center``: the live page of the team of processes this run started."""
 
-    def __init__(self, session: Any, team: Any, header: dict[str, Any] | None, library: Any) -> None:
+    hub: LiveHub
+    """The page's hub, from :meth:`serve` on."""
+
+    def __init__(
+        self, session: LiveSession, team: ProcessTeam, header: dict[str, Any] | None, library: PlanLibrary | None
+    ) -> None:
         from alica.app.center.team_feed import TeamFeed
 
         assert header is not None
         self.session, self.team, self.header, self.library = session, team, header, library
         self.feed = TeamFeed([agent.listen for agent in team.agents.values()], "alica")
         team.on_fault = self.feed.put  # kill -9, restarts and partitions are this process's doing
-        self.server: Any = None
-        self.loop: Any = None
+        self.server: uvicorn.Server | None = None
+        self.loop: CommandLoop | None = None
 
     def serve(self) -> None:
         """Serve the page now (the team's events come once its agents are up)."""
@@ -478,7 +503,9 @@ def _process_reason(agent: dict[str, Any]) -> str:
     return f"ended {status} at {agent.get('path') or 'no plan'}"
 
 
-def _run_showing(team: Any, args: argparse.Namespace, changed: set[str], running_tree: Any) -> None:
+def _run_showing(
+    team: SimulatedTeam, args: argparse.Namespace, changed: set[str], running_tree: Callable[[AgentEngine], str]
+) -> None:
     ticks = 0
     while True:
         if args.ticks is not None and ticks >= args.ticks:
@@ -514,7 +541,7 @@ class _Reasons:
             return
         self.last[event["agent"]] = f"{text} at t={event['t']:.2f} s" if kind != "fault" else text
 
-    def of(self, team: Any, name: str, status: str) -> str | None:
+    def of(self, team: SimulatedTeam, name: str, status: str) -> str | None:
         """Why agent ``name`` has not succeeded: what it waits for, or the last problem reported; ``None`` on success."""
         if status == "success":
             return None
@@ -528,7 +555,7 @@ class _Reasons:
         return "; ".join(parts) or "not started"
 
 
-def _feedback(engine: Any) -> list[tuple[str, str]]:
+def _feedback(engine: AgentEngine) -> list[tuple[str, str]]:
     """Each running behaviour of the agent's plan tree with its own word on its progress (``feedback_message``)."""
     found: list[tuple[str, str]] = []
     nodes = [engine.root] if engine.root is not None else []
@@ -542,7 +569,7 @@ def _feedback(engine: Any) -> list[tuple[str, str]]:
     return found
 
 
-def _waiting(engine: Any) -> str | None:
+def _waiting(engine: AgentEngine) -> str | None:
     """What a running agent waits for: a child's reason (e.g. no valid assignment), else its state's transitions."""
     node = engine.root
     if node is None:

@@ -7,16 +7,21 @@ control center, so none of them imports another command's module.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.app.options import did_you_mean
 from alica.errors import AlicaError
+
+if TYPE_CHECKING:
+    from alica.allocation import AgentSpec
+    from alica.io import Loader
+    from alica.model import AbstractPlan, Document, PlanLibrary
 
 #: Exit codes of every command: valid or done, invalid input or a failed run, a usage error.
 EXIT_OK, EXIT_INVALID, EXIT_USAGE = 0, 1, 2
 
 
-def load_entry(path: str | Path, loader: Any = None) -> tuple[Any, Any]:
+def load_entry(path: str | Path, loader: Loader | None = None) -> tuple[PlanLibrary, Document]:
     """The library of a plan file's set and the file's own document, each file read once."""
     from alica.io import Loader
 
@@ -24,7 +29,7 @@ def load_entry(path: str | Path, loader: Any = None) -> tuple[Any, Any]:
     return loader.load(path), loader.document(path)
 
 
-def root_plans(library: Any, entry: Any, name: str | None) -> list[str]:
+def root_plans(library: PlanLibrary, entry: Document, name: str | None) -> list[str]:
     """The plans to start from: ``name`` if given, else the entry file's plans (and problems) no other uses."""
     if name is not None:
         library.abstract(name)
@@ -34,17 +39,18 @@ def root_plans(library: Any, entry: Any, name: str | None) -> list[str]:
         + [p.name for p in entry.problems]
         + [b.name for b in entry.behaviours if not entry.plans]
     )
-    used = {c for e in (*entry.plans, *entry.plantypes, *entry.problems) for c in library.children(e)}
+    parents: list[AbstractPlan] = [*entry.plans, *entry.plantypes, *entry.problems]
+    used = {c for e in parents for c in library.children(e)}
     roots = [n for n in own if n not in used]
     return roots or own
 
 
 def agent_roles(
-    library: Any,
+    library: PlanLibrary,
     agents: dict[str, str | frozenset[str] | None],
     roleset: str | None,
     options: dict[str, str] | None = None,
-) -> dict[str, Any]:
+) -> dict[str, str | AgentSpec]:
     """Each agent's role (or capabilities); ``options`` names the option that gave an agent its role (``--agents``).
 
     Raises:
@@ -56,7 +62,7 @@ def agent_roles(
     sets = [library.rolesets[roleset]] if roleset in library.rolesets else list(library.rolesets.values())
     known = sorted({r.name for rs in sets for r in rs.roles})
     names = {r.name.lower(): r.name for rs in library.rolesets.values() for r in rs.roles}
-    out: dict[str, Any] = {}
+    out: dict[str, str | AgentSpec] = {}
     for name, role in agents.items():
         option = (options or {}).get(name, "--agents")
         if isinstance(role, frozenset):

@@ -29,7 +29,7 @@ import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any
+from typing import IO, Any, Literal
 
 from alica.comm.faults import describe_fault
 from alica.comm.relay import LinkRelay
@@ -40,6 +40,14 @@ POLL = 0.05
 """Seconds between two looks at the agents and the faults due."""
 STOP_GRACE = 10.0
 """Seconds an agent process has to exit after SIGTERM before it is killed."""
+
+#: A fault of :meth:`ProcessTeam.run`, ``(t, kind, what)`` with ``t`` in seconds since the start:
+#: ``(t, "crash", name)``, ``(t, "recover", name)``, ``(t, "partition", (groups, start, end))`` or ``(t, "heal", None)``.
+Fault = (
+    tuple[float, Literal["crash", "recover"], str]
+    | tuple[float, Literal["partition"], tuple[list[list[str]], float, float | None]]
+    | tuple[float, Literal["heal"], None]
+)
 
 
 @dataclass
@@ -164,7 +172,7 @@ class ProcessTeam:
 
     def run(
         self,
-        faults: Sequence[tuple[float, str, Any]],
+        faults: Sequence[Fault],
         max_time: float,
         *,
         on_started: Callable[[int, float], None] | None = None,
@@ -182,13 +190,13 @@ class ProcessTeam:
         announced = on_started is None
         while not self.done() and self.now() < max_time:
             while pending and self.now() >= pending[0][0]:
-                _, kind, what = pending.pop(0)
-                if kind == "crash":
-                    self.crash(what)
-                elif kind == "recover":
-                    self.recover(what)
-                elif kind == "partition":
-                    self.partition(*what)
+                fault = pending.pop(0)
+                if fault[1] == "crash":
+                    self.crash(fault[2])
+                elif fault[1] == "recover":
+                    self.recover(fault[2])
+                elif fault[1] == "partition":
+                    self.partition(*fault[2])
                 else:
                     self.heal()
             self.exited()
@@ -293,7 +301,7 @@ class ProcessTeam:
         except KeyError:
             raise AlicaError(f"no agent named '{name}' in the team; agents: {', '.join(self.agents)}") from None
 
-    def _fault(self, kind: str, **fields: Any) -> None:
+    def _fault(self, kind: str, **fields: object) -> None:
         record = {
             "t": round(self.now(), 3),
             "agent": fields.pop("agent", "-"),

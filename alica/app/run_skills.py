@@ -5,13 +5,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.errors import AlicaError
 from alica.lang.skills import SkillRegistry, SkillSpec
 from alica.model import Behaviour, PlanLibrary, PlanningProblem
+
+if TYPE_CHECKING:
+    from alica.engine import SimulatedTeam
+    from alica.worldsim.world import World
 
 
 def plan_skills(library: PlanLibrary, plan: str) -> list[str]:
@@ -105,7 +109,7 @@ def skill_wiring(
     return SkillWiring(view, real, scripted)
 
 
-def _blocks_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
+def _blocks_world(args: argparse.Namespace, agents: Sequence[str]) -> World:
     from alica.worldsim.scenarios import blocksworld
 
     stacks = [[b.strip() for b in stack.split(",") if b.strip()] for stack in args.stacks.split(";") if stack.strip()]
@@ -126,7 +130,7 @@ def _blocks_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
     return world
 
 
-def _lunar_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
+def _lunar_world(args: argparse.Namespace, agents: Sequence[str]) -> World:
     from alica.app.skill_options import lunar_field
 
     world = lunar_field(args)
@@ -142,7 +146,9 @@ def _lunar_world(args: argparse.Namespace, agents: Sequence[str]) -> Any:
 
 
 @contextlib.contextmanager
-def run_world(args: argparse.Namespace, agents: Sequence[str]) -> Iterator[tuple[Any, Any]]:
+def run_world(
+    args: argparse.Namespace, agents: Sequence[str]
+) -> Iterator[tuple[World | None, Callable[[SimulatedTeam], None] | None]]:
     """The world of ``--world`` (closed afterwards) and its perception hook; ``(None, None)`` without it."""
     if args.world is None:
         yield None, None
@@ -154,7 +160,7 @@ def run_world(args: argparse.Namespace, agents: Sequence[str]) -> Iterator[tuple
     with _c_prints_to_stderr():
         world = _blocks_world(args, agents) if args.world == "blocks" else _lunar_world(args, agents)
     try:
-        perception = None
+        perception: Callable[[SimulatedTeam], None] | None = None
         if args.world == "blocks":
             from alica.worldsim.scenarios import blocks_perception
 

@@ -11,6 +11,7 @@ from alica.app.options import add_field_options
 
 if TYPE_CHECKING:
     from alica.lang.skills import SkillRegistry
+    from alica.worldsim.world import World
 
 #: Origin of the shipped catalogue's declarations (its entry point's module).
 SHIPPED = "alica.skills.catalog"
@@ -33,7 +34,7 @@ def add_lunar_options(parser: Any) -> None:
     add_field_options(parser)
 
 
-def lunar_field(args: argparse.Namespace) -> Any:
+def lunar_field(args: argparse.Namespace) -> World:
     """The lunar world of ``args`` (seed, rocks, samples, size).
 
     Raises:

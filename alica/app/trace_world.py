@@ -25,11 +25,16 @@ from __future__ import annotations
 import hashlib
 import math
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from alica.engine.trace import MAP_ENCODING, encode_cells
+
+if TYPE_CHECKING:
+    from alica.engine import SimulatedTeam
+    from alica.skills.mapping import LogOddsGrid
+    from alica.worldsim.world import World
 
 #: Robot poses per simulated second, by default.
 POSE_HZ = 2.0
@@ -59,7 +64,7 @@ def tee(sinks: Sequence[Sink]) -> Sink:
     return each
 
 
-def team_grid(team: Any) -> Any:
+def team_grid(team: SimulatedTeam) -> LogOddsGrid | None:
     """The team map (:func:`alica.skills.mapping.team_map`) of the first running agent that has one, else ``None``."""
     from alica.skills.mapping import team_map
 
@@ -70,7 +75,9 @@ def team_grid(team: Any) -> Any:
     return None
 
 
-def world_header(world: Any, kind: str, *, pose_hz: float = POSE_HZ, map_every: float | None = None) -> dict[str, Any]:
+def world_header(
+    world: World | None, kind: str, *, pose_hz: float = POSE_HZ, map_every: float | None = None
+) -> dict[str, Any]:
     """The header fields (:func:`alica.engine.trace.trace_header`) of a run in ``world`` (``None``: no world)."""
     if world is None:
         return {"world": "none", "bounds": None}
@@ -108,10 +115,10 @@ class WorldTrace:
     def __init__(
         self,
         sink: Sink,
-        world: Any,
+        world: World,
         *,
         alive: Callable[[str], bool] | None = None,
-        team_map: Callable[[], Any] | None = None,
+        team_map: Callable[[], LogOddsGrid | None] | None = None,
         pose_hz: float = POSE_HZ,
         map_every: float = MAP_EVERY,
     ) -> None:

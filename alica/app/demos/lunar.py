@@ -39,7 +39,15 @@ from alica.errors import AlicaError
 from alica.io.loader import plans_dir
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from alica.app.center.live import LiveSession
+    from alica.engine import SimulatedTeam
+    from alica.engine.agent import Observer
+    from alica.prophet.tasks import CreatedTasks
+    from alica.skills.mapping import LogOddsGrid
+    from alica.worldsim.robots import Robot
+    from alica.worldsim.world import World
 
 MISSION = plans_dir() / "lunar" / "impera.yaml"
 PLAN = "ImperaMission"
@@ -234,7 +242,7 @@ class Operator:
         self.chosen: list[str] = []
         self.reason = ""
 
-    def read(self, team: Any) -> bool:
+    def read(self, team: SimulatedTeam) -> bool:
         """Update the found samples from the running agents' world models; whether ``explored`` holds."""
         explored = False
         for engine in team.running():
@@ -282,11 +290,11 @@ class Operator:
 def run_lunar(
     config: LunarConfig,
     *,
-    observers: Iterable[Callable[[dict[str, Any]], None]] = (),
+    observers: Iterable[Observer] = (),
     on_second: Callable[[dict[str, Any]], None] | None = None,
     out: Path | None = None,
     gui: bool = False,
-    prepare_world: Callable[[Any], None] | None = None,
+    prepare_world: Callable[[World], None] | None = None,
     live: LiveSession | None = None,
 ) -> LunarResult:
     """Run the lunar mission once (see the module docstring).
@@ -337,7 +345,7 @@ def run_lunar(
     trace = JsonlTrace(out / "trace.jsonl", header=header) if out is not None else None
     hub = live.start(header, library) if live is not None else None
     sinks = [s for s in (trace, hub) if s is not None]
-    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *sinks]
+    watchers: list[Observer] = [counter, *observers, *sinks]
     settings = engine_config(frequency=config.frequency)
     try:
         if prepare_world is not None:
@@ -423,18 +431,18 @@ def run_lunar(
         world.close()
 
 
-def _made_plans(team: Any) -> list[Any]:
+def _made_plans(team: SimulatedTeam) -> list[CreatedTasks]:
     """Every plan the team generated (each once, crashed agents' too), in the order of generation and version."""
     from alica.prophet import made_plans
 
-    seen: dict[str, tuple[int, int, Any]] = {}
+    seen: dict[str, tuple[int, int, CreatedTasks]] = {}
     for engine in team.engines.values():
         for generation, version, created in made_plans(engine):
             seen.setdefault(created.plan.name, (generation, version, created))
     return [created for _, _, created in sorted(seen.values(), key=lambda m: (m[0], m[1], m[2].plan.name))]
 
 
-def replica_views(team: Any) -> dict[str, Any]:
+def replica_views(team: SimulatedTeam) -> dict[str, Any]:
     """What each running robot's replica of the world model holds, and whether they agree.
 
     Returns:
@@ -464,11 +472,11 @@ def replica_views(team: Any) -> dict[str, Any]:
     return {"agree": agree, "found": found, "map_digest": digest}
 
 
-def _gui(gui: bool) -> dict[str, Any]:
+def _gui(gui: bool) -> dict[str, bool]:
     return {"gui": True} if gui else {}
 
 
-def _mission_knowledge(team: Any, world: Any, base: tuple[float, float]) -> None:
+def _mission_knowledge(team: SimulatedTeam, world: World, base: tuple[float, float]) -> None:
     """What every robot knows at the start: where g is, and whether its own hand is empty."""
     for name, engine in team.engines.items():
         wm = engine.world_model
@@ -485,10 +493,10 @@ class _Run:
     def __init__(
         self,
         config: LunarConfig,
-        team: Any,
-        world: Any,
+        team: SimulatedTeam,
+        world: World,
         base: tuple[float, float],
-        trace: Callable[[dict[str, Any]], None] | None = None,
+        trace: Observer | None = None,
     ) -> None:
         self.config = config
         self.trace = trace  # where ``found`` events go (the trace file), if anywhere
@@ -501,7 +509,7 @@ class _Run:
         self.distance = dict.fromkeys(config.robots, 0.0)
         self.tracks: dict[str, list[tuple[float, float]]] = {n: [] for n in config.robots}
         self.crash_places: dict[str, tuple[float, float]] = {}
-        self.truth_free: Any = None
+        self.truth_free: np.ndarray | None = None
         self._coverage = 0.0
         self._coverage_at = -math.inf
 
@@ -600,7 +608,7 @@ class _Run:
                 out.append(name)
         return out
 
-    def team_map(self) -> Any:
+    def team_map(self) -> LogOddsGrid | None:
         from alica.app.trace_world import team_grid
 
         return team_grid(self.team)
@@ -649,13 +657,12 @@ class _Run:
         )
 
 
-def _held_name(robot: Any) -> str | None:
-    arm = getattr(robot, "arm", None)
-    held = getattr(arm, "held", None) if arm is not None else None
-    return getattr(held, "name", None)
+def _held_name(robot: Robot) -> str | None:
+    held = robot.arm.held if robot.arm is not None else None
+    return held.name if held is not None else None
 
 
-def _lifts_sample(world: Any, name: str) -> bool:
+def _lifts_sample(world: World, name: str) -> bool:
     """Whether robot ``name`` holds a sample lifted off the ground (the grasp is done; the lift is under way)."""
     held = _held_name(world.robots[name])
     obj = world.objects.get(held) if held is not None else None
