@@ -8,36 +8,51 @@ are the phases of the monolithic :class:`~alica.skills.handling.Pickup` and
 arm planning, execution and checks (:class:`~alica.skills.handling.ArmSkill`).
 
 What the gripper holds is in the world (``robot.arm``); the steps hand the
-rest on in the agent's scratch space (``context.scratch``):
+rest on in the agent's scratch space (``context.scratch``), in the typed slots
+of :mod:`alica.skills.arm_scratch`:
 
-``"grasp"``
-    ``{"object", "attempts", "retry"}``: the grasp attempts on an object
-    (Grasp counts them, OpenGripper marks the next one a retry,
-    ValidateGrip's success ends the count).
-``"names"``
-    ``{name: world name}``: the world object each name a plan gave Grasp stands for.
-``"held"``
-    ``{"object", "world"}``: what Grasp took (the plan's name and the world's);
-    OpenGripper and ValidateGrip (on a slip) drop it.
-``"arm_retreat"``
-    ``{"robot", "paths"}``: the rest of the last arm plan (the lift after a
-    grasp, the retreat after a placement), which MoveArmToTransport follows
-    when it starts where the arm is.
-``"tried_sides"``
-    ``{"object", "sides"}``: stand-off points from which Grasp found no arm
-    plan; AlignWithObject takes another side of the object.
+``"grasp"`` (:class:`~alica.skills.arm_scratch.GraspCount`)
+    the grasp attempts on an object (Grasp counts them, OpenGripper marks
+    the next one a retry, ValidateGrip's success ends the count).
+``"names"`` (:class:`~alica.skills.arm_scratch.GraspedNames`)
+    the world object each name a plan gave Grasp stands for.
+``"held"`` (:class:`~alica.skills.arm_scratch.Held`)
+    what Grasp took (the plan's name and the world's); OpenGripper and
+    ValidateGrip (on a slip) drop it.
+``"arm_retreat"`` (:class:`~alica.skills.arm_scratch.Retreat`)
+    the rest of the last arm plan (the lift after a grasp, the retreat after
+    a placement), which MoveArmToTransport follows when it starts where the arm is.
+``"tried_sides"`` (:class:`~alica.skills.arm_scratch.TriedSides`)
+    stand-off points from which Grasp found no arm plan; AlignWithObject
+    takes another side of the object.
+``"aligned"`` (:class:`~alica.skills.arm_scratch.Aligned`)
+    where AlignWithObject left the robot.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
 from alica.skills.arm_motion import ArmStep, arm_xy, held_object_box
+from alica.skills.arm_scratch import (
+    ALIGNED,
+    ARM_RETREAT,
+    GRASP,
+    HELD,
+    NAMES,
+    TRIED_SIDES,
+    Aligned,
+    GraspCount,
+    GraspedNames,
+    Held,
+    Retreat,
+    TriedSides,
+)
 from alica.skills.arm_world import REACH, find_object, place_area, write_held, write_placed, write_released
 from alica.skills.handling import PLACE_TOLERANCE, SETTLE, ArmSkill, Phase, Pickup, Putdown
 from alica.skills.world_skill import WorldSkill, distance, number_param
@@ -55,19 +70,19 @@ REACH_SLACK = 0.25
 ON_GROUND = 0.03
 
 
-def _scratch(skill: WorldSkill) -> dict[str, Any]:
+def _scratch(skill: WorldSkill) -> dict[str, object]:
     """The agent's scratch space (an own dict when the context has none)."""
-    scratch = skill.context.scratch if skill.context is not None else None
-    if scratch is None:
-        scratch = skill.__dict__.setdefault("_own_scratch", {})
-    return cast("dict[str, Any]", scratch)
+    if skill.context is not None:
+        return skill.context.scratch
+    own: dict[str, object] = skill.__dict__.setdefault("_own_scratch", {})
+    return own
 
 
 def _label(skill: WorldSkill, obj: WorldThing) -> str:
     """The name the plan gave the held object ``obj`` (the world's name when Grasp did not take it)."""
-    held = _scratch(skill).get("held")
-    if isinstance(held, dict) and held.get("world") == obj.name:
-        return str(held["object"])
+    held = HELD.get(_scratch(skill))
+    if held is not None and held.world == obj.name:
+        return held.object
     return obj.name
 
 
@@ -98,9 +113,9 @@ class AlignWithObject(ArmSkill):
         self.standoff_m = None if given is None else number_param(self, "standoff", None)
         self.tolerance = number_param(self, "tolerance", 0.02)
         self.drives = 0
-        tried = _scratch(self).get("tried_sides")
-        if isinstance(tried, dict) and tried.get("object") == self.object_label():
-            self.approach.tried_sides = [tuple(side) for side in tried.get("sides", [])]
+        tried = TRIED_SIDES.get(_scratch(self))
+        if tried is not None and tried.object == self.object_label():
+            self.approach.tried_sides = list(tried.sides)
 
     def site(self) -> tuple[float, float]:
         """Where the object is: the world model's estimate, else the world's."""
@@ -125,7 +140,7 @@ class AlignWithObject(ArmSkill):
         gap = distance((x, y), site)
         wanted = self.standoff()
         if abs(gap - wanted) <= self.tolerance + 1e-9:
-            _scratch(self)["aligned"] = {"object": self.object_label(), "site": site, "pose": self.robot.estimate}
+            ALIGNED.put(_scratch(self), Aligned(self.object_label(), site, self.robot.estimate))
             return self.succeed(
                 f"facing {self.object_label()} at {gap:.3f} m (stand-off {wanted:.2f} m, tolerance {self.tolerance:g} m)"
             )
@@ -164,11 +179,11 @@ class Grasp(Pickup):
         self.retries = 1
         name = self.object_label()
         scratch = _scratch(self)
-        record = scratch.get("grasp")
-        again = isinstance(record, dict) and record.get("object") == name and record.get("retry")
-        self.attempt = int(cast("dict[str, Any]", record)["attempts"]) + 1 if again else 1
-        scratch["grasp"] = {"object": name, "attempts": self.attempt, "retry": False}
-        scratch.pop("arm_retreat", None)
+        record = GRASP.get(scratch)
+        again = record is not None and record.object == name and record.retry
+        self.attempt = record.attempts + 1 if record is not None and again else 1
+        GRASP.put(scratch, GraspCount(name, self.attempt))
+        scratch.pop(ARM_RETREAT.key, None)
         if self.world_model is not None:
             self.world_model.set("attempts", self.robot.name, value=self.attempt)
         self._retreat: list[np.ndarray] = []
@@ -204,22 +219,19 @@ class Grasp(Pickup):
         """Hand the lift and the names on."""
         scratch = _scratch(self)
         obj = self.target_object()
-        scratch["arm_retreat"] = {"robot": self.robot.name, "paths": self._retreat}
-        scratch["held"] = {"object": self.object_label(), "world": obj.name}
-        names = scratch.setdefault("names", {})
-        names[self.object_label()] = obj.name
+        ARM_RETREAT.put(scratch, Retreat(self.robot.name, self._retreat))
+        HELD.put(scratch, Held(self.object_label(), obj.name))
+        NAMES.setdefault(scratch, GraspedNames).names[self.object_label()] = obj.name
         return self.succeed(f"grasped {self.object_label()} with {self.force:g} N (attempt {self.attempt})")
 
     def _retry(self, reason: str) -> Status:
         """No retry here (the plan retries): fail; remember a side from which no arm plan was found."""
         if reason.startswith("no arm plan"):
             scratch = _scratch(self)
-            tried = scratch.get("tried_sides")
-            sides = (
-                list(tried["sides"]) if isinstance(tried, dict) and tried.get("object") == self.object_label() else []
-            )
+            tried = TRIED_SIDES.get(scratch)
+            sides = list(tried.sides) if tried is not None and tried.object == self.object_label() else []
             x, y, _ = self.robot.estimate
-            scratch["tried_sides"] = {"object": self.object_label(), "sides": [*sides, (float(x), float(y))]}
+            TRIED_SIDES.put(scratch, TriedSides(self.object_label(), [*sides, (float(x), float(y))]))
         if self.arm.held is not None:
             self.arm.open()
         return self.fail(f"attempt {self.attempt}: {reason}")
@@ -245,9 +257,11 @@ class MoveArmToTransport(ArmSkill):
         self.retries = 1
         self.motion.released = True  # stopped midway, the arm goes on to the transport pose (never back)
         self.stored: list[np.ndarray] | None = None
-        record = _scratch(self).pop("arm_retreat", None)
-        if isinstance(record, dict) and record.get("robot") == self.robot.name and record.get("paths"):
-            paths = [np.asarray(p, dtype=float) for p in record["paths"]]
+        scratch = _scratch(self)
+        record = ARM_RETREAT.get(scratch)
+        scratch.pop(ARM_RETREAT.key, None)
+        if record is not None and record.robot == self.robot.name and record.paths:
+            paths = [np.asarray(p, dtype=float) for p in record.paths]
             q = np.asarray(self.arm.q(), dtype=float)
             if float(np.abs(paths[0][0] - q).max()) < 1e-3:
                 self.stored = paths
@@ -330,7 +344,7 @@ class MoveArmToPlace(Putdown):
 
     def finished(self) -> Status:
         """Hand the retreat on."""
-        _scratch(self)["arm_retreat"] = {"robot": self.robot.name, "paths": self._retreat}
+        ARM_RETREAT.put(_scratch(self), Retreat(self.robot.name, self._retreat))
         x, y, _ = self.place_top()
         return self.succeed(f"{self.object_label()} at its place ({x:.2f}, {y:.2f})")
 
@@ -363,10 +377,10 @@ class OpenGripper(WorldSkill):
             if held is not None:
                 self.let_go = _label(self, held)
                 write_released(self, self.let_go)
-                scratch.pop("held", None)
-            grasp = scratch.get("grasp")
-            if isinstance(grasp, dict):
-                grasp["retry"] = True
+                scratch.pop(HELD.key, None)
+            grasp = GRASP.get(scratch)
+            if grasp is not None:
+                grasp.retry = True
             self.until = self.now() + (SETTLE if held is not None else 0.0)
         if self.now() < self.until:
             return self.running(f"letting {self.let_go} settle")
@@ -396,22 +410,22 @@ class ValidateGrip(WorldSkill):
         scratch = _scratch(self)
         held = arm.held
         force = arm.grip_force()
-        record = scratch.get("held")
+        record = HELD.get(scratch)
         if held is None:
-            if not isinstance(record, dict):
+            if record is None:
                 return self.fail(f"the gripper holds nothing (finger force {force:g} N)")
-            name = str(record["object"])
+            name = record.object
             write_released(self, name)
             self.write(True, "onground", name)
-            scratch.pop("held", None)
+            scratch.pop(HELD.key, None)
             return self.fail(
                 f"{name} slipped out of the gripper (finger force {force:g} N, at least {self.min_force:g} N needed)"
             )
         name = _label(self, held)
         if force < self.min_force:
             return self.fail(f"the finger force on {name} is {force:g} N, below {self.min_force:g} N")
-        scratch.pop("grasp", None)
-        scratch.pop("tried_sides", None)
+        scratch.pop(GRASP.key, None)
+        scratch.pop(TRIED_SIDES.key, None)
         write_held(self, name)
         return self.succeed(f"holding {name} with {force:g} N")
 

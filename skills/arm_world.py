@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from alica.errors import SkillError
+from alica.skills.arm_scratch import NAMES
 from alica.skills.world_skill import WorldSkill, distance
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 
@@ -78,9 +79,9 @@ def find_object(skill: WorldSkill, name: object) -> WorldThing:
         SkillError: no such object, and none where the world model puts ``name``.
     """
     objects = skill.world.objects
-    names = (skill.context.scratch if skill.context is not None else {}).get("names")  # what Grasp took under this name
-    if isinstance(name, str) and isinstance(names, dict) and names.get(name) in objects:
-        return objects[names[name]]
+    taken = NAMES.get(skill.context.scratch) if skill.context is not None else None  # what Grasp took under this name
+    if isinstance(name, str) and taken is not None and taken.names.get(name) in objects:
+        return objects[taken.names[name]]
     if isinstance(name, str) and name not in objects and skill.world_model is not None:
         known = skill.world_model.lookup("pos", (name,))
         if isinstance(known, (tuple, list)) and len(known) >= 2:

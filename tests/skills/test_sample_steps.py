@@ -15,6 +15,7 @@ import pytest
 
 from alica.errors import SkillError
 from alica.lang.fact import Fact
+from alica.skills.arm_scratch import ARM_RETREAT
 from alica.worldmodel import WorldModel
 
 pytest.importorskip("pybullet")
@@ -101,7 +102,7 @@ def test_grasp_holds_the_sample_writes_the_facts_and_counts_the_attempt(skill_ru
     assert arm.held is field.objects["a"] and arm.grip_force() == 8.0
     assert run.holds("holding", "stummel", "a") and not run.holds("handempty", "stummel")
     assert run.values[Fact("attempts", ("stummel",))] == 1
-    assert steps.scratch["arm_retreat"]["paths"]  # the lift, for MoveArmToTransport
+    assert ARM_RETREAT.require(steps.scratch, "the test").paths  # the lift, for MoveArmToTransport
 
 
 def test_move_arm_to_transport_plans_its_own_way_without_a_stored_one(skill_run, field):
