@@ -25,14 +25,17 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alica.app.demos.labels import BESIDE, Label, place_labels
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
+
+    from alica.worldsim.world import World
 
 __all__ = [
     "BlockPose",
@@ -92,7 +95,7 @@ class Camera:
     width: int = WIDTH
     height: int = HEIGHT
 
-    def render(self, world: Any) -> np.ndarray:
+    def render(self, world: World) -> np.ndarray:
         """The world's picture through this camera (pybullet's renderer)."""
         from alica.worldsim.camera import render
 
@@ -226,12 +229,11 @@ class BlockPose:
     holder: str = ""
 
 
-def block_poses(world: Any) -> list[BlockPose]:
+def block_poses(world: World) -> list[BlockPose]:
     """Every block of ``world`` with its true centre, edge and holder, in name order."""
     held = {}
     for robot in world.robots.values():
-        arm = getattr(robot, "arm", None)
-        obj = arm.held if arm is not None else None
+        obj = robot.arm.held if robot.arm is not None else None
         if obj is not None:
             held[obj.name] = robot.name
     poses = []
@@ -262,13 +264,13 @@ def read_stacks(blocks: Sequence[BlockPose]) -> list[list[str]]:
     return [[b.name for b in sorted(stack, key=lambda b: b.z)] for stack in sorted(stacks, key=lambda s: s[0].x)]
 
 
-def robot_boxes(world: Any) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+def robot_boxes(world: World) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Each robot's axis-aligned box (low, high), its base and its arm's links together."""
     client = world.client
     boxes = {}
     for name, robot in world.robots.items():
         parts = [client.getAABB(robot.body_id)]
-        arm = getattr(robot, "arm", None)
+        arm = robot.arm
         if arm is not None:
             parts += [client.getAABB(arm.body_id, link) for link in range(-1, client.getNumJoints(arm.body_id))]
         low = np.min([p[0] for p in parts], axis=0)
@@ -283,7 +285,7 @@ def _corners(low: Sequence[float] | np.ndarray, high: Sequence[float] | np.ndarr
     ]
 
 
-def scene_camera(world: Any) -> Camera:
+def scene_camera(world: World) -> Camera:
     """The camera framed on the blocks and the robots of ``world``."""
     points = []
     for block in block_poses(world):
@@ -299,7 +301,7 @@ def scene_camera(world: Any) -> Camera:
     return frame_camera(points)
 
 
-def stacks_camera(world: Any) -> Camera:
+def stacks_camera(world: World) -> Camera:
     """The camera framed on the blocks alone (the close-up), from a lower angle than :func:`scene_camera`."""
     points = []
     for block in block_poses(world):
@@ -313,7 +315,7 @@ def stacks_camera(world: Any) -> Camera:
     return frame_camera(points, pitch=CLOSE_PITCH, margin=1.5 * size, width=CLOSE_WIDTH, height=None)
 
 
-def camera_labels(world: Any, camera: Camera) -> list[Label]:
+def camera_labels(world: World, camera: Camera) -> list[Label]:
     """A label for every robot (at the top of its base) and every block (on the face seen), in image pixels.
 
     Robots come first (fewer, larger), then the blocks from the top of each stack down, so that the
@@ -336,7 +338,7 @@ def _stacks_text(stacks: Sequence[Sequence[str]]) -> str:
     return "  ".join("[" + " ".join(stack) + "]" for stack in stacks) or "none"
 
 
-def _side_view(ax: Any, blocks: Sequence[BlockPose], goal: Sequence[Sequence[str]] | None) -> None:
+def _side_view(ax: Axes, blocks: Sequence[BlockPose], goal: Sequence[Sequence[str]] | None) -> None:
     """The schematic: each stack a column of squares at the blocks' true heights, the held blocks after them."""
     from matplotlib.patches import Rectangle
 
@@ -370,7 +372,7 @@ def _side_view(ax: Any, blocks: Sequence[BlockPose], goal: Sequence[Sequence[str
     ax.set_title("side view from the true poses (stacks left to right)\n" + "\n".join(lines), fontsize=11)
 
 
-def picture_figure(world: Any, *, goal: Sequence[Sequence[str]] | None = None, title: str = "") -> Figure:
+def picture_figure(world: World, *, goal: Sequence[Sequence[str]] | None = None, title: str = "") -> Figure:
     """The picture (see the module docstring) as a matplotlib figure; the caller closes it.
 
     Args:
@@ -407,7 +409,7 @@ def picture_figure(world: Any, *, goal: Sequence[Sequence[str]] | None = None, t
 
 
 def write_picture(
-    world: Any, path: str | Path, *, goal: Sequence[Sequence[str]] | None = None, title: str = ""
+    world: World, path: str | Path, *, goal: Sequence[Sequence[str]] | None = None, title: str = ""
 ) -> Path:
     """Write the picture of ``world`` (see the module docstring) as a PNG; missing folders are made.
 

@@ -11,7 +11,14 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.backend_bases import RendererBase
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.text import Annotation
+    from matplotlib.transforms import Bbox
 
 __all__ = ["BESIDE", "OFFSETS", "Label", "overlap", "place_labels", "text_extent"]
 
@@ -75,7 +82,7 @@ def overlap(a: Box, b: Box) -> float:
     return width * height if width > 0 and height > 0 else 0.0
 
 
-def text_extent(annotation: Any, renderer: Any) -> Any:
+def text_extent(annotation: Annotation, renderer: RendererBase) -> Bbox:
     """The display box of an annotation's text alone (matplotlib's own extent takes in the leader line too)."""
     from matplotlib.text import Text
 
@@ -84,14 +91,14 @@ def text_extent(annotation: Any, renderer: Any) -> Any:
 
 
 def place_labels(
-    ax: Any,
+    ax: Axes,
     labels: Sequence[Label],
     *,
     avoid: Iterable[tuple[float, float]] = (),
     marker_px: float = 8.0,
     box: dict[str, Any] | None = None,
     offsets: Mapping[str, Sequence[tuple[float, float, str, str]]] | None = None,
-) -> list[Any]:
+) -> list[Annotation]:
     """Draw ``labels`` on ``ax`` where they overlap least, in order (put the important ones first).
 
     The axes' limits and aspect must be set before: placement works in display pixels.
@@ -110,7 +117,7 @@ def place_labels(
     """
     fig = ax.figure
     fig.canvas.draw()  # fixes the axes' position (aspect) before anything is measured
-    renderer = fig.canvas.get_renderer()
+    renderer = cast("FigureCanvasAgg", fig.canvas).get_renderer()  # the demos draw with Agg (its canvases measure text)
     frame = ax.get_window_extent(renderer)
     to_px = ax.transData.transform
     points = [(lb.x, lb.y) for lb in labels] + list(avoid)
@@ -120,9 +127,9 @@ def place_labels(
         blocked.append((px - marker_px, py - marker_px, px + marker_px, py + marker_px))
     backing = box if box is not None else {"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.75}
     placed: list[Box] = []
-    drawn: list[Any] = []
+    drawn: list[Annotation] = []
     for index, label in enumerate(labels):
-        best: tuple[float, Any, Box] | None = None
+        best: tuple[float, Annotation, Box] | None = None
         for reach in REACH:
             for dx, dy, ha, va in (offsets or {}).get(label.kind, OFFSETS):
                 if reach > 1.0 and dx == dy == 0.0:

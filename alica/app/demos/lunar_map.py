@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -12,6 +12,10 @@ from alica.app.demos.labels import Label, place_labels
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
+
+    from alica.app.demos.lunar import Operator
+    from alica.skills.mapping import LogOddsGrid
+    from alica.worldsim.world import World
 
 #: Colours of the robots' tracks.
 TRACK_COLOURS = {"scout": "tab:blue", "stummel": "tab:orange", "amparo": "tab:green"}
@@ -26,8 +30,8 @@ BASE_FONT = 11.0
 
 
 def map_labels(
-    world: Any,
-    operator: Any,
+    world: World,
+    operator: Operator,
     tracks: Mapping[str, Sequence[tuple[float, float]]],
     crashes: Mapping[str, tuple[float, float]],
     bodies: Mapping[str, str] | None = None,
@@ -59,7 +63,7 @@ def map_labels(
                 Label(f"{name} crashed", float(x), float(y), "crash", colour="red", size=ROBOT_FONT, bold=True)
             )
             continue
-        points = tracks.get(name) or [tuple(world.robots[name].pose[:2])]
+        points = tracks.get(name) or [world.robots[name].pose[:2]]
         x, y = points[-1]
         labels.append(
             Label(
@@ -78,6 +82,7 @@ def map_labels(
             (n for n, d in off.items() if d < 0.5 and operator.found.get(n, "") in (obj.sample_kind, "")),
             key=off.__getitem__,
         )
+        assert obj.sample_kind is not None  # a sample always has its kind
         text = obj.sample_kind + (f"\nfound as {near[0]}" if near else "\nnot found")
         chosen = bool(near) and near[0] in operator.chosen
         labels.append(Label(text, float(x), float(y), "sample", size=SAMPLE_FONT, bold=chosen))
@@ -85,9 +90,9 @@ def map_labels(
 
 
 def map_figure(
-    world: Any,
-    grid: Any,
-    operator: Any,
+    world: World,
+    grid: LogOddsGrid | None,
+    operator: Operator,
     tracks: Mapping[str, Sequence[tuple[float, float]]],
     crashes: Mapping[str, tuple[float, float]],
     bodies: Mapping[str, str] | None = None,
@@ -143,9 +148,9 @@ def map_figure(
 
 
 def draw_map(
-    world: Any,
-    grid: Any,
-    operator: Any,
+    world: World,
+    grid: LogOddsGrid | None,
+    operator: Operator,
     tracks: Mapping[str, Sequence[tuple[float, float]]],
     crashes: Mapping[str, tuple[float, float]],
     path: Path,
