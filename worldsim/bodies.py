@@ -66,7 +66,7 @@ def make_block(
     c = world.client
     size = _positive(size, f"the size of block {name!r}")
     x, y, z = _xyz(position, 0.5 * size, f"block {name!r}")
-    world._check_in_field(x, y, f"block {name!r}")
+    world.field.check(x, y, f"block {name!r}")
     if colour is None:
         colour = BLOCK_PALETTE[sum(1 for o in world.objects.values() if o.kind == "block") % len(BLOCK_PALETTE)]
     rgba = parse_colour(colour)
@@ -97,7 +97,7 @@ def make_sample(
     radius = _positive(radius, f"the radius of sample {name!r}")
     height = _positive(height, f"the height of sample {name!r}")
     x, y, z = _xyz(position, 0.5 * height, f"sample {name!r}")
-    world._check_in_field(x, y, f"sample {name!r}")
+    world.field.check(x, y, f"sample {name!r}")
     third = height / 3.0
     visuals = [
         c.createVisualShape(c.GEOM_CYLINDER, radius=radius, length=third, rgbaColor=COLOURS[s]) for s in sections
@@ -138,7 +138,7 @@ def make_collection_point(world: World, name: str, position: Sequence[float], ra
     c = world.client
     radius = _positive(radius, f"the radius of collection point {name!r}")
     x, y, _ = _xyz(position, 0.0, f"collection point {name!r}")
-    world._check_in_field(x, y, f"collection point {name!r}")
+    world.field.check(x, y, f"collection point {name!r}")
     rgba = (0.95, 0.8, 0.1, 0.6)
     body = c.createMultiBody(
         baseMass=0.0,
@@ -166,7 +166,7 @@ def make_table(
     ly = _positive(size[1], f"the width of table {name!r}")
     height = _positive(height, f"the height of table {name!r}")
     x, y, _ = _xyz(position, 0.0, f"table {name!r}")
-    world._check_in_field(x, y, f"table {name!r}")
+    world.field.check(x, y, f"table {name!r}")
     half = [0.5 * lx, 0.5 * ly, 0.5 * height]
     rgba = COLOURS["brown"]
     body = c.createMultiBody(
@@ -202,7 +202,7 @@ def make_rock(
     c = world.client
     radius = _positive(radius, f"the radius of rock {name!r}")
     x, y, z = _xyz(position, 0.0, f"rock {name!r}")
-    world._check_in_field(x, y, f"rock {name!r}")
+    world.field.check(x, y, f"rock {name!r}")
     mesh = rock_mesh(radius, seed, height_ratio)
     vertices = mesh.vertices.tolist()
     shade = 0.42 + 0.12 * np.random.default_rng(seed).random()

@@ -238,7 +238,7 @@ class Robot:
                 raise WorldError(f"set_pose of robot '{self.name}' takes (x, y, yaw), got {x!r}") from None
         x, y = float(x), float(y)  # type: ignore[arg-type]
         yaw = self._yaw if yaw is None else float(yaw)
-        self._world._check_in_field(x, y, f"robot '{self.name}'", self.spec.radius)
+        self._world.field.check(x, y, f"robot '{self.name}'", self.spec.radius)
         self._x, self._y, self._yaw = x, y, wrap_angle(yaw)
         self._near_at = (math.inf, math.inf)
         self._apply_pose()

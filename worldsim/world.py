@@ -24,24 +24,21 @@ from alica.worldsim import queries as _queries
 from alica.worldsim._quiet import quiet_stdout
 from alica.worldsim.errors import WorldError
 from alica.worldsim.faults import Faults, SensorNoise
+from alica.worldsim.field import Field
 from alica.worldsim.geometry import Footprints
 from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.objects import WorldObject
+from alica.worldsim.resting import SETTLE_STEPS, Resting
 from alica.worldsim.robots import ROBOT_KINDS, Robot, RobotSpec
+from alica.worldsim.snapshots import Snapshots
 
 with quiet_stdout():
     import pybullet
     from pybullet_utils.bullet_client import BulletClient
 
-__all__ = ["Obstacle2D", "World", "WorldError", "WorldObject"]
+__all__ = ["SETTLE_STEPS", "Obstacle2D", "World", "WorldError", "WorldObject"]
 
 logger = logging.getLogger(__name__)
-
-#: Physics steps every free object must be still before a world with ``rest_when_still`` skips pybullet's step.
-SETTLE_STEPS = 120
-#: Speed (m/s) and spin (rad/s) below which a free object counts as still.
-STILL_SPEED = 1e-3
-STILL_SPIN = 1e-2
 
 
 class World:
@@ -58,13 +55,18 @@ class World:
         quiet: hide pybullet's C-level prints while connecting and loading models.
         rest_when_still: skip pybullet's step while nothing can move a body: no arm follows a
             path, nothing was added, removed, grasped or released, and every free object has
-            been still for :data:`SETTLE_STEPS` steps. Robots, arms and the clock go on as usual;
+            been still for :data:`~alica.worldsim.resting.SETTLE_STEPS` steps. Robots, arms and the clock go on as usual;
             resting bodies stay where they are (as pybullet's own sleeping would keep them), and
             the run stays deterministic. Off by default: code that pushes bodies through
             :attr:`client` directly needs every step.
         arm_visuals: load the arms' detailed visual meshes. Without them pybullet draws the arms
             (in the GUI, pictures and the robots' cameras) from their collision hulls, and each
             arm costs about 1 MB instead of about 48 MB in pybullet's renderer; physics is the same.
+
+    Attributes:
+        field: the :class:`~alica.worldsim.field.Field` (its bounds) that robots and objects stay in.
+        faults: the fault settings (:class:`~alica.worldsim.faults.Faults`); ``noise`` the sensors' noise.
+        snapshots: saved states to go back to (:class:`~alica.worldsim.snapshots.Snapshots`).
 
     Raises:
         WorldError: a non-positive time step or empty bounds.
@@ -96,7 +98,8 @@ class World:
         self.quiet = bool(quiet)
         self.arm_visuals = bool(arm_visuals)
         self._time_step = float(time_step)
-        self._bounds = tuple(float(b) for b in bounds)
+        xmin, ymin, xmax, ymax = (float(b) for b in bounds)
+        self.field = Field((xmin, ymin, xmax, ymax))
         self.robots: dict[str, Robot] = {}
         self.objects: dict[str, WorldObject] = {}
         self.faults = Faults(self)
@@ -106,12 +109,11 @@ class World:
         self._steps = 0
         self._pending = 0.0
         self.rest_when_still = bool(rest_when_still)
-        self._still = 0
-        self._seen_version = -1
         self.physics_steps = 0
-        self._states: dict[int, dict[str, Any]] = {}
         self._closed = False
-        self._client = self._connect(gui)
+        self._client = _connect(gui, self.quiet)
+        self.snapshots = Snapshots(self)
+        self._resting = Resting(self._client, self.objects, self._held_bodies)
         c = self._client
         c.setGravity(0.0, 0.0, -9.81)
         c.setTimeStep(self._time_step)
@@ -122,22 +124,6 @@ class World:
         self._step_simulation = c.stepSimulation
         if ground:
             self.add_terrain()
-
-    def _connect(self, gui: bool) -> Any:
-        mode = pybullet.DIRECT
-        if gui:
-            if os.environ.get("DISPLAY"):
-                mode = pybullet.GUI
-            else:
-                logger.warning(
-                    "gui=True but DISPLAY is not set; running without a GUI (pybullet would exit without an X server)"
-                )
-        with quiet_stdout(self.quiet):
-            client = BulletClient(connection_mode=mode)
-            if client._client < 0 and mode == pybullet.GUI:
-                logger.warning("could not open a pybullet GUI (only one per process); running without one")
-                client = BulletClient(connection_mode=pybullet.DIRECT)
-        return client
 
     # ------------------------------------------------------------ properties
     @property
@@ -153,7 +139,7 @@ class World:
     @property
     def bounds(self) -> tuple[float, float, float, float]:
         """The field ``(xmin, ymin, xmax, ymax)``."""
-        return self._bounds  # type: ignore[return-value]
+        return self.field.bounds
 
     @property
     def steps(self) -> int:
@@ -195,7 +181,7 @@ class World:
         t = self.clock.now()
         rest = self.rest_when_still
         for _ in range(n):
-            if not rest or self._physics_needed(arms):
+            if not rest or self._resting.needed(self._version, arms):
                 step_simulation()
                 self.physics_steps += 1
             t += dt
@@ -211,27 +197,6 @@ class World:
         if n:
             self.clock.advance(n * dt)
         return n
-
-    def _physics_needed(self, arms: list[Any]) -> bool:
-        """Whether the next physics step can change anything (see ``rest_when_still``)."""
-        if self._version != self._seen_version or any(arm._path is not None for arm in arms):
-            self._seen_version = self._version
-            self._still = 0
-            return True
-        if self._still >= SETTLE_STEPS:
-            return False
-        self._still = 0 if self._anything_moving() else self._still + 1
-        return True
-
-    def _anything_moving(self) -> bool:
-        held = self._held_bodies()
-        velocity = self._client.getBaseVelocity
-        for obj in self.objects.values():
-            if obj.mass > 0.0 and obj.body_id not in held:
-                (vx, vy, vz), (wx, wy, wz) = velocity(obj.body_id)
-                if vx * vx + vy * vy + vz * vz > STILL_SPEED**2 or wx * wx + wy * wy + wz * wz > STILL_SPIN**2:
-                    return True
-        return False
 
     # ------------------------------------------------------------- building
     def add_robot(self, kind: str | RobotSpec, name: str, pose: Sequence[float] = (0.0, 0.0, 0.0)) -> Robot:
@@ -251,8 +216,8 @@ class World:
         if len(pose) != 3 or not all(math.isfinite(float(v)) for v in pose):
             raise WorldError(f"the pose of robot '{name}' is (x, y, yaw) of finite numbers, got {tuple(pose)}")
         x, y, yaw = (float(v) for v in pose)
-        self._check_in_field(x, y, f"robot '{name}'", spec.radius)
-        blocker = self._blocker(x, y, spec.radius)
+        self.field.check(x, y, f"robot '{name}'", spec.radius)
+        blocker = self.blocker(x, y, spec.radius)
         if blocker is not None:
             raise WorldError(f"robot '{name}' at ({x:.2f}, {y:.2f}) would overlap {blocker}; choose a free pose")
         with quiet_stdout(self.quiet):
@@ -342,68 +307,8 @@ class World:
                 f"remove: no robot or object named '{name}' (robots: {', '.join(sorted(self.robots)) or '-'}; "
                 f"objects: {', '.join(sorted(self.objects)) or '-'})"
             )
-        self._drop_states()
+        self.snapshots.discard_all()
         self._version += 1
-
-    # ------------------------------------------------------------ snapshots
-    def save_state(self) -> int:
-        """Save physics (pybullet ``saveState``) and the kinematic state; returns the state id.
-
-        The clock and :attr:`rng` are not part of the state (time never goes back).
-        """
-        self._check_open()
-        state_id = int(self._client.saveState())
-        self._states[state_id] = {
-            "objects": set(self.objects),
-            "robots": {n: r._state() for n, r in self.robots.items()},
-            "arms": {n: r.arm._state() for n, r in self.robots.items() if r.arm is not None},
-        }
-        return state_id
-
-    def restore_state(self, state_id: int) -> None:
-        """Go back to a state of :meth:`save_state` (bodies and kinematic state).
-
-        Raises:
-            WorldError: an unknown id, or one saved before bodies were added or removed.
-        """
-        self._check_open()
-        saved = self._states.get(state_id)
-        if saved is None:
-            raise WorldError(
-                f"restore_state: unknown state id {state_id}; use an id returned by save_state "
-                f"(states are dropped when robots or objects are removed)"
-            )
-        if set(saved["robots"]) != set(self.robots) or saved["objects"] != set(self.objects):
-            raise WorldError(
-                f"restore_state: state {state_id} was saved with other robots or objects; "
-                f"save a new state after adding bodies"
-            )
-        # Held objects are massless; give them their mass back first so that the bodies match the saved ones.
-        for robot in self.robots.values():
-            if robot.arm is not None and robot.arm.held is not None:
-                robot.arm._grip_physics(robot.arm.held, False)
-        try:
-            with quiet_stdout(self.quiet):
-                self._client.restoreState(stateId=state_id)
-        except pybullet.error as exc:
-            raise WorldError(
-                f"restore_state: pybullet could not restore state {state_id} ({exc}); "
-                f"it was probably saved before bodies were added; save a new state"
-            ) from None
-        for name, robot in self.robots.items():
-            robot._restore(saved["robots"][name])
-            if robot.arm is not None:
-                robot.arm._restore(saved["arms"][name])
-        self._version += 1
-
-    def discard_state(self, state_id: int) -> None:
-        """Free a saved state."""
-        if self._states.pop(state_id, None) is not None and not self._closed:
-            self._client.removeState(state_id)
-
-    def _drop_states(self) -> None:
-        for state_id in list(self._states):
-            self.discard_state(state_id)
 
     # ----------------------------------------------------------- ground truth
     def ground_truth_obstacles(self, *, include_samples: bool = False) -> list[Obstacle2D]:
@@ -423,7 +328,7 @@ class World:
 
     def is_free(self, x: float, y: float, radius: float, *, margin: float = 0.0) -> bool:
         """Whether a circle fits in the field without touching obstacles, movable objects or robots."""
-        return self._inside_field(x, y, radius + margin) and self._blocker(x, y, radius + margin) is None
+        return self.field.inside(x, y, radius + margin) and self.blocker(x, y, radius + margin) is None
 
     def contacts(self, robot: Robot | str, *, margin: float = 0.0, include_ground: bool = False) -> set[str]:
         """Names of the robots and objects that the robot's base, arm or held object touches (within ``margin``).
@@ -439,7 +344,7 @@ class World:
         if self._closed:
             return
         self._closed = True
-        self._states.clear()
+        self.snapshots.forget()
         try:
             self._client.disconnect()
         except pybullet.error:
@@ -468,22 +373,23 @@ class World:
             what = "robot" if name in self.robots else self.objects[name].kind
             raise WorldError(f"the name '{name}' is taken by a {what}; choose another name or remove('{name}') first")
 
-    def _inside_field(self, x: float, y: float, radius: float = 0.0) -> bool:
-        xmin, ymin, xmax, ymax = self._bounds
-        return xmin + radius <= x <= xmax - radius and ymin + radius <= y <= ymax - radius
-
-    def _check_in_field(self, x: float, y: float, what: str, radius: float = 0.0) -> None:
-        if not (math.isfinite(x) and math.isfinite(y)) or not self._inside_field(x, y, radius):
-            xmin, ymin, xmax, ymax = self._bounds
-            raise WorldError(
-                f"{what} at ({x}, {y}) is off the field x in [{xmin}, {xmax}], y in [{ymin}, {ymax}]"
-                + (f" (with its radius {radius} m)" if radius else "")
-                + "; choose a position inside or make the World with larger bounds"
-            )
-
     def _held_bodies(self) -> set[int]:
         return {r.arm.held.body_id for r in self.robots.values() if r.arm is not None and r.arm.held is not None}
 
-    def _blocker(self, x: float, y: float, radius: float) -> str | None:
-        """What a circle at ``(x, y)`` would overlap (``"rock 'r3'"``), or ``None``."""
-        return _queries.blocker(self, x, y, radius)
+
+def _connect(gui: bool, quiet: bool) -> Any:
+    """A new pybullet client: DIRECT, or a GUI when asked for and possible."""
+    mode = pybullet.DIRECT
+    if gui:
+        if os.environ.get("DISPLAY"):
+            mode = pybullet.GUI
+        else:
+            logger.warning(
+                "gui=True but DISPLAY is not set; running without a GUI (pybullet would exit without an X server)"
+            )
+    with quiet_stdout(quiet):
+        client = BulletClient(connection_mode=mode)
+        if client._client < 0 and mode == pybullet.GUI:
+            logger.warning("could not open a pybullet GUI (only one per process); running without one")
+            client = BulletClient(connection_mode=pybullet.DIRECT)
+    return client

@@ -73,11 +73,11 @@ def test_save_and_restore_bring_the_estimate_back() -> None:
         world.faults.set_sensor_noise(odometry_drift=0.05)
         robot = world.robots["scout"]
         _drive(world)
-        state = world.save_state()
+        state = world.snapshots.save()
         saved = robot.estimate
         _drive(world)
         assert robot.estimate != saved
-        world.restore_state(state)
+        world.snapshots.restore(state)
         assert robot.estimate == saved
 
 

@@ -89,33 +89,33 @@ def test_save_and_restore_state(world: World) -> None:
     r = world.add_robot("manipulator", "r", (0.0, 0.0, 0.0))
     block = world.add_block("b", (1.0, 1.0))
     world.step(0.1)
-    sid = world.save_state()
+    sid = world.snapshots.save()
     before = (r.pose, r.arm.q(), block.position())
     r.drive(0.5, 0.2)
     r.arm.set_q(r.arm.home_q + 0.2)
     world.client.resetBasePositionAndOrientation(block.body_id, (2.0, 2.0, 1.0), (0, 0, 0, 1))
     world.step(0.5)
-    world.restore_state(sid)
+    world.snapshots.restore(sid)
     assert r.pose == before[0]
     assert np.allclose(r.arm.q(), before[1])
     assert np.allclose(block.position(), before[2], atol=1e-9)
     assert r.velocity == (0.0, 0.0)
     with pytest.raises(WorldError, match="unknown state id"):
-        world.restore_state(sid + 100)
+        world.snapshots.restore(sid + 100)
     world.add_block("new", (2.0, 2.0))
     with pytest.raises(WorldError, match="save a new state after adding bodies"):
-        world.restore_state(sid)
+        world.snapshots.restore(sid)
 
 
 def test_restore_state_while_holding(world: World) -> None:
     r = world.add_robot("manipulator", "r", (0.0, 0.0, 0.0))
     block = world.add_block("b", (1.0, 1.0))
-    sid = world.save_state()
+    sid = world.snapshots.save()
     ee = r.arm.ee_pose()[0]
     world.client.resetBasePositionAndOrientation(block.body_id, ee.tolist(), (0, 0, 0, 1))
     assert r.arm.attach(block)
     world.step(0.2)
-    world.restore_state(sid)
+    world.snapshots.restore(sid)
     assert r.arm.held is None
     world.step(0.5)
     assert block.position() == pytest.approx([1.0, 1.0, 0.025], abs=2e-3)
