@@ -35,7 +35,7 @@ import signal
 import sys
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.options import add_time_limit, time_limit
@@ -43,8 +43,17 @@ from alica.app.skill_options import add_skills_option
 from alica.app.timed import timed
 from alica.errors import AlicaError
 
+if TYPE_CHECKING:
+    from alica.allocation import AgentSpec
+    from alica.app.run_skills import SkillWiring
+    from alica.comm.zenoh_transport import ZenohTransport
+    from alica.engine import AgentEngine
+    from alica.engine.agent import Observer
+    from alica.model import PlanLibrary
+    from alica.worldmodel import WorldModel
 
-def add_parser(sub: Any) -> None:
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``agent`` subcommand to the ``alica`` parser."""
     p = sub.add_parser(
         "agent",
@@ -195,10 +204,10 @@ def cmd_agent(args: argparse.Namespace) -> int:
 
 def _run(
     args: argparse.Namespace,
-    library: Any,
+    library: PlanLibrary,
     plan: str,
-    roles: dict[str, Any],
-    wiring: Any,
+    roles: dict[str, str | AgentSpec],
+    wiring: SkillWiring,
     facts: list[tuple[str, float, float | None]],
     settings: dict[str, object],
 ) -> int:
@@ -238,7 +247,7 @@ def _run(
         plan_path=plan_path_names(),
     )
     trace = JsonlTrace(args.trace, header=header, line_buffered=True) if args.trace else None  # kept up to a kill -9
-    sinks: list[Any] = [trace] if trace is not None else []
+    sinks: list[Observer] = [trace] if trace is not None else []
 
     def observe(event: dict[str, Any]) -> None:
         record = {**event, "t": round(event["t"] - start, 6)}  # seconds since the start
@@ -272,6 +281,7 @@ def _run(
         sinks.append(feed)
     fallback = default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None
     try:
+        world_model = WorldModel(args.name, clock=clock, relay=False)
         engine = AgentEngine(
             args.name,
             roster,
@@ -279,7 +289,7 @@ def _run(
             plan,
             roleset,
             transport,
-            WorldModel(args.name, clock=clock, relay=False),
+            world_model,
             clock,
             config=config,
             skills=SkillBinder(None, wiring.registry, fallback),
@@ -305,7 +315,7 @@ def _run(
             if trace is not None and world.changed and now - world.at >= WORLD_TRACE_GAP:
                 # the world model's fingerprint in the trace: when two agents' agree, their states are equal
                 world.changed, world.at = False, now
-                digest = _digest(engine.world_model)
+                digest = _digest(world_model)
                 if digest != world.digest:
                     world.digest = digest
                     engine.emit("world", digest=digest, facts=len(engine.world_model.facts()))
@@ -335,7 +345,7 @@ def _run(
             # of one core, while ticking (start-up left out)
             cpu_percent=round(100 * (sum(os.times()[:2]) - began_cpu) / max(1e-9, time.monotonic() - began), 2),
             transport=_counters(transport),
-            world_digest=_digest(engine.world_model),
+            world_digest=_digest(world_model),
             world_facts=[str(fact) for fact in engine.world_model.facts()],
         )
     finally:
@@ -359,7 +369,7 @@ def _run(
     return 0 if summary["status"] == "success" else 1
 
 
-def apply_command(engine: Any, command: dict[str, Any]) -> None:
+def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:
     """Apply one operator's command from a control center (:class:`alica.comm.center_feed.CenterFeed`) to ``engine``.
 
     The same checks as in a simulated team (:class:`alica.engine.runner.SimulatedTeam`): a goal or a
@@ -431,12 +441,12 @@ class _WorldTrace:
         self.changed = True
 
 
-def _counters(transport: Any) -> dict[str, int]:
+def _counters(transport: ZenohTransport) -> dict[str, int]:
     stats = transport.stats
     return {name: getattr(stats, name) for name in stats.__slots__}
 
 
-def _digest(world_model: Any) -> str:
+def _digest(world_model: WorldModel) -> str:
     """A short fingerprint of the world model's state: equal on two agents when their states are equal."""
     import hashlib
 

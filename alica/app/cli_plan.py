@@ -23,16 +23,20 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.errors import AlicaError
 from alica.prophet.planner import DEFAULT_MEMORY_MB, LimitReached, Limits, Plan, PlanResult, PlanStatus
+
+if TYPE_CHECKING:
+    from alica.prophet.pddl import Domain, Problem
+    from alica.prophet.planner import Planner
 
 EXIT_OK, EXIT_ERROR, EXIT_UNSOLVABLE, EXIT_TIMEOUT = 0, 1, 3, 4
 PLAN_FILE_SUFFIXES = (".yaml", ".yml", ".xml")
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``plan`` subcommand to the ``alica`` parser."""
     from alica.prophet.planners import PLANNERS
 
@@ -336,7 +340,7 @@ def _plan_file(args: argparse.Namespace, limits: Limits) -> int:
     return _report(args, planning.planner.name, result.run, cost_of, tasks)
 
 
-def _check_features(planner: Any, domain: Any, problem: Any) -> None:
+def _check_features(planner: Planner, domain: Domain, problem: Problem) -> None:
     lacking = planner.missing(domain.requirements | problem.requirements)
     if lacking:
         names = ", ".join(sorted(f.value for f in lacking))
@@ -345,7 +349,7 @@ def _check_features(planner: Any, domain: Any, problem: Any) -> None:
         )
 
 
-def _validated_cost(name: str, task: tuple[Any, Any], plan: Plan) -> float:
+def _validated_cost(name: str, task: tuple[Domain, Problem], plan: Plan) -> float:
     """The plan's cost as :func:`alica.prophet.validate.validate_plan` computes it.
 
     Raises:

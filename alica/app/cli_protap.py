@@ -24,12 +24,16 @@ import json
 import random
 import statistics
 import time
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.app.options import add_deprecated
 from alica.app.skill_options import add_skills_option
 from alica.errors import AlicaError
+
+if TYPE_CHECKING:
+    from alica.prophet.protap import ProblemSpec, ProtapModel, StepRecord
 
 
 def _grid(text: str) -> tuple[int, int]:
@@ -45,7 +49,7 @@ def _count(text: str) -> int:
     return int(text)
 
 
-def _number(what: str, *, zero: bool) -> Any:
+def _number(what: str, *, zero: bool) -> Callable[[str], float]:
     """An argparse type: a number of ``what`` (``"seconds"``, ``"metres"``) above 0, or from 0 with ``zero``."""
 
     def parse(text: str) -> float:
@@ -79,7 +83,7 @@ def _goto_fault(text: str) -> tuple[str, int]:
 
 
 #: The options that only ``--world lunar`` reads, with their defaults there.
-_WORLD_DEFAULTS: dict[str, Any] = {
+_WORLD_DEFAULTS: dict[str, object] = {
     "uda_skill": "DetectCircles",
     "cell_size": 3.0,
     "grid_rocks": 4,
@@ -95,7 +99,7 @@ def _problem_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, metavar="S", help="seeds the problem and the runs (default 0)")
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``protap`` subcommand (``generate``, ``run``) to the ``alica`` parser."""
     p = sub.add_parser(
         "protap",
@@ -175,7 +179,7 @@ def add_parser(sub: Any) -> None:
     r.set_defaults(run=cmd_run)
 
 
-def _spec(args: argparse.Namespace, horizon: int = 10) -> Any:
+def _spec(args: argparse.Namespace, horizon: int = 10) -> ProblemSpec:
     from alica.prophet.protap import random_spec
 
     width, height = args.grid
@@ -257,7 +261,6 @@ def _run_lunar(args: argparse.Namespace) -> int:
     from alica.app.protap_world import GotoFault, GridLayout, run_lunar_episode
     from alica.app.skill_options import skill_registry
     from alica.prophet.protap import Budget, PlannerPolicy, ProtapModel, ProtapPlanner, Recorder
-    from alica.prophet.protap.dispatch import StepRecord
 
     for name, default in _WORLD_DEFAULTS.items():
         if getattr(args, name) is None:
@@ -340,7 +343,7 @@ def _run_lunar(args: argparse.Namespace) -> int:
     return 0
 
 
-def _step_trace(model: Any, episode: int, step: Any) -> dict[str, Any]:
+def _step_trace(model: ProtapModel, episode: int, step: StepRecord) -> dict[str, Any]:
     """One step of the ``--json`` trace: each robot's action, outcome and skills (simulated seconds)."""
     robots = []
     for robot, (action, outcome) in enumerate(zip(step.actions, step.outcomes, strict=True)):
@@ -368,7 +371,7 @@ def _step_trace(model: Any, episode: int, step: Any) -> dict[str, Any]:
     return {"episode": episode + 1, "step": step.step + 1, "reward": round(step.reward, 3), "robots": robots}
 
 
-def _print_step(model: Any, episode: int, episodes: int, step: Any) -> None:
+def _print_step(model: ProtapModel, episode: int, episodes: int, step: StepRecord) -> None:
     """One line per step, and one per robot that acted: what it did and how it went."""
     label = f"step {step.step + 1}" if episodes == 1 else f"episode {episode + 1} step {step.step + 1}"
     print(f"  {label}: reward {step.reward:g}")

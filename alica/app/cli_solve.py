@@ -27,14 +27,20 @@ import argparse
 import json
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from alica.errors import AlicaError
+
+if TYPE_CHECKING:
+    from alica.allocation import AgentSpec
+    from alica.lang import FactBase
+    from alica.model import Document, Plan, PlanLibrary
+    from alica.solver.query import Place
 
 EXIT_OK, EXIT_ERROR, EXIT_INFEASIBLE, EXIT_TIMEOUT = 0, 1, 3, 4
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``solve`` subcommand to the ``alica`` parser."""
     from alica.app.cli_plan import _positive
     from alica.app.skill_options import add_skills_option
@@ -115,7 +121,7 @@ def cmd_solve(args: argparse.Namespace) -> int:
     return {"solved": EXIT_OK, "infeasible": EXIT_INFEASIBLE}.get(solution.status, EXIT_TIMEOUT)
 
 
-def _pick_plan(library: Any, entry: Any, name: str | None, path: str) -> Any:
+def _pick_plan(library: PlanLibrary, entry: Document, name: str | None, path: str) -> Plan:
     if name is not None:
         if name not in library.plans:
             raise AlicaError(f"{path} has no plan named '{name}'; plans: {', '.join(sorted(library.plans))}")
@@ -126,7 +132,9 @@ def _pick_plan(library: Any, entry: Any, name: str | None, path: str) -> Any:
     raise AlicaError(f"{path} defines no plan with constraints; name one with --plan")
 
 
-def _allocate(library: Any, plan: Any, roles: dict[str, Any], roleset_name: str | None) -> dict[str, Any]:
+def _allocate(
+    library: PlanLibrary, plan: Plan, roles: dict[str, str | AgentSpec], roleset_name: str | None
+) -> dict[str, Place]:
     """Agent -> (entry point, its initial state), as the engine's initial allocation gives them."""
     from alica.allocation import AgentSpec, AllocationProblem, allocate, assign_roles
     from alica.engine import pick_roleset
@@ -137,13 +145,13 @@ def _allocate(library: Any, plan: Any, roles: dict[str, Any], roleset_name: str 
     result = allocate(AllocationProblem(tuple(sorted(specs)), role_of, roleset, (plan,)))
     if result.assignment is None:
         raise AlicaError(f"the team cannot run plan '{plan.name}': {result.why}")
-    places: dict[str, Any] = {}
+    places: dict[str, Place] = {}
     for agent, ep in result.assignment.entries:
         places[agent] = (ep, plan.entry_point(ep).state if ep is not None else None)
     return places
 
 
-def _place(plan: Any, places: dict[str, Any], texts: list[str]) -> None:
+def _place(plan: Plan, places: dict[str, Place], texts: list[str]) -> None:
     """Move agents to the states ``--at`` names (and to the entry point a state lies under, if it is another)."""
     for text in texts:
         for part in (p.strip() for p in text.split(",") if p.strip()):
@@ -165,7 +173,7 @@ def _place(plan: Any, places: dict[str, Any], texts: list[str]) -> None:
             places[agent] = (entry, state)
 
 
-def _world(path: str | None, facts: list[str]) -> Any:
+def _world(path: str | None, facts: list[str]) -> FactBase:
     """The belief the formulas read: ``--world`` objects, values and facts, then ``--fact`` literals."""
     from alica.lang import FactBase, literals
 
@@ -202,9 +210,10 @@ def _read_world(path: str) -> dict[str, Any]:
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
+        marked = exc if isinstance(exc, yaml.MarkedYAMLError) else None
+        mark = marked.problem_mark if marked is not None else None
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else path
-        raise AlicaError(f"{where}: error: not valid YAML: {getattr(exc, 'problem', exc)}") from None
+        raise AlicaError(f"{where}: error: not valid YAML: {marked.problem if marked is not None else exc}") from None
     if data is None:
         return {}
     if not isinstance(data, dict) or not set(data) <= {"objects", "values", "facts"}:
