@@ -19,11 +19,14 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from alica.worldsim.errors import WorldError
+
+if TYPE_CHECKING:
+    from alica.worldsim.world import World
 
 __all__ = ["DEFAULT_PITCH", "DEFAULT_YAW", "FOV", "render", "snapshot"]
 
@@ -42,7 +45,7 @@ LIGHT = (0.4, -0.6, 1.0)
 
 
 def snapshot(
-    world: Any,
+    world: World,
     path: str | Path,
     *,
     width: int = 640,
@@ -80,7 +83,7 @@ def snapshot(
 
 
 def render(
-    world: Any,
+    world: World,
     *,
     width: int = 640,
     height: int = 480,
@@ -94,9 +97,7 @@ def render(
     Raises:
         WorldError: as :func:`snapshot`.
     """
-    from alica.worldsim.world import pybullet
-
-    if getattr(world, "closed", False):
+    if world.closed:
         raise WorldError("snapshot: the world is closed; take pictures before world.close()")
     width, height = _size(width, "width"), _size(height, "height")
     if not (math.isfinite(pitch) and -90.0 <= pitch < 0.0):
@@ -112,7 +113,7 @@ def render(
     view = client.computeViewMatrixFromYawPitchRoll(list(aim), far, yaw, pitch, 0.0, 2)
     projection = client.computeProjectionMatrixFOV(FOV, aspect, max(0.01, 0.02 * far), 4.0 * far + 10.0)
     _, _, rgba, _, _ = client.getCameraImage(
-        width, height, view, projection, renderer=pybullet.ER_TINY_RENDERER, lightDirection=list(LIGHT), shadow=0
+        width, height, view, projection, renderer=client.ER_TINY_RENDERER, lightDirection=list(LIGHT), shadow=0
     )
     pixels = np.asarray(rgba, dtype=np.uint8).reshape(height, width, 4)
     return np.ascontiguousarray(pixels[:, :, :3])
@@ -124,7 +125,7 @@ def _size(value: object, what: str) -> int:
     return int(value)
 
 
-def _target(world: Any, target: Sequence[float] | None) -> tuple[float, float, float]:
+def _target(world: World, target: Sequence[float] | None) -> tuple[float, float, float]:
     """The point looked at: the given one (z = 0 when 2-D), or the middle of the field."""
     if target is None:
         xmin, ymin, xmax, ymax = world.bounds
@@ -135,7 +136,7 @@ def _target(world: Any, target: Sequence[float] | None) -> tuple[float, float, f
     return values[0], values[1], values[2] if len(values) == 3 else 0.0
 
 
-def _content(world: Any) -> list[tuple[float, float, float]]:
+def _content(world: World) -> list[tuple[float, float, float]]:
     """Points to keep in the picture: robots (base top) and objects (their bounding-box corners)."""
     points = [(float(x), float(y), float(r.spec.height)) for r in world.robots.values() for x, y, _ in [r.pose]]
     for obj in world.objects.values():
@@ -146,7 +147,7 @@ def _content(world: Any) -> list[tuple[float, float, float]]:
     return points
 
 
-def _fit_distance(world: Any, aim: tuple[float, float, float], yaw: float, pitch: float, aspect: float) -> float:
+def _fit_distance(world: World, aim: tuple[float, float, float], yaw: float, pitch: float, aspect: float) -> float:
     """The camera distance at which every robot and object (with :data:`FRAME_MARGIN`) is in the picture.
 
     Points are taken into the camera's frame (right, up, forward) at distance 0; each one
