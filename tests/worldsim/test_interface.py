@@ -16,3 +16,28 @@ def test_the_world_is_a_robot_world() -> None:
 
 def test_something_else_is_not() -> None:
     assert not isinstance(object(), RobotWorld)
+
+
+def test_the_interface_loads_only_plain_data_of_the_world() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, alica.worldsim.interface\n"
+        "loaded = {m for m in sys.modules if m.startswith('alica.worldsim.')}\n"
+        "assert 'pybullet' not in sys.modules, 'pybullet was imported'\n"
+        "extra = loaded - {'alica.worldsim.interface', 'alica.worldsim.camera_image', 'alica.worldsim.kinds',\n"
+        "                  'alica.worldsim.robot_specs'}\n"
+        "assert not extra, sorted(extra)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+
+
+def test_the_interface_re_exports_the_data_the_world_uses() -> None:
+    from alica.worldsim import interface, objects, robot_camera, robots
+
+    assert interface.CameraImage is robot_camera.CameraImage
+    assert interface.RobotSpec is robots.RobotSpec
+    assert interface.SAMPLE_KINDS is objects.SAMPLE_KINDS
+    assert interface.OBJECT_KINDS is objects.OBJECT_KINDS

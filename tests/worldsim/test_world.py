@@ -214,3 +214,17 @@ def test_contacts(world: World) -> None:
     assert world.contacts(r, margin=0.01) == {"b"}
     assert "ground" in world.contacts(r, margin=0.01, include_ground=True)
     assert math.isfinite(r.pose[0])
+
+
+def test_the_field_checks_positions() -> None:
+    from alica.worldsim.field import Field
+
+    field = Field((-1.0, -2.0, 3.0, 4.0))
+    assert field.inside(0.0, 0.0) and field.inside(3.0, 4.0) and not field.inside(2.5, 0.0, radius=1.0)
+    field.check(0.0, 0.0, "block 'b'")
+    with pytest.raises(WorldError, match=r"block 'b' at \(5.0, 0.0\) is off the field"):
+        field.check(5.0, 0.0, "block 'b'")
+    with pytest.raises(WorldError, match="with its radius 1.0 m"):
+        field.check(2.5, 0.0, "robot 'r'", 1.0)
+    with pytest.raises(WorldError, match="off the field"):
+        field.check(float("nan"), 0.0, "robot 'r'")
