@@ -83,6 +83,7 @@ def __dir__() -> list[str]:
 
 if TYPE_CHECKING:  # mypy proves that the simulator satisfies the interfaces it implements
     from alica.engine.sim_world import SimWorld
+    from alica.worldsim.bodies import BuildingWorld
     from alica.worldsim.interface import RobotWorld
     from alica.worldsim.world import World
 
@@ -91,3 +92,6 @@ if TYPE_CHECKING:  # mypy proves that the simulator satisfies the interfaces it 
 
     def _world_is_a_sim_world(world: World) -> SimWorld:
         return world  # what the runtime's simulated team uses: its clock, its step, its robots' crash and recover
+
+    def _world_builds_bodies(world: World) -> BuildingWorld:
+        return world  # what the body builders use (the world hands them itself untyped, through _register)

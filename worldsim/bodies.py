@@ -2,14 +2,15 @@
 
 Boxes and cylinders from pybullet primitives; rocks as convex hulls of
 perturbed, flattened icospheres made with trimesh. Each builder takes the
-:class:`~alica.worldsim.world.World` it adds to; use the world's ``add_*`` methods,
-which call them and register the result.
+world it adds to (a :class:`BuildingWorld`: its client, field and objects); use
+the :class:`~alica.worldsim.world.World`'s ``add_*`` methods, which call them and
+register the result.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 import trimesh
@@ -19,9 +20,42 @@ from alica.worldsim.geometry import yaw_to_quat
 from alica.worldsim.objects import BLOCK_PALETTE, COLOURS, MOVABLE_GROUP, WorldObject, parse_colour, sample_sections
 
 if TYPE_CHECKING:
-    from alica.worldsim.world import World
+    from alica.worldsim.field import Field
 
-__all__ = ["make_block", "make_collection_point", "make_rock", "make_sample", "make_table", "make_terrain", "rock_mesh"]
+__all__ = [
+    "BuildingWorld",
+    "make_block",
+    "make_collection_point",
+    "make_rock",
+    "make_sample",
+    "make_table",
+    "make_terrain",
+    "rock_mesh",
+]
+
+
+class BuildingWorld(Protocol):
+    """What the builders use of the world they add to."""
+
+    @property
+    def client(self) -> Any:
+        """The world's pybullet client: the bodies are made in it."""
+        ...
+
+    @property
+    def field(self) -> Field:
+        """The field every position is checked against."""
+        ...
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """The field's ``(xmin, ymin, xmax, ymax)`` (the terrain covers it)."""
+        ...
+
+    @property
+    def objects(self) -> Mapping[str, WorldObject]:
+        """The objects so far (a new block takes the next colour of the palette)."""
+        ...
 
 
 def _xyz(position: Sequence[float], z_default: float, what: str) -> tuple[float, float, float]:
@@ -55,7 +89,7 @@ def _movable_dynamics(c: Any, body: int) -> None:
 
 
 def make_block(
-    world: World,
+    world: BuildingWorld,
     name: str,
     position: Sequence[float],
     size: float = 0.05,
@@ -83,7 +117,7 @@ def make_block(
 
 
 def make_sample(
-    world: World,
+    world: BuildingWorld,
     name: str,
     kind: str,
     position: Sequence[float],
@@ -133,7 +167,9 @@ def make_sample(
     )
 
 
-def make_collection_point(world: World, name: str, position: Sequence[float], radius: float = 0.5) -> WorldObject:
+def make_collection_point(
+    world: BuildingWorld, name: str, position: Sequence[float], radius: float = 0.5
+) -> WorldObject:
     """A flat disc marker on the ground (no collision)."""
     c = world.client
     radius = _positive(radius, f"the radius of collection point {name!r}")
@@ -151,7 +187,7 @@ def make_collection_point(world: World, name: str, position: Sequence[float], ra
 
 
 def make_table(
-    world: World,
+    world: BuildingWorld,
     name: str,
     position: Sequence[float],
     size: Sequence[float] = (1.0, 0.6),
@@ -196,7 +232,7 @@ def rock_mesh(radius: float, seed: int = 0, height_ratio: float = 0.7, subdivisi
 
 
 def make_rock(
-    world: World, name: str, position: Sequence[float], radius: float, seed: int = 0, height_ratio: float = 0.7
+    world: BuildingWorld, name: str, position: Sequence[float], radius: float, seed: int = 0, height_ratio: float = 0.7
 ) -> WorldObject:
     """A static convex rock; a 2-D position sinks its lower half into the ground."""
     c = world.client
@@ -219,7 +255,7 @@ def make_rock(
     return WorldObject(name, "rock", body, c, size=radius, radius=radius, colour=rgba, mesh=mesh)
 
 
-def make_terrain(world: World, name: str = "ground", friction: float = 0.8) -> WorldObject:
+def make_terrain(world: BuildingWorld, name: str = "ground", friction: float = 0.8) -> WorldObject:
     """A flat ground plane at z = 0 (a thin visual slab over the field)."""
     c = world.client
     xmin, ymin, xmax, ymax = world.bounds
