@@ -11,7 +11,7 @@ import json
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, Protocol, TextIO
+from typing import TYPE_CHECKING, Any, Protocol, TextIO
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.options import (
@@ -26,8 +26,12 @@ from alica.app.options import (
 from alica.app.timed import add_fault_options, add_network_options, partition, timed
 from alica.errors import AlicaError
 
+if TYPE_CHECKING:
+    from alica.app.demos.blocksworld import DemoResult
+    from alica.app.demos.lunar import LunarConfig
 
-def add_parser(sub: Any) -> None:
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``demo`` subcommand to the ``alica`` parser."""
     p = sub.add_parser(
         "demo", help="run a demo mission in the simulator", description="Run a demo mission in the pybullet simulator."
@@ -74,7 +78,7 @@ def add_parser(sub: Any) -> None:
     _add_lunar(demos)
 
 
-def _add_lunar(demos: Any) -> None:
+def _add_lunar(demos: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     lunar = demos.add_parser(
         "lunar",
         help="explore, find samples, plan and fetch them as a team (IMPERA Sections 6.4, 7, 8.1)",
@@ -128,7 +132,7 @@ def _add_lunar(demos: Any) -> None:
     lunar.set_defaults(run=cmd_lunar)
 
 
-def lunar_config(args: argparse.Namespace) -> Any:
+def lunar_config(args: argparse.Namespace) -> LunarConfig:
     """The lunar demo's configuration from the command line.
 
     Raises:
@@ -379,7 +383,7 @@ def _recover(who: str, team: Faultable) -> None:
     team.recover(who)
 
 
-def _print_summary(result: Any) -> None:
+def _print_summary(result: DemoResult) -> None:
     state = "success" if result.success else "time limit reached"
     print(
         f"blocksworld: {state} after {result.sim_time_s:.2f} s simulated, {result.wall_time_s:.2f} s wall ({result.real_time_factor:.1f}x real time)"

@@ -13,7 +13,7 @@ import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from alica.app.plan_entry import EXIT_INVALID, EXIT_OK, EXIT_USAGE
 
@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 SHOWN_PER_CONSTRUCT = 3
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``import-designer`` subcommand to the ``alica`` parser."""
     p = sub.add_parser(
         "import-designer",

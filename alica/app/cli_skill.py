@@ -8,14 +8,19 @@ import json
 import os
 import sys
 from collections.abc import Iterator
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.app.options import add_time_limit, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option, lunar_field, skill_registry
 from alica.errors import AlicaError
 
+if TYPE_CHECKING:
+    from alica.lang.skills import SkillRegistry, SkillSpec
+    from alica.skills.testing import SkillRun
+    from alica.worldsim.world import World
 
-def add_parser(sub: Any) -> None:
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``skill`` subcommand to the ``alica`` parser."""
     p = sub.add_parser(
         "skill",
@@ -77,7 +82,7 @@ def _params(items: list[str]) -> dict[str, object]:
     return params
 
 
-def _world(args: argparse.Namespace) -> Any:
+def _world(args: argparse.Namespace) -> World:
     if args.world == "lunar":
         return lunar_field(args)
     from alica.worldsim.scenarios import blocksworld
@@ -106,7 +111,8 @@ def _c_prints_to_stderr() -> Iterator[None]:
         os.close(saved)
 
 
-def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, object], run_skill: Any) -> Any:
+def _run(args: argparse.Namespace, registry: SkillRegistry, spec: SkillSpec, params: dict[str, object]) -> SkillRun:
+    from alica.skills.testing import run_skill
     from alica.worldmodel import WorldModel
 
     steps = [registry.get(name) for name in args.after]
@@ -122,16 +128,33 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
                     f"no robot of the {args.world} world can run {names} (needs {', '.join(sorted(needs))})"
                 )
             robot = fits[0]
-        shared: dict[str, Any] = {"world_model": WorldModel(robot, clock=world.clock), "scratch": {}}
+        world_model = WorldModel(robot, clock=world.clock)
+        scratch: dict[str, object] = {}  # shared by the steps and the skill, as their world model
         for step in steps:
             run = run_skill(
-                step.name, world, robot, {}, timeout=args.time_limit, seed=args.seed, registry=registry, **shared
+                step.name,
+                world,
+                robot,
+                {},
+                timeout=args.time_limit,
+                seed=args.seed,
+                registry=registry,
+                world_model=world_model,
+                scratch=scratch,
             )
             if not run.ok:
                 run.reason = f"step {step.name} before {args.name} did not succeed: {run.reason}"
                 return run
         return run_skill(
-            args.name, world, robot, params, timeout=args.time_limit, seed=args.seed, registry=registry, **shared
+            args.name,
+            world,
+            robot,
+            params,
+            timeout=args.time_limit,
+            seed=args.seed,
+            registry=registry,
+            world_model=world_model,
+            scratch=scratch,
         )
     finally:
         world.close()
@@ -140,7 +163,6 @@ def _run(args: argparse.Namespace, registry: Any, spec: Any, params: dict[str, o
 def cmd_skill_run(args: argparse.Namespace) -> int:
     """Run ``alica skill run``; returns the exit code."""
     from alica.skills.motion import configure_ompl
-    from alica.skills.testing import run_skill
 
     time_limit(args)
     registry = skill_registry(args)
@@ -148,7 +170,7 @@ def cmd_skill_run(args: argparse.Namespace) -> int:
     spec = registry.get(args.name)
     params = _params(args.param)
     with _c_prints_to_stderr():
-        run = _run(args, registry, spec, params, run_skill)
+        run = _run(args, registry, spec, params)
     if args.json:
         print(
             json.dumps(

@@ -50,7 +50,7 @@ class _Deprecated(argparse.Action):
         self,
         parser: argparse.ArgumentParser,
         namespace: argparse.Namespace,
-        values: Any,
+        values: object,
         option_string: str | None = None,
     ) -> None:
         print(deprecation(option_string or self.option_strings[0], self.new), file=sys.stderr)
@@ -58,7 +58,13 @@ class _Deprecated(argparse.Action):
 
 
 def add_deprecated(
-    parser: Any, old: str, new: str, *, dest: str, type: Callable[[str], Any] | None = None, metavar: str | None = None
+    parser: argparse._ActionsContainer,
+    old: str,
+    new: str,
+    *,
+    dest: str,
+    type: Callable[[str], object] = str,
+    metavar: str | None = None,
 ) -> None:
     """Add ``old`` as a hidden alias of the option ``new`` (stored in ``dest``) for one release.
 
@@ -67,7 +73,7 @@ def add_deprecated(
         old: the old spelling, e.g. ``--max-time``.
         new: the spelling to use, as the warning names it, e.g. ``--time-limit``.
         dest: the attribute the new option stores into.
-        type: converts the value (as argparse's ``type``); ``None`` keeps the text.
+        type: converts the value (as argparse's ``type``); ``str`` (the default) keeps the text.
         metavar: the value's name in error messages.
     """
     parser.add_argument(
@@ -109,7 +115,7 @@ def time_limit(args: argparse.Namespace) -> float | None:
     return value
 
 
-def add_field_options(parser: Any) -> None:
+def add_field_options(parser: argparse._ActionsContainer) -> None:
     """Add ``--size M``, ``--rocks N`` and ``--samples K``: the lunar field, with the shared defaults.
 
     The command checks the values (each has its own least number of samples).
@@ -133,7 +139,9 @@ def add_field_options(parser: Any) -> None:
     )
 
 
-def add_time_limit(parser: Any, default: float | None, text: str, *, old: Sequence[str] = ()) -> None:
+def add_time_limit(
+    parser: argparse._ActionsContainer, default: float | None, text: str, *, old: Sequence[str] = ()
+) -> None:
     """Add ``--time-limit S`` (stored as ``time_limit``; :func:`time_limit` checks it), with ``old`` spellings
     as deprecated aliases.
 

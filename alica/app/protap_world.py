@@ -45,7 +45,7 @@ import random
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from alica.errors import AlicaError, SkillError
 from alica.prophet.protap.dispatch import (
@@ -370,7 +370,7 @@ class LunarExecutor:
         crashed: list[str] = []
         faulted = {fault.robot for fault in self.faults if fault.step == self.steps}
 
-        def inject(world: Any, robot: str, index: int) -> None:
+        def inject(world: World, robot: str, index: int) -> None:
             if robot in faulted and robot not in crashed and sequences[robot][index].label == "goto":
                 world.faults.crash(robot)
                 crashed.append(robot)

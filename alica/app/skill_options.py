@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from alica.app.options import add_field_options
 
@@ -17,7 +17,7 @@ if TYPE_CHECKING:
 SHIPPED = "alica.skills.catalog"
 
 
-def add_skills_option(parser: Any) -> None:
+def add_skills_option(parser: argparse._ActionsContainer) -> None:
     """Add the repeatable ``--skills MODULE`` option to a subcommand's parser."""
     parser.add_argument(
         "--skills",
@@ -29,7 +29,7 @@ def add_skills_option(parser: Any) -> None:
     )
 
 
-def add_lunar_options(parser: Any) -> None:
+def add_lunar_options(parser: argparse._ActionsContainer) -> None:
     """Add ``--size``, ``--rocks`` and ``--samples``: the lunar field of ``--world lunar`` (shared defaults)."""
     add_field_options(parser)
 

@@ -3,18 +3,21 @@
 from __future__ import annotations
 
 import re
-from typing import Any
+from typing import TYPE_CHECKING
 
 from alica.errors import AlicaError
 
+if TYPE_CHECKING:
+    import argparse
 
-def add_fault_options(parser: Any, crash: str, recover: str) -> None:
+
+def add_fault_options(parser: argparse._ActionsContainer, crash: str, recover: str) -> None:
     """Add the repeatable ``--crash NAME@T`` and ``--recover NAME@T`` options; ``crash``/``recover`` are their help."""
     for option, text in (("--crash", crash), ("--recover", recover)):
         parser.add_argument(option, action="append", default=[], metavar="NAME@T", help=text)
 
 
-def add_network_options(parser: Any) -> None:
+def add_network_options(parser: argparse._ActionsContainer) -> None:
     """Add ``--loss P``, ``--delay MS`` and the repeatable ``--partition A,B|C@T1-T2`` (the simulated network's faults)."""
     parser.add_argument(
         "--loss",

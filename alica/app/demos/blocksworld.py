@@ -32,6 +32,8 @@ from alica.io.loader import plans_dir
 
 if TYPE_CHECKING:
     from alica.app.center.live import LiveSession
+    from alica.engine import SimulatedTeam
+    from alica.engine.agent import Observer
 
 Stacks = list[list[str]]
 PROBLEM = "StackBlocks"
@@ -195,9 +197,9 @@ def _renamed(stacks: Stacks, names: Sequence[str]) -> Stacks:
 def run_demo(
     config: DemoConfig,
     *,
-    observers: Iterable[Callable[[dict[str, Any]], None]] = (),
+    observers: Iterable[Observer] = (),
     on_second: Callable[[float, int, int, int], None] | None = None,
-    actions: Iterable[tuple[float, Callable[[Any], None]]] = (),
+    actions: Iterable[tuple[float, Callable[[SimulatedTeam], None]]] = (),
     out: Path | None = None,
     gui: bool = False,
     live: LiveSession | None = None,
@@ -232,10 +234,9 @@ def run_demo(
         )
     start, goal = configurations(config)
     library = load_library(MISSION)
-    extra: dict[str, Any] = {"opponents": config.opponents} if config.opponents else {}
-    if gui:
-        extra["gui"] = True
-    world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed, **extra)
+    world = blocksworld(
+        [list(s) for s in start], agents=config.agents, seed=config.seed, opponents=config.opponents, gui=gui
+    )
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
     header = trace_header(
         plans=[f"alica:plans/{MISSION.relative_to(plans_dir()).as_posix()}"],
@@ -255,7 +256,7 @@ def run_demo(
     trace = JsonlTrace(out / "trace.jsonl", header=header) if out is not None else None
     hub = live.start(header, library) if live is not None else None
     sinks = [s for s in (trace, hub) if s is not None]
-    watchers: list[Callable[[dict[str, Any]], None]] = [counter, *observers, *sinks]
+    watchers: list[Observer] = [counter, *observers, *sinks]
     settings = engine_config(frequency=config.frequency)
     perception = blocks_perception()
     registry = default_registry()

@@ -5,7 +5,11 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from alica.engine import AgentEngine, SimulatedTeam
+    from alica.prophet.tasks import CreatedTasks
 
 __all__ = ["StepCounter", "plan_yaml_text", "planning_leader"]
 
@@ -71,7 +75,7 @@ class StepCounter:
         self.steps[agent] = self.steps.get(agent, 0) + 1
         self.tasks.setdefault(agent, set()).add(step.task)
 
-    def finish(self, team: Any, facts: Iterable[tuple[object, ...]]) -> None:
+    def finish(self, team: SimulatedTeam, facts: Iterable[tuple[object, ...]]) -> None:
         """Count the steps still running at the end whose effects hold in the world (the goal came true mid-step)."""
         from alica.lang import literals
 
@@ -94,7 +98,7 @@ class StepCounter:
                 self._carried_out(agent, self.running.pop(agent))
 
 
-def planning_leader(team: Any) -> Any:
+def planning_leader(team: SimulatedTeam) -> AgentEngine | None:
     """A running agent that made a plan for a planning problem (the leader), or None."""
     from alica.prophet import latest_plans
 
@@ -102,7 +106,7 @@ def planning_leader(team: Any) -> Any:
     return running[0] if running else None
 
 
-def plan_yaml_text(created: Any, mission: Path, out: Path | None) -> str:
+def plan_yaml_text(created: CreatedTasks, mission: Path, out: Path | None) -> str:
     """The generated plan as YAML, importing the ``mission`` file from where it is written (``out``):
     a shipped mission as ``alica:plans/...``, so the file stays valid wherever it is moved."""
     from alica.io import import_reference
