@@ -267,10 +267,12 @@ def read_goal_file(path: str) -> tuple[list[list[str]] | None, list[list[str]]]:
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
+        marked = exc if isinstance(exc, yaml.MarkedYAMLError) else None
+        mark = marked.problem_mark if marked is not None else None
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark is not None else path
         raise AlicaError(
-            f"{where}: not valid YAML ({getattr(exc, 'problem', exc)}); write e.g. 'goal: [[a, b], [c]]'"
+            f"{where}: not valid YAML ({marked.problem if marked is not None else exc}); "
+            "write e.g. 'goal: [[a, b], [c]]'"
         ) from None
     if not isinstance(data, dict) or "goal" not in data:
         raise AlicaError(

@@ -76,7 +76,7 @@ def _params(items: list[str]) -> dict[str, object]:
             value = yaml.safe_load(text) if text.strip() else ""
         except yaml.YAMLError as exc:
             raise AlicaError(
-                f"--param {key}: '{text}' is not a YAML value ({exc.problem if hasattr(exc, 'problem') else exc})"
+                f"--param {key}: '{text}' is not a YAML value ({exc.problem if isinstance(exc, yaml.MarkedYAMLError) else exc})"
             ) from None
         params[key] = tuple(value) if isinstance(value, list) else value
     return params
