@@ -37,6 +37,77 @@ _NEAR_MARGIN = 0.5
 _NEAR_STEPS = 60
 
 
+class _Nearby:
+    """What a moving robot may bump into: the obstacles within reach, and how far it may go without touching them.
+
+    The list is refreshed as the robot goes (:meth:`refresh`: when it moved :data:`_NEAR_MARGIN`,
+    after :data:`_NEAR_STEPS` steps, when bodies changed); the field border and other robots are
+    checked at every step.
+
+    Attributes:
+        near: footprints of the static and movable obstacles within reach at the last refresh.
+        at: where the robot was at the last refresh (``inf`` to force one).
+        free: how far from ``at`` the footprint cannot touch anything in ``near``.
+        age: steps since the last refresh.
+        version: the world's body version at the last refresh.
+    """
+
+    __slots__ = ("_robot", "age", "at", "free", "near", "version")
+
+    def __init__(self, robot: Robot) -> None:
+        self._robot = robot
+        self.near: list[tuple[float, ...]] = []
+        self.at = (math.inf, math.inf)
+        self.age = 0
+        self.version = -1
+        self.free = 0.0
+
+    def refresh(self) -> None:
+        """List what lies within reach of the robot now, and how far it may go before it can touch any of it."""
+        robot = self._robot
+        world = robot._world
+        x, y, radius = robot._x, robot._y, robot.spec.radius
+        reach = radius + _NEAR_MARGIN + robot.spec.max_speed * _NEAR_STEPS * world.time_step
+        near = world._static_footprints.near(x, y, reach)
+        held = world._held_bodies()
+        movable = Footprints()
+        for obj in world.objects.values():
+            if obj.movable and obj.body_id not in held:
+                fp = obj.footprint()
+                if fp is None:
+                    continue
+                if fp.kind == "circle":
+                    movable.add_circle(obj.name, fp.x, fp.y, fp.radius)
+                else:
+                    movable.add_box(obj.name, fp.x, fp.y, fp.half_x, fp.half_y, fp.yaw)
+        near.extend(movable.near(x, y, reach))
+        self.near = near
+        # Within this distance of the refresh point the footprint cannot touch anything in ``near``
+        # (nor what lies beyond ``reach``), so the per-step check skips them.
+        clearance = reach - radius
+        if near:
+            gap = -Footprints.depth(x, y, radius, near)
+            clearance = min(clearance, gap)
+        self.free = max(0.0, clearance)
+        self.at = (x, y)
+        self.age = 0
+        self.version = world._version
+
+    def depth(self, x: float, y: float) -> float:
+        """Deepest penetration of the robot's footprint at ``(x, y)`` into anything it must not touch."""
+        robot = self._robot
+        r = robot.spec.radius
+        xmin, ymin, xmax, ymax = robot._world.bounds
+        worst = max(xmin - (x - r), (x + r) - xmax, ymin - (y - r), (y + r) - ymax)
+        if math.hypot(x - self.at[0], y - self.at[1]) >= self.free:
+            worst = max(worst, Footprints.depth(x, y, r, self.near))
+        for other in robot._world.robots.values():
+            if other is not robot:
+                d = r + other.spec.radius - math.hypot(x - other._x, y - other._y)
+                worst = max(worst, d)
+        return worst
+
+
 class Robot:
     """One robot in a :class:`~alica.worldsim.world.World` (make it with ``world.add_robot``).
 
@@ -52,11 +123,7 @@ class Robot:
     __slots__ = (
         "_cos",
         "_crashed",
-        "_near",
-        "_near_age",
-        "_near_at",
-        "_near_free",
-        "_near_version",
+        "_nearby",
         "_odometry",
         "_quat",
         "_sin",
@@ -82,11 +149,7 @@ class Robot:
         self._w = 0.0
         self._crashed = False
         self.bumped = False
-        self._near: list[tuple[float, ...]] = []
-        self._near_at = (math.inf, math.inf)
-        self._near_age = 0
-        self._near_version = -1
-        self._near_free = 0.0
+        self._nearby = _Nearby(self)
         self._cos, self._sin = math.cos(self._yaw), math.sin(self._yaw)
         self._quat = yaw_to_quat(self._yaw)
         c = world.client
@@ -240,7 +303,7 @@ class Robot:
         yaw = self._yaw if yaw is None else float(yaw)
         self._world.field.check(x, y, f"robot '{self.name}'", self.spec.radius)
         self._x, self._y, self._yaw = x, y, wrap_angle(yaw)
-        self._near_at = (math.inf, math.inf)
+        self._nearby.at = (math.inf, math.inf)
         self._apply_pose()
         self._odometry.reset()
 
@@ -297,47 +360,6 @@ class Robot:
         if self.arm is not None:
             self.arm._base_moved()
 
-    def _refresh_near(self) -> None:
-        world = self._world
-        reach = self.spec.radius + _NEAR_MARGIN + self.spec.max_speed * _NEAR_STEPS * world.time_step
-        near = world._static_footprints.near(self._x, self._y, reach)
-        held = world._held_bodies()
-        movable = Footprints()
-        for obj in world.objects.values():
-            if obj.movable and obj.body_id not in held:
-                fp = obj.footprint()
-                if fp is None:
-                    continue
-                if fp.kind == "circle":
-                    movable.add_circle(obj.name, fp.x, fp.y, fp.radius)
-                else:
-                    movable.add_box(obj.name, fp.x, fp.y, fp.half_x, fp.half_y, fp.yaw)
-        near.extend(movable.near(self._x, self._y, reach))
-        self._near = near
-        # Within this distance of the refresh point the footprint cannot touch anything in ``near``
-        # (nor what lies beyond ``reach``), so the per-step check skips them.
-        clearance = reach - self.spec.radius
-        if near:
-            gap = -Footprints.depth(self._x, self._y, self.spec.radius, near)
-            clearance = min(clearance, gap)
-        self._near_free = max(0.0, clearance)
-        self._near_at = (self._x, self._y)
-        self._near_age = 0
-        self._near_version = world._version
-
-    def _depth(self, x: float, y: float) -> float:
-        """Deepest penetration of the footprint at ``(x, y)`` into anything it must not touch."""
-        r = self.spec.radius
-        xmin, ymin, xmax, ymax = self._world.bounds
-        worst = max(xmin - (x - r), (x + r) - xmax, ymin - (y - r), (y + r) - ymax)
-        if math.hypot(x - self._near_at[0], y - self._near_at[1]) >= self._near_free:
-            worst = max(worst, Footprints.depth(x, y, r, self._near))
-        for other in self._world.robots.values():
-            if other is not self:
-                d = r + other.spec.radius - math.hypot(x - other._x, y - other._y)
-                worst = max(worst, d)
-        return worst
-
     def _advance(self, dt: float) -> bool:
         """Integrate the command over one physics step; returns whether the base moved."""
         v, w = self._v, self._w
@@ -349,16 +371,16 @@ class Robot:
             mid = yaw + 0.5 * w * dt
             nx = self._x + v * math.cos(mid) * dt
             ny = self._y + v * math.sin(mid) * dt
-            world = self._world
-            self._near_age += 1
+            nearby = self._nearby
+            nearby.age += 1
             if (
-                self._near_version != world._version
-                or self._near_age >= _NEAR_STEPS
-                or math.hypot(nx - self._near_at[0], ny - self._near_at[1]) > _NEAR_MARGIN
+                nearby.version != self._world._version
+                or nearby.age >= _NEAR_STEPS
+                or math.hypot(nx - nearby.at[0], ny - nearby.at[1]) > _NEAR_MARGIN
             ):
-                self._refresh_near()
-            new = self._depth(nx, ny)
-            if new > 0.0 and new > self._depth(self._x, self._y) + 1e-12:
+                nearby.refresh()
+            new = nearby.depth(nx, ny)
+            if new > 0.0 and new > nearby.depth(self._x, self._y) + 1e-12:
                 self._v = 0.0
                 self._w = 0.0
                 self.bumped = True
@@ -386,7 +408,7 @@ class Robot:
         self._v, self._w = state["v"], state["w"]
         self.bumped = state["bumped"]
         self._crashed = state["crashed"]
-        self._near_at = (math.inf, math.inf)
+        self._nearby.at = (math.inf, math.inf)
         self._apply_pose()
         if "odometry" in state:
             self._odometry._restore(state["odometry"])
