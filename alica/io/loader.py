@@ -224,7 +224,7 @@ class Loader:
         except PlanPathError as exc:
             return None, Diagnostic(span, f"cannot use import path: {exc}", "fix the path")
         except (OSError, ValueError) as exc:
-            reason = getattr(exc, "strerror", None) or str(exc)
+            reason = (exc.strerror if isinstance(exc, OSError) else None) or str(exc)
             return None, Diagnostic(span, f"cannot use import path '{shown_raw}': {reason}", "fix the path")
         if not _inside(target, roots):
             return None, Diagnostic(

@@ -126,7 +126,8 @@ class _Reader:
             reason = f"it has {digits} digits"
             hint = "write a smaller number"
         else:
-            reason = " ".join(str(getattr(exc, "problem", None) or exc).split())[:80]
+            marked = exc if isinstance(exc, yaml.MarkedYAMLError) else None
+            reason = " ".join(str((marked.problem if marked else None) or exc).split())[:80]
             hint = "write a valid value, or quote it to keep it as text"
         return Diagnostic(span, f"cannot read '{shown}' as {kind}: {reason}", hint)
 
@@ -230,9 +231,10 @@ def read_yaml(text: str, path: str) -> tuple[Node | None, list[Diagnostic]]:
             )
         ]
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        span = reader.span(mark) if mark else SourceSpan(path, 1, 1)
-        return None, [Diagnostic(span, f"YAML value: {getattr(exc, 'problem', exc)}", "fix the value")]
+        marked = exc if isinstance(exc, yaml.MarkedYAMLError) else None
+        span = reader.span(marked.problem_mark) if marked and marked.problem_mark else SourceSpan(path, 1, 1)
+        reason = marked.problem if marked and marked.problem is not None else exc
+        return None, [Diagnostic(span, f"YAML value: {reason}", "fix the value")]
     return tree, reader.diagnostics
 
 

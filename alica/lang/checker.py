@@ -124,7 +124,7 @@ class _Checker:
                     self.report(
                         operand,
                         f"'{unparse(operand)}' is {_describe(operand)}, not a number",
-                        f"arithmetic needs numbers, e.g. x {getattr(node, 'op', '-')} 1",
+                        f"arithmetic needs numbers, e.g. x {node.op} 1",
                     )
         elif isinstance(node, Compare) and node.op not in ("==", "!="):
             for operand in (node.left, node.right):

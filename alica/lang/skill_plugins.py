@@ -101,7 +101,7 @@ def load_entry_points(registry: SkillRegistry, group: str = ENTRY_POINT_GROUP) -
         try:
             target = entry.load()
         except Exception as exc:  # an installed package's broken plug-in: say which, in one line
-            dist = getattr(getattr(entry, "dist", None), "name", None)
+            dist = entry.dist.name if entry.dist is not None else None
             of = f" of package '{dist}'" if dist else ""
             raise SkillPluginError(
                 f"skill module '{entry.value}' (entry point '{entry.name}'{of}) cannot be loaded: {type(exc).__name__}: {exc}"

@@ -7,7 +7,6 @@ the declarations afterwards, by :mod:`alica.prophet.rddl.check`.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 from alica.prophet.rddl.ast import (
@@ -96,10 +95,12 @@ class _BlockReader(Cursor):
             if word.kind != NAME or word.text not in allowed:
                 hint = suggestion(word.text, allowed) or "expected one of: " + ", ".join(allowed)
                 raise self.error(word, f"unknown keyword {word.shown()} in {what}", hint)
-            section: Callable[[Token, dict[str, Any]], None] = getattr(
-                self, "_" + keyword.text.replace("-", "_") + "_section"
-            )
-            section(word, fields)
+            parse_section = {
+                "domain": self._domain_section,
+                "non-fluents": self._non_fluents_section,
+                "instance": self._instance_section,
+            }[keyword.text]
+            parse_section(word, fields)
         if keyword.text == "domain":
             return Domain(name.text, **fields, line=keyword.line, column=keyword.column)
         if "domain" not in fields:

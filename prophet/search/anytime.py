@@ -174,7 +174,9 @@ def search_task(
             ff = SwitchingFF(relaxed, relaxed.ff_unit, relaxed.r_unit)  # every operator 1
         ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
     else:
-        evaluate: Evaluator = getattr(relaxed, first.heuristic)
+        evaluate: Evaluator = {"ff": relaxed.ff, "ff_add_unit": relaxed.ff_add_unit, "ff_cost": relaxed.ff_cost}[
+            first.heuristic
+        ]
         ops, _exhausted = yield from lazy_search(ct, evaluate, stats, weight=first.weight, seed=first.seed)
     if ops is None:
         yield Done(PlanStatus.UNSOLVABLE, stats.expansions, "every reachable state was expanded")
