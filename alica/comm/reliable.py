@@ -187,6 +187,11 @@ class Inbox:
         self.errors: dict[str, int] = {}
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
 
+    @property
+    def held(self) -> int:
+        """Reliable messages taken in and not delivered yet (waiting for a gap to be filled, or for where to start)."""
+        return sum(len(stream.held) for state in self._senders.values() for stream in state.streams.values())
+
     def subscribe(self, topic: str, now: float) -> None:
         """Take in ``topic`` from now on (a second call keeps the first time)."""
         self.subscribed.setdefault(topic, now)
