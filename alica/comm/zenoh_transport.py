@@ -18,9 +18,12 @@ It keeps the meanings of the simulated network (:mod:`alica.comm.transport`):
   incarnation: receivers start over with its numbers, and deliver from it
   every reliable message sent after they subscribed.
 
-Everything arriving is handled by zenoh's threads (callbacks) and a daemon
-timer thread (heartbeats, query time-outs), under one lock; the engine's
-thread only drains the inbox in :meth:`ZenohTransport.poll`. Always close the
+The bookkeeping is pure and synchronous, in :mod:`alica.comm.reliable`: the
+sender's :class:`~alica.comm.reliable.History` and the receiver's
+:class:`~alica.comm.reliable.Inbox`; this module is the zenoh shell around
+them. Everything arriving is handled by zenoh's threads (callbacks) and a
+daemon timer thread (heartbeats, query time-outs), under one lock; the
+engine's thread only drains the inbox in :meth:`ZenohTransport.poll`. Always close the
 transport (``with ZenohTransport(...) as t:`` or ``close()`` in ``finally``):
 a zenoh session with Python callbacks keeps its process alive until closed.
 
