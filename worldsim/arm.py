@@ -26,8 +26,8 @@ from alica.worldsim.gripper import FINGER_OPEN, GRASP_TOLERANCE, GRIP_FORCE, Gri
 from alica.worldsim.objects import ARM_GROUP, MOVABLE_GROUP
 
 if TYPE_CHECKING:
-    from alica.worldsim.arm_scene import ArmScene
-    from alica.worldsim.robots import Robot
+    from alica.worldsim.arm_host import ArmMount
+    from alica.worldsim.arm_scene import ArmPlanningModel, ArmScene
 
 __all__ = ["GRASP_TOLERANCE", "GRIP_FORCE", "PANDA_URDF", "Arm"]
 
@@ -46,7 +46,7 @@ class Arm(GripperMixin):
     """A Panda arm with a parallel gripper on a robot (``robot.arm``).
 
     Attributes:
-        robot: the robot that carries it.
+        robot: the robot that carries it (an :class:`~alica.worldsim.arm_host.ArmMount`).
         body_id: the pybullet body of the arm.
         urdf_path: the URDF file (for planners that load their own copy).
         mount_offset: ``(x, y, z)`` of the arm base in the robot base frame (z from the ground).
@@ -84,7 +84,7 @@ class Arm(GripperMixin):
         "urdf_path",
     )
 
-    def __init__(self, robot: Robot, mount_offset: Sequence[float]) -> None:
+    def __init__(self, robot: ArmMount, mount_offset: Sequence[float]) -> None:
         world = robot.world
         c = world.client
         self.robot = robot
@@ -167,9 +167,9 @@ class Arm(GripperMixin):
             world = self.robot.world
             model = next(
                 (
-                    r.arm._scene.model
+                    r.arm.planning_model
                     for r in world.robots.values()
-                    if r.arm is not None and r.arm._scene is not None and r.arm.urdf_path == self.urdf_path
+                    if r.arm is not None and r.arm.urdf_path == self.urdf_path and r.arm.planning_model is not None
                 ),
                 None,
             )
@@ -178,6 +178,11 @@ class Arm(GripperMixin):
             scene = self._scene = ArmScene(self.urdf_path, self.base_pose(), seed=world.seed, model=model)
         scene.set_base_pose(self.base_pose())
         return scene
+
+    @property
+    def planning_model(self) -> ArmPlanningModel | None:
+        """The planning model of the arm's scene (shared by the arms of a world), ``None`` before :meth:`planning_scene`."""
+        return None if self._scene is None else self._scene.model
 
     def q(self) -> np.ndarray:
         """The seven joint positions (a copy)."""
@@ -292,11 +297,12 @@ class Arm(GripperMixin):
         """Put the pybullet bodies where the kinematic state says (arm base, joints, held object)."""
         if self._base_dirty:
             # pybullet poses a base by its centre of mass: mount offset plus the link's inertial offset.
-            r = self.robot
-            cy, sy = r._cos, r._sin
+            x, y, yaw = self.robot.pose
+            cy, sy = math.cos(yaw), math.sin(yaw)
+            base_quat = yaw_to_quat(yaw)
             lx, ly, lz = self._com_local
-            com = (r._x + cy * lx - sy * ly, r._y + sy * lx + cy * ly, lz)
-            quat = r._quat if self._com_quat is None else quat_multiply(r._quat, self._com_quat)
+            com = (x + cy * lx - sy * ly, y + sy * lx + cy * ly, lz)
+            quat = base_quat if self._com_quat is None else quat_multiply(base_quat, self._com_quat)
             self._reset_pose(self.body_id, com, quat)
             self._base_dirty = False
         if not self._moved:

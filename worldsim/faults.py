@@ -113,8 +113,11 @@ class Faults:
             return self._world.robots[robot]
         return robot
 
-    def _draw_slip(self, now: float) -> float | None:
-        """The time a new grasp will slip, or ``None`` (draws from the world rng only if slips are on)."""
+    def draw_slip(self, now: float) -> float | None:
+        """The time a new grasp will slip, or ``None`` (draws from the world rng only if slips are on).
+
+        The gripper asks it at every successful attach.
+        """
         if self.grasp_slip <= 0.0:
             return None
         rng = self._world.rng

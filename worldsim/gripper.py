@@ -20,7 +20,7 @@ from alica.worldsim.geometry import pose_inverse, pose_multiply
 from alica.worldsim.objects import WorldObject
 
 if TYPE_CHECKING:
-    from alica.worldsim.robots import Robot
+    from alica.worldsim.arm_host import ArmMount
 
 __all__ = ["FINGER_OPEN", "GRASP_TOLERANCE", "GRIP_FORCE", "GripperMixin"]
 
@@ -62,7 +62,7 @@ class GripperMixin:
     _joints_dirty: bool
 
     if TYPE_CHECKING:
-        robot: Robot
+        robot: ArmMount
         body_id: int
         _client: Any
 
@@ -148,7 +148,7 @@ class GripperMixin:
         if self._held is not None:
             raise WorldError(f"attach: robot '{self.robot.name}' already holds '{self._held.name}'; detach it first")
         for other in world.robots.values():
-            if other.arm is not None and other.arm._held is obj:
+            if other.arm is not None and other.arm.held is obj:
                 raise WorldError(f"attach: '{obj.name}' is held by robot '{other.name}'")
         if self.robot.crashed:
             return False
@@ -165,7 +165,7 @@ class GripperMixin:
         self._fingers = min(FINGER_OPEN, _half_width(obj))
         self._moved = True
         self._joints_dirty = True
-        self._slip_at = world.faults._draw_slip(world.now())
+        self._slip_at = world.faults.draw_slip(world.now())
         world._version += 1
         return True
 

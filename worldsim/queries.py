@@ -8,7 +8,8 @@ skills ask :meth:`~alica.worldsim.interface.RobotWorld.blocker` and
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -16,13 +17,64 @@ from alica.worldsim.grid import Obstacle2D
 
 if TYPE_CHECKING:
     from alica.worldsim.interface import RobotWorld
-    from alica.worldsim.robots import Robot
-    from alica.worldsim.world import World
+    from alica.worldsim.objects import WorldObject
 
-__all__ = ["blocker", "blocks_facts", "body_names", "contacts", "obstacles"]
+__all__ = ["BodiedRobot", "BodiedWorld", "blocker", "blocks_facts", "body_names", "contacts", "obstacles"]
 
 
-def obstacles(world: World, *, include_samples: bool = False) -> list[Obstacle2D]:
+class _BodiedArm(Protocol):
+    """An arm as the geometric questions see it: its body and what it holds."""
+
+    @property
+    def body_id(self) -> int:
+        """The arm's pybullet body."""
+        ...
+
+    @property
+    def held(self) -> WorldObject | None:
+        """The object in the gripper, or ``None``."""
+        ...
+
+
+class BodiedRobot(Protocol):
+    """A robot as the geometric questions see it: its base body and its arm."""
+
+    @property
+    def body_id(self) -> int:
+        """The pybullet body of the base."""
+        ...
+
+    @property
+    def arm(self) -> _BodiedArm | None:
+        """The arm, or ``None``."""
+        ...
+
+
+class BodiedWorld(Protocol):
+    """The world as :func:`obstacles`, :func:`body_names` and :func:`contacts` read it (the concrete
+    :class:`~alica.worldsim.world.World` satisfies it, checked by mypy where it hands itself to them)."""
+
+    @property
+    def client(self) -> Any:
+        """The world's own pybullet client."""
+        ...
+
+    @property
+    def objects(self) -> Mapping[str, WorldObject]:
+        """The objects by name."""
+        ...
+
+    @property
+    def robots(self) -> Mapping[str, BodiedRobot]:
+        """The robots by name."""
+        ...
+
+    def _held_bodies(self) -> set[int]:
+        """The bodies of the objects the arms hold now."""
+        ...
+
+
+def obstacles(world: BodiedWorld, *, include_samples: bool = False) -> list[Obstacle2D]:
     """Footprints of rocks, tables and blocks (and samples), leaving out held objects."""
     held = world._held_bodies()
     out: list[Obstacle2D] = []
@@ -109,7 +161,7 @@ def blocks_facts(world: RobotWorld, tolerance: float | None = None) -> set[tuple
     return facts
 
 
-def body_names(world: World) -> dict[int, str]:
+def body_names(world: BodiedWorld) -> dict[int, str]:
     """The name of the robot or object each pybullet body belongs to."""
     names = {o.body_id: n for n, o in world.objects.items()}
     for n, r in world.robots.items():
@@ -119,7 +171,7 @@ def body_names(world: World) -> dict[int, str]:
     return names
 
 
-def contacts(world: World, robot: Robot, *, margin: float = 0.0, include_ground: bool = False) -> set[str]:
+def contacts(world: BodiedWorld, robot: BodiedRobot, *, margin: float = 0.0, include_ground: bool = False) -> set[str]:
     """Names of what the robot's base, arm or held object touches (closest points within ``margin``)."""
     c = world.client
     own = [robot.body_id]

@@ -121,12 +121,9 @@ class Robot:
     """
 
     __slots__ = (
-        "_cos",
         "_crashed",
         "_nearby",
         "_odometry",
-        "_quat",
-        "_sin",
         "_v",
         "_w",
         "_world",
@@ -150,8 +147,6 @@ class Robot:
         self._crashed = False
         self.bumped = False
         self._nearby = _Nearby(self)
-        self._cos, self._sin = math.cos(self._yaw), math.sin(self._yaw)
-        self._quat = yaw_to_quat(self._yaw)
         c = world.client
         half = 0.5 * spec.height
         self.body_id: int = c.createMultiBody(
@@ -354,9 +349,8 @@ class Robot:
     # --------------------------------------------------------------- internals
     def _apply_pose(self) -> None:
         yaw = self._yaw
-        self._cos, self._sin = math.cos(yaw), math.sin(yaw)
-        self._quat = (0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw))
-        self._world._reset_base(self.body_id, (self._x, self._y, 0.5 * self.spec.height), self._quat)
+        quat = (0.0, 0.0, math.sin(0.5 * yaw), math.cos(0.5 * yaw))
+        self._world._reset_base(self.body_id, (self._x, self._y, 0.5 * self.spec.height), quat)
         if self.arm is not None:
             self.arm._base_moved()
 

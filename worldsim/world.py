@@ -20,7 +20,6 @@ import numpy as np
 
 from alica.clock import ManualClock
 from alica.worldsim import bodies as _bodies
-from alica.worldsim import queries as _queries
 from alica.worldsim._quiet import quiet_stdout
 from alica.worldsim.errors import WorldError
 from alica.worldsim.faults import Faults, SensorNoise
@@ -28,6 +27,7 @@ from alica.worldsim.field import Field
 from alica.worldsim.geometry import Footprints
 from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.objects import WorldObject
+from alica.worldsim.queries import blocker, blocks_facts, contacts, obstacles
 from alica.worldsim.resting import SETTLE_STEPS, Resting
 from alica.worldsim.robots import ROBOT_KINDS, Robot, RobotSpec
 from alica.worldsim.snapshots import Snapshots
@@ -316,15 +316,15 @@ class World:
 
         Held objects are left out; samples only with ``include_samples``.
         """
-        return _queries.obstacles(self, include_samples=include_samples)
+        return obstacles(self, include_samples=include_samples)
 
     def blocker(self, x: float, y: float, radius: float) -> str | None:
         """What a circle at ``(x, y)`` would overlap (``"rock 'r3'"``), or ``None`` (held objects do not count)."""
-        return _queries.blocker(self, x, y, radius)
+        return blocker(self, x, y, radius)
 
     def blocks_facts(self) -> set[tuple[str, ...]]:
         """The IPC blocks facts of the simulated state (:func:`~alica.worldsim.queries.blocks_facts`): perfect perception."""
-        return _queries.blocks_facts(self)
+        return blocks_facts(self)
 
     def is_free(self, x: float, y: float, radius: float, *, margin: float = 0.0) -> bool:
         """Whether a circle fits in the field without touching obstacles, movable objects or robots."""
@@ -336,7 +336,7 @@ class World:
         The ground counts only with ``include_ground``.
         """
         robot = self.robots[robot] if isinstance(robot, str) else robot
-        return _queries.contacts(self, robot, margin=margin, include_ground=include_ground)
+        return contacts(self, robot, margin=margin, include_ground=include_ground)
 
     # -------------------------------------------------------------- lifecycle
     def close(self) -> None:
