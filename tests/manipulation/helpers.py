@@ -1,11 +1,16 @@
-"""Helpers of the manipulation tests: the mobile-base set-up and an independent path check."""
+"""Helpers of the manipulation tests: the mobile-base set-up, the arm-scene fixtures and an independent path check.
+
+The fixtures are used by tests/manipulation and tests/worldsim (the scene is the world's); each conftest imports them.
+"""
 
 from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Iterator
 
 import numpy as np
+import pytest
 
 from alica.skills.manipulation import Box
 from alica.worldsim.arm_scene import ArmScene
@@ -14,6 +19,22 @@ from alica.worldsim.arm_scene import ArmScene
 BASE_HEIGHT = 0.3
 #: ... which is modelled as a box under the arm, its front edge 0.15 m ahead of the arm's axis.
 PLATFORM = Box("platform", (-0.1, 0.0, 0.15), (0.25, 0.25, 0.145))
+
+
+@pytest.fixture
+def scene() -> Iterator[ArmScene]:
+    """A Panda with its base at the origin on the ground, no obstacles."""
+    s = ArmScene()
+    yield s
+    s.close()
+
+
+@pytest.fixture
+def mobile_scene() -> Iterator[ArmScene]:
+    """A Panda on a 0.3 m high mobile base (the platform is an obstacle)."""
+    s = ArmScene(base_pose=((0.0, 0.0, BASE_HEIGHT), (0.0, 0.0, 0.0, 1.0)), obstacles=[PLATFORM])
+    yield s
+    s.close()
 
 
 def dense_states(path: np.ndarray, step: float = 0.02) -> np.ndarray:

@@ -7,6 +7,9 @@ from collections.abc import Iterator
 import pytest
 
 from alica.worldsim.world import World
+from tests.manipulation.helpers import mobile_scene, scene
+
+__all__ = ["mobile_scene", "scene"]  # the arm scene's fixtures, shared with tests/manipulation
 
 
 @pytest.fixture

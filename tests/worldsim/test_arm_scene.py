@@ -6,7 +6,6 @@ Also: an arm gives its scene (Arm.planning_scene), the arms of a world share one
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
 
 import numpy as np
 import pytest
@@ -16,23 +15,6 @@ from alica.worldsim.arm_interface import ArmPlanningScene
 from alica.worldsim.arm_scene import ArmScene, default_urdf
 from alica.worldsim.geometry import Box
 from alica.worldsim.world import World
-from tests.manipulation.helpers import BASE_HEIGHT, PLATFORM
-
-
-@pytest.fixture
-def scene() -> Iterator[ArmScene]:
-    """A Panda with its base at the origin on the ground, no obstacles."""
-    s = ArmScene()
-    yield s
-    s.close()
-
-
-@pytest.fixture
-def mobile_scene() -> Iterator[ArmScene]:
-    """A Panda on a 0.3 m high mobile base (the platform is an obstacle)."""
-    s = ArmScene(base_pose=((0.0, 0.0, BASE_HEIGHT), (0.0, 0.0, 0.0, 1.0)), obstacles=[PLATFORM])
-    yield s
-    s.close()
 
 
 def test_panda_joints_limits_and_tool_link(scene: ArmScene) -> None:
