@@ -22,6 +22,14 @@ center's question for its history, and applies the operator's commands (a
 goal, facts, a decision on a plan proposed under ``--review``) between two
 ticks (:mod:`alica.comm.center_feed`).
 
+With ``--parent-pipe FD`` the agent stops, as on SIGTERM, when that file
+descriptor reaches end of file: the process that started it holds the
+pipe's other end, so the agent does not outlive it, even after a
+``kill -9``. ``alica run --processes`` passes each agent's standard input
+and the run's deadline (``--time-limit``).
+
+``--trace FILE`` is checked before the agent starts; its folder must exist.
+
 Exit codes: 0 the root plan succeeded, 1 it failed or is still running when
 the agent stops (time limit, Ctrl-C, SIGTERM), 2 wrong usage.
 """
@@ -38,7 +46,7 @@ import time
 from typing import TYPE_CHECKING, Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
-from alica.app.options import add_time_limit, time_limit
+from alica.app.options import add_time_limit, check_output, time_limit
 from alica.app.skill_options import add_skills_option
 from alica.app.timed import timed
 from alica.errors import AlicaError
@@ -149,7 +157,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     add_skills_option(p)
     add_engine_options(p)
-    p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace")
+    p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace (in an existing folder)")
+    p.add_argument(
+        "--parent-pipe",
+        type=int,
+        metavar="FD",
+        help="stop when this file descriptor reaches end of file: the read end of a pipe whose other end the "
+        "process that started this agent holds, so the agent ends with it (alica run --processes gives 0, "
+        "standard input)",
+    )
     p.add_argument("--json", action="store_true", help="print status and summary lines as JSON")
     p.set_defaults(run=cmd_agent)
 
@@ -182,6 +198,16 @@ def cmd_agent(args: argparse.Namespace) -> int:
     if args.frequency <= 0:
         raise AlicaError(f"--frequency must be > 0, got {args.frequency}")
     time_limit(args)
+    if args.parent_pipe is not None:
+        try:
+            os.fstat(args.parent_pipe)
+        except (OSError, OverflowError):
+            raise AlicaError(
+                f"--parent-pipe {args.parent_pipe}: no such open file descriptor; give the read end of a pipe the "
+                "parent holds open (0: standard input)"
+            ) from None
+    if args.trace:
+        check_output(args.trace, "--trace", make_folders=False)
     registry = skill_registry(args)
     library, entry = load_entry(args.plan, Loader(skills=registry))
     plan = args.root
@@ -256,6 +282,9 @@ def _run(
 
     stop = threading.Event()
     previous = {sig: signal.signal(sig, lambda *_: stop.set()) for sig in (signal.SIGTERM, signal.SIGINT)}
+    orphaned = threading.Event()
+    if args.parent_pipe is not None:
+        _watch_parent(args.parent_pipe, stop, orphaned)
     pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])
     try:
         transport = ZenohTransport(
@@ -335,6 +364,9 @@ def _run(
             before_tick=operator,
             after_tick=report,
         )
+        if orphaned.is_set():
+            why = "parent gone"
+            print(f"alica agent {args.name}: the process that started it is gone; stopping", file=sys.stderr)
         summary = describe_agent(engine, root_status(engine))
         summary.update(
             name=args.name,
@@ -427,6 +459,24 @@ def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:
             raise ValueError(f"no such operator's command: {what!r}")
     except (AlicaError, ValueError, TypeError) as exc:
         engine.emit("note", message=f"the operator's command {what!r} is refused: {exc}")
+
+
+def _watch_parent(fd: int, stop: threading.Event, orphaned: threading.Event) -> None:
+    """Set ``orphaned`` and ``stop`` once ``fd`` reaches end of file (the parent is gone), from a daemon thread.
+
+    The thread blocks in ``os.read`` (no lock, no polling), so the ticks do not pay for it.
+    """
+
+    def watch() -> None:
+        try:
+            while os.read(fd, 4096):
+                pass  # the parent writes nothing; anything it does write is ignored
+        except OSError:
+            pass  # a closed or broken descriptor: the parent is gone as well
+        orphaned.set()
+        stop.set()
+
+    threading.Thread(target=watch, name="parent-pipe", daemon=True).start()
 
 
 class _WorldTrace:

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
-from alica.app.options import add_time_limit, parse_roster, time_limit
+from alica.app.options import add_time_limit, check_output, parse_roster, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
@@ -157,6 +157,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
     time_limit(args)
+    if args.trace:
+        check_output(args.trace, "--trace", make_folders=True)  # before any agent starts, not after the run
     session = live_session(args)
     if args.center and args.show_tree:
         raise AlicaError("--center shows the team in a web page; it does not go with --show-tree")
@@ -400,7 +402,9 @@ def _run_processes(
         options.append("--review")
     options += engine_arguments(args)
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
-        team = ProcessTeam(args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition))
+        team = ProcessTeam(
+            args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition), deadline=args.time_limit
+        )
         live = _ProcessCenter(session, team, header, library) if session is not None else None
         interrupted = False
         try:

@@ -17,9 +17,11 @@ works and prints one line on standard error.
 from __future__ import annotations
 
 import argparse
+import os
 import re
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from alica.errors import AlicaError
@@ -113,6 +115,38 @@ def time_limit(args: argparse.Namespace) -> float | None:
     if value is not None and not 0 < value < float("inf"):
         raise AlicaError(f"--time-limit must be a positive number of seconds, not {value:g}")
     return value
+
+
+def check_output(path: str | Path, option: str, *, make_folders: bool) -> None:
+    """Check, before anything starts, that the file an option names can be written.
+
+    Args:
+        path: the file.
+        option: the option that names it, for the message, e.g. ``--trace``.
+        make_folders: whether the command creates the missing folders on the way to
+            ``path`` (``alica run``); else its folder must exist (``alica agent``).
+
+    Raises:
+        AlicaError: the path is a folder, its folder is missing (unless ``make_folders``),
+            something on the way is a file, or the place is not writable; the message
+            names the file, what is wrong and what to do.
+    """
+    target = Path(path)
+    where = f"{option} {target}"
+    if target.is_dir():
+        raise AlicaError(f"{where}: is a folder; give a file name, e.g. {target / 'trace.jsonl'}")
+    folder = target.parent
+    if not make_folders and not folder.is_dir():
+        what = f"{folder} is not a folder" if folder.exists() else f"no such folder {folder}"
+        raise AlicaError(f"{where}: {what}; create it first (mkdir -p {folder}) or give a file in an existing folder")
+    existing = folder
+    while not existing.exists() and existing.parent != existing:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise AlicaError(f"{where}: {existing} is a file, not a folder; give a path whose folders are folders")
+    if not os.access(existing, os.W_OK | os.X_OK) or (target.exists() and not os.access(target, os.W_OK)):
+        blocked = target if target.exists() else existing
+        raise AlicaError(f"{where}: {blocked} is not writable; give a file in a folder you can write to")
 
 
 def add_field_options(parser: argparse._ActionsContainer) -> None:

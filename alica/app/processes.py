@@ -14,6 +14,14 @@ again (a new incarnation with an empty memory, which catches up from its
 teammates). The run ends when every agent that has not crashed has
 finished its root plan, at ``--time-limit``, or on Ctrl-C; then every
 process gets SIGTERM, prints its summary and exits.
+
+The agents do not outlive this process. Each one's standard input is a
+pipe this process never writes to, and the agent watches it
+(``alica agent --parent-pipe 0``): when this process is gone, even by
+``kill -9``, the pipe reaches end of file and the agent stops. With a
+``deadline`` each agent also gets ``--time-limit`` of the run's deadline
+plus :data:`DEADLINE_MARGIN`, so it ends by itself even when this process
+is alive but cannot stop it (frozen, say).
 """
 
 from __future__ import annotations
@@ -40,6 +48,8 @@ POLL = 0.05
 """Seconds between two looks at the agents and the faults due."""
 STOP_GRACE = 10.0
 """Seconds an agent process has to exit after SIGTERM before it is killed."""
+DEADLINE_MARGIN = 5.0
+"""Seconds past the run's deadline at which an agent ends by itself: after this process has stopped it, normally."""
 
 #: A fault of :meth:`ProcessTeam.run`, ``(t, kind, what)`` with ``t`` in seconds since the start:
 #: ``(t, "crash", name)``, ``(t, "recover", name)``, ``(t, "partition", (groups, start, end))`` or ``(t, "heal", None)``.
@@ -78,6 +88,9 @@ class ProcessTeam:
         workdir: where the agents' traces and logs go.
         relays: link the agents through relays, so that :meth:`partition` can cut them.
         own: more options for single agents, by name (one robot's operator, say).
+        deadline: the run's end in seconds after the start (``max_time`` of :meth:`run`); each
+            agent gets ``--time-limit`` of it plus :data:`DEADLINE_MARGIN`. ``None``: the agents
+            get none from here (``options`` may give one).
     """
 
     def __init__(
@@ -90,8 +103,10 @@ class ProcessTeam:
         *,
         relays: bool = False,
         own: dict[str, list[str]] | None = None,
+        deadline: float | None = None,
     ) -> None:
         self.plan = plan
+        self.deadline = deadline
         self.roster = agents
         self.options = list(options)
         self.own = dict(own or {})
@@ -146,9 +161,15 @@ class ProcessTeam:
             "--json",
             *self.options,
             *self.own.get(agent.name, ()),
+            "--parent-pipe",
+            "0",  # its standard input: end of file when this process is gone
         ]
+        if self.deadline is not None:
+            argv += ["--time-limit", repr(self.deadline + DEADLINE_MARGIN)]
         agent.log = (self.workdir / f"{agent.name}.{agent.incarnation}.log").open("w", encoding="utf-8")
-        agent.process = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=agent.log, text=True, bufsize=1)
+        agent.process = subprocess.Popen(
+            argv, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=agent.log, text=True, bufsize=1
+        )
         agent.status = "starting"
         agent.reader = threading.Thread(target=self._read, args=(agent, agent.process), daemon=True)
         agent.reader.start()
@@ -220,6 +241,7 @@ class ProcessTeam:
         with contextlib.suppress(ProcessLookupError):
             os.kill(agent.process.pid, signal.SIGKILL)
         agent.process.wait()
+        _close_pipe(agent.process)
         with self._lock:
             agent.status = "crashed"
         self._fault("crash", agent=name)
@@ -288,6 +310,8 @@ class ProcessTeam:
                 agent.process.kill()
                 agent.process.wait()
         for agent in self.agents.values():
+            if agent.process is not None:
+                _close_pipe(agent.process)  # after the SIGTERM: the agents' summaries say "stopped"
             if agent.reader is not None:
                 agent.reader.join(timeout=5.0)
             if agent.log is not None:
@@ -420,3 +444,10 @@ class ProcessTeam:
             return None
         lines = [line for line in log.read_text(encoding="utf-8").splitlines() if line.strip()]
         return lines[-1] if lines else None
+
+
+def _close_pipe(process: subprocess.Popen[str]) -> None:
+    """Close this end of the agent's parent pipe (its standard input)."""
+    if process.stdin is not None:
+        with contextlib.suppress(OSError):
+            process.stdin.close()
