@@ -138,7 +138,7 @@ def test_kill_9_of_the_parent_ends_its_agents(tmp_path):
 def test_agents_of_a_frozen_parent_end_at_the_runs_deadline(tmp_path):
     from alica.app.processes import DEADLINE_MARGIN
 
-    limit = 4.0
+    limit = 8.0
     began = time.monotonic()
     parent, agents = start_team(tmp_path, "--time-limit", repr(limit))
     try:
