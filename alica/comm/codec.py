@@ -6,10 +6,12 @@ processes must turn them into bytes. Payloads are plain immutable data
 dataclasses, named tuples and enums made of those. :func:`encode` pickles them (the C
 pickler is the fastest encoder of such data in the standard library);
 :func:`decode` unpickles with an unpickler that loads no class except the
-dataclasses, named tuples and enums of the modules it is allowed (``alica.`` and whatever a
-user's skills add with :func:`allow_module`). A peer on the network therefore
-cannot make a receiver import a module or call a function: a plain
-``pickle.loads`` would run any code the sender asked for.
+message classes of an allow-list (:data:`MESSAGES`: what the team sends, and
+whatever a user's skills add with :func:`allow_module`). A peer on the network
+therefore cannot make a receiver import a module, create a class or call a
+function: a plain ``pickle.loads`` would run any code the sender asked for. An
+enum of the list is only ever looked up by its value (a pickle that calls it
+with more arguments, which would create a new enum class, is refused).
 """
 
 from __future__ import annotations
@@ -21,8 +23,34 @@ import io
 import pickle
 import threading
 
-#: Module prefixes whose dataclasses and enums :func:`decode` may build.
-_ALLOWED: set[str] = {"alica."}
+MESSAGES: frozenset[tuple[str, str]] = frozenset(
+    {
+        ("alica.engine.sync", "SyncTalk"),
+        ("alica.engine.team", "AuthorityClaim"),
+        ("alica.engine.team", "Claim"),
+        ("alica.engine.team", "TeamMessage"),
+        ("alica.lang.fact", "Fact"),
+        ("alica.prophet.board", "PlanShare"),
+        ("alica.prophet.board", "ReplanRequest"),
+        ("alica.prophet.board", "ShareStatus"),
+        ("alica.prophet.magic.messages", "Final"),
+        ("alica.prophet.magic.messages", "Result"),
+        ("alica.prophet.magic.messages", "Share"),
+        ("alica.prophet.planner", "PlanStatus"),
+        ("alica.prophet.planner", "PlanStep"),
+        ("alica.prophet.search.anytime", "FirstSearch"),
+        ("alica.worldmodel.delta", "Add"),
+        ("alica.worldmodel.delta", "Delta"),
+        ("alica.worldmodel.delta", "Key"),
+        ("alica.worldmodel.delta", "Write"),
+        ("alica.worldmodel.stamp", "Stamp"),
+    }
+)
+"""(module, class) of every message class the team sends (the engine, the world model, pRoPhEt and MAGiC);
+:func:`decode` builds these and no other ``alica`` class (issue 37)."""
+
+#: Module prefixes of users' messages (:func:`allow_module`) whose dataclasses, named tuples and enums decode.
+_ALLOWED: set[str] = set()
 _LOCK = threading.Lock()
 _CACHE: dict[tuple[str, str], type] = {}
 
@@ -70,7 +98,7 @@ class _Unpickler(pickle.Unpickler):
         cached = _CACHE.get(key)
         if cached is not None:
             return cached
-        if not _allowed(module):
+        if key not in MESSAGES and not _allowed(module):
             raise CodecError(
                 f"a payload names {module}.{name}, and module '{module}' is not allowed; "
                 "call alica.comm.codec.allow_module() with it in every agent process"
@@ -83,8 +111,19 @@ class _Unpickler(pickle.Unpickler):
             dataclasses.is_dataclass(found) or issubclass(found, enum.Enum) or _named_tuple(found)
         ):
             raise CodecError(f"a payload names {module}.{name}, which is not a dataclass, a named tuple or an enum")
+        if issubclass(found, enum.Enum):
+            found = _by_value(found)
         _CACHE[key] = found
         return found
+
+
+def _by_value(cls: type[enum.Enum]) -> type:
+    """``cls`` as the unpickler may call it: looked up by one value, never called to make a new enum class."""
+
+    def member(value: object) -> enum.Enum:
+        return cls(value)
+
+    return member  # type: ignore[return-value]
 
 
 def _named_tuple(cls: type) -> bool:

@@ -12,7 +12,12 @@ send (a history question) comes back as a value. The caller (the zenoh shell,
 
 Bounds: a kept message goes when it is older than ``seconds``, or, while the
 kept messages take more than ``max_bytes``, the oldest of the topic being
-published goes first; each topic keeps at least its newest message.
+published goes first; each topic keeps at least its newest message. The
+inbox holds at most ``max_held`` messages per sender and ``max_held_total``
+in all (one more is not held: the sender's history gives it again once the
+gap is filled); a sender unheard for ``quiet`` seconds loses what is held of
+it and is no longer asked; at most ``max_senders`` senders are remembered
+(then the one heard longest ago goes, never-answered ones first).
 """
 
 from __future__ import annotations
@@ -148,6 +153,10 @@ class _Sender:
     """Per topic: the last number delivered from this sender (offset included)."""
     asked_at: float | None = None
     """When a history question to this sender went out (``None``: none outstanding)."""
+    heard_at: float = 0.0
+    """When a frame, heartbeat or answer of this sender came last."""
+    answered: bool = False
+    """Whether its history ever answered (senders that never did are forgotten first)."""
 
     def stream(self, topic: str) -> _Stream:
         found = self.streams.get(topic)
@@ -173,16 +182,36 @@ class Inbox:
 
     Args:
         agent_id: the receiver's own id (its own frames are ignored).
+        quiet: seconds after which a sender not heard is no longer asked and what is held of it is dropped.
+        max_held: the most messages held for one sender.
+        max_held_total: the most messages held for all senders.
+        max_senders: the most senders remembered.
     """
 
-    def __init__(self, agent_id: str) -> None:
+    def __init__(
+        self,
+        agent_id: str,
+        *,
+        quiet: float = 20.0,
+        max_held: int = 10_000,
+        max_held_total: int = 100_000,
+        max_senders: int = 1024,
+    ) -> None:
         self._id = agent_id
+        self._quiet = quiet
+        self._max_held = max_held
+        self._max_held_total = max_held_total
+        self._max_senders = max_senders
+        self._held = 0
+        self._held_by: dict[str, int] = {}
         self.subscribed: dict[str, float] = {}
         """The topics subscribed to, and when."""
         self._senders: dict[str, _Sender] = {}
         self._out: list[Envelope | None] = []
         self._pending: dict[tuple[str, str], int] = {}
         self.counts = dict.fromkeys(("recovered", "duplicates", "superseded", "lost", "undecodable"), 0)
+        self.dropped = dict.fromkeys(("held", "quiet", "senders"), 0)
+        """Bounds met: messages not held (a cap), dropped from a quiet sender, and senders forgotten (the cap)."""
         """What happened so far (the counters of the same names of :class:`~alica.comm.zenoh_transport.ZenohStats`)."""
         self.errors: dict[str, int] = {}
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
@@ -210,7 +239,7 @@ class Inbox:
         incarnation, sender, topic, seq, rseq, gseq, sent_at, data = frame
         if topic not in self.subscribed or sender == self._id:
             return None
-        state = self._sender(sender, incarnation)
+        state = self._sender(sender, incarnation, now)
         if state is None:
             return None
         shown = state.offset.get(topic, 0) + seq
@@ -234,15 +263,20 @@ class Inbox:
         if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
             self.counts["duplicates"] += 1
             return None
+        if stream.next is None or rseq != stream.next:
+            if not self._room(sender):
+                self.dropped["held"] += 1  # its history gives it again once the gap is filled
+                return self._want(sender, state, now)
         stream.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
-        self._release(state)
+        self._count_held(sender, 1)
+        self._release(sender, state)
         return self._want(sender, state, now) if stream.gapped() else None
 
     def heard(self, sender: str, incarnation: int, last: Mapping[str, int], now: float) -> str | None:
         """Take in a heartbeat (per topic, the last reliable number sent); returns the sender when it must be asked."""
         if sender == self._id:
             return None
-        state = self._sender(sender, incarnation)
+        state = self._sender(sender, incarnation, now)
         if state is None:
             return None
         behind = False
@@ -253,9 +287,21 @@ class Inbox:
         return self._want(sender, state, now) if behind else None
 
     def overdue(self, now: float, timeout: float) -> list[str]:
-        """The senders asked more than ``timeout`` seconds ago and not answered: they count as asked again now."""
+        """The senders asked more than ``timeout`` seconds ago and not answered: they count as asked again now.
+
+        A sender not heard for ``quiet`` seconds is not asked again, and what is held of it is dropped.
+        """
         retry = []
         for sender, state in self._senders.items():
+            if now - state.heard_at > self._quiet:
+                state.asked_at = None
+                dropped = self._held_by.get(sender, 0)
+                if dropped:
+                    for stream in state.streams.values():
+                        stream.held.clear()
+                    self._count_held(sender, -dropped)
+                    self.dropped["quiet"] += dropped
+                continue
             if state.asked_at is not None and now - state.asked_at > timeout:
                 state.asked_at = now
                 retry.append(sender)
@@ -285,10 +331,11 @@ class Inbox:
             start: per topic, the number of the sender's next reliable message.
             oldest: per topic, the oldest number the sender still keeps.
         """
-        state = self._sender(sender, incarnation)
+        state = self._sender(sender, incarnation, None)
         if state is None:
             return
         state.asked_at = None
+        state.answered = True
         decoded = list(frames)
         first_answer = {topic for topic in start if topic in self.subscribed and state.stream(topic).next is None}
         for topic in first_answer:
@@ -297,6 +344,7 @@ class Inbox:
             stream.next = min(numbers) if numbers else int(start[topic])
             for number in [n for n in stream.held if n < stream.next]:
                 del stream.held[number]  # sent before this agent subscribed
+                self._count_held(sender, -1)
         for topic, first in oldest.items():
             known = state.streams.get(topic)
             if topic not in first_answer and known is not None and known.next is not None and first > known.next:
@@ -307,11 +355,15 @@ class Inbox:
             known = state.streams.get(topic)
             if known is None or known.next is None or rseq < known.next or rseq in known.held:
                 continue
+            if rseq != known.next and not self._room(sender):
+                self.dropped["held"] += 1
+                continue
             shown = state.offset.get(topic, 0) + seq
             payload = self._payload(data, sender, topic)
             known.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
+            self._count_held(sender, 1)
             self.counts["recovered"] += topic not in first_answer
-        self._release(state)
+        self._release(sender, state)
 
     def _payload(self, data: object, sender: str, topic: str) -> object:
         """The decoded payload, or :data:`_UNDECODABLE` (counted, its reason kept)."""
@@ -326,19 +378,51 @@ class Inbox:
             self.errors[f"{sender} on {topic}: {exc}"] += 1
             return _UNDECODABLE
 
-    def _sender(self, sender: str, incarnation: int) -> _Sender | None:
-        """The state of ``sender``, started over for a new incarnation; ``None`` for an old one."""
+    def _sender(self, sender: str, incarnation: int, now: float | None) -> _Sender | None:
+        """The state of ``sender``, started over for a new incarnation; ``None`` for an old one.
+
+        ``now`` (``None``: an answer, which is no sign of life) marks the sender heard, and a new sender
+        may make the inbox forget the one heard longest ago, never-answered ones first.
+        """
         state = self._senders.get(sender)
         if state is None:
+            if now is None:
+                return None
+            if len(self._senders) >= self._max_senders:
+                self._forget_one()
             state = self._senders[sender] = _Sender(incarnation)
         elif incarnation > state.incarnation:
             numbers = dict(state.last_seq)
+            self._count_held(sender, -self._held_by.get(sender, 0))
             state = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
         elif incarnation < state.incarnation:
             return None
+        if now is not None:
+            state.heard_at = now
         return state
 
-    def _release(self, state: _Sender) -> None:
+    def _forget_one(self) -> None:
+        """Forget the sender heard longest ago, preferring one whose history never answered."""
+        victim = min(self._senders, key=lambda name: (self._senders[name].answered, self._senders[name].heard_at))
+        del self._senders[victim]
+        self._count_held(victim, -self._held_by.get(victim, 0))
+        self._pending = {key: index for key, index in self._pending.items() if key[0] != victim}
+        self.dropped["senders"] += 1
+
+    def _room(self, sender: str) -> bool:
+        """Whether one more message of ``sender`` may be held."""
+        return self._held < self._max_held_total and self._held_by.get(sender, 0) < self._max_held
+
+    def _count_held(self, sender: str, change: int) -> None:
+        if change:
+            self._held += change
+            left = self._held_by.get(sender, 0) + change
+            if left > 0:
+                self._held_by[sender] = left
+            else:
+                self._held_by.pop(sender, None)
+
+    def _release(self, sender: str, state: _Sender) -> None:
         """Deliver the sender's held reliable messages that can go, in its send order.
 
         A message goes when its topic has no gap before it and no other topic
@@ -358,6 +442,7 @@ class Inbox:
             if gate is not None and gseq > gate:
                 return
             del best.held[best.next]
+            self._count_held(sender, -1)
             best.next += 1
             best.last_gseq = gseq
             if envelope is None:

@@ -38,14 +38,14 @@ import json
 import re
 import threading
 import time
-from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
 
 import zenoh
 
 from alica.clock import Clock, SystemClock
-from alica.comm.codec import CodecError, decode, encode
+from alica.comm import frames
+from alica.comm.codec import encode
 from alica.comm.reliable import Frame, History, Inbox
 from alica.comm.transport import Envelope, QoS, Transport
 
@@ -84,7 +84,10 @@ class ZenohStats:
         superseded: best-effort messages replaced by a newer one before a poll, or older than one delivered.
         lost: reliable messages a sender no longer had in its history when asked for (a very long partition).
         queries: history queries sent.
-        undecodable: messages that could not be decoded (another version, a foreign class).
+        undecodable: payloads that could not be decoded (another version, a foreign class).
+        rejected: frames dropped because they were not well-formed (too big, undecodable, a field
+            of the wrong type or out of bounds, nested too deep), by reason
+            (:class:`alica.comm.frames.Reason`, e.g. ``{"topic": 2}``).
     """
 
     sent: int
@@ -95,6 +98,7 @@ class ZenohStats:
     lost: int
     queries: int
     undecodable: int
+    rejected: dict[str, int] = field(default_factory=dict, hash=False)
 
 
 class ZenohTransport(Transport):
@@ -170,9 +174,10 @@ class ZenohTransport(Transport):
         self._history = History(self._incarnation, seconds=self._history_s, max_bytes=float(history_mb) * 1024 * 1024)
         self._publishers: dict[tuple[str, QoS], zenoh.Publisher] = {}
         # receiving
-        self._inbox = Inbox(self._id)
+        self._inbox = Inbox(self._id, quiet=10.0 * float(lease))
         self._alive: set[str] = set()
-        self._counts = dict.fromkeys(ZenohStats.__slots__, 0)
+        self._counts = dict.fromkeys([name for name in ZenohStats.__slots__ if name != "rejected"], 0)
+        self._rejected: dict[str, int] = {}
         self.errors = self._inbox.errors
         """Why payloads could not be decoded (sender, topic, reason) and how often."""
         self._subscribers: list[zenoh.Subscriber[None] | zenoh.LivelinessToken | zenoh.Queryable[None]] = []
@@ -317,7 +322,8 @@ class ZenohTransport(Transport):
             counts = dict(self._counts)
             for name, count in self._inbox.counts.items():
                 counts[name] += count
-        return ZenohStats(**counts)
+            rejected = frames.by_reason(self._rejected)
+        return ZenohStats(**counts, rejected=rejected)
 
     @property
     def closed(self) -> bool:
@@ -362,41 +368,38 @@ class ZenohTransport(Transport):
             else:
                 self._alive.discard(name)
 
-    def _decode(self, data: bytes, size: int) -> tuple[Any, ...] | None:
-        """The tuple of ``size`` items in ``data``, or ``None`` (counted) when it is something else (lock held)."""
-        try:
-            value = decode(data)
-        except CodecError:
-            value = None
-        if not isinstance(value, tuple) or len(value) != size:
-            self._counts["undecodable"] += 1
-            return None
-        return value
+    def _reject(self, bad: frames.BadFrame) -> None:
+        """Count a frame that is not well-formed (lock held); it is dropped."""
+        frames.count(self._rejected, bad.reason)
 
     def _on_message(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
+        key = str(sample.key_expr)
         with self._lock:
             if self._closed:
                 return
-            frame = self._decode(data, _FRAME_LEN)
-            ask = self._receive(frame) if frame is not None else None
+            try:
+                frame = frames.frame(frames.load(data, _FRAME_LEN))
+                if key != f"{self._team}/m/{frame[1]}/{frame[2]}":
+                    raise frames.BadFrame(frames.Reason.SENDER, "the frame's sender and topic are not its key's")
+            except frames.BadFrame as bad:
+                self._reject(bad)
+                return
+            ask = self._inbox.receive(frame, self._clock.now())
         if ask is not None:
             self._ask(ask)
-
-    def _receive(self, frame: Frame) -> str | None:
-        """Take in one frame (lock held); returns the sender when its history must be asked."""
-        return self._inbox.receive(frame, self._clock.now())
 
     def _on_heartbeat(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
         with self._lock:
             if self._closed:
                 return
-            beat = self._decode(data, 3)
-            if beat is None:
-                return
-            incarnation, sender, last = beat
-            if not isinstance(last, dict):
+            try:
+                incarnation, sender, last = frames.heartbeat(frames.load(data, 3))
+                if str(sample.key_expr) != f"{self._team}/hb/{sender}":
+                    raise frames.BadFrame(frames.Reason.SENDER, "the heartbeat's sender is not its key's")
+            except frames.BadFrame as bad:
+                self._reject(bad)
                 return
             ask = self._inbox.heard(sender, incarnation, last, self._clock.now())
         if ask is not None:
@@ -413,7 +416,7 @@ class ZenohTransport(Transport):
         try:
             self._session.get(
                 f"{self._team}/hist/{sender}",
-                self._on_reply,
+                lambda reply: self._on_reply(sender, reply),
                 payload=encode(request),
                 timeout=self._query_timeout,
                 consolidation=zenoh.ConsolidationMode.NONE,
@@ -434,18 +437,19 @@ class ZenohTransport(Transport):
         with self._lock:
             if self._closed or not data:
                 return
-            request = self._decode(data, 3)
-            if request is None or not isinstance(request[2], dict):
+            try:
+                _who, incarnation, wanted = frames.question(frames.load(data, 3))
+            except frames.BadFrame as bad:
+                self._reject(bad)
                 return
-            _who, incarnation, wanted = request
-            frames, start, oldest = self._history.answer(incarnation, wanted)
-        answer = encode((self._incarnation, self._id, frames, start, oldest))
+            kept, start, oldest = self._history.answer(incarnation, wanted)
+        answer = encode((self._incarnation, self._id, kept, start, oldest))
         try:
             query.reply(f"{self._team}/hist/{self._id}", answer)
         except Exception:  # (the asker left)
             return
 
-    def _on_reply(self, reply: zenoh.Reply) -> None:
+    def _on_reply(self, asked: str, reply: zenoh.Reply) -> None:
         sample = reply.ok
         if sample is None:
             return
@@ -453,13 +457,27 @@ class ZenohTransport(Transport):
         with self._lock:
             if self._closed:
                 return
-            answer = self._decode(data, 5)
-            if answer is None:
+            try:
+                incarnation, sender, kept, start, oldest = frames.answer(frames.load(data, 5, frames.MAX_ANSWER_BYTES))
+                if sender != asked:
+                    raise frames.BadFrame(frames.Reason.SENDER, "an answer from another sender than the one asked")
+            except frames.BadFrame as bad:
+                self._reject(bad)
                 return
-            incarnation, sender, frames, start, oldest = answer
             # decoded only once the inbox knows the answer is about the sender's current incarnation
-            decoded = (frame for frame in (self._decode(d, _FRAME_LEN) for d in frames) if frame is not None)
-            self._inbox.answered(incarnation, sender, decoded, start, oldest)
+            self._inbox.answered(incarnation, sender, self._frames_of(sender, kept), start, oldest)
+
+    def _frames_of(self, sender: str, kept: tuple[bytes, ...]) -> Iterator[Frame]:
+        """The well-formed frames of ``sender`` in a history answer (the others counted and skipped; lock held)."""
+        for data in kept:
+            try:
+                frame = frames.frame(frames.load(data, _FRAME_LEN))
+                if frame[1] != sender:
+                    raise frames.BadFrame(frames.Reason.SENDER, "a frame of another sender in a history answer")
+            except frames.BadFrame as bad:
+                self._reject(bad)
+                continue
+            yield frame
 
     def _check_open(self, what: str) -> None:
         if self._closed:
