@@ -18,12 +18,12 @@ import contextlib
 import json
 import os
 import queue
+import select
 import signal
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -71,14 +71,27 @@ def agents_of(parent: int) -> list[int]:
     return found
 
 
-def wait_for(condition: Callable[[], bool], timeout: float) -> bool:
-    """Poll ``condition`` until it holds or ``timeout`` seconds passed; whether it held."""
+def all_exit(pids: list[int], timeout: float) -> bool:
+    """Wait until every process of ``pids`` has exited, at most ``timeout`` seconds; whether they all did.
+
+    Event-driven, not polled: a pidfd of each process becomes readable when it exits (Linux 5.3+).
+    A zombie (exited, not yet reaped by its new parent) counts as gone, as in :func:`alive`.
+    """
     end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if condition():
-            return True
-        time.sleep(0.05)
-    return condition()
+    for pid in pids:
+        try:
+            fd = os.pidfd_open(pid)
+        except ProcessLookupError:
+            continue
+        try:
+            while alive(pid):
+                remaining = end - time.monotonic()
+                if remaining <= 0:
+                    return False
+                select.select([fd], [], [], min(remaining, 1.0))  # wakes on exit; 1 s bounds the zombie re-check
+        finally:
+            os.close(fd)
+    return True
 
 
 def start_team(tmp_path: Path, *argv: str) -> tuple[subprocess.Popen[str], list[int]]:
@@ -129,7 +142,7 @@ def test_kill_9_of_the_parent_ends_its_agents(tmp_path):
         assert all(alive(pid) for pid in agents)
         os.kill(parent.pid, signal.SIGKILL)  # the parent only: its agents get no signal
         parent.wait(timeout=10)
-        assert wait_for(lambda: not any(alive(pid) for pid in agents), 15.0), [p for p in agents if alive(p)]
+        assert all_exit(agents, 15.0), [p for p in agents if alive(p)]
     finally:
         kill_group(parent)
 
@@ -143,7 +156,7 @@ def test_agents_of_a_frozen_parent_end_at_the_runs_deadline(tmp_path):
     parent, agents = start_team(tmp_path, "--time-limit", repr(limit))
     try:
         os.kill(parent.pid, signal.SIGSTOP)  # alive, so the pipes stay open, but it cannot stop anyone
-        gone = wait_for(lambda: not any(alive(pid) for pid in agents), limit + DEADLINE_MARGIN + 20.0)
+        gone = all_exit(agents, limit + DEADLINE_MARGIN + 20.0)
         assert gone, [p for p in agents if alive(p)]
         assert time.monotonic() - began >= limit  # they ended at the deadline, not at once
     finally:
