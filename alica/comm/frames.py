@@ -56,6 +56,8 @@ class Reason(enum.Enum):
     """An incarnation or sequence number that is not an int in bounds, or a time that is not finite."""
     NESTING = "nesting"
     """A payload nested deeper than :data:`MAX_DEPTH`, or with more than :data:`MAX_ITEMS` values."""
+    ROSTER = "roster"
+    """A sender, or a liveliness token's name, that is not in the team's roster."""
 
 
 class BadFrame(ValueError):
