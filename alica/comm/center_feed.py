@@ -21,6 +21,17 @@ Two sides, both on zenoh keys under the team's prefix (``--key-prefix``):
 Every published event carries the attachment ``"INCARNATION SEQ"``: the
 agent's process (a restarted agent is a new incarnation) and the event's
 number, so a center drops what it already had from a history answer.
+
+**Operator commands are signed** when the team has credentials
+(:class:`~alica.comm.credentials.TeamKeys`): the center's command carries the
+attachment ``"SIGNER AT SIGNATURE"`` (the center's identity, its
+``time.time_ns()``, and its signature of the team's prefix, the time and the
+command); an agent takes only commands signed by the team's center, at most
+:data:`COMMAND_SKEW` seconds off its clock, and each signature once. A
+command reaches agents through the one the center is connected to, so zenoh's
+access control cannot tell who sent it; the signature does. Commands over
+:data:`MAX_COMMAND` bytes, malformed or unsigned ones are dropped and counted
+(:attr:`CenterFeed.refused`).
 """
 
 from __future__ import annotations
@@ -31,17 +42,30 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
-from typing import Any, Self, cast
+from typing import TYPE_CHECKING, Any, Self, cast
 
 import zenoh
 
-from alica.comm.zenoh_transport import ZenohTransport, _check_name, zenoh_config
+from alica.comm.zenoh_transport import ZenohTransport, _check_name, alive_of, zenoh_config
+
+if TYPE_CHECKING:
+    from alica.comm.credentials import TeamKeys
 
 KEEP = 50_000
 """The events an agent keeps for a center that joins late (the older ones are dropped, and counted)."""
 EVENTS = "center/events"
 HISTORY = "center/history"
 OPERATOR = "center/operator"
+MAX_COMMAND = 1024 * 1024
+"""The largest operator's command an agent takes, in bytes."""
+COMMAND_SKEW = 300.0
+"""Seconds a signed command's time may differ from the agent's clock (hosts' clocks kept by NTP)."""
+
+
+def _signed_text(prefix: str, at: int, data: bytes) -> bytes:
+    """What the center signs: the team, the time, and the command (so a signature is good for one of each)."""
+    return b"%s\n%d\n%s" % (prefix.encode(), at, data)
+
 
 _Declared = zenoh.Publisher | zenoh.Subscriber[None] | zenoh.Queryable[None] | zenoh.MatchingListener[None]
 """What a feed or a center declared on a session, undeclared when it closes."""
@@ -55,15 +79,28 @@ class CenterFeed:
         header: the agent's trace header, sent first in every history answer.
         start: the team's start (seconds since the epoch), sent with the history.
         keep: how many events to keep for late centers.
+        keys: the team's credentials: take only commands signed by the team's center (``None``: any command).
 
     Call it with each trace event (an observer); close it before the transport.
     """
 
-    def __init__(self, transport: ZenohTransport, header: Mapping[str, Any], start: float, keep: int = KEEP) -> None:
+    def __init__(
+        self,
+        transport: ZenohTransport,
+        header: Mapping[str, Any],
+        start: float,
+        keep: int = KEEP,
+        keys: TeamKeys | None = None,
+    ) -> None:
         if keep < 1:
             raise ValueError(f"keep must be at least 1 event, got {keep}")
         self.name = transport.agent_id
-        prefix = transport.team
+        prefix = self._prefix = transport.team
+        self._keys = keys
+        self._signatures: dict[bytes, int] = {}
+        """Signatures of the commands taken, and their times (forgotten after :data:`COMMAND_SKEW`)."""
+        self.refused = 0
+        """Operator's commands dropped: too big, not JSON objects, or not signed by the team's center."""
         session = transport.session
         self._header = json.dumps(dict(header), sort_keys=True, default=str)
         self._start = float(start)
@@ -152,12 +189,41 @@ class CenterFeed:
             return
 
     def _on_command(self, sample: zenoh.Sample) -> None:
-        try:
-            command = json.loads(sample.payload.to_bytes())
-        except (ValueError, UnicodeDecodeError):
-            return
+        data = sample.payload.to_bytes()
+        command: object = None
+        if len(data) <= MAX_COMMAND and (self._keys is None or self._signed(data, sample.attachment)):
+            try:
+                command = json.loads(data)
+            except (ValueError, UnicodeDecodeError, RecursionError):
+                command = None
         if isinstance(command, dict):
             self._commands.put(command)
+        else:
+            with self._lock:
+                self.refused += 1
+
+    def _signed(self, data: bytes, attachment: zenoh.ZBytes | None) -> bool:
+        """Whether ``data`` carries a fresh signature of the team's center (its first use)."""
+        keys = self._keys
+        if keys is None or attachment is None:
+            return False
+        try:
+            signer, at_text, signature_hex = attachment.to_bytes().decode("ascii").split(" ")
+            at, signature = int(at_text), bytes.fromhex(signature_hex)
+        except (ValueError, UnicodeDecodeError):
+            return False
+        now = time.time_ns()
+        skew = int(COMMAND_SKEW * 1e9)
+        if signer != keys.center or abs(at - now) > skew or len(signature) > 256:
+            return False
+        if not keys.verifies(signer, _signed_text(self._prefix, at, data), signature):
+            return False
+        with self._lock:
+            self._signatures = {sig: t for sig, t in self._signatures.items() if now - t <= skew}
+            if signature in self._signatures:
+                return False  # replayed
+            self._signatures[signature] = at
+        return True
 
 
 class CenterLink:
@@ -172,6 +238,7 @@ class CenterLink:
         on_gone: called with an agent's name when its liveliness token goes.
         config: more zenoh configuration (key path -> JSON-able value).
         query_timeout: seconds before an unanswered history query is sent again.
+        keys: the team's credentials (the center's identity): commands go signed.
 
     Raises:
         ValueError: a bad prefix or endpoint, or zenoh could not open the session.
@@ -187,8 +254,10 @@ class CenterLink:
         *,
         config: Mapping[str, object] | None = None,
         query_timeout: float = 2.0,
+        keys: TeamKeys | None = None,
     ) -> None:
         self.prefix = _check_name("key prefix", prefix)
+        self._keys = keys
         self.connect = tuple(connect)
         if not self.connect:
             raise ValueError("give at least one endpoint of an agent of the team, e.g. tcp/127.0.0.1:7447")
@@ -198,8 +267,8 @@ class CenterLink:
         self._timeout = float(query_timeout)
         self._lock = threading.Lock()
         self._closed = False
-        self.alive: set[str] = set()
-        """Agents whose liveliness token the session sees now."""
+        self._tokens: dict[str, set[int]] = {}
+        """Agent -> the incarnations whose liveliness token the session sees now."""
         self._known: dict[str, tuple[int, int]] = {}
         """Agent -> (incarnation, number of the last event handed on)."""
         self._waiting: dict[str, list[tuple[int, int, dict[str, Any]]]] = {}
@@ -214,7 +283,7 @@ class CenterLink:
         try:
             self._declared: list[_Declared] = [
                 self._session.declare_subscriber(f"{prefix}/{EVENTS}/*", self._on_sample),
-                self._session.liveliness().declare_subscriber(f"{prefix}/alive/*", self._on_alive, history=True),
+                self._session.liveliness().declare_subscriber(f"{prefix}/alive/*/*", self._on_alive, history=True),
             ]
             self._publisher = self._session.declare_publisher(
                 f"{prefix}/{OPERATOR}", congestion_control=zenoh.CongestionControl.BLOCK
@@ -227,8 +296,20 @@ class CenterLink:
         self._timer.start()
 
     def send(self, command: Mapping[str, Any]) -> None:
-        """Publish an operator's command to every agent reached."""
-        self._publisher.put(json.dumps(dict(command), sort_keys=True, default=str))
+        """Publish an operator's command to every agent reached (signed when the center has the team's keys)."""
+        data = json.dumps(dict(command), sort_keys=True, default=str).encode()
+        if self._keys is None:
+            self._publisher.put(data)
+            return
+        at = time.time_ns()
+        signature = self._keys.sign(_signed_text(self.prefix, at, data))
+        self._publisher.put(data, attachment=f"{self._keys.name} {at} {signature.hex()}")
+
+    @property
+    def alive(self) -> frozenset[str]:
+        """Agents whose liveliness token the session sees now."""
+        with self._lock:
+            return frozenset(self._tokens)
 
     def agents_reached(self) -> int:
         """How many agents answered a history query so far."""
@@ -256,16 +337,24 @@ class CenterLink:
     # -- zenoh's threads ----------------------------------------------------------
 
     def _on_alive(self, sample: zenoh.Sample) -> None:
-        name = str(sample.key_expr).rsplit("/", 1)[-1]
-        if sample.kind == zenoh.SampleKind.PUT:
-            with self._lock:
-                self.alive.add(name)
+        token = alive_of(str(sample.key_expr))
+        if token is None:
+            return
+        name, incarnation = token
+        put = sample.kind == zenoh.SampleKind.PUT
+        with self._lock:
+            tokens = self._tokens.setdefault(name, set())
+            if put:
+                tokens.add(incarnation)
+            else:
+                tokens.discard(incarnation)
+                if not tokens:
+                    del self._tokens[name]
+            gone = name not in self._tokens
+        if put:
             self._ask(name)
-        else:
-            with self._lock:
-                self.alive.discard(name)
-            if self._on_gone is not None:
-                self._on_gone(name)
+        elif gone and self._on_gone is not None:
+            self._on_gone(name)
 
     def _ask(self, name: str) -> None:
         with self._lock:
@@ -286,7 +375,7 @@ class CenterLink:
         while not self._stop.wait(0.25):
             now = time.monotonic()
             with self._lock:
-                due = [n for n, at in self._asked.items() if n in self.alive and now - at > self._timeout]
+                due = [n for n, at in self._asked.items() if n in self._tokens and now - at > self._timeout]
             for name in due:
                 self._ask(name)
 

@@ -17,10 +17,10 @@ import threading
 
 
 def _address(endpoint: str) -> tuple[str, int]:
-    """``("127.0.0.1", 7447)`` from ``tcp/127.0.0.1:7447``."""
+    """``("127.0.0.1", 7447)`` from ``tcp/127.0.0.1:7447`` (or ``tls/...``: TLS goes through the relay untouched)."""
     proto, _, rest = endpoint.partition("/")
     host, _, port = rest.rpartition(":")
-    if proto != "tcp" or not host or not port.isdigit():
+    if proto not in ("tcp", "tls") or not host or not port.isdigit():
         raise ValueError(f"a relay forwards to a TCP endpoint such as 'tcp/127.0.0.1:7447', got {endpoint!r}")
     return host, int(port)
 
@@ -39,7 +39,7 @@ class LinkRelay:
     def __init__(self, target: str, host: str = "127.0.0.1") -> None:
         self._target = _address(target)
         self._server = socket.create_server((host, 0))
-        self.endpoint = f"tcp/{host}:{self._server.getsockname()[1]}"
+        self.endpoint = f"{target.partition('/')[0]}/{host}:{self._server.getsockname()[1]}"
         self._lock = threading.Lock()
         self._open: set[socket.socket] = set()
         self._cut = False

@@ -157,6 +157,8 @@ class _Sender:
     """When a frame, heartbeat or answer of this sender came last."""
     answered: bool = False
     """Whether its history ever answered (senders that never did are forgotten first)."""
+    retired: bool = False
+    """Whether this incarnation's session is gone while an older one of the same id lives (a duplicate stopped)."""
 
     def stream(self, topic: str) -> _Stream:
         found = self.streams.get(topic)
@@ -175,7 +177,9 @@ class Inbox:
     sender and topic not taken yet, and one older than a delivered one is
     dropped. A sender's new incarnation (a restart) starts over, with its
     envelope numbers going on from the old ones; frames of an older
-    incarnation are ignored.
+    incarnation are ignored, until the newer one's session is gone
+    (:meth:`retire`: it was a duplicate of the name) or it has been quiet for
+    ``quiet`` seconds (a forged incarnation cannot silence a sender for good).
 
     Methods that may need a history question return the sender to ask; the
     caller then asks :meth:`question` and hands the answer to :meth:`answered`.
@@ -392,14 +396,28 @@ class Inbox:
                 self._forget_one()
             state = self._senders[sender] = _Sender(incarnation)
         elif incarnation > state.incarnation:
-            numbers = dict(state.last_seq)
-            self._count_held(sender, -self._held_by.get(sender, 0))
-            state = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
+            state = self._start_over(sender, state, incarnation)
         elif incarnation < state.incarnation:
-            return None
+            if now is None or not (state.retired or now - state.heard_at > self._quiet):
+                return None
+            # the newer incarnation stopped (a duplicate) or went quiet (a forgery): the older one speaks again
+            state = self._start_over(sender, state, incarnation)
         if now is not None:
             state.heard_at = now
         return state
+
+    def _start_over(self, sender: str, state: _Sender, incarnation: int) -> _Sender:
+        """A new state of ``sender`` for ``incarnation``, its envelope numbers going on from ``state``'s."""
+        numbers = dict(state.last_seq)
+        self._count_held(sender, -self._held_by.get(sender, 0))
+        new = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
+        return new
+
+    def retire(self, sender: str, incarnation: int) -> None:
+        """``sender``'s session ``incarnation`` is gone while an older one lives: take the older one's frames again."""
+        state = self._senders.get(sender)
+        if state is not None and state.incarnation == incarnation:
+            state.retired = True
 
     def _forget_one(self) -> None:
         """Forget the sender heard longest ago, preferring one whose history never answered."""

@@ -17,6 +17,16 @@ It keeps the meanings of the simulated network (:mod:`alica.comm.transport`):
 * A **restarted** agent (a new process with the same id) is a new
   incarnation: receivers start over with its numbers, and deliver from it
   every reliable message sent after they subscribed.
+* **Names are unique.** Each session's liveliness token names its agent and
+  incarnation (``{team}/alive/{id}/{incarnation}``). A transport that finds
+  another live session with its own id when it opens refuses to
+  (:class:`NameTaken`); one that sees an older session with its id appear
+  later (a partition healed) reports it (``on_name_taken``) and the agent
+  stops. Teammates keep hearing the older one: a duplicate's token leaving
+  does not take the name out of :meth:`ZenohTransport.peers`.
+* With a **roster** (the team's agent ids), frames, heartbeats and tokens of
+  any other name are dropped and counted (``stats.rejected["roster"]``): facts
+  from outside the team are never merged.
 
 The bookkeeping is pure and synchronous, in :mod:`alica.comm.reliable`: the
 sender's :class:`~alica.comm.reliable.History` and the receiver's
@@ -34,11 +44,12 @@ on, a lease of 2 s.
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import re
 import threading
 import time
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, field
 
 import zenoh
@@ -54,6 +65,32 @@ _CHUNK = re.compile(r"[^/*$?#\s]+")
 _SYNC = ("sync",)
 _SYNC_BYTES = encode(_SYNC)
 _FRAME_LEN = 8
+
+FUTURE_INCARNATION = 300.0
+"""Seconds an incarnation (the sender's ``time.time_ns()`` at its start) may lie ahead of this host's clock.
+
+Hosts of a team keep their clocks within this of each other (NTP); a frame whose incarnation is
+further ahead is forged, and taking it would make the sender's real frames look old."""
+
+
+class NameTaken(ValueError):
+    """Another live session of the team has this agent's id."""
+
+
+def alive_key(team: str, name: str, incarnation: int) -> str:
+    """The key of the liveliness token of ``name``'s session ``incarnation`` in ``team``."""
+    return f"{team}/alive/{name}/{incarnation}"
+
+
+def alive_of(key: str) -> tuple[str, int] | None:
+    """(name, incarnation) of a liveliness token's key; ``None`` for a key of another shape."""
+    parts = key.rsplit("/", 3)
+    if len(parts) != 4 or parts[1] != "alive" or not parts[3].isdigit() or len(parts[3]) > 19:
+        return None
+    try:
+        return _check_name("agent id", parts[2]), int(parts[3])
+    except ValueError:
+        return None
 
 
 def _check_topic(topic: object) -> str:
@@ -128,8 +165,13 @@ class ZenohTransport(Transport):
         config: more zenoh configuration, key path -> JSON-able value, e.g.
             ``{"scouting/multicast/enabled": True}``; applied last.
         query_timeout: seconds before an unanswered history query is sent again.
+        roster: the ids of the team's agents; frames, heartbeats and liveliness tokens of other
+            names are dropped and counted (``None``: any name is a teammate).
+        on_name_taken: called (from a zenoh thread, with the reason) when an older live session with
+            this agent's id appears after this one opened; the agent should stop.
 
     Raises:
+        NameTaken: another live session of the team has this id.
         ValueError: a bad id, team, endpoint list, or zenoh configuration.
     """
 
@@ -148,8 +190,14 @@ class ZenohTransport(Transport):
         clock: Clock | None = None,
         config: Mapping[str, object] | None = None,
         query_timeout: float = 1.0,
+        roster: Iterable[str] | None = None,
+        on_name_taken: Callable[[str], None] | None = None,
     ) -> None:
         self._id = _check_name("agent id", agent_id)
+        self._roster = None if roster is None else frozenset(_check_name("agent id", n) for n in roster) | {self._id}
+        self._on_name_taken = on_name_taken
+        self.name_taken: str | None = None
+        """Why this agent must stop: an older live session has its id (``None``: its id is its own)."""
         self._team = _check_name("team", team)
         if mode not in ("peer", "client"):
             raise ValueError(f"mode must be 'peer' or 'client', got {mode!r}")
@@ -175,7 +223,8 @@ class ZenohTransport(Transport):
         self._publishers: dict[tuple[str, QoS], zenoh.Publisher] = {}
         # receiving
         self._inbox = Inbox(self._id, quiet=10.0 * float(lease))
-        self._alive: set[str] = set()
+        self._alive: dict[str, set[int]] = {}
+        """Teammate -> the incarnations whose liveliness token is up (two only while a duplicate stops)."""
         self._counts = dict.fromkeys([name for name in ZenohStats.__slots__ if name != "rejected"], 0)
         self._rejected: dict[str, int] = {}
         self.errors = self._inbox.errors
@@ -194,8 +243,8 @@ class ZenohTransport(Transport):
             # One subscriber for every topic, so that zenoh hands over each sender's messages in the order
             # they were sent (two subscribers' callbacks may run at once); poll() filters by topic.
             self._subscribers += [
-                liveliness.declare_subscriber(f"{prefix}/alive/*", self._on_liveliness, history=True),
-                liveliness.declare_token(f"{prefix}/alive/{self._id}"),
+                liveliness.declare_subscriber(f"{prefix}/alive/*/*", self._on_liveliness, history=True),
+                liveliness.declare_token(alive_key(prefix, self._id, self._incarnation)),
                 self._session.declare_subscriber(f"{prefix}/m/**", self._on_message),
                 self._session.declare_subscriber(f"{prefix}/hb/*", self._on_heartbeat),
                 self._session.declare_queryable(f"{prefix}/hist/{self._id}", self._on_query),
@@ -207,6 +256,7 @@ class ZenohTransport(Transport):
             self._session.close()
             raise
         self._sync()
+        self._check_unique()
         self._stop = threading.Event()
         self._timer = threading.Thread(target=self._tick, name=f"zenoh-{self._id}", daemon=True)
         self._timer.start()
@@ -289,6 +339,20 @@ class ZenohTransport(Transport):
         except Exception:  # (nobody to ask, or closing: nothing to wait for)
             return
 
+    def _check_unique(self) -> None:
+        """Refuse to go on when an older live session of the team has this id (the session closes)."""
+        try:
+            for reply in self._session.liveliness().get(
+                f"{self._team}/alive/{self._id}/*", timeout=self._query_timeout
+            ):
+                if reply.ok is not None:
+                    self._on_liveliness(reply.ok)
+        except zenoh.ZError:  # (nobody to ask)
+            pass
+        if self.name_taken is not None:
+            self._session.close()
+            raise NameTaken(self.name_taken)
+
     def poll(self) -> list[Envelope]:
         """See :meth:`Transport.poll`: what arrived, in arrival order (reliable ones in send order per sender)."""
         self._check_open("poll")
@@ -301,6 +365,11 @@ class ZenohTransport(Transport):
         """The agents whose liveliness token this session sees (never this agent itself)."""
         with self._lock:
             return frozenset(self._alive)
+
+    @property
+    def roster(self) -> frozenset[str] | None:
+        """The names taken as teammates (this agent's included); ``None``: any name."""
+        return self._roster
 
     def close(self) -> None:
         """Leave the team: the token goes, the session closes. Closing twice is harmless."""
@@ -359,14 +428,42 @@ class ZenohTransport(Transport):
     # ------------------------------------------------------------------ receiving (zenoh threads)
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
-        name = str(sample.key_expr).rsplit("/", 1)[-1]
+        token = alive_of(str(sample.key_expr))
+        if token is None:
+            return
+        name, incarnation = token
+        put = sample.kind == zenoh.SampleKind.PUT
         if name == self._id:
+            if put and incarnation < self._incarnation and self.name_taken is None:
+                started = time.strftime("%H:%M:%S", time.localtime(incarnation / 1e9))
+                self.name_taken = (
+                    f"another agent named {name!r} has been in team {self._team!r} since {started}: give this "
+                    "one another --name, or stop the other first (a process that just died leaves the team "
+                    "within the zenoh lease)"
+                )
+                if self._on_name_taken is not None:
+                    self._on_name_taken(self.name_taken)
             return
         with self._lock:
-            if sample.kind == zenoh.SampleKind.PUT:
-                self._alive.add(name)
+            if self._roster is not None and name not in self._roster:
+                frames.count(self._rejected, frames.Reason.ROSTER)
+                return
+            tokens = self._alive.setdefault(name, set())
+            if put:
+                tokens.add(incarnation)
+                return
+            tokens.discard(incarnation)
+            if tokens:  # a duplicate left: the teammate is the older session, still there
+                self._inbox.retire(name, incarnation)
             else:
-                self._alive.discard(name)
+                del self._alive[name]
+
+    def _check_sender(self, sender: str, incarnation: int) -> None:
+        """Refuse a sender outside the roster, and an incarnation from the future (a forgery)."""
+        if self._roster is not None and sender not in self._roster:
+            raise frames.BadFrame(frames.Reason.ROSTER, f"{sender!r} is not in the team's roster")
+        if incarnation > time.time_ns() + int(FUTURE_INCARNATION * 1e9):
+            raise frames.BadFrame(frames.Reason.NUMBER, "an incarnation further ahead than hosts' clocks differ")
 
     def _reject(self, bad: frames.BadFrame) -> None:
         """Count a frame that is not well-formed (lock held); it is dropped."""
@@ -382,12 +479,17 @@ class ZenohTransport(Transport):
                 frame = frames.frame(frames.load(data, _FRAME_LEN))
                 if key != f"{self._team}/m/{frame[1]}/{frame[2]}":
                     raise frames.BadFrame(frames.Reason.SENDER, "the frame's sender and topic are not its key's")
+                self._check_sender(frame[1], frame[0])
             except frames.BadFrame as bad:
                 self._reject(bad)
                 return
-            ask = self._inbox.receive(frame, self._clock.now())
+            ask = self._receive(frame)
         if ask is not None:
             self._ask(ask)
+
+    def _receive(self, frame: Frame) -> str | None:
+        """Take in one well-formed frame (lock held); the sender to ask, if any (``bench/transport.py`` stamps here)."""
+        return self._inbox.receive(frame, self._clock.now())
 
     def _on_heartbeat(self, sample: zenoh.Sample) -> None:
         data = sample.payload.to_bytes()
@@ -398,6 +500,7 @@ class ZenohTransport(Transport):
                 incarnation, sender, last = frames.heartbeat(frames.load(data, 3))
                 if str(sample.key_expr) != f"{self._team}/hb/{sender}":
                     raise frames.BadFrame(frames.Reason.SENDER, "the heartbeat's sender is not its key's")
+                self._check_sender(sender, incarnation)
             except frames.BadFrame as bad:
                 self._reject(bad)
                 return
@@ -461,6 +564,7 @@ class ZenohTransport(Transport):
                 incarnation, sender, kept, start, oldest = frames.answer(frames.load(data, 5, frames.MAX_ANSWER_BYTES))
                 if sender != asked:
                     raise frames.BadFrame(frames.Reason.SENDER, "an answer from another sender than the one asked")
+                self._check_sender(sender, incarnation)
             except frames.BadFrame as bad:
                 self._reject(bad)
                 return
@@ -514,6 +618,30 @@ def zenoh_config(
         except Exception as exc:  # (zenoh reports a bad key or value as a generic error)
             raise ValueError(f"zenoh configuration {key} = {value!r} is not accepted: {exc}") from None
     return config
+
+
+def off_loopback(endpoints: Iterable[str]) -> list[str]:
+    """The endpoints that reach beyond this machine (``tcp/127.0.0.1:7447`` does not; ``tcp/0.0.0.0:7447`` does).
+
+    Loopback addresses (``127.0.0.0/8``, ``::1``), ``localhost`` and Unix sockets stay on the machine;
+    any other address or host name, and the unspecified address (every interface), does not.
+    """
+    out = []
+    for endpoint in endpoints:
+        proto, _, rest = endpoint.partition("/")
+        if proto.startswith("unixsock"):
+            continue
+        address = re.split(r"[?#]", rest, maxsplit=1)[0]
+        host = address.rpartition(":")[0].strip("[]") if ":" in address else address
+        if host == "localhost":
+            continue
+        try:
+            if ipaddress.ip_address(host).is_loopback:
+                continue
+        except ValueError:
+            pass
+        out.append(endpoint)
+    return out
 
 
 def free_endpoints(count: int, host: str = "127.0.0.1") -> list[str]:
