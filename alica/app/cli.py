@@ -291,6 +291,7 @@ def build_parser() -> argparse.ArgumentParser:
     from alica.app.cli_run import add_parser as add_run_parser
     from alica.app.cli_skill import add_parser as add_skill_parser
     from alica.app.cli_solve import add_parser as add_solve_parser
+    from alica.app.cli_team import add_parser as add_team_parser
 
     add_run_parser(sub)
     add_agent_parser(sub)
@@ -301,6 +302,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_protap_parser(sub)
     add_center_parser(sub)
     add_import_parser(sub)
+    add_team_parser(sub)
     return parser
 
 
