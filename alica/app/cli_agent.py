@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING, Any
 from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.options import add_time_limit, check_output, time_limit
 from alica.app.skill_options import add_skills_option
+from alica.app.team_keys import add_team_keys_option, team_settings
 from alica.app.timed import timed
 from alica.errors import AlicaError
 
@@ -110,6 +111,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         metavar="KEY=JSON",
         help="more zenoh configuration, e.g. scouting/multicast/enabled=true (repeatable)",
     )
+    add_team_keys_option(p)
     p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
     p.add_argument("--seed", type=int, default=0, help="seed of the agent's random choices (default 0)")
     p.add_argument(
@@ -224,7 +226,12 @@ def cmd_agent(args: argparse.Namespace) -> int:
     roles = agent_roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
     wiring = skill_wiring(registry, plan_skills(library, plan), world=False, stand_ins=args.stand_ins, plan=plan)
-    settings = _zenoh_settings(args.zenoh)
+    members = agents if args.agents else None
+    endpoints = [*args.connect, *args.listen]
+    settings = {
+        **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints),
+        **_zenoh_settings(args.zenoh),
+    }
     return _run(args, library, plan, roles, wiring, facts, settings)
 
 
@@ -286,6 +293,12 @@ def _run(
     if args.parent_pipe is not None:
         _watch_parent(args.parent_pipe, stop, orphaned)
     pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])
+    taken: list[str] = []
+
+    def name_taken(why: str) -> None:
+        taken.append(why)
+        stop.set()
+
     try:
         transport = ZenohTransport(
             args.name,
@@ -295,6 +308,8 @@ def _run(
             mode=args.mode,
             clock=clock,
             config=settings,
+            roster=list(roster) if args.agents else None,
+            on_name_taken=name_taken,
         )
     except ValueError as exc:
         raise AlicaError(f"alica agent {args.name}: {exc}") from None
@@ -303,7 +318,7 @@ def _run(
         from alica.comm.center_feed import CenterFeed
 
         try:
-            feed = CenterFeed(transport, header, start)
+            feed = CenterFeed(transport, header, start, keys=args.keys)
         except BaseException:
             transport.close()
             raise
@@ -367,6 +382,9 @@ def _run(
         if orphaned.is_set():
             why = "parent gone"
             print(f"alica agent {args.name}: the process that started it is gone; stopping", file=sys.stderr)
+        if taken:
+            why = "name taken"
+            print(f"alica agent {args.name}: {taken[0]}; stopping", file=sys.stderr)
         summary = describe_agent(engine, root_status(engine))
         summary.update(
             name=args.name,
@@ -398,6 +416,8 @@ def _run(
             f"{summary['ticks']} ticks, {summary['messages_out']} sent, {summary['messages_in']} received; "
             f"at {summary['path'] or '-'}"
         )
+    if taken:
+        return 2
     return 0 if summary["status"] == "success" else 1
 
 

@@ -18,6 +18,7 @@ from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
 from alica.app.options import add_time_limit, check_output, parse_roster, time_limit
 from alica.app.skill_options import add_lunar_options, add_skills_option
+from alica.app.team_keys import add_team_keys_option
 from alica.app.timed import add_fault_options, add_network_options, partition
 from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     from alica.app.center.team_feed import CommandLoop
     from alica.app.processes import Fault, ProcessTeam
     from alica.app.run_skills import SkillWiring
+    from alica.comm.credentials import TeamKeys
     from alica.engine import AgentEngine, SimulatedTeam
     from alica.engine.agent import Observer
     from alica.lang.skills import SkillRegistry
@@ -140,6 +142,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--crash is then a kill -9, --recover a restart, --partition cuts the links between groups; "
         "times are wall seconds; with --center this process serves the team's live page",
     )
+    add_team_keys_option(p, insecure=False)
     p.set_defaults(run=cmd_run)
 
 
@@ -178,6 +181,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         wiring = skill_wiring(registry, skills, world=args.world is not None, stand_ins=args.stand_ins, plan=plan)
     except AlicaError as exc:
         raise AlicaError(f"{exc}{_declared_in_files(registry, skills)}") from None
+    if args.team_keys is not None and not args.processes:
+        raise AlicaError("--team-keys goes with --processes (a simulated team has no network to secure)")
     if args.processes:
         header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
         return _run_processes(args, plan, list(agents), wiring, header, library, session)
@@ -401,12 +406,23 @@ def _run_processes(
     if args.review:
         options.append("--review")
     options += engine_arguments(args)
+    keys = _team_keys(args, names, session is not None)
+    if keys is not None:
+        options += ["--team-keys", args.team_keys]
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
         team = ProcessTeam(
-            args.plan, args.agents, names, options, Path(tmp), relays=bool(args.partition), deadline=args.time_limit
+            args.plan,
+            args.agents,
+            names,
+            options,
+            Path(tmp),
+            relays=bool(args.partition),
+            deadline=args.time_limit,
+            tls=keys is not None,
         )
-        live = _ProcessCenter(session, team, header, library) if session is not None else None
+        live = _ProcessCenter(session, team, header, library, keys) if session is not None else None
         interrupted = False
+        terminate = _TerminateAsInterrupt()
         try:
             if live is not None:
                 live.serve()
@@ -419,6 +435,7 @@ def _run_processes(
                 live.close()
             raise
         finally:
+            terminate.restore()
             team.stop()
         summary = team.summary(plan, args.seed)
         if args.trace:
@@ -437,6 +454,49 @@ def _run_processes(
     return 0 if summary["success"] else 1
 
 
+class _TerminateAsInterrupt:
+    """While the team runs, SIGTERM stops it as Ctrl-C does: agents stopped, summary and merged trace written."""
+
+    def __init__(self) -> None:
+        import signal
+        import threading
+
+        self._previous: Any = None
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGTERM, self._interrupt)
+
+    @staticmethod
+    def _interrupt(*_: object) -> None:
+        raise KeyboardInterrupt
+
+    def restore(self) -> None:
+        import signal
+
+        if self._previous is not None:
+            signal.signal(signal.SIGTERM, self._previous)
+            self._previous = None
+
+
+def _team_keys(args: argparse.Namespace, names: list[str], center: bool) -> TeamKeys | None:
+    """``--team-keys`` of ``alica run --processes``: every agent's (and the center's) keys load, before anything starts.
+
+    Returns:
+        The center's keys with ``--center`` (``None`` without credentials); otherwise the first agent's.
+    """
+    if args.team_keys is None:
+        return None
+    from alica.comm.credentials import CENTER, TeamKeys
+
+    loaded = [TeamKeys.load(args.team_keys, name) for name in names]
+    outside = sorted(set(names) - loaded[0].members)
+    if outside:
+        raise AlicaError(
+            f"alica run: {', '.join(outside)} hold(s) no keys of the team in {args.team_keys}; add them with "
+            f"'alica team keys --out {args.team_keys} --add {' '.join(outside)}'"
+        )
+    return TeamKeys.load(args.team_keys, CENTER) if center else loaded[0]
+
+
 class _ProcessCenter:
     """``alica run --processes --center``: the live page of the team of processes this run started."""
 
@@ -444,13 +504,18 @@ class _ProcessCenter:
     """The page's hub, from :meth:`serve` on."""
 
     def __init__(
-        self, session: LiveSession, team: ProcessTeam, header: dict[str, Any] | None, library: PlanLibrary | None
+        self,
+        session: LiveSession,
+        team: ProcessTeam,
+        header: dict[str, Any] | None,
+        library: PlanLibrary | None,
+        keys: TeamKeys | None = None,
     ) -> None:
         from alica.app.center.team_feed import TeamFeed
 
         assert header is not None
         self.session, self.team, self.header, self.library = session, team, header, library
-        self.feed = TeamFeed([agent.listen for agent in team.agents.values()], "alica")
+        self.feed = TeamFeed([agent.listen for agent in team.agents.values()], "alica", keys=keys)
         team.on_fault = self.feed.put  # kill -9, restarts and partitions are this process's doing
         self.server: uvicorn.Server | None = None
         self.loop: CommandLoop | None = None

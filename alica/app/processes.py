@@ -91,6 +91,7 @@ class ProcessTeam:
         deadline: the run's end in seconds after the start (``max_time`` of :meth:`run`); each
             agent gets ``--time-limit`` of it plus :data:`DEADLINE_MARGIN`. ``None``: the agents
             get none from here (``options`` may give one).
+        tls: the agents' links are TLS (``tls/`` endpoints; ``options`` give ``--team-keys``).
     """
 
     def __init__(
@@ -104,6 +105,7 @@ class ProcessTeam:
         relays: bool = False,
         own: dict[str, list[str]] | None = None,
         deadline: float | None = None,
+        tls: bool = False,
     ) -> None:
         self.plan = plan
         self.deadline = deadline
@@ -118,6 +120,8 @@ class ProcessTeam:
         self._lock = threading.Lock()
         self.relays: dict[tuple[str, str], LinkRelay] = {}
         endpoints = free_endpoints(len(names))
+        if tls:
+            endpoints = [f"tls/{endpoint.partition('/')[2]}" for endpoint in endpoints]
         self.agents: dict[str, _Agent] = {}
         for index, name in enumerate(names):
             connect = []
@@ -238,13 +242,14 @@ class ProcessTeam:
         agent = self._agent(name)
         if agent.process is None or agent.status == "crashed":
             return
+        at = self.now()  # the kill's time: teammates may see the process gone before it is reaped
         with contextlib.suppress(ProcessLookupError):
             os.kill(agent.process.pid, signal.SIGKILL)
         agent.process.wait()
         _close_pipe(agent.process)
         with self._lock:
             agent.status = "crashed"
-        self._fault("crash", agent=name)
+        self._fault("crash", at=at, agent=name)
 
     def recover(self, name: str) -> None:
         """Start a crashed agent's process again."""
@@ -325,9 +330,9 @@ class ProcessTeam:
         except KeyError:
             raise AlicaError(f"no agent named '{name}' in the team; agents: {', '.join(self.agents)}") from None
 
-    def _fault(self, kind: str, **fields: object) -> None:
+    def _fault(self, kind: str, at: float | None = None, **fields: object) -> None:
         record = {
-            "t": round(self.now(), 3),
+            "t": round(self.now() if at is None else at, 3),
             "agent": fields.pop("agent", "-"),
             "event": "fault",
             "fault": kind,

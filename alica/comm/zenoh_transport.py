@@ -628,9 +628,9 @@ def off_loopback(endpoints: Iterable[str]) -> list[str]:
     """
     out = []
     for endpoint in endpoints:
-        proto, _, rest = endpoint.partition("/")
-        if proto.startswith("unixsock"):
-            continue
+        proto, slash, rest = endpoint.partition("/")
+        if not slash or proto.startswith("unixsock"):
+            continue  # (not an endpoint at all: the session's configuration says so)
         address = re.split(r"[?#]", rest, maxsplit=1)[0]
         host = address.rpartition(":")[0].strip("[]") if ":" in address else address
         if host == "localhost":

@@ -184,9 +184,14 @@ def test_a_center_that_joins_late_gets_the_history_and_decides() -> None:
         assert wrong.returncode == 1
         assert wrong.stdout == ""
         assert wrong.stderr.strip().splitlines() == [
+            PLAIN,
             f"alica: error: no agent of the team answered within 2 s at {endpoints[0]}: "
-            "no agent with the key prefix 'other' is there (the agents' --key-prefix)"
+            "no agent with the key prefix 'other' is there (the agents' --key-prefix)",
         ]
+
+
+PLAIN = "alica center: no team credentials (--team-keys): unauthenticated and unencrypted, on loopback only"
+"""What a center without credentials says first (issue 37)."""
 
 
 def _center_fails(*argv: str) -> subprocess.CompletedProcess[str]:
@@ -205,13 +210,16 @@ def test_a_center_refuses_an_endpoint_nothing_listens_on_and_a_bad_prefix() -> N
     assert time.monotonic() - began < 20
     assert nobody.returncode == 1 and nobody.stdout == ""
     lines = nobody.stderr.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"alica: error: cannot reach the team at {endpoint}: ")
+    assert len(lines) == 2 and lines[0] == PLAIN
+    assert lines[1].startswith(f"alica: error: cannot reach the team at {endpoint}: ")
     bad = _center_fails("--team", endpoint, "--key-prefix", "a/b")
     assert bad.returncode == 1
     assert "key prefix must be a non-empty name without '/'" in bad.stderr
-    assert len(bad.stderr.strip().splitlines()) == 1
+    assert bad.stderr.strip().splitlines()[0] == PLAIN and len(bad.stderr.strip().splitlines()) == 2
     misplaced = _center_fails("--plan", PLAN, "--key-prefix", "x")
-    assert misplaced.returncode == 1 and "--key-prefix and --wait go with --team" in misplaced.stderr
+    assert misplaced.returncode == 1 and "--key-prefix go(es) with --team" in misplaced.stderr
+    keys = _center_fails("--plan", PLAN, "--team-keys", "keys", "--wait", "3")
+    assert keys.returncode == 1 and "--wait and --team-keys go(es) with --team" in keys.stderr
     not_an_endpoint = _center_fails("--team", "localhost")
     assert not_an_endpoint.returncode == 1 and "looks like 'tcp/127.0.0.1:7447'" in not_an_endpoint.stderr
 

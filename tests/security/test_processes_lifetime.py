@@ -235,3 +235,16 @@ def test_alica_agent_does_not_create_the_traces_folder(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == 1 and "no such folder" in err, err
     assert not (tmp_path / "missing").exists()
+
+
+@needs_proc
+def test_sigterm_of_the_run_stops_its_agents_and_keeps_the_summary_and_trace(tmp_path):
+    parent, agents = start_team(tmp_path, "--time-limit", "120", "--trace", "run.jsonl")
+    try:
+        parent.send_signal(signal.SIGTERM)  # before: the run died at once, without the merged trace
+        assert parent.wait(timeout=30) == 130
+        assert all_exit(agents, 15.0), [p for p in agents if alive(p)]
+        events = [json.loads(line) for line in (tmp_path / "run.jsonl").read_text(encoding="utf-8").splitlines()]
+        assert events[0]["event"] == "trace" and {e.get("agent") for e in events[1:]} >= {"scout", "stummel", "amparo"}
+    finally:
+        kill_group(parent)

@@ -7,6 +7,7 @@ import sys
 from collections.abc import Sequence
 from typing import Any
 
+from alica.app.team_keys import add_team_keys_option
 from alica.errors import AlicaError
 
 
@@ -22,14 +23,29 @@ def _cmd_center(args: argparse.Namespace) -> int:
     registry = skill_registry(args)  # the --skills modules must load, whatever the mode (a clear error if not)
     if args.team is not None:
         from alica.app.center.team_feed import JOIN_WAIT, serve_team
+        from alica.app.team_keys import team_settings
+        from alica.comm.credentials import CENTER
 
         wait = JOIN_WAIT if args.wait is None else args.wait
         if not wait > 0:
             raise AlicaError(f"--wait must be a positive number of seconds, got {args.wait}")
-        serve_team(args.team, args.key_prefix or "alica", args.host, args.port, token, wait=wait, skills=args.skills)
+        prefix = args.key_prefix or "alica"
+        args.key_prefix = prefix
+        team_settings(args, "alica center", CENTER, None, args.team)  # the keys load, the endpoints fit them
+        serve_team(args.team, prefix, args.host, args.port, token, wait=wait, skills=args.skills, keys=args.keys)
         return 0
-    if args.key_prefix is not None or args.wait is not None:
-        raise AlicaError("--key-prefix and --wait go with --team (a running team of processes)")
+    misplaced = [
+        option
+        for option, given in (
+            ("--key-prefix", args.key_prefix is not None),
+            ("--wait", args.wait is not None),
+            ("--team-keys", args.team_keys is not None),
+            ("--insecure", args.insecure),
+        )
+        if given
+    ]
+    if misplaced:
+        raise AlicaError(f"{' and '.join(misplaced)} go(es) with --team (a running team of processes)")
     if args.trace is not None:
         from alica.app.center.trace_file import TraceFormatError, load_trace
 
@@ -189,6 +205,7 @@ def add_parser(sub: Any) -> None:
         metavar="S",
         help="with --team: seconds to wait for a first agent to answer (default 10)",
     )
+    add_team_keys_option(p.add_argument_group("with --team"))
     add_skills_option(p)
     p.add_argument(
         "--no-trace-skills",

@@ -30,13 +30,16 @@ import threading
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from alica.app.center.live import LiveHub, wait_for_stop
 from alica.app.center.team_view import TeamView
 from alica.engine import PlanDecision
 from alica.errors import AlicaError
 from alica.lang.walk import literal_text
+
+if TYPE_CHECKING:
+    from alica.comm.credentials import TeamKeys
 
 TICK = 0.1
 """Wall seconds between two turns of the loop that runs the operator's actions and moves the clock on."""
@@ -112,11 +115,15 @@ class TeamFeed:
         connect: agents' listen endpoints.
         prefix: the team's key prefix.
         start: the team's start (seconds since the epoch) when known, else taken from the first history.
+        keys: the team's credentials as the center's identity (TLS, and signed operator's commands).
     """
 
-    def __init__(self, connect: Iterable[str], prefix: str, start: float | None = None) -> None:
+    def __init__(
+        self, connect: Iterable[str], prefix: str, start: float | None = None, *, keys: TeamKeys | None = None
+    ) -> None:
         self.connect = tuple(connect)
         self.prefix = prefix
+        self.keys = keys
         self.start = start
         self.hub: LiveHub | None = None
         self.link: Any = None
@@ -138,7 +145,10 @@ class TeamFeed:
         from alica.comm.center_feed import CenterLink
 
         try:
-            self.link = CenterLink(self.connect, self.prefix, self._history, self._event, self._gone)
+            config = self.keys.zenoh_settings(self.prefix) if self.keys is not None else None
+            self.link = CenterLink(
+                self.connect, self.prefix, self._history, self._event, self._gone, config=config, keys=self.keys
+            )
         except ValueError as exc:
             raise AlicaError(f"cannot reach the team at {', '.join(self.connect)}: {exc}") from None
 
@@ -293,16 +303,18 @@ def serve_team(
     wait: float = JOIN_WAIT,
     out: TextIO = sys.stdout,
     skills: Sequence[str] = (),
+    keys: TeamKeys | None = None,
 ) -> None:
     """``alica center --team``: serve the live page of a running team of processes until Ctrl-C or SIGTERM.
 
     Args:
         skills: skill modules to load besides those the agents' header records (``--skills``).
+        keys: the team's credentials as the center's identity (``--team-keys``).
 
     Raises:
         AlicaError: nothing listens at the endpoints, or no agent with the key prefix answered within ``wait`` s.
     """
-    feed = TeamFeed(connect, prefix)
+    feed = TeamFeed(connect, prefix, keys=keys)
     feed.open()
     try:
         if not feed.wait_first(wait):
