@@ -23,7 +23,13 @@ receiver minus the stamp in the payload (all processes read one host clock):
 
 Parts (``--parts``, all by default):
 
-1. ``team``: latency and CPU/RSS per process for teams of ``--sizes`` agents.
+1. ``team``: latency and CPU/RSS per process for teams of ``--sizes`` agents,
+   over plain TCP links and over the team's credentials (``--tls``, both by
+   default, run back to back per team size: tcp, tls, tcp, tls... with
+   ``--repeat``): TLS links with mutual authentication and zenoh's access
+   control (:meth:`alica.comm.credentials.TeamKeys.zenoh_settings`), with
+   keys made once per run in a temporary folder; the ``link`` column says
+   which.
 2. ``throughput``: one publisher process sends 1 KB payloads as fast as it
    can for ``--flood`` seconds, reliable and best-effort, to 1 and 3
    receiver processes that poll at 30 Hz; reliable loss and order checked.
@@ -38,7 +44,10 @@ Parts (``--parts``, all by default):
 5. ``soak``: ``--soak-agents`` agents for ``--soak`` seconds: reliable loss
    and order, RSS every 10 s, latency spikes over 50 ms.
 
-Run: ``.venv/bin/python bench/transport.py [--quick] [--parts team,throughput,kill,partition,soak] [--soak 600]``
+The other parts run over plain TCP.
+
+Run: ``.venv/bin/python bench/transport.py [--quick] [--parts team,throughput,kill,partition,soak] [--soak 600]
+[--tls off|on|both] [--repeat N]``
 """
 
 from __future__ import annotations
@@ -49,6 +58,7 @@ import multiprocessing.connection as mpc
 import os
 import statistics
 import sys
+import tempfile
 import time
 import traceback
 from array import array
@@ -87,6 +97,8 @@ class Spec:
     reliable: bool = True
     phase: float = 0.0
     """Seconds after the common start at which this agent's ticks begin (agents are not in step)."""
+    keys: str = ""
+    """The folder of the team's credentials: TLS links with mutual authentication and access control ("": plain TCP)."""
 
 
 # ---------------------------------------------------------------------------------------------- in the agent process
@@ -129,7 +141,12 @@ def _stamped_transport(spec: Spec) -> Any:
                 self.spikes.append((now, lat, frame[1], frame[2]))
             return super()._receive(frame)
 
-    return Stamped(spec.name, listen=[spec.listen], connect=list(spec.connect), team=spec.team)
+    config = None
+    if spec.keys:
+        from alica.comm.credentials import TeamKeys
+
+        config = TeamKeys.load(spec.keys, spec.name).zenoh_settings(spec.team)
+    return Stamped(spec.name, listen=[spec.listen], connect=list(spec.connect), team=spec.team, config=config)
 
 
 def _child(spec: Spec, conn: Any, start_at: Any, stop: Any) -> None:
@@ -424,14 +441,18 @@ class Team:
         self.conns.clear()
 
 
-def _mesh(names: list[str], team: str, *, aligned: bool = False, **kw: Any) -> list[Spec]:
+def _mesh(names: list[str], team: str, *, aligned: bool = False, keys: str = "", **kw: Any) -> list[Spec]:
     """Full-mesh specs: agent ``i`` listens on its endpoint and connects to every earlier one's.
 
     Unless ``aligned``, agent ``i`` ticks ``i / n`` of a tick after agent 0 (robots are not in step).
+    With ``keys`` (the folder of the team's credentials), the links are TLS.
     """
+    from alica.comm.credentials import tls_endpoint
     from alica.comm.zenoh_transport import free_endpoints
 
     endpoints = free_endpoints(len(names))
+    if keys:
+        endpoints = [tls_endpoint(e) for e in endpoints]
     return [
         Spec(
             name,
@@ -440,6 +461,7 @@ def _mesh(names: list[str], team: str, *, aligned: bool = False, **kw: Any) -> l
             tuple(n for n in names if n != name),
             team=team,
             phase=0.0 if aligned else i / len(names) / kw.get("rate", 30.0),
+            keys=keys,
             **kw,
         )
         for i, name in enumerate(names)
@@ -487,11 +509,19 @@ def _zsum(results: dict[str, dict[str, Any]], key: str) -> int:
     return sum(r["zenoh"][key] for r in results.values())
 
 
+def _names(size: int) -> list[str]:
+    return [f"a{i:02d}" for i in range(size)]
+
+
 def run_team(
-    size: int, duration: float, *, team: str = "t", rss_every: float = 10.0, aligned: bool = False
+    size: int, duration: float, *, team: str = "t", rss_every: float = 10.0, aligned: bool = False, keys: str = ""
 ) -> dict[str, dict[str, Any]]:
-    names = [f"a{i:02d}" for i in range(size)]
-    specs = _mesh(names, f"{team}{size}{int(aligned)}", duration=duration, rss_every=rss_every, aligned=aligned)
+    """Run ``size`` agents for ``duration`` seconds; with ``keys`` (a folder made by ``make_keys`` for their names) over TLS."""
+    names = _names(size)
+    link = "tls" if keys else "tcp"
+    specs = _mesh(
+        names, f"{team}{size}{int(aligned)}{link}", duration=duration, rss_every=rss_every, aligned=aligned, keys=keys
+    )
     box = Team()
     try:
         for spec in specs:
@@ -506,43 +536,100 @@ def run_team(
     return box.results
 
 
-def part_team(sizes: list[int], duration: float, aligned: list[int]) -> None:
+def part_team(sizes: list[int], duration: float, aligned: list[int], tls: str = "off", repeat: int = 1) -> None:
+    from alica.comm.credentials import make_keys
+
+    links = {"off": ["tcp"], "on": ["tls"], "both": ["tcp", "tls"]}[tls]
     print(f"\n## 1+3. Team messages at 30 Hz between agent processes ({duration:g} s per team size, full mesh)\n")
     print("latency in ms as p50 / p99 / max; 'at poll' includes waiting for the receiver's next tick (up to 33 ms);")
     print(
-        "ticks: 'staggered' = agent i ticks i/n of a tick after agent 0; 'in step' = every agent ticks at the same instant\n"
+        "ticks: 'staggered' = agent i ticks i/n of a tick after agent 0; 'in step' = every agent ticks at the same instant;"
     )
     print(
-        "| agents | ticks | team msgs polled | team at arrival | team at poll | reliable at arrival | reliable at poll "
+        "link: 'tcp' = plain TCP; 'tls' = the team's credentials (TLS with mutual authentication, zenoh access control)\n"
+    )
+    print(
+        "| agents | ticks | link | team msgs polled | team at arrival | team at poll | reliable at arrival | reliable at poll "
         "| reliable delivered / expected, gaps, dups | arrival > 50 ms | CPU per process mean / max | "
         "RSS per process MB (end, max) | ticks late > 10 ms, max late ms |"
     )
-    print("|---:|---|---:|---|---|---|---|---|---:|---|---|---|")
-    for size, in_step in [(n, False) for n in sizes] + [(n, True) for n in aligned]:
-        phase = "in step" if in_step else "staggered"
-        try:
-            res = run_team(size, duration, aligned=in_step)
-        except Exception as exc:
-            print(f"| {size} | {phase} | failed: {exc} |")
-            continue
-        rs = list(res.values())
-        team_poll = _floats(rs, "poll_team")
-        arrival = _floats(rs, "arr_team")
-        d, e, g, u = _reliable_check(res)
-        cpu = [r["cpu"] * 100 for r in rs]
-        rss_end = [r["rss"][-1][1] for r in rs]
-        spikes = sum(len(r["spikes"]) for r in rs)
-        print(
-            f"| {size} | {phase} | {len(team_poll)} | {_ms(arrival)} | {_ms(team_poll)} | {_ms(_floats(rs, 'arr_world'))} | "
-            f"{_ms(_floats(rs, 'poll_world'))} | {d} / {e}, {g}, {u} | {spikes} | "
-            f"{statistics.mean(cpu):.1f} % / {max(cpu):.1f} % | {_mb(statistics.median(rss_end))}, {_mb(max(rss_end))} | "
-            f"{sum(r['late_ticks'] for r in rs)} of {sum(r['ticks'] for r in rs)}, {max(r['max_late'] for r in rs) * 1e3:.1f} |",
-            flush=True,
-        )
+    print("|---:|---|---|---:|---|---|---|---|---|---:|---|---|---|")
+    runs = [(n, False) for n in sizes if n > 0] + [(n, True) for n in aligned if n > 0]  # (0: none)
+    with tempfile.TemporaryDirectory(prefix="alica-bench-keys-") as tmp:
+        keys = ""
+        if "tls" in links and runs:
+            keys = os.path.join(tmp, "keys")
+            make_keys(keys, _names(max(n for n, _ in runs)))
+        figures: dict[tuple[int, bool, str], list[dict[str, float]]] = {}
+        for size, in_step in runs:
+            for _ in range(repeat):
+                for link in links:
+                    row = _team_row(size, duration, in_step, link, keys if link == "tls" else "")
+                    if row is not None:
+                        figures.setdefault((size, in_step, link), []).append(row)
     print(
         "\nCPU: user+sys time of the whole process (zenoh's threads included) over the publishing window / wall time; "
         f"the machine has {os.cpu_count()} cores shared by all the processes."
     )
+    if len(links) == 2:
+        _tls_cost(runs, figures)
+
+
+def _tls_cost(runs: list[tuple[int, bool]], figures: dict[tuple[int, bool, str], list[dict[str, float]]]) -> None:
+    """The cost of TLS per team size: tls against tcp, means over the runs of each."""
+    print("\nTLS against plain TCP, means over the runs of each link (tls - tcp; CPU also in % of tcp's):\n")
+    print(
+        "| agents | ticks | runs tcp, tls | CPU per process % | team at arrival p50 ms | team at arrival p99 ms "
+        "| reliable at arrival p50 ms | reliable at arrival p99 ms | team at poll p50 ms | team at poll p99 ms "
+        "| RSS per process MB |"
+    )
+    print("|---:|---|---|---|---|---|---|---|---|---|---|")
+    for size, in_step in runs:
+        tcp, tls = figures.get((size, in_step, "tcp"), []), figures.get((size, in_step, "tls"), [])
+        if not tcp or not tls:
+            continue
+        cells = []
+        for key in ("cpu", "arr50", "arr99", "rel50", "rel99", "poll50", "poll99", "rss"):
+            a, b = statistics.mean(r[key] for r in tcp), statistics.mean(r[key] for r in tls)
+            cell = f"{a:.2f} -> {b:.2f} ({b - a:+.2f}"
+            cell += f", {(b - a) / a * 100:+.0f} %)" if key == "cpu" and a else ")"
+            cells.append(cell)
+        print(f"| {size} | {'in step' if in_step else 'staggered'} | {len(tcp)}, {len(tls)} | {' | '.join(cells)} |")
+
+
+def _team_row(size: int, duration: float, in_step: bool, link: str, keys: str) -> dict[str, float] | None:
+    """Run one team and print its row of the table of :func:`part_team`; its main figures (``None``: it failed)."""
+    phase = "in step" if in_step else "staggered"
+    try:
+        res = run_team(size, duration, aligned=in_step, keys=keys)
+    except Exception as exc:
+        print(f"| {size} | {phase} | {link} | failed: {exc} |", flush=True)
+        return None
+    rs = list(res.values())
+    team_poll = _floats(rs, "poll_team")
+    arrival = _floats(rs, "arr_team")
+    d, e, g, u = _reliable_check(res)
+    cpu = [r["cpu"] * 100 for r in rs]
+    rss_end = [r["rss"][-1][1] for r in rs]
+    spikes = sum(len(r["spikes"]) for r in rs)
+    print(
+        f"| {size} | {phase} | {link} | {len(team_poll)} | {_ms(arrival)} | {_ms(team_poll)} | {_ms(_floats(rs, 'arr_world'))} | "
+        f"{_ms(_floats(rs, 'poll_world'))} | {d} / {e}, {g}, {u} | {spikes} | "
+        f"{statistics.mean(cpu):.1f} % / {max(cpu):.1f} % | {_mb(statistics.median(rss_end))}, {_mb(max(rss_end))} | "
+        f"{sum(r['late_ticks'] for r in rs)} of {sum(r['ticks'] for r in rs)}, {max(r['max_late'] for r in rs) * 1e3:.1f} |",
+        flush=True,
+    )
+    world = _floats(rs, "arr_world")
+    return {
+        "cpu": statistics.mean(cpu),
+        "arr50": _pct(arrival, 0.5) * 1e3,
+        "arr99": _pct(arrival, 0.99) * 1e3,
+        "rel50": _pct(world, 0.5) * 1e3,
+        "rel99": _pct(world, 0.99) * 1e3,
+        "poll50": _pct(team_poll, 0.5) * 1e3,
+        "poll99": _pct(team_poll, 0.99) * 1e3,
+        "rss": statistics.median(rss_end) / 2**20,
+    }
 
 
 def run_flood(receivers: int, reliable: bool, duration: float) -> tuple[dict[str, Any], list[dict[str, Any]]]:
@@ -851,9 +938,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--parts", default="team,throughput,kill,partition,soak", help="comma-separated parts to run")
     parser.add_argument("--sizes", default="3,10,20", help="team sizes of the latency/CPU part (default 3,10,20)")
     parser.add_argument(
-        "--in-step", default="10", help="team sizes also run with every agent ticking in step (default 10)"
+        "--in-step", default="10", help="team sizes also run with every agent ticking in step (default 10; 0: none)"
     )
     parser.add_argument("--duration", type=float, default=20.0, metavar="S", help="seconds per team size (default 20)")
+    parser.add_argument(
+        "--tls",
+        choices=("off", "on", "both"),
+        default="both",
+        help="links of the team part: plain TCP, TLS with the team's credentials, or both back to back (default both)",
+    )
+    parser.add_argument(
+        "--repeat", type=int, default=1, help="runs of each team size and link, interleaved (default 1)"
+    )
     parser.add_argument(
         "--flood", type=float, default=5.0, metavar="S", help="seconds of the throughput runs (default 5)"
     )
@@ -870,7 +966,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"# zenoh transport between processes ({os.cpu_count()} cores, Python {sys.version.split()[0]})")
     started = time.time()
     if "team" in parts:
-        part_team(_ints(args.sizes), args.duration, _ints(args.in_step))
+        part_team(_ints(args.sizes), args.duration, _ints(args.in_step), args.tls, max(1, args.repeat))
     if "throughput" in parts:
         part_throughput(args.flood)
     if "kill" in parts:
