@@ -19,7 +19,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from alica.comm.codec import CodecError, decode
+from alica.comm.codec import MAX_DEPTH as _CODEC_DEPTH
+from alica.comm.codec import CodecError, TooDeep, decode
 
 MAX_FRAME_BYTES = 16 * 1024 * 1024
 """The largest frame, heartbeat or history question taken in, in bytes."""
@@ -33,8 +34,8 @@ MAX_NUMBER = 2**63 - 1
 """The largest incarnation or sequence number (an incarnation is the sender's ``time.time_ns()``)."""
 MAX_TOPICS = 1024
 """The most topics in one heartbeat, history question or answer."""
-MAX_DEPTH = 64
-"""The deepest nesting of a payload (tuples, lists, dicts, sets, dataclasses)."""
+MAX_DEPTH = _CODEC_DEPTH
+"""The deepest nesting of a payload (tuples, lists, dicts, sets, dataclasses); the codec refuses deeper pickles."""
 MAX_ITEMS = 1_000_000
 """The most values in one payload, all levels together."""
 
@@ -80,6 +81,8 @@ def load(data: object, size: int, limit: int = MAX_FRAME_BYTES) -> tuple[Any, ..
         raise BadFrame(Reason.SIZE, f"{len(data)} bytes, at most {limit}")
     try:
         value = decode(data)
+    except TooDeep as exc:  # (found in the pickle's opcodes, before the unpickler built anything)
+        raise BadFrame(Reason.NESTING, str(exc)) from None
     except CodecError as exc:
         raise BadFrame(Reason.UNDECODABLE, str(exc)) from None
     check_nesting(value)
