@@ -13,9 +13,10 @@ send (a history question) comes back as a value. The caller (the zenoh shell,
 Bounds: a kept message goes when it is older than ``seconds``, or, while the
 kept messages take more than ``max_bytes``, the oldest of the topic being
 published goes first; each topic keeps at least its newest message. The
-inbox holds at most ``max_held`` messages per sender and ``max_held_total``
-in all (one more is not held: the sender's history gives it again once the
-gap is filled); a sender unheard for ``quiet`` seconds loses what is held of
+inbox holds at most ``max_held`` messages and ``max_held_bytes`` payload
+bytes per sender, and ``max_held_total`` messages and ``max_held_bytes_total``
+bytes in all (one more is not held: the sender's history gives it again once
+the gap is filled); a sender unheard for ``quiet`` seconds loses what is held of
 it and is no longer asked; at most ``max_senders`` senders are remembered
 (then the one heard longest ago goes, never-answered ones first).
 """
@@ -131,8 +132,8 @@ class _Stream:
 
     next: int | None = None
     """The next reliable number to deliver; ``None`` until the sender's history said where to start."""
-    held: dict[int, tuple[int, Envelope | None]] = field(default_factory=dict)
-    """Reliable messages not delivered yet, by number: (gseq, envelope; ``None`` when it cannot be decoded)."""
+    held: dict[int, tuple[int, Envelope | None, int]] = field(default_factory=dict)
+    """Reliable messages not delivered yet, by number: (gseq, envelope (``None`` when it cannot be decoded), bytes)."""
     last_gseq: int = 0
     """The sender-wide number of the last message delivered from this stream."""
 
@@ -190,6 +191,8 @@ class Inbox:
         max_held: the most messages held for one sender.
         max_held_total: the most messages held for all senders.
         max_senders: the most senders remembered.
+        max_held_bytes: the most payload bytes held for one sender.
+        max_held_bytes_total: the most payload bytes held for all senders.
     """
 
     def __init__(
@@ -200,8 +203,14 @@ class Inbox:
         max_held: int = 10_000,
         max_held_total: int = 100_000,
         max_senders: int = 1024,
+        max_held_bytes: int = 16 * 1024 * 1024,
+        max_held_bytes_total: int = 64 * 1024 * 1024,
     ) -> None:
         self._id = agent_id
+        self._max_bytes = max_held_bytes
+        self._max_bytes_total = max_held_bytes_total
+        self._bytes = 0
+        self._bytes_by: dict[str, int] = {}
         self._quiet = quiet
         self._max_held = max_held
         self._max_held_total = max_held_total
@@ -267,12 +276,13 @@ class Inbox:
         if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
             self.counts["duplicates"] += 1
             return None
+        size = _size(data)
         if stream.next is None or rseq != stream.next:
-            if not self._room(sender):
+            if not self._room(sender, size):
                 self.dropped["held"] += 1  # its history gives it again once the gap is filled
                 return self._want(sender, state, now)
-        stream.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
-        self._count_held(sender, 1)
+        stream.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at), size)
+        self._count_held(sender, 1, size)
         self._release(sender, state)
         return self._want(sender, state, now) if stream.gapped() else None
 
@@ -303,7 +313,7 @@ class Inbox:
                 if dropped:
                     for stream in state.streams.values():
                         stream.held.clear()
-                    self._count_held(sender, -dropped)
+                    self._drop_held(sender)
                     self.dropped["quiet"] += dropped
                 continue
             if state.asked_at is not None and now - state.asked_at > timeout:
@@ -347,8 +357,8 @@ class Inbox:
             numbers = [f[4] for f in decoded if f[2] == topic]
             stream.next = min(numbers) if numbers else int(start[topic])
             for number in [n for n in stream.held if n < stream.next]:
-                del stream.held[number]  # sent before this agent subscribed
-                self._count_held(sender, -1)
+                size = stream.held.pop(number)[2]  # sent before this agent subscribed
+                self._count_held(sender, -1, -size)
         for topic, first in oldest.items():
             known = state.streams.get(topic)
             if topic not in first_answer and known is not None and known.next is not None and first > known.next:
@@ -359,13 +369,14 @@ class Inbox:
             known = state.streams.get(topic)
             if known is None or known.next is None or rseq < known.next or rseq in known.held:
                 continue
-            if rseq != known.next and not self._room(sender):
+            size = _size(data)
+            if rseq != known.next and not self._room(sender, size):
                 self.dropped["held"] += 1
                 continue
             shown = state.offset.get(topic, 0) + seq
             payload = self._payload(data, sender, topic)
-            known.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at))
-            self._count_held(sender, 1)
+            known.held[rseq] = (gseq, _envelope(topic, sender, shown, payload, sent_at), size)
+            self._count_held(sender, 1, size)
             self.counts["recovered"] += topic not in first_answer
         self._release(sender, state)
 
@@ -409,7 +420,7 @@ class Inbox:
     def _start_over(self, sender: str, state: _Sender, incarnation: int) -> _Sender:
         """A new state of ``sender`` for ``incarnation``, its envelope numbers going on from ``state``'s."""
         numbers = dict(state.last_seq)
-        self._count_held(sender, -self._held_by.get(sender, 0))
+        self._drop_held(sender)
         new = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
         return new
 
@@ -423,22 +434,35 @@ class Inbox:
         """Forget the sender heard longest ago, preferring one whose history never answered."""
         victim = min(self._senders, key=lambda name: (self._senders[name].answered, self._senders[name].heard_at))
         del self._senders[victim]
-        self._count_held(victim, -self._held_by.get(victim, 0))
+        self._drop_held(victim)
         self._pending = {key: index for key, index in self._pending.items() if key[0] != victim}
         self.dropped["senders"] += 1
 
-    def _room(self, sender: str) -> bool:
-        """Whether one more message of ``sender`` may be held."""
-        return self._held < self._max_held_total and self._held_by.get(sender, 0) < self._max_held
+    def _room(self, sender: str, size: int) -> bool:
+        """Whether one more message of ``sender``, of ``size`` payload bytes, may be held."""
+        return (
+            self._held < self._max_held_total
+            and self._held_by.get(sender, 0) < self._max_held
+            and self._bytes + size <= self._max_bytes_total
+            and self._bytes_by.get(sender, 0) + size <= self._max_bytes
+        )
 
-    def _count_held(self, sender: str, change: int) -> None:
+    def _count_held(self, sender: str, change: int, size: int) -> None:
+        """Count ``change`` messages of ``size`` payload bytes (both negative when they go) held for ``sender``."""
         if change:
             self._held += change
+            self._bytes += size
             left = self._held_by.get(sender, 0) + change
             if left > 0:
                 self._held_by[sender] = left
+                self._bytes_by[sender] = self._bytes_by.get(sender, 0) + size
             else:
                 self._held_by.pop(sender, None)
+                self._bytes_by.pop(sender, None)
+
+    def _drop_held(self, sender: str) -> None:
+        """Count everything held for ``sender`` as gone (the caller drops the messages themselves)."""
+        self._count_held(sender, -self._held_by.get(sender, 0), -self._bytes_by.get(sender, 0))
 
     def _release(self, sender: str, state: _Sender) -> None:
         """Deliver the sender's held reliable messages that can go, in its send order.
@@ -456,11 +480,11 @@ class Inbox:
                         best = stream
             if best is None or best.next is None:
                 return
-            gseq, envelope = best.held[best.next]
+            gseq, envelope, size = best.held[best.next]
             if gate is not None and gseq > gate:
                 return
             del best.held[best.next]
-            self._count_held(sender, -1)
+            self._count_held(sender, -1, -size)
             best.next += 1
             best.last_gseq = gseq
             if envelope is None:
@@ -476,6 +500,11 @@ class Inbox:
             return None
         state.asked_at = now
         return sender
+
+
+def _size(data: object) -> int:
+    """The payload bytes a held message counts for."""
+    return len(data) if isinstance(data, bytes | bytearray) else 0
 
 
 def _envelope(topic: str, sender: str, seq: int, payload: object, sent_at: float) -> Envelope | None:

@@ -49,3 +49,21 @@ def test_the_senders_remembered_are_bounded_never_answered_ones_forgotten_first(
     assert inbox.dropped["senders"] == 12_001 - 50
     inbox.receive(frame("real", 2), 12_000.0)
     assert [e.payload for e in inbox.take()] == ["x" * 100]  # no duplicate, no restart: number 2 only
+
+
+def test_the_bytes_held_are_bounded_per_sender_and_in_all_and_freed_when_delivered():
+    big = encode("y" * 1000)
+    size = len(big)
+    inbox = Inbox("me", max_held_bytes=10 * size, max_held_bytes_total=25 * size)
+    inbox.subscribe("news", 0.0)
+    for rseq in range(2, 40):  # few frames, but large ones (before: only their number was capped)
+        inbox.receive((1, "fake", "news", rseq, rseq, rseq, 0.0, big), 1.0)
+    assert inbox.held == 10 and inbox.dropped["held"] == 28
+    for name in ("f1", "f2", "f3"):
+        for rseq in range(2, 20):
+            inbox.receive((1, name, "news", rseq, rseq, rseq, 0.0, big), 1.0)
+    assert inbox.held == 25
+    inbox.answered(1, "fake", [(1, "fake", "news", 1, 1, 1, 0.0, big)], {"news": 1}, {"news": 1})  # the gap filled
+    assert len(inbox.take()) == 11 and inbox.held == 15
+    inbox.receive((1, "f4", "news", 2, 2, 2, 0.0, big), 2.0)  # room again in all
+    assert inbox.held == 16
