@@ -12,12 +12,15 @@ from starlette.testclient import TestClient
 
 from alica.app.center.cli import plan_views
 from alica.app.center.replay import Replay
-from alica.app.center.server import COOKIE, plan_app, replay_app
+from alica.app.center.server import cookie_name, plan_app, replay_app
 from alica.app.center.trace_file import load_trace
 from alica.io import plans_dir
 
 from .conftest import TOKEN
 from .live_run import serving
+
+COOKIE = cookie_name(80)
+"""The token cookie of a center reached as TestClient does (http://testserver, port 80)."""
 
 
 def _client(trace: Path) -> TestClient:

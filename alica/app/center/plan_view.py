@@ -305,13 +305,42 @@ def trace_trees(
     return {"trees": trees, "agents": shown, "notes": notes}
 
 
+def plan_roots(trace_path: str | Path) -> list[Path]:
+    """The folders a trace's header may name plan files in: the trace's folder, its project, the plan path.
+
+    A header is data from a file, or from the network for a live team: the center reads no plan
+    file outside these (so a header cannot make it tell whether another file exists, or show its
+    first key). The project is the nearest folder above the trace's holding ``pyproject.toml``,
+    ``.git``, ... (:func:`alica.io.plan_paths.project_root`); the plan path is the shipped plans and
+    ``ALICA_PLAN_PATH``.
+    """
+    from alica.io.plan_paths import PlanPathError, default_search_path, project_root
+
+    folder = Path(trace_path).parent.resolve()
+    roots = [folder]
+    project = project_root(folder / "trace")
+    if project is not None:
+        roots.append(project.resolve())
+    try:
+        roots += [path.resolve() for path in default_search_path()]
+    except PlanPathError:
+        pass
+    return roots
+
+
 def _load_library(
     given: str, trace_path: str | Path, make_loader: Callable[[], Loader] = Loader
 ) -> tuple[PlanLibrary | None, str]:
-    candidates = plan_candidates(given, trace_path)
+    roots = plan_roots(trace_path)
+    candidates = [p for p in plan_candidates(given, trace_path) if any(p.resolve().is_relative_to(r) for r in roots)]
+    if not candidates:
+        return None, (
+            f"plan file {given} is outside the trace's folder, its project and the plan path: not read (add its "
+            "folder to ALICA_PLAN_PATH to show its plans)"
+        )
     tried = [p for p in candidates if p.is_file()]
     if not tried:
-        where = " or ".join(str(p) for p in candidates) or given
+        where = " or ".join(str(p) for p in candidates)
         return None, f"plan file {given} not found (looked for {where}): no plan tree from it"
     try:
         return make_loader().load(tried[0]), ""

@@ -3,7 +3,10 @@
 Every request (page, API, static file) must carry the token: as the query
 parameter ``token=``, as the cookie the first visit sets, or as an
 ``Authorization: Bearer`` header. Without it the answer is 403 (a WebSocket is
-closed unaccepted).
+closed unaccepted). Inside the gate, :class:`~alica.app.center.request_checks.RequestChecks`
+checks the Origin of WebSockets and POSTs and the POST bodies, and the server
+closes connections whose request headers are late
+(:class:`~alica.app.center.header_timeout.HeaderTimeout`).
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import hmac
 import json
+import math
 import socket
 import sys
 import threading
@@ -32,11 +36,18 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 from alica.app.center import operator
 from alica.app.center.live import LiveHub
 from alica.app.center.replay import FAULT_KINDS, REPLAN_KINDS, Replay
+from alica.app.center.request_checks import RequestChecks
 from alica.engine import PlanDecision
 from alica.errors import AlicaError
 from alica.lang.walk import literals
 
 COOKIE = "alica_center_token"
+"""The start of the token cookie's name; :func:`cookie_name` adds the center's port."""
+
+
+def cookie_name(port: object) -> str:
+    """The token cookie of the center on ``port``: two centers on one host keep their own (a cookie has no port)."""
+    return f"{COOKIE}_{port}"
 
 
 class TokenGate:
@@ -59,7 +70,7 @@ class TokenGate:
         auth = connection.headers.get("authorization", "")
         if auth.lower().startswith("bearer "):
             return auth[7:].strip(), False
-        return connection.cookies.get(COOKIE), False
+        return connection.cookies.get(cookie_name(_port(scope))), False
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
         if scope["type"] not in ("http", "websocket"):
@@ -76,7 +87,7 @@ class TokenGate:
         if not from_query or scope["type"] != "http":
             await self.app(scope, receive, send)
             return
-        cookie = f"{COOKIE}={self.token}; HttpOnly; Path=/; SameSite=strict"
+        cookie = f"{cookie_name(_port(scope))}={self.token}; HttpOnly; Path=/; SameSite=strict"
 
         async def send_with_cookie(message: Message) -> None:
             if message["type"] == "http.response.start":
@@ -84,6 +95,16 @@ class TokenGate:
             await send(message)
 
         await self.app(scope, receive, send_with_cookie)
+
+
+def _port(scope: Scope) -> object:
+    server = scope.get("server")
+    return server[1] if server else None
+
+
+def _middleware(token: str) -> list[Middleware]:
+    """The token gate, then the request checks."""
+    return [Middleware(TokenGate, token=token), Middleware(RequestChecks)]
 
 
 def _static(name: str) -> str:
@@ -110,9 +131,12 @@ def _number(request: Request, name: str) -> float | None:
     if raw in (None, ""):
         return None
     try:
-        return float(raw)
+        value = float(raw)
     except ValueError:
         raise ValueError(f"'{name}' must be a number, not {raw!r}") from None
+    if not math.isfinite(value):
+        raise ValueError(f"'{name}' must be a finite number, not {raw!r}")
+    return value
 
 
 def replay_app(replay: Replay, token: str, trees: dict[str, Any] | None = None) -> Starlette:
@@ -172,7 +196,7 @@ def replay_app(replay: Replay, token: str, trees: dict[str, Any] | None = None) 
         Route("/api/trees", plan_trees),
         Route("/static/{name}", _static_file),
     ]
-    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+    return Starlette(routes=routes, middleware=_middleware(token))
 
 
 def plan_app(file: str, trees: dict[str, dict[str, Any]], svgs: dict[str, str], token: str) -> Starlette:
@@ -196,7 +220,7 @@ def plan_app(file: str, trees: dict[str, dict[str, Any]], svgs: dict[str, str], 
         Route("/api/plan.svg", plan_svg),
         Route("/static/{name}", _static_file),
     ]
-    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+    return Starlette(routes=routes, middleware=_middleware(token))
 
 
 HELLO_EVENTS = 2000
@@ -365,7 +389,7 @@ def live_app(
         WebSocketRoute("/ws", feed),
         Route("/static/{name}", _static_file),
     ]
-    return Starlette(routes=routes, middleware=[Middleware(TokenGate, token=token)])
+    return Starlette(routes=routes, middleware=_middleware(token))
 
 
 def bind(host: str, port: int) -> socket.socket:
@@ -397,9 +421,11 @@ def serve(app: Starlette, host: str, port: int, token: str, out: TextIO = sys.st
     """Bind, print the address line, and serve until interrupted."""
     import uvicorn
 
+    from alica.app.center.header_timeout import HeaderTimeout
+
     sock = bind(host, port)
     print(address(host, sock, token), file=out, flush=True)
-    config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off")
+    config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off", http=HeaderTimeout)
     uvicorn.Server(config).run(sockets=[sock])
 
 
@@ -414,8 +440,12 @@ def serve_in_thread(app: Starlette, host: str, port: int, token: str, out: TextI
     """
     import uvicorn
 
+    from alica.app.center.header_timeout import HeaderTimeout
+
     sock = bind(host, port)
-    config = uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio")
+    config = uvicorn.Config(
+        app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio", http=HeaderTimeout
+    )
     server = uvicorn.Server(config)
     thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, name="alica-center", daemon=True)
     thread.start()
