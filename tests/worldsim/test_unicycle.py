@@ -88,3 +88,16 @@ def test_bad_maps_and_poses_are_refused_with_a_clear_error():
         world.add_robot("scout", "scout", (8.0, 1.0, 0.0))
     with pytest.raises(WorldError, match="without a camera"):
         world.robots["scout"].camera()
+
+
+def test_the_explore_plans_skills_map_localize_and_explore_on_it():
+    cells = np.zeros((40, 40), dtype=bool)  # 10 m x 10 m, walled, two long blocks
+    cells[[0, -1], :] = cells[:, [0, -1]] = True
+    cells[10:14, 8:30] = True
+    cells[26:30, 12:36] = True
+    world = UnicycleWorld(OccupancyMap(cells, 0.25), seed=0, lidar_noise=0.01)
+    world.add_robot("scout", "scout", (1.0, 1.0, 0.0))
+    scratch: dict[str, object] = {}  # one agent's scratch space: the map BuildMap makes, the others use
+    for skill in ("BuildMap", "Localize", "ExploreFrontier"):
+        run = run_skill(skill, world, "scout", {}, timeout=200, scratch=scratch)
+        assert run.status == "success", (skill, run.reason)
