@@ -229,7 +229,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
     members = agents if args.agents else None
     endpoints = [*args.connect, *args.listen]
     settings = {
-        **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints),
+        **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints, args.key_prefix),
         **_zenoh_settings(args.zenoh),
     }
     return _run(args, library, plan, roles, wiring, facts, settings)
@@ -293,12 +293,6 @@ def _run(
     if args.parent_pipe is not None:
         _watch_parent(args.parent_pipe, stop, orphaned)
     pending = sorted(((at, literals(what)) for what, at, _ in facts), key=lambda item: item[0])
-    taken: list[str] = []
-
-    def name_taken(why: str) -> None:
-        taken.append(why)
-        stop.set()
-
     try:
         transport = ZenohTransport(
             args.name,
@@ -309,7 +303,7 @@ def _run(
             clock=clock,
             config=settings,
             roster=list(roster) if args.agents else None,
-            on_name_taken=name_taken,
+            on_name_taken=lambda _why: stop.set(),  # the reason stays in transport.name_taken
         )
     except ValueError as exc:
         raise AlicaError(f"alica agent {args.name}: {exc}") from None
@@ -382,9 +376,9 @@ def _run(
         if orphaned.is_set():
             why = "parent gone"
             print(f"alica agent {args.name}: the process that started it is gone; stopping", file=sys.stderr)
-        if taken:
+        if transport.name_taken is not None:
             why = "name taken"
-            print(f"alica agent {args.name}: {taken[0]}; stopping", file=sys.stderr)
+            print(f"alica agent {args.name}: {transport.name_taken}; stopping", file=sys.stderr)
         summary = describe_agent(engine, root_status(engine))
         summary.update(
             name=args.name,
@@ -416,7 +410,7 @@ def _run(
             f"{summary['ticks']} ticks, {summary['messages_out']} sent, {summary['messages_in']} received; "
             f"at {summary['path'] or '-'}"
         )
-    if taken:
+    if transport.name_taken is not None:
         return 2
     return 0 if summary["status"] == "success" else 1
 

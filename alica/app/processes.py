@@ -121,7 +121,9 @@ class ProcessTeam:
         self.relays: dict[tuple[str, str], LinkRelay] = {}
         endpoints = free_endpoints(len(names))
         if tls:
-            endpoints = [f"tls/{endpoint.partition('/')[2]}" for endpoint in endpoints]
+            from alica.comm.credentials import tls_endpoint
+
+            endpoints = [tls_endpoint(endpoint) for endpoint in endpoints]
         self.agents: dict[str, _Agent] = {}
         for index, name in enumerate(names):
             connect = []

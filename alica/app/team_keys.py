@@ -39,17 +39,37 @@ def add_team_keys_option(parser: argparse.ArgumentParser | argparse._ArgumentGro
     )
 
 
+def check_members(keys: TeamKeys, members: Iterable[str], who: str) -> None:
+    """Refuse ``members`` that hold no keys of ``keys``'s team (``who``: the process, for the message).
+
+    Raises:
+        AlicaError: some do not, with the command that adds them.
+    """
+    outside = sorted(set(members) - keys.members)
+    if outside:
+        raise AlicaError(
+            f"{who}: {', '.join(outside)} hold(s) no keys of the team in {keys.folder}; add them with "
+            f"'alica team keys --out {keys.folder} --add {' '.join(outside)}'"
+        )
+
+
 def team_settings(
-    args: argparse.Namespace, who: str, name: str, members: Iterable[str] | None, endpoints: Iterable[str]
+    args: argparse.Namespace,
+    who: str,
+    name: str,
+    members: Iterable[str] | None,
+    endpoints: Iterable[str],
+    prefix: str,
 ) -> dict[str, object]:
     """The zenoh settings of ``args.team_keys`` for ``name``; sets ``args.keys`` (``None`` without credentials).
 
     Args:
-        args: the parsed command line (``team_keys``, ``insecure``, ``key_prefix``).
+        args: the parsed command line (``team_keys``, ``insecure``).
         who: the process, for messages (``"alica agent b"``).
         name: the process's identity in the team (an agent's name, or ``center``).
         members: the agents the process takes as its team (each must hold keys of the team).
         endpoints: the zenoh endpoints the process listens on and connects to.
+        prefix: the team's zenoh key prefix.
 
     Raises:
         AlicaError: credentials that do not load, a member without keys, an endpoint that is not TLS
@@ -73,12 +93,7 @@ def team_settings(
     from alica.comm.credentials import TeamKeys, tls_endpoint
 
     keys: TeamKeys = TeamKeys.load(args.team_keys, name)
-    outside = sorted(set(members or ()) - keys.members)
-    if outside:
-        raise AlicaError(
-            f"{who}: {', '.join(outside)} hold(s) no keys of the team in {args.team_keys}; add them with "
-            f"'alica team keys --out {args.team_keys} --add {' '.join(outside)}'"
-        )
+    check_members(keys, members or (), who)
     for endpoint in endpoints:
         if not endpoint.startswith("tls/"):
             try:
@@ -87,4 +102,4 @@ def team_settings(
                 hint = "use a tls/HOST:PORT endpoint"
             raise AlicaError(f"{who}: with --team-keys the team's links are TLS: {endpoint} is not; {hint}")
     args.keys = keys
-    return keys.zenoh_settings(args.key_prefix)
+    return keys.zenoh_settings(prefix)

@@ -182,16 +182,12 @@ def _issue(
     """
     ca_key_file, ca_file = folder / f"{CA}.key", folder / f"{CA}.pem"
     ca_cert = _read_cert(ca_file, "the team's CA certificate")
-    try:
-        ca_key = serialization.load_pem_private_key(ca_key_file.read_bytes(), password=None)
-    except FileNotFoundError:
-        raise CredentialsError(
-            f"no {ca_key_file}: only the holder of the team's CA key can add members; add them where it is"
-        ) from None
-    except (ValueError, TypeError) as exc:
-        raise CredentialsError(f"{ca_key_file} is not a PEM private key ({exc}): is the folder damaged?") from None
-    if not isinstance(ca_key, ec.EllipticCurvePrivateKey) or not _same_key(ca_key.public_key(), ca_cert):
-        raise CredentialsError(f"{ca_key_file} is not the key of {ca_file}: is the folder damaged?")
+    ca_key = _read_key(
+        ca_key_file,
+        ca_cert,
+        missing=f"no {ca_key_file}: only the holder of the team's CA key can add members; add them where it is",
+        mismatch=f"{ca_key_file} is not the key of {ca_file}: is the folder damaged?",
+    )
     key = ec.generate_private_key(ec.SECP256R1())
     dns = [x509.DNSName(name)] if _DNS_LABEL.fullmatch(name) else []
     if not_before is None:
@@ -337,6 +333,19 @@ def _read_roster(folder: Path) -> tuple[frozenset[str], str]:
         raise CredentialsError(f"{path}: {exc}") from None
 
 
+def _read_key(path: Path, cert: x509.Certificate, *, missing: str, mismatch: str) -> ec.EllipticCurvePrivateKey:
+    """The EC private key in ``path``, which must be ``cert``'s (``missing``, ``mismatch``: the errors' words)."""
+    try:
+        key = serialization.load_pem_private_key(path.read_bytes(), password=None)
+    except FileNotFoundError:
+        raise CredentialsError(missing) from None
+    except (ValueError, TypeError) as exc:
+        raise CredentialsError(f"{path} is not a PEM private key without a password ({exc})") from None
+    if not isinstance(key, ec.EllipticCurvePrivateKey) or not _same_key(key.public_key(), cert):
+        raise CredentialsError(mismatch)
+    return key
+
+
 def _same_key(public: object, cert: x509.Certificate) -> bool:
     if not isinstance(public, ec.EllipticCurvePublicKey):
         return False
@@ -444,16 +453,12 @@ class TeamKeys:
             f"renew it where the team's {CA}.key is: delete {name}.pem and {name}.key there, then run "
             f"{_make_hint(folder, [name])}",
         )
-        try:
-            private = serialization.load_pem_private_key(key_file.read_bytes(), password=None)
-        except FileNotFoundError:
-            raise CredentialsError(
-                f"no private key for {who} in {folder}/ ({key_file}): copy {name}.key with {name}.pem"
-            ) from None
-        except (ValueError, TypeError) as exc:
-            raise CredentialsError(f"{key_file} is not a PEM private key without a password ({exc})") from None
-        if not isinstance(private, ec.EllipticCurvePrivateKey) or not _same_key(private.public_key(), cert):
-            raise CredentialsError(f"{key_file} is not the key of {cert_file}: copy both from the same folder")
+        private = _read_key(
+            key_file,
+            cert,
+            missing=f"no private key for {who} in {folder}/ ({key_file}): copy {name}.key with {name}.pem",
+            mismatch=f"{key_file} is not the key of {cert_file}: copy both from the same folder",
+        )
         keys = cls(folder, name, ca_file, cert_file, key_file, members, center)
         keys._private.append(private)
         keys._signers[name] = cert

@@ -232,7 +232,7 @@ class Inbox:
     @property
     def held(self) -> int:
         """Reliable messages taken in and not delivered yet (waiting for a gap to be filled, or for where to start)."""
-        return sum(len(stream.held) for state in self._senders.values() for stream in state.streams.values())
+        return self._held
 
     def subscribe(self, topic: str, now: float) -> None:
         """Take in ``topic`` from now on (a second call keeps the first time)."""
@@ -421,8 +421,8 @@ class Inbox:
         """A new state of ``sender`` for ``incarnation``, its envelope numbers going on from ``state``'s."""
         numbers = dict(state.last_seq)
         self._drop_held(sender)
-        new = self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
-        return new
+        self._senders[sender] = _Sender(incarnation, offset=numbers, last_seq=dict(numbers))
+        return self._senders[sender]
 
     def retire(self, sender: str, incarnation: int) -> None:
         """``sender``'s session ``incarnation`` is gone while an older one lives: take the older one's frames again."""

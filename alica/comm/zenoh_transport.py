@@ -366,11 +366,6 @@ class ZenohTransport(Transport):
         with self._lock:
             return frozenset(self._alive)
 
-    @property
-    def roster(self) -> frozenset[str] | None:
-        """The names taken as teammates (this agent's included); ``None``: any name."""
-        return self._roster
-
     def close(self) -> None:
         """Leave the team: the token goes, the session closes. Closing twice is harmless."""
         with self._lock:

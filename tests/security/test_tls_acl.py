@@ -20,6 +20,7 @@ import zenoh
 from alica.comm.credentials import CENTER, TeamKeys, make_keys, tls_endpoint
 from alica.comm.transport import QoS
 from alica.comm.zenoh_transport import ZenohTransport, free_endpoints, zenoh_config
+from tests.comm.test_zenoh import drain, wait_for
 
 P = "acl"
 WAIT = 15.0
@@ -80,12 +81,9 @@ class Seen:
 
 def _linked(*sessions: zenoh.Session, count: int = 1) -> bool:
     """Wait (at most :data:`WAIT`) until each session has ``count`` peers or routers."""
-    deadline = time.monotonic() + WAIT
-    while time.monotonic() < deadline:
-        if all(len(list(s.info.peers_zid())) + len(list(s.info.routers_zid())) >= count for s in sessions):
-            return True
-        time.sleep(0.02)
-    return False
+    return wait_for(
+        lambda: all(len(list(s.info.peers_zid())) + len(list(s.info.routers_zid())) >= count for s in sessions), WAIT
+    )
 
 
 def _until(seen: Seen, send: Callable[[], None]) -> bool:
@@ -241,10 +239,7 @@ def test_agents_with_credentials_talk_and_see_each_other(team):
     ):
         b.subscribe("news")
         a.publish("news", "hello", QoS.RELIABLE)
-        got: list[object] = []
-        deadline = time.monotonic() + WAIT
-        while not (got and a.peers() == {"b"} and b.peers() == {"a"}) and time.monotonic() < deadline:
-            got += [e.payload for e in b.poll()]
-            time.sleep(0.02)
+        got = [e.payload for e in drain(b, 1, WAIT)]
+        assert wait_for(lambda: a.peers() == {"b"} and b.peers() == {"a"}, WAIT)
         assert got == ["hello"]
         assert a.peers() == {"b"} and b.peers() == {"a"}

@@ -30,8 +30,7 @@ def _cmd_center(args: argparse.Namespace) -> int:
         if not wait > 0:
             raise AlicaError(f"--wait must be a positive number of seconds, got {args.wait}")
         prefix = args.key_prefix or "alica"
-        args.key_prefix = prefix
-        team_settings(args, "alica center", CENTER, None, args.team)  # the keys load, the endpoints fit them
+        team_settings(args, "alica center", CENTER, None, args.team, prefix)  # the keys load, the endpoints fit
         serve_team(args.team, prefix, args.host, args.port, token, wait=wait, skills=args.skills, keys=args.keys)
         return 0
     misplaced = [
