@@ -303,6 +303,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_center_parser(sub)
     add_import_parser(sub)
     add_team_parser(sub)
+    __import__("alica.app.cli_world", fromlist=["add_parser"]).add_parser(sub)
     return parser
 
 
