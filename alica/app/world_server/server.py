@@ -174,7 +174,6 @@ class WorldServer:
                 pass
             else:
                 self._handle(kind, item)
-                continue
             if self.lockstep:
                 if self._all_ticked():
                     self._step_lockstep()
