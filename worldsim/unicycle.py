@@ -18,13 +18,19 @@ of from a map.
   on, marching at a quarter of a cell, with Gaussian range noise from the
   world's seed; no hit reads ``max_range``.
 * **No camera, no arm**: :meth:`UnicycleRobot.camera` raises a clear error,
-  ``arm`` is ``None``; skills that need them refuse such a robot.
+  ``arm`` is ``None``, and its spec's capabilities are only ``base`` and
+  ``lidar2d``; skills that need more refuse such a robot.
+* **Plug-in.** :func:`make_robot` is the robot factory of ``--robot unicycle``
+  (the entry point of the group ``alica.robots``): one robot in a world of its
+  own, from string options (a map file, a pose, a kind).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -36,7 +42,7 @@ from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 from alica.worldsim.robot_specs import ROBOT_KINDS, RobotSpec
 
-__all__ = ["OccupancyMap", "UnicycleRobot", "UnicycleWorld"]
+__all__ = ["FIELD", "OccupancyMap", "UnicycleRobot", "UnicycleWorld", "make_robot"]
 
 _SUBSTEP = 0.02
 """Seconds of one integration step of :meth:`UnicycleWorld.step`."""
@@ -201,6 +207,15 @@ class UnicycleRobot:
     def stop(self) -> None:
         self._command = (0.0, 0.0)
 
+    def crash(self) -> None:
+        """Lose power: stop where it is (a fault; :meth:`recover` powers it up again)."""
+        self._command = (0.0, 0.0)
+        self.crashed = True
+
+    def recover(self) -> None:
+        """Power up again where it stopped."""
+        self.crashed = False
+
     def _advance(self, dt: float) -> None:
         """Integrate the command over ``dt`` seconds (an exact arc); stay and bump instead of hitting something."""
         v, w = self._command
@@ -266,6 +281,7 @@ class UnicycleWorld:
         x, y, yaw = (float(v) for v in pose)
         if not self.map.disc_free(x, y, spec.radius) or self.blocker(x, y, spec.radius):
             raise WorldError(f"robot '{name}' does not fit at ({x:g}, {y:g}): an occupied cell or a robot is there")
+        spec = dataclasses.replace(spec, capabilities=spec.capabilities & {"base", "lidar2d"})  # what it has
         robot = self._robots[name] = UnicycleRobot(self, name, spec, (x, y, yaw))
         return robot
 
@@ -319,6 +335,95 @@ class UnicycleWorld:
 
     def blocks_facts(self) -> set[tuple[str, ...]]:
         return set()
+
+
+#: The field of :func:`make_robot` without a ``map`` option: 12 m x 12 m of 0.25 m cells, walled, with three blocks.
+FIELD = (
+    ["#" * 48]
+    + ["#" + "." * 46 + "#"] * 9
+    + ["#" + "." * 10 + "#" * 4 + "." * 32 + "#"] * 12
+    + ["#" + "." * 46 + "#"] * 4
+    + ["#" + "." * 24 + "#" * 14 + "." * 8 + "#"] * 4
+    + ["#" + "." * 46 + "#"] * 8
+    + ["#" + "." * 6 + "#" * 6 + "." * 34 + "#"] * 3
+    + ["#" + "." * 46 + "#"] * 6
+    + ["#" * 48]
+)
+
+
+def make_robot(name: str, role: str, options: Mapping[str, str]) -> UnicycleWorld:
+    """The robot factory of the plug-in ``unicycle``: a world of its own holding one unicycle named ``name``.
+
+    Options (all strings, as ``--robot-option KEY=VALUE`` gives them):
+
+    * ``map``: a text file of ``#`` (occupied) and ``.`` (free) rows, the first row at the top
+      (default :data:`FIELD`);
+    * ``resolution``: metres per cell (default 0.25);
+    * ``origin``: ``x,y`` of the map's lower-left corner (default ``0,0``);
+    * ``pose``: ``x,y,yaw`` where the robot starts (default: 1 m from the lower-left corner, ``x0+1,y0+1,0``);
+    * ``kind``: the robot kind whose size and speeds it takes (default: the role's, lower-cased, when
+      it is a kind; else ``scout``);
+    * ``seed``: the lidar noise's seed (default 0); ``lidar_noise``: its standard deviation in metres
+      (default 0.01).
+
+    The world is simulated: the run steps it (:meth:`UnicycleWorld.step`) once per tick.
+
+    Raises:
+        ValueError: an unknown option, or a value that is not what the option takes (the message says which).
+        WorldError: the robot does not fit where it starts.
+    """
+    known = {"map", "resolution", "origin", "pose", "kind", "seed", "lidar_noise"}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise ValueError(f"the unicycle has no option {', '.join(unknown)}; its options: {', '.join(sorted(known))}")
+
+    def number(key: str, default: float) -> float:
+        text = options.get(key)
+        try:
+            value = default if text is None else float(text)
+        except ValueError:
+            raise ValueError(f"option {key}: '{text}' is not a number") from None
+        if not math.isfinite(value):
+            raise ValueError(f"option {key}: '{text}' is not a finite number")
+        return value
+
+    rows = FIELD
+    if "map" in options:
+        try:
+            rows = [line.strip() for line in Path(options["map"]).read_text(encoding="utf-8").splitlines()]
+        except (OSError, UnicodeDecodeError) as exc:
+            raise ValueError(f"option map: cannot read '{options['map']}': {exc}") from None
+        rows = [row for row in rows if row]
+    origin = _numbers(options, "origin", "0,0", "x,y")
+    try:
+        occupancy = OccupancyMap.from_rows(rows, number("resolution", 0.25), (origin[0], origin[1]))
+    except ValueError as exc:
+        raise ValueError(f"option map: {exc}") from None
+    pose = _numbers(options, "pose", f"{origin[0] + 1:g},{origin[1] + 1:g},0", "x,y,yaw")
+    kind = options.get("kind") or (role.lower() if role.lower() in ROBOT_KINDS else "scout")
+    if kind not in ROBOT_KINDS:
+        raise ValueError(f"option kind: no robot kind '{kind}'; kinds: {', '.join(sorted(ROBOT_KINDS))}")
+    seed = number("seed", 0)
+    if seed != int(seed):
+        raise ValueError(f"option seed: '{options['seed']}' is not a whole number")
+    noise = number("lidar_noise", 0.01)
+    if noise < 0:
+        raise ValueError(f"option lidar_noise: must be >= 0, got {noise:g}")
+    world = UnicycleWorld(occupancy, seed=int(seed), lidar_noise=noise)
+    world.add_robot(kind, name, pose)
+    return world
+
+
+def _numbers(options: Mapping[str, str], key: str, default: str, shape: str) -> list[float]:
+    """The comma-separated finite numbers of option ``key`` (as many as ``shape`` names)."""
+    text = options.get(key, default)
+    try:
+        values = [float(v) for v in text.split(",")]
+    except ValueError:
+        values = []
+    if len(values) != shape.count(",") + 1 or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"option {key}: '{text}' is not {shape} ({shape.count(',') + 1} numbers)")
+    return values
 
 
 if TYPE_CHECKING:  # mypy checks that the unicycle satisfies the robot interface

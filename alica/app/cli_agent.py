@@ -8,8 +8,11 @@ zenoh endpoints). The engine ticks at ``--frequency`` in real time
 on the network (zenoh liveliness). ``alica run --processes`` starts one
 ``alica agent`` per agent on loopback (:mod:`alica.app.processes`).
 
-Skills: any skill that needs no shared simulated world, and with
-``--stand-ins`` scripted stand-ins for the others.
+Skills: any skill that needs no robot; with ``--robot PLUGIN`` (a robot
+driver, :mod:`alica.app.robot_plugin`) the skills that act on a robot too; with
+``--stand-ins`` scripted stand-ins for the others. A simulated driver (one
+whose world has ``step(seconds)``) is moved on by the wall time between two
+ticks; a hardware driver runs on its own.
 
 With ``--json`` it prints one JSON object per line on standard output: a
 ``status`` line whenever its root plan's status changes, and a ``summary``
@@ -47,6 +50,7 @@ from typing import TYPE_CHECKING, Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.options import add_time_limit, check_output, time_limit
+from alica.app.robot_plugin import add_robot_options
 from alica.app.skill_options import add_skills_option
 from alica.app.team_keys import add_team_keys_option, team_settings
 from alica.app.timed import timed
@@ -60,6 +64,7 @@ if TYPE_CHECKING:
     from alica.engine.agent import Observer
     from alica.model import PlanLibrary
     from alica.worldmodel import WorldModel
+    from alica.worldsim.interface import RobotWorld
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -158,6 +163,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "(by default it does: with no center listening it only keeps its last events in memory)",
     )
     add_skills_option(p)
+    add_robot_options(p)
     add_engine_options(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace (in an existing folder)")
     p.add_argument(
@@ -191,8 +197,10 @@ def _zenoh_settings(items: list[str]) -> dict[str, object]:
 
 def cmd_agent(args: argparse.Namespace) -> int:
     """Run ``alica agent``; returns the exit code."""
+    from alica.allocation import AgentSpec
     from alica.app.options import parse_roster
     from alica.app.plan_entry import agent_roles, load_entry, root_plans
+    from alica.app.robot_plugin import close_world, robot_plugin
     from alica.app.run_skills import plan_skills, skill_wiring
     from alica.app.skill_options import skill_registry
     from alica.io import Loader
@@ -225,14 +233,24 @@ def cmd_agent(args: argparse.Namespace) -> int:
         agents[args.name] = args.role
     roles = agent_roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
-    wiring = skill_wiring(registry, plan_skills(library, plan), world=False, stand_ins=args.stand_ins, plan=plan)
+    plugin = robot_plugin(args, agents)
+    wiring = skill_wiring(
+        registry, plan_skills(library, plan), world=plugin is not None, stand_ins=args.stand_ins, plan=plan
+    )
     members = agents if args.agents else None
     endpoints = [*args.connect, *args.listen]
     settings = {
         **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints, args.key_prefix),
         **_zenoh_settings(args.zenoh),
     }
-    return _run(args, library, plan, roles, wiring, facts, settings)
+    if plugin is None:
+        return _run(args, library, plan, roles, wiring, facts, settings)
+    mine = roles[args.name]
+    world = plugin.make(args.name, (mine.role if isinstance(mine, AgentSpec) else mine) or "")
+    try:
+        return _run(args, library, plan, roles, wiring, facts, settings, world)
+    finally:
+        close_world(world)
 
 
 def _run(
@@ -243,8 +261,10 @@ def _run(
     wiring: SkillWiring,
     facts: list[tuple[str, float, float | None]],
     settings: dict[str, object],
+    robot_world: RobotWorld | None = None,
 ) -> int:
     from alica.allocation import AgentSpec, assign_roles
+    from alica.app.robot_plugin import is_simulated, wall_seconds
     from alica.app.trace_sources import plan_path_names
     from alica.clock import SystemClock
     from alica.comm.zenoh_transport import ZenohTransport
@@ -333,8 +353,11 @@ def _run(
             skills=SkillBinder(None, wiring.registry, fallback),
             seed=args.seed,
             observers=(observe,) if sinks else (),
+            world=robot_world,
             listen_first=2 * config.broadcast_interval,
         )
+        stepped: Any = getattr(robot_world, "step") if robot_world is not None and is_simulated(robot_world) else None  # noqa: B009
+        last_step = [time.monotonic()]
         status = ["running"]
 
         def operator(now: float) -> None:
@@ -350,6 +373,8 @@ def _run(
         engine.world_model.on_change(world.touch)
 
         def report(now: float) -> None:
+            if stepped is not None:
+                stepped(wall_seconds(last_step))  # a simulated robot moves on as the wall clock did
             if trace is not None and world.changed and now - world.at >= WORLD_TRACE_GAP:
                 # the world model's fingerprint in the trace: when two agents' agree, their states are equal
                 world.changed, world.at = False, now

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
 from alica.app.options import add_time_limit, check_output, parse_roster, time_limit
+from alica.app.robot_plugin import add_robot_options
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.team_keys import add_team_keys_option
 from alica.app.timed import add_fault_options, add_network_options, partition
@@ -32,6 +33,7 @@ if TYPE_CHECKING:
     from alica.app.center.live import LiveHub, LiveSession
     from alica.app.center.team_feed import CommandLoop
     from alica.app.processes import Fault, ProcessTeam
+    from alica.app.robot_plugin import PluggedRobots, RobotPlugin
     from alica.app.run_skills import SkillWiring
     from alica.comm.credentials import TeamKeys
     from alica.engine import AgentEngine, SimulatedTeam
@@ -122,6 +124,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first (default 'a,b;c')")
     add_lunar_options(p)
+    add_robot_options(p)
     p.add_argument(
         "--stand-ins",
         action="store_true",
@@ -149,6 +152,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 def cmd_run(args: argparse.Namespace) -> int:
     """Run the ``run`` subcommand; returns the exit code."""
     from alica.app.plan_entry import agent_roles, load_entry, root_plans
+    from alica.app.robot_plugin import robot_plugin
     from alica.app.run_skills import plan_skills, run_world, skill_wiring
     from alica.app.skill_options import skill_registry
     from alica.io import Loader
@@ -177,8 +181,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     agents = parse_roster(args.agents)
     roles = agent_roles(library, agents, args.roleset)
     skills = plan_skills(library, plan)
+    plugin = robot_plugin(args, agents)
+    if plugin is not None and args.world is not None:
+        raise AlicaError("--robot and --world both give the team its robots: choose one")
+    has_robots = args.world is not None or plugin is not None
     try:
-        wiring = skill_wiring(registry, skills, world=args.world is not None, stand_ins=args.stand_ins, plan=plan)
+        wiring = skill_wiring(registry, skills, world=has_robots, stand_ins=args.stand_ins, plan=plan)
     except AlicaError as exc:
         raise AlicaError(f"{exc}{_declared_in_files(registry, skills)}") from None
     if args.team_keys is not None and not args.processes:
@@ -186,8 +194,31 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.processes:
         header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
         return _run_processes(args, plan, list(agents), wiring, header, library, session)
+    if plugin is not None:
+        return _run_plugged(args, library, plan, roles, wiring, plugin, session)
     with run_world(args, sorted(agents)) as (world, perception):
         return _run_team(args, library, plan, roles, wiring, world, perception, session)
+
+
+def _run_plugged(
+    args: argparse.Namespace,
+    library: PlanLibrary,
+    plan: str,
+    roles: dict[str, str | AgentSpec],
+    wiring: SkillWiring,
+    plugin: RobotPlugin,
+    session: LiveSession | None,
+) -> int:
+    """``alica run --robot``: every agent's skills act on its own robot of the plug-in, stepped in simulated time."""
+    from alica.allocation import AgentSpec
+    from alica.app.robot_plugin import PluggedRobots
+
+    role_names = {name: (r.role if isinstance(r, AgentSpec) else r) or "" for name, r in roles.items()}
+    robots = PluggedRobots(plugin, role_names)
+    try:
+        return _run_team(args, library, plan, roles, wiring, None, None, session, robots)
+    finally:
+        robots.close()
 
 
 def _declared_in_files(registry: SkillRegistry, skills: list[str]) -> str:
@@ -241,6 +272,7 @@ def _run_team(
     world: World | None,
     perception: Callable[[SimulatedTeam], None] | None,
     session: LiveSession | None = None,
+    robots: PluggedRobots | None = None,
 ) -> int:
     from alica.app.trace_world import WorldTrace, team_grid, tee
     from alica.engine import JsonlTrace, SimulatedTeam, running_tree
@@ -283,8 +315,9 @@ def _run_team(
         fallback=default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None,
         observers=observers,
         trace_messages=args.trace_messages,
-        world=world,
+        world=world if robots is None else robots,
         perception=perception,
+        agent_worlds=None if robots is None else robots.worlds,
     )
     sinks = [s for s in (trace, hub) if s is not None]
     if sinks and world is not None:
@@ -327,6 +360,8 @@ def _run_team(
             trace.close()
     summary = team.summary()
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": args.world}
+    if robots is not None:
+        summary["skills"]["robot"] = args.robot
     for name, agent in summary["agents"].items():
         agent["reason"] = reasons.of(team, name, agent["status"])
     if args.json:
@@ -395,6 +430,8 @@ def _run_processes(
     options = ["--frequency", repr(args.frequency), "--seed", str(args.seed)]
     options += [arg for text in args.fact for arg in ("--fact", text)]
     options += [arg for module in args.skills for arg in ("--skills", module)]
+    if args.robot:
+        options += ["--robot", args.robot, *(arg for item in args.robot_option for arg in ("--robot-option", item))]
     if args.name:
         options += ["--root", args.name]
     if args.roleset:
@@ -441,6 +478,8 @@ def _run_processes(
         if args.trace:
             team.trace(Path(args.trace), header)
     summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
+    if args.robot:
+        summary["skills"]["robot"] = args.robot
     for agent in summary["agents"].values():
         agent["reason"] = None if agent["status"] == "success" else _process_reason(agent)
     if args.json:

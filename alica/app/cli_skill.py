@@ -8,9 +8,10 @@ import json
 import os
 import sys
 from collections.abc import Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from alica.app.options import add_time_limit, time_limit
+from alica.app.robot_plugin import RobotPlugin, WallPaced, add_robot_options, close_world, is_simulated, robot_plugin
 from alica.app.skill_options import add_lunar_options, add_skills_option, lunar_field, skill_registry
 from alica.errors import AlicaError
 
@@ -36,7 +37,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--time-limit. Exit 0 on success, 1 otherwise.",
     )
     r.add_argument("name", metavar="NAME", help="the skill, e.g. MoveToPosition (alica list-skills lists them)")
-    r.add_argument("--world", choices=("lunar", "blocks"), default="lunar", help="the scenario (default lunar)")
+    r.add_argument(
+        "--world",
+        choices=("lunar", "blocks"),
+        help="the scenario (default lunar; leave it out with --robot)",
+    )
     r.add_argument(
         "--param",
         action="append",
@@ -53,7 +58,16 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "(repeatable, in order): a pipeline step by step, e.g. --after DetectCircles --after CropCandidate "
         "for BlobDetect; the run stops at the first step that does not succeed",
     )
-    r.add_argument("--robot", metavar="NAME", help="the robot (default: the first one that has what the skills need)")
+    r.add_argument(
+        "--robot-name",
+        metavar="NAME",
+        help="the robot: with --world, one of the scenario's (default: the first one that has what the skills need); "
+        "with --robot, the name the factory gets (default robot)",
+    )
+    r.add_argument(
+        "--role", default="", help="with --robot: the role the factory gets (the unicycle takes its kind from it)"
+    )
+    add_robot_options(r)
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
     add_lunar_options(r)
     r.add_argument("--stacks", default="a,b;c", help="blocks world stacks, bottom first, e.g. 'a,b;c' (default)")
@@ -83,7 +97,7 @@ def _params(items: list[str]) -> dict[str, object]:
 
 
 def _world(args: argparse.Namespace) -> World:
-    if args.world == "lunar":
+    if args.world in (None, "lunar"):
         return lunar_field(args)
     from alica.worldsim.scenarios import blocksworld
 
@@ -118,9 +132,19 @@ def _run(args: argparse.Namespace, registry: SkillRegistry, spec: SkillSpec, par
     steps = [registry.get(name) for name in args.after]
     needs = frozenset().union(spec.capabilities, *(step.capabilities for step in steps))
     names = ", ".join([*args.after, args.name])
-    world = _world(args)
     try:
-        robot = args.robot
+        plugin = robot_plugin(args, [args.robot_name or "robot"])
+    except AlicaError as exc:
+        if args.robot is None or ":" in args.robot:
+            raise
+        raise AlicaError(
+            f"{exc}; to pick a robot of the --world scenario by name, use --robot-name {args.robot}"
+        ) from None
+    if plugin is not None and args.world is not None:
+        raise AlicaError("--robot and --world both give the robot: choose one")
+    world: Any = _world(args) if plugin is None else _plugged(plugin, args.robot_name or "robot", args.role)
+    try:
+        robot = args.robot_name or ("robot" if plugin is not None else None)
         if robot is None:
             fits = [n for n, r in sorted(world.robots.items()) if needs <= r.spec.capabilities]
             if not fits:
@@ -157,7 +181,13 @@ def _run(args: argparse.Namespace, registry: SkillRegistry, spec: SkillSpec, par
             scratch=scratch,
         )
     finally:
-        world.close()
+        close_world(world)
+
+
+def _plugged(plugin: RobotPlugin, name: str, role: str) -> Any:
+    """The plug-in's world for ``alica skill run --robot``; a hardware one is ticked on the wall clock."""
+    world = plugin.make(name, role)
+    return world if is_simulated(world) else WallPaced(world)
 
 
 def cmd_skill_run(args: argparse.Namespace) -> int:

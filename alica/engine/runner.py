@@ -104,6 +104,8 @@ class SimulatedTeam:
             robots sense into their world models.
         step_world: whether :meth:`tick` steps the world (``False`` when a caller
             runs several teams in one world and steps it itself).
+        agent_worlds: the robot interface each agent's skills get, by agent name, when
+            it is not ``world`` (robot plug-ins: each agent's driver is a world of its own).
     """
 
     def __init__(
@@ -127,6 +129,7 @@ class SimulatedTeam:
         world: SimWorld | None = None,
         perception: Callable[[SimulatedTeam], None] | None = None,
         step_world: bool = True,
+        agent_worlds: Mapping[str, object] | None = None,
     ) -> None:
         if not agents:
             raise AlicaError("a team needs at least one agent")
@@ -147,6 +150,7 @@ class SimulatedTeam:
         self._sim_world = world
         self.perception = perception
         self.step_world = step_world
+        self.agent_worlds = dict(agent_worlds or {})
         manual = ManualClock()
         self._manual: ManualClock | None = manual if world is None else None
         """The team's own clock when it runs without a world (it advances it every tick)."""
@@ -189,7 +193,7 @@ class SimulatedTeam:
             registry=self.registry,
             seed=self.seed,
             observers=tuple(self.observers),
-            world=self.world,
+            world=self.agent_worlds.get(name, self.world),
             listen_first=listen_first,
         )
 
