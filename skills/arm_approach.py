@@ -23,6 +23,7 @@ from py_trees.common import Status
 from alica.skills import reservations
 from alica.skills.arm_world import inside_field
 from alica.skills.navigation import MoveToPosition
+from alica.skills.team_poses import teammate_discs
 from alica.skills.world_skill import distance
 from alica.worldsim.geometry import wrap_angle
 
@@ -106,7 +107,7 @@ class Approach:
 
     def avoid_here(self) -> None:
         """The arm found no plan from where the robot stands: take another side next."""
-        pose = self.skill.robot.pose
+        pose = self.skill.robot.estimate
         self.tried_sides.append((float(pose[0]), float(pose[1])))
         self.mover = None
 
@@ -127,14 +128,10 @@ class Approach:
         x, y, _ = robot.estimate
         standoff = skill.standoff()
         heading = math.atan2(site[1] - y, site[0] - x)
-        others = [
-            (r.pose[0], r.pose[1], r.spec.radius + STANDOFF_MARGIN)
-            for r in skill.world.robots.values()
-            if r is not robot
-        ]
+        others = teammate_discs(skill, margin=STANDOFF_MARGIN)  # the poses teammates shared
         others += [(rx, ry, rr + STANDOFF_MARGIN) for rx, ry, rr in reservations.reserved(skill)]
         # the motion planner's own check of a goal (static obstacles, blocks, other robots)
-        checker = robot_checker(skill.world, robot, skill.world_model).with_robots(others)
+        checker = robot_checker(skill.world, robot, skill.world_model, skill.team_model).with_robots(others)
         for k in range(STANDOFF_TRIES):
             turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
             angle = heading + turn
@@ -205,6 +202,7 @@ class Approach:
             skill.context,
         )
         mover.setup(context=skill.context)
+        mover.team_source = skill.team_source  # an inner skill's approach hears the same team
         self.reserve(goal)
         return mover
 

@@ -55,6 +55,7 @@ from alica.skills.arm_scratch import (
 )
 from alica.skills.arm_world import REACH, find_object, place_area, write_held, write_placed, write_released
 from alica.skills.handling import PLACE_TOLERANCE, SETTLE, ArmSkill, Phase, Pickup, Putdown
+from alica.skills.team_poses import holders
 from alica.skills.world_skill import WorldSkill, distance, number_param
 from alica.worldsim.arm_interface import ArmPlanningScene
 from alica.worldsim.interface import WorldThing
@@ -453,8 +454,8 @@ class VerifyPlaced(WorldSkill):
         obj = find_object(self, self.param("object"))
         if arm.held is not None:
             return self.fail(f"the gripper still holds {_label(self, arm.held)}")
-        holder = next((r.name for r in self.world.robots.values() if r.arm is not None and r.arm.held is obj), None)
-        if holder is not None:
+        holder = holders(self.team_model).get(name)  # the team's holding facts
+        if holder is not None and holder != self.robot.name:
             return self.fail(f"{name} is in the gripper of robot '{holder}'")
         low, _ = obj.aabb()
         x, y = (float(v) for v in obj.position()[:2])

@@ -50,8 +50,10 @@ from alica.skills.arm_world import (
 )
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
+from alica.skills.team_poses import holders
 from alica.skills.world_skill import WorldSkill, distance
 from alica.worldsim.arm_interface import ArmPlanningScene, RobotArm
+from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import WorldThing
 
 if TYPE_CHECKING:
@@ -347,21 +349,17 @@ def _grip_or_release(skill: ArmSkill) -> str | None:
         skill.motion.release(arm)
         return None
     obj = skill.target_object()
-    holder = next(
-        (
-            r.name
-            for r in skill.world.robots.values()
-            if r.arm is not None and r.arm.held is obj and r is not skill.robot
-        ),
-        None,
-    )
-    if holder is not None:
+    holder = holders(skill.team_model).get(obj.name)  # what the team says; the gripper tells the rest
+    if holder is not None and holder != skill.robot.name:
         return f"{obj.name} was taken by robot '{holder}' before the grip"
     refusal = skill.before_grip(obj)
     if refusal is not None:
         return refusal
     arm.close(skill.finger_force())
-    arm.attach(obj.name)
+    try:
+        arm.attach(obj.name)
+    except WorldError as exc:  # taken by a teammate whose holding(...) has not reached this robot yet
+        return f"{obj.name} could not be gripped: {exc}"
     return None
 
 

@@ -28,8 +28,10 @@ Which grid depends on what the robot knows (:func:`planning_grid`):
   robot that bumps into one remembers the spot and plans around it for the
   rest of the drive, as in map mode.
 
-In both modes the other robots are the world's robot poses (``_others``): a
-stand-in for the positions robots broadcast in a real team.
+In both modes the other robots are the poses the teammates shared through the
+world model (``_others``, :mod:`alica.skills.team_poses`): a teammate that
+never shared, or whose pose is stale, is not avoided (in map mode the team map
+still shows its body where the lidar saw it).
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from py_trees.common import Status
 
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
+from alica.skills.team_poses import teammates
 from alica.skills.world_skill import WorldSkill, distance, world_cache
 from alica.worldmodel.protocol import WorldModelLike
 from alica.worldsim.interface import MobileRobot, RobotWorld
@@ -143,14 +146,21 @@ def planning_checker(world: RobotWorld, radius: float, world_model: WorldModelLi
     return checker
 
 
-def robot_checker(world: RobotWorld, robot: MobileRobot, world_model: WorldModelLike | None = None) -> GridChecker:
+def robot_checker(
+    world: RobotWorld,
+    robot: MobileRobot,
+    world_model: WorldModelLike | None = None,
+    team_model: WorldModelLike | None = None,
+) -> GridChecker:
     """:func:`planning_checker` for ``robot``; in map mode without the cells of the robots' bodies.
 
     A team map made with lidar shows the robots where teammates saw them. The
     cells within :data:`BODY_MARGIN` of a robot's body are cleared around the
-    robot's pose estimate and the other robots' positions (the world's robot
-    poses, as ``MoveToPosition._others``), so that a robot can plan from where
-    it stands; the other robots are checked as robots.
+    robot's pose estimate and the poses its teammates shared in ``world_model``
+    (:func:`alica.skills.team_poses.teammates`, as ``MoveToPosition._others``),
+    so that a robot can plan from where it stands; the other robots are checked
+    as robots. The teammates' poses come from ``team_model`` when given, else
+    from ``world_model``.
     """
     radius = robot.spec.radius
     checker = planning_checker(world, radius, world_model)
@@ -158,9 +168,8 @@ def robot_checker(world: RobotWorld, robot: MobileRobot, world_model: WorldModel
         return checker
     x, y, _ = robot.estimate
     bodies = [(x, y, radius + BODY_MARGIN)]
-    bodies += [
-        (r.pose[0], r.pose[1], r.spec.radius + BODY_MARGIN) for _, r in sorted(world.robots.items()) if r is not robot
-    ]
+    team = team_model if team_model is not None else world_model
+    bodies += [(p.x, p.y, p.radius + BODY_MARGIN) for p in teammates(team, world, robot.name)]
     return checker.with_cleared_disks(bodies)
 
 
@@ -342,7 +351,7 @@ class MoveToPosition(WorldSkill):
         In map mode without the robots' bodies' cells, and with what the robot
         bumped into on this drive (:meth:`_remember_bump`).
         """
-        checker = robot_checker(self.world, self.robot, self.map_source)
+        checker = robot_checker(self.world, self.robot, self.map_source, self.team_model)
         if self.bumps:
             reach = checker.robot_radius + checker.margin + BUMP_RADIUS
             checker = checker.with_blocked_disks(np.array(self.bumps), reach)
@@ -387,11 +396,8 @@ class MoveToPosition(WorldSkill):
         map_scan(self.robot, mapper, max_range=min(DRIVE_SCAN_RANGE, self.robot.spec.lidar_range), now=now)
 
     def _others(self) -> list[tuple[float, float, float]]:
-        return [
-            (r.pose[0], r.pose[1], r.spec.radius)
-            for name, r in sorted(self.world.robots.items())
-            if r is not self.robot
-        ]
+        """The teammates' bodies as ``(x, y, radius)``, from the poses they shared (:mod:`alica.skills.team_poses`)."""
+        return [p.disc for p in teammates(self.team_model, self.world, self.robot.name)]
 
     def _replan(self) -> None:
         """Plan again to the target; in map mode the drivable point near the goal is sought again (the map changed)."""

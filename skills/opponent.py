@@ -295,6 +295,7 @@ class RandomBlockSkill(WorldSkill):
         params = _catalog_params(action.skill, {**action.params(), **extra})
         inner = _skill_class(action.skill)(f"{self.name}/{action.label}", params, context)
         inner.setup(context=context)
+        inner.team_source = self.world_model  # it writes no facts, but hears the opponent's own team
         return inner
 
     def _tick_inner(self) -> Status:
@@ -338,6 +339,7 @@ class RandomBlockSkill(WorldSkill):
             context,
         )
         aside.setup(context=context)
+        aside.team_source = self.world_model
         return aside
 
     # -- blocking ---------------------------------------------------------------

@@ -26,6 +26,7 @@ from alica.errors import SkillError
 from alica.lang.fact import Fact
 from alica.lang.skill_plugins import default_registry
 from alica.lang.skills import SkillRegistry
+from alica.skills.team_poses import POSE, SHARERS, share_pose
 from alica.worldmodel.protocol import WorldModelLike
 
 if TYPE_CHECKING:
@@ -184,6 +185,7 @@ class SkillSession:
         from py_trees.common import Status
 
         behaviour = self.behaviour
+        self._hear_team()
         behaviour.tick_once()
         self.ticks += 1
         seen = (behaviour.status.value, behaviour.feedback_message)
@@ -197,6 +199,18 @@ class SkillSession:
         elif behaviour.status == Status.FAILURE:
             self.status = "failure"
         return not self.running
+
+    def _hear_team(self) -> None:
+        """Every robot of the world shares its pose into the session's world model (a loss-free team network).
+
+        The harness plays the application's part, which shares each robot's
+        pose on every tick (:func:`alica.skills.team_poses.share_pose`,
+        throttled), and the network's: a robot standing by is avoided as in a
+        team whose robots all share. A test that wants a robot unseen builds
+        and ticks the skill itself, with a world model of its own.
+        """
+        for robot in self.world.robots.values():
+            share_pose(self.world_model, self.world, robot)
 
     def stop(self) -> None:
         """Stop a running skill (py_trees runs its ``terminate``); it counts as ``timeout``."""
@@ -216,8 +230,9 @@ class SkillSession:
         if not reason and self.status == "timeout":
             reason = "still running" + (f" after {timeout:.0f} s" if timeout is not None else "")
         wm = self.world_model
-        facts = sorted(wm.facts(), key=lambda fact: repr(fact.flat))
-        written = {Fact(key, args): value for key, args, value in wm.values()}
+        # the robots' shared poses are the team's traffic (alica.skills.team_poses), not the skill's outcome
+        facts = sorted((f for f in wm.facts() if f.predicate != SHARERS), key=lambda fact: repr(fact.flat))
+        written = {Fact(key, args): value for key, args, value in wm.values() if key != POSE}
         return SkillRun(
             self.name,
             self.robot,

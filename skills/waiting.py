@@ -42,6 +42,7 @@ from py_trees.common import Status
 from alica.skills import reservations
 from alica.skills.handling import inside_field
 from alica.skills.navigation import DriveToFreeSpace, lying_sites
+from alica.skills.team_poses import holders, teammates
 from alica.skills.world_skill import distance
 
 #: Radii (m) of the rings around a step's work site where a robot waits for its turn.
@@ -97,10 +98,11 @@ class WaitAside(DriveToFreeSpace):
         here = self._here()
         radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
         found: list[tuple[float, tuple[float, float]]] = []
+        held = holders(self.team_model)
         for label in value.split():
             obj = self.world.objects.get(label)
-            if obj is None or any(r.arm is not None and r.arm.held is obj for r in self.world.robots.values()):
-                continue  # no such object, or held: its work site is elsewhere
+            if obj is None or label in held or (self.robot.arm is not None and self.robot.arm.held is obj):
+                continue  # no such object, or held (the team's holding facts): its work site is elsewhere
             position = obj.position()
             xy = (float(position[0]), float(position[1]))
             if name == "guard" and any(distance(xy, (x, y)) <= radius for x, y, _ in super()._others()):
@@ -201,11 +203,8 @@ class WaitAside(DriveToFreeSpace):
 
     def _holders(self) -> list[tuple[float, float]]:
         """Where the other robots that hold something stand: they need room to put it down."""
-        return [
-            (float(r.pose[0]), float(r.pose[1]))
-            for r in self.world.robots.values()
-            if r is not self.robot and r.arm is not None and r.arm.held is not None
-        ]
+        holding = set(holders(self.team_model).values())
+        return [(p.x, p.y) for p in teammates(self.team_model, self.world, self.robot.name) if p.robot in holding]
 
     def _others(self) -> list[tuple[float, float, float]]:
         """The other robots, with the points teammates reserved as robots standing there (for the path too).

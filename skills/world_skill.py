@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import re
 import weakref
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import py_trees
@@ -23,6 +23,7 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import DeferredJobs, Jobs
+from alica.skills.team_poses import share_pose
 from alica.worldmodel.protocol import WorldModelLike
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 
@@ -60,6 +61,8 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         self._world: RobotWorld | None = None
         self._robot: MobileRobot | None = None
         self.jobs: Jobs = DeferredJobs()
+        #: The team's world model for an inner skill that has none of its own (see :attr:`team_model`).
+        self.team_source: WorldModelLike | None = None
 
     @property
     def world(self) -> RobotWorld:
@@ -117,6 +120,18 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         jobs = context.extra.get("jobs")
         self.jobs = jobs if isinstance(jobs, Jobs) else DeferredJobs()
 
+    def tick(self) -> Iterator[py_trees.behaviour.Behaviour]:
+        """Share the robot's pose with the team (throttled), then tick as py_trees does.
+
+        Not the skill's behaviour (that is :meth:`update`): every world skill
+        passes here on each tick, so a robot that runs any world skill tells its
+        teammates where it believes it is (:func:`alica.skills.team_poses.share_pose`;
+        at most about two writes a second).
+        """
+        if self._robot is not None and self._world is not None:
+            share_pose(self.team_model, self._world, self._robot)
+        yield from super().tick()
+
     def now(self) -> float:
         """Simulated (or wall) time of the run."""
         return float(self.context.now()) if self.context is not None else self.world.now()
@@ -142,6 +157,16 @@ class WorldSkill(py_trees.behaviour.Behaviour):
     def world_model(self) -> WorldModelLike | None:
         """The agent's world-model replica, or None."""
         return self.context.world_model if self.context is not None else None
+
+    @property
+    def team_model(self) -> WorldModelLike | None:
+        """The world model through which the robot shares its pose and reads its teammates'.
+
+        :attr:`team_source` when set (an inner skill run without a world model
+        of its own, so that it writes no facts, still hears its team), else
+        :attr:`world_model`.
+        """
+        return self.team_source if self.team_source is not None else self.world_model
 
     def write(self, positive: bool, pred: str, *args: object) -> None:
         """Write an outcome fact to the world model, when there is one."""

@@ -308,6 +308,7 @@ class ExploreFrontier(WorldSkill):
             context,
         )
         inner.map_model = self.world_model  # it plans on the team map, though it writes no facts
+        inner.team_source = self.world_model  # and shares its pose with the team, and avoids its teammates
         inner.setup(context=context)
         return inner
 
