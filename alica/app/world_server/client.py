@@ -117,7 +117,12 @@ class RemoteWorld:
         self._robot_states: dict[str, tuple[int, RobotState]] = {}
         self._things: dict[str, ThingState] = {}
         self._things_version = -1
+        self._statics: dict[str, ThingState] = {}
+        self._epoch = -1
+        self._statics_stale = False
         self._time_version = -1
+        self._step = -1
+        self._scans: dict[str, tuple[int, int, float | None, np.ndarray]] = {}
         self._robots: dict[str, RemoteRobot] = {}
         self._thing_views: dict[str, RemoteThing] = {}
         self._meshes: dict[str, tuple[np.ndarray, np.ndarray] | None] = {}
@@ -221,14 +226,16 @@ class RemoteWorld:
 
     def _on_state(self, sample: zenoh.Sample) -> None:
         try:
-            state = wire.parse_state(wire.decode(sample.payload.to_bytes()).header)
+            frame = wire.decode(sample.payload.to_bytes())
+            state = wire.parse_state(frame.header)
+            scans = _scans(frame)
         except BadPayload as exc:
             self.rejected[exc.reason] += 1
             return
-        self._take(state)
+        self._take(state, scans)
 
-    def _take(self, state: WorldState) -> None:
-        """Keep what is newer in ``state`` than what this client has."""
+    def _take(self, state: WorldState, scans: Mapping[str, tuple[int, float | None, np.ndarray]] | None = None) -> None:
+        """Keep what is newer in ``state`` (and its lidar scans) than what this client has."""
         with self._lock:
             if state.server != self._server:
                 if self._server != -1 and self._info.get("server") != state.server:
@@ -237,12 +244,25 @@ class RemoteWorld:
                 self._robot_states.clear()
                 self._things_version = -1
                 self._time_version = -1
+                self._step = -1
+                self._scans.clear()
+            if scans is not None and state.step >= self._step:  # (a full state: its scans are of its step)
+                for n, (rays, max_range, ranges) in scans.items():
+                    self._scans[n] = (state.step, rays, max_range, ranges)
+                self._step = state.step
             for n, r in state.robots.items():
                 held = self._robot_states.get(n)
                 if held is None or held[0] <= state.version:
                     self._robot_states[n] = (state.version, r)
             if state.objects is not None and state.version >= self._things_version:
-                self._things = state.objects
+                if state.static_names is not None:  # a full state
+                    self._statics = {n: s for n, s in state.objects.items() if n in state.static_names}
+                    self._epoch = state.epoch
+                    self._statics_stale = False
+                    self._things = dict(state.objects)
+                else:
+                    self._statics_stale = state.epoch != self._epoch
+                    self._things = {**self._statics, **state.objects}
                 self._things_version = state.version
             if state.version >= self._time_version:
                 self._time = state.time
@@ -316,7 +336,26 @@ class RemoteWorld:
             raise WorldError(f"the world server at {self._where()} has not told the state of robot '{robot}'")
         return held[1]
 
+    def _scan(self, robot: str, n_rays: int, max_range: float | None) -> np.ndarray | None:
+        """The streamed scan of ``robot`` of the last step heard, if it was cast with these settings."""
+        with self._lock:
+            held = self._scans.get(robot)
+            if held is None or held[0] != self._step or held[1] != n_rays or held[2] != max_range:
+                return None
+            return held[3].copy()
+
+    def _fresh_statics(self) -> None:
+        """Fetch a full state when the server's static objects changed (a rock added, a table removed)."""
+        if self._statics_stale:
+            frame = self._call(wire.call_key(self.prefix), "state", {}, what="the world's state")
+            try:
+                self._take(wire.parse_state(frame.header))
+            except BadPayload as exc:
+                self.rejected[exc.reason] += 1
+                raise WorldError(f"the world server at {self._where()} sent a malformed state: {exc}") from None
+
     def _thing_state(self, obj: str) -> ThingState:
+        self._fresh_statics()
         with self._lock:
             state = self._things.get(obj)
         if state is None:
@@ -349,6 +388,7 @@ class RemoteWorld:
     @property
     def objects(self) -> Mapping[str, RemoteThing]:
         """The objects by name, as the last state told them."""
+        self._fresh_statics()
         with self._lock:
             names = list(self._things)
         views = self._thing_views
@@ -395,7 +435,7 @@ class RemoteWorld:
         wait = self.step_timeout if timeout is None else timeout
         frame = self._call(wire.call_key(self.prefix), "tick", {}, what="the lock-step tick", timeout=wait)
         try:
-            self._take(wire.parse_state(frame.header))
+            self._take(wire.parse_state(frame.header), _scans(frame))
         except BadPayload as exc:
             self.rejected[exc.reason] += 1
             raise WorldError(f"the world server answered the tick with a malformed state: {exc}") from None
@@ -437,6 +477,26 @@ class RemoteWorld:
 
     def __repr__(self) -> str:
         return f"RemoteWorld({self.name!r} at {self._where()})"
+
+
+def _scans(frame: wire.Frame) -> dict[str, tuple[int, float | None, np.ndarray]]:
+    """The lidar scans a state frame carries: robot -> ``(rays, max_range, ranges)``.
+
+    Raises:
+        BadPayload: a scan that does not match its settings.
+    """
+    out: dict[str, tuple[int, float | None, np.ndarray]] = {}
+    for robot, settings in wire.mapping(frame.header.get("scans", {}), "scans", 1000).items():
+        wire.name(robot, "scan robot")
+        if not isinstance(settings, list) or len(settings) != 2:
+            raise BadPayload("type", "a scan's settings are [rays, max_range]")
+        rays = wire.integer(settings[0], "rays", 1, 100_000)
+        max_range = wire.optional_number(settings[1], "max_range", 0.0, 1e4)
+        ranges = wire.array(frame.arrays, f"scan/{robot}", "scan", ndim=1)
+        if len(ranges) != rays:
+            raise BadPayload("array", f"the scan of {robot!r} has {len(ranges)} rays, not {rays}")
+        out[robot] = (rays, max_range, ranges)
+    return out
 
 
 def _spec(entry: Any) -> RobotSpec:
@@ -575,7 +635,12 @@ class RemoteRobot:
         self.call("stop", "stop")
 
     def lidar(self, n_rays: int, max_range: float | None = None) -> np.ndarray:
-        """One lidar scan from the server."""
+        """One lidar scan: the one the server cast at the last step (its lidar streams at the world's rate once
+        asked), or, when there is none with these settings yet, one cast on request."""
+        max_range = None if max_range is None else float(max_range)
+        streamed = self._world._scan(self._name, int(n_rays), max_range)
+        if streamed is not None:
+            return streamed
         frame = self.call("lidar", "a lidar scan", {"n_rays": int(n_rays), "max_range": max_range})
         try:
             ranges = wire.array(frame.arrays, "ranges", "lidar", ndim=1)

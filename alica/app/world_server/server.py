@@ -56,6 +56,10 @@ logger = logging.getLogger(__name__)
 MAX_RAYS = 100_000
 MAX_PIXELS = 1280 * 960
 MAX_PATH = 100_000
+FAST_CALLS = frozenset({"drive", "stop", "set_bumped", "set_estimate"})
+"""Robot calls served at once on zenoh's thread (they only set commands, never touch pybullet)."""
+SENSOR_CALLS = frozenset({"lidar", "camera", "camera_pose"})
+"""Robot calls that only read the world: served without holding the lock, so fast calls do not wait for them."""
 
 
 @dataclass
@@ -134,6 +138,10 @@ class WorldServer:
         self._crashed_by_us: set[str] = set()
         self._ticks: dict[str, list[zenoh.Query]] = {}
         self._static: dict[str, dict[str, Any]] = {}
+        self._streams: dict[str, tuple[int, float | None]] = {}
+        self._static_names: frozenset[str] = frozenset()
+        self._epoch = 0
+        self._lock = threading.RLock()
         try:
             self._session = zenoh.open(zenoh_config(tuple(connect), tuple(listen), mode, lease, settings))
         except zenoh.ZError as exc:
@@ -152,9 +160,22 @@ class WorldServer:
 
     def _queue_for(self, robot: str) -> Callable[[zenoh.Query], None]:
         def put(query: zenoh.Query) -> None:
-            self._inbox.put((robot, query))
+            self._on_robot_query(robot, query)
 
         return put
+
+    def _on_robot_query(self, robot: str, query: zenoh.Query) -> None:
+        """(zenoh's thread) Serve a fast call at once, under the lock; queue the others for the world's thread."""
+        try:
+            frame = _decode(query)
+        except BadPayload as exc:
+            self._malformed(query, exc)
+            return
+        if frame.header.get("call") in FAST_CALLS:
+            with self._lock:
+                self._serve(robot, query, frame)
+        else:
+            self._inbox.put((robot, (query, frame)))
 
     # -- life ----------------------------------------------------------------------------------------------
 
@@ -206,11 +227,14 @@ class WorldServer:
 
     # -- stepping ------------------------------------------------------------------------------------------
 
-    def _step(self) -> None:
-        self.world.step(self.period)
-        self.stats.steps += 1
-        self._version += 1
-        self._publish()
+    def _step(self) -> bytes:
+        """Step the world, cast the lidar streams, publish; returns the frame published (for lock-step replies)."""
+        with self._lock:
+            self.world.step(self.period)
+            self.stats.steps += 1
+            self._version += 1
+            state = self._state_json(objects=True)
+        return self._publish(state)
 
     def _all_ticked(self) -> bool:
         waiting = {a for a, qs in self._ticks.items() if qs}
@@ -221,8 +245,7 @@ class WorldServer:
         return (self._alive & set(self.world.robots)) <= waiting
 
     def _step_lockstep(self) -> None:
-        self._step()
-        reply = wire.encode({"ok": True, **self._state_json(objects=True)})
+        reply = self._step()
         for agent in list(self._ticks):
             queries = self._ticks[agent]
             if queries:
@@ -230,8 +253,17 @@ class WorldServer:
                 q.reply(q.key_expr, reply)
                 q.drop()
 
-    def _publish(self) -> None:
-        self._publisher.put(wire.encode(self._state_json(objects=True)))
+    def _publish(self, state: dict[str, Any] | None = None) -> bytes:
+        if state is None:
+            with self._lock:
+                state = self._state_json(objects=True)
+        scans: dict[str, np.ndarray] = {}
+        for robot, (n, max_range) in self._streams.items():
+            scans[f"scan/{robot}"] = np.asarray(self.world.robots[robot].lidar(n, max_range), dtype=np.float64)
+        state["scans"] = {robot: [n, max_range] for robot, (n, max_range) in self._streams.items()}
+        frame = wire.encode({"ok": True, **state}, scans)
+        self._publisher.put(frame)
+        return frame
 
     # -- state ---------------------------------------------------------------------------------------------
 
@@ -276,17 +308,26 @@ class WorldServer:
             self._static[obj.name] = entry
         return entry
 
-    def _state_json(self, *, objects: bool, robots: Iterable[str] | None = None) -> dict[str, Any]:
+    def _state_json(self, *, objects: bool, robots: Iterable[str] | None = None, full: bool = False) -> dict[str, Any]:
+        """The state now: the ``robots`` (default all); with ``objects`` the movable objects (all with ``full``)."""
         world = self.world
         names = world.robots if robots is None else robots
         out: dict[str, Any] = {
             "server": self._id,
             "version": self._version,
+            "step": self.stats.steps,
             "t": world.now(),
             "robots": {n: self._robot_json(world.robots[n]) for n in names},
         }
         if objects:
-            out["objects"] = {n: self._thing_json(o) for n, o in world.objects.items()}
+            statics = frozenset(n for n, o in world.objects.items() if not o.movable)
+            if statics != self._static_names:
+                self._static_names = statics
+                self._epoch += 1
+            out["epoch"] = self._epoch
+            out["objects"] = {n: self._thing_json(o) for n, o in world.objects.items() if full or o.movable}
+            if full:
+                out["static_names"] = sorted(statics)
         return out
 
     # -- agents' liveliness ----------------------------------------------------------------------------------
@@ -301,6 +342,10 @@ class WorldServer:
         except BadPayload as exc:
             self.stats.rejected[exc.reason] += 1
             return
+        with self._lock:
+            self._agent_changed(agent, alive)
+
+    def _agent_changed(self, agent: str, alive: bool) -> None:
         robot = self.world.robots.get(agent)
         if alive:
             self._alive.add(agent)
@@ -313,6 +358,7 @@ class WorldServer:
                 logger.info("agent %s is back: its robot recovered", agent)
         else:
             self._alive.discard(agent)
+            self._streams.pop(agent, None)
             for q in self._ticks.pop(agent, []):
                 q.drop()
             if robot is not None and not robot.crashed:
@@ -328,12 +374,34 @@ class WorldServer:
         if kind == "alive":
             self._agent_seen(*item)
             return
-        query: zenoh.Query = item
+        if kind == "world":
+            try:
+                frame = _decode(item)
+            except BadPayload as exc:
+                self._malformed(item, exc)
+                return
+            self._serve(kind, item, frame)
+            return
+        query, frame = item
+        if frame.header.get("call") in SENSOR_CALLS:
+            self._serve(kind, query, frame)
+        else:
+            with self._lock:
+                self._serve(kind, query, frame)
+
+    def _malformed(self, query: zenoh.Query, exc: BadPayload) -> None:
+        with self._lock:
+            self.stats.rejected[exc.reason] += 1
+        logger.debug("refused a malformed call: %s", exc)
+        try:
+            query.reply(query.key_expr, wire.encode({"ok": False, "error": f"malformed call: {exc}"}))
+        finally:
+            query.drop()
+
+    def _serve(self, kind: str, query: zenoh.Query, frame: wire.Frame) -> None:
+        """Serve one decoded call: ``kind`` is ``world`` or the robot whose queryable it came to."""
         held = False
         try:
-            payload = query.payload
-            data = b"" if payload is None else payload.to_bytes()
-            frame = wire.decode(data)
             caller = wire.name(frame.header.get("caller"), "caller")
             call = wire.name(frame.header.get("call"), "call")
             args = wire.mapping(frame.header.get("args", {}), "args", 16)
@@ -347,15 +415,19 @@ class WorldServer:
                 header, arrays = self._world_call(call, args)
             else:
                 if caller != kind:
-                    self.stats.refused += 1
+                    with self._lock:
+                        self.stats.refused += 1
                     raise _Refused(f"robot '{kind}' answers only its own agent, not '{caller}'")
                 header, arrays = self._robot_call(self.world.robots[kind], call, args, frame.arrays)
-                self._version += 1
-                header["state"] = self._state_json(objects=False, robots=(kind,))
-            self.stats.calls += 1
+                with self._lock:
+                    self._version += 1
+                    header["state"] = self._state_json(objects=False, robots=(kind,))
+            with self._lock:
+                self.stats.calls += 1
             query.reply(query.key_expr, wire.encode({"ok": True, **header}, arrays))
         except BadPayload as exc:
-            self.stats.rejected[exc.reason] += 1
+            with self._lock:
+                self.stats.rejected[exc.reason] += 1
             logger.debug("refused a malformed call: %s", exc)
             query.reply(query.key_expr, wire.encode({"ok": False, "error": f"malformed call: {exc}"}))
         except _Refused as exc:
@@ -371,7 +443,8 @@ class WorldServer:
         if call == "info":
             return self._info()
         if call == "state":
-            return self._state_json(objects=True), {}
+            with self._lock:
+                return self._state_json(objects=True, full=True), {}
         if call == "blocker":
             x = wire.number(args.get("x"), "x")
             y = wire.number(args.get("y"), "y")
@@ -451,7 +524,9 @@ class WorldServer:
         if call == "lidar":
             n = wire.integer(args.get("n_rays"), "n_rays", 1, MAX_RAYS)
             max_range = wire.optional_number(args.get("max_range"), "max_range", 0.0, 1e4)
-            return {}, {"ranges": np.asarray(robot.lidar(n, max_range), dtype=np.float64)}
+            ranges = np.asarray(robot.lidar(n, max_range), dtype=np.float64)
+            self._streams[robot.name] = (n, max_range)  # (from now on cast at every step)
+            return {}, {"ranges": ranges}
         if call == "camera_pose":
             at = args.get("pose")
             position, rotation = robot.camera_pose(
@@ -531,3 +606,10 @@ class WorldServer:
         else:
             raise BadPayload("call", f"there is no arm call {call!r}")
         return {}, {}
+
+
+def _decode(query: zenoh.Query) -> wire.Frame:
+    payload = query.payload
+    if payload is not None and len(payload) > wire.MAX_FRAME:
+        raise BadPayload("size", f"a frame of {len(payload)} bytes is over the limit of {wire.MAX_FRAME}")
+    return wire.decode(b"" if payload is None else payload.to_bytes())

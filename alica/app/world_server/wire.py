@@ -8,8 +8,8 @@ camera pictures and arm paths travel as arrays. No pickle: decoding a frame
 builds only dicts, lists, strings, numbers and numpy arrays of a listed dtype.
 
 Every frame received is checked before use (:func:`decode`): its size
-(:data:`MAX_FRAME`, :data:`MAX_HEADER`), the JSON (no ``NaN`` or ``Infinity``,
-bounded nesting), the arrays' dtypes and shapes against the bytes present.
+(:data:`MAX_FRAME`, :data:`MAX_HEADER`), the JSON (no ``NaN`` or ``Infinity``;
+nesting deeper than the interpreter's recursion limit is refused), the arrays' dtypes and shapes against the bytes present.
 The values are then checked by the one who reads them, with the helpers here
 (:func:`number`, :func:`integer`, :func:`name`, ...), each raising
 :class:`BadPayload` with a reason a log can count.
@@ -52,7 +52,7 @@ MAX_FRAME = 32 * 1024 * 1024
 """Largest frame accepted, bytes (a 1280x960 picture with float64 depth fits)."""
 MAX_HEADER = 1024 * 1024
 """Largest JSON header accepted, bytes."""
-MAX_ARRAYS = 8
+MAX_ARRAYS = 256
 """Most arrays in one frame."""
 MAX_NAME = 64
 """Longest robot, agent or object name."""
@@ -61,7 +61,6 @@ MAX_BOUND = 1e6
 _DTYPES = {"f8": "<f8", "f4": "<f4", "u1": "|u1", "i4": "<i4"}
 _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_\-.]*$")
 _LEN = struct.Struct("<I")
-_MAX_DEPTH = 16
 
 
 class BadPayload(ValueError):
@@ -135,16 +134,6 @@ def _no_constant(token: str) -> float:
     raise BadPayload("number", f"{token} is not a number a frame may carry")
 
 
-def _depth(value: Any, level: int = 0) -> int:
-    if level > _MAX_DEPTH:
-        return level
-    if isinstance(value, dict):
-        return max((_depth(v, level + 1) for v in value.values()), default=level)
-    if isinstance(value, list):
-        return max((_depth(v, level + 1) for v in value), default=level)
-    return level
-
-
 def decode(data: bytes) -> Frame:
     """Check and decode a frame.
 
@@ -167,8 +156,6 @@ def decode(data: bytes) -> Frame:
         raise BadPayload("json", f"the header is not JSON: {str(exc)[:80]}") from None
     if not isinstance(header, dict):
         raise BadPayload("json", "the header is not a JSON object")
-    if _depth(header) > _MAX_DEPTH:
-        raise BadPayload("json", f"the header nests deeper than {_MAX_DEPTH}")
     arrays: dict[str, np.ndarray] = {}
     listed = header.pop("arrays", [])
     if not isinstance(listed, list) or len(listed) > MAX_ARRAYS:
@@ -178,7 +165,7 @@ def decode(data: bytes) -> Frame:
         if not (isinstance(item, list) and len(item) == 3):
             raise BadPayload("array", "each array is [name, dtype, shape]")
         key, code, shape = item
-        if not isinstance(key, str) or len(key) > MAX_NAME or key in arrays:
+        if not isinstance(key, str) or len(key) > 2 * MAX_NAME or key in arrays:
             raise BadPayload("array", "an array name must be a unique short string")
         if code not in _DTYPES:
             raise BadPayload("array", f"array {key!r}: dtype {code!r} is not one of {sorted(_DTYPES)}")
@@ -353,13 +340,21 @@ class ThingState:
 
 @dataclass(frozen=True, slots=True)
 class WorldState:
-    """The world after a step: time, robots and objects, and the order of states (``server``, ``version``)."""
+    """The world after a step: time, robots and objects, and the order of states (``server``, ``version``).
+
+    A full state (``static_names`` given) has every object; a published one only the movable objects:
+    the static ones (rocks, tables, markers) stay as the last full state gave them while ``epoch``, the
+    number of the set of static objects, stays the same.
+    """
 
     server: int
     version: int
+    step: int
     time: float
     robots: dict[str, RobotState]
     objects: dict[str, ThingState] | None
+    epoch: int = 0
+    static_names: frozenset[str] | None = None
 
 
 def robot_state_json(
@@ -443,9 +438,15 @@ def parse_state(header: Mapping[str, Any]) -> WorldState:
     """
     robots = mapping(header.get("robots", {}), "robots", 1000)
     objects = header.get("objects")
+    statics = header.get("static_names")
+    if statics is not None and not (isinstance(statics, list) and len(statics) <= 100_000):
+        raise BadPayload("type", "static_names must be a list of names")
     return WorldState(
+        epoch=integer(header.get("epoch", 0), "epoch", 0, 2**63),
+        static_names=None if statics is None else frozenset(name(n, "static name") for n in statics),
         server=integer(header.get("server"), "server", 0, 2**63),
         version=integer(header.get("version"), "version", 0, 2**63),
+        step=integer(header.get("step"), "step", 0, 2**63),
         time=number(header.get("t"), "time", 0.0, 1e12),
         robots={name(k, "robot name"): parse_robot(v, f"robot {k!r}") for k, v in robots.items()},
         objects=None
