@@ -42,6 +42,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import signal
 import sys
 import threading
@@ -132,6 +133,21 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         metavar="LITERALS@T",
         help="the operator sets facts in this agent's world model T seconds after the start (repeatable)",
     )
+    p.add_argument(
+        "--object",
+        action="append",
+        default=[],
+        metavar="NAME:TYPE",
+        help="the mission's data: an object this agent knows from the start, e.g. g:location (repeatable)",
+    )
+    p.add_argument(
+        "--value",
+        action="append",
+        default=[],
+        metavar="FUNCTION(ARGS)=VALUE",
+        help="the mission's data: a value this agent knows from the start, VALUE read as YAML, e.g. "
+        "'pos(g)=[0, 0]' (repeatable)",
+    )
     add_time_limit(
         p,
         None,
@@ -164,6 +180,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     add_skills_option(p)
     add_robot_options(p)
+    p.add_argument(
+        "--world",
+        metavar="ENDPOINT",
+        help="drive this agent's robot in a world served by alica world serve at this zenoh endpoint, e.g. "
+        "tcp/127.0.0.1:7448; the agent then runs on the world's simulated time (in lock-step with the other "
+        "agents when the server was started with --lockstep)",
+    )
     add_engine_options(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace (in an existing folder)")
     p.add_argument(
@@ -233,9 +256,16 @@ def cmd_agent(args: argparse.Namespace) -> int:
         agents[args.name] = args.role
     roles = agent_roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
+    args.knowledge = mission_knowledge(args.object, args.value)
     plugin = robot_plugin(args, agents)
+    if plugin is not None and args.world is not None:
+        raise AlicaError("--robot and --world both give the agent its robot: choose one")
     wiring = skill_wiring(
-        registry, plan_skills(library, plan), world=plugin is not None, stand_ins=args.stand_ins, plan=plan
+        registry,
+        plan_skills(library, plan),
+        world=plugin is not None or args.world is not None,
+        stand_ins=args.stand_ins,
+        plan=plan,
     )
     members = agents if args.agents else None
     endpoints = [*args.connect, *args.listen]
@@ -243,6 +273,8 @@ def cmd_agent(args: argparse.Namespace) -> int:
         **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints, args.key_prefix),
         **_zenoh_settings(args.zenoh),
     }
+    if args.world is not None:
+        return _run_in_served_world(args, library, plan, roles, wiring, facts, settings)
     if plugin is None:
         return _run(args, library, plan, roles, wiring, facts, settings)
     mine = roles[args.name]
@@ -251,6 +283,29 @@ def cmd_agent(args: argparse.Namespace) -> int:
         return _run(args, library, plan, roles, wiring, facts, settings, world)
     finally:
         close_world(world)
+
+
+def _run_in_served_world(
+    args: argparse.Namespace,
+    library: PlanLibrary,
+    plan: str,
+    roles: dict[str, str | AgentSpec],
+    wiring: SkillWiring,
+    facts: list[tuple[str, float, float | None]],
+    settings: dict[str, object],
+) -> int:
+    """``alica agent --world EP``: the agent's robot is a remote one of a world server; the agent runs on its time."""
+    from alica.app.world_server import RemoteWorld
+    from alica.worldsim.errors import WorldError
+
+    try:
+        world = RemoteWorld([args.world], args.name, prefix=args.key_prefix, settings=settings or None)
+    except (WorldError, ValueError) as exc:
+        raise AlicaError(f"alica agent {args.name} --world {args.world}: {exc}") from None
+    try:
+        return _run(args, library, plan, roles, wiring, facts, settings, world)
+    finally:
+        world.close()
 
 
 def _run(
@@ -266,7 +321,7 @@ def _run(
     from alica.allocation import AgentSpec, assign_roles
     from alica.app.robot_plugin import is_simulated, wall_seconds
     from alica.app.trace_sources import plan_path_names
-    from alica.clock import SystemClock
+    from alica.clock import Clock, SystemClock
     from alica.comm.zenoh_transport import ZenohTransport
     from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset, trace_header
     from alica.engine.realtime import RealTimeLoop
@@ -276,8 +331,13 @@ def _run(
     from alica.testing import default_fallback
     from alica.worldmodel import WorldModel
 
-    clock = SystemClock()
-    start = args.start_at if args.start_at is not None else clock.now()
+    # a served world's robot lives in the server's simulated time: the agent runs on it (from its time 0)
+    served: Any = robot_world if callable(getattr(robot_world, "tick_done", None)) else None
+    clock: Clock = served.clock if served is not None else SystemClock()
+    if served is not None:
+        start = 0.0
+    else:
+        start = args.start_at if args.start_at is not None else clock.now()
     specs = {n: r if isinstance(r, AgentSpec) else AgentSpec(role=r) for n, r in sorted(roles.items())}
     roleset = pick_roleset(library, (s.role for s in specs.values()), args.roleset)
     roster = assign_roles(specs, roleset)
@@ -369,10 +429,20 @@ def _run(
                 for command in feed.commands():
                     apply_command(engine, command)
 
+        objects, values = args.knowledge
+        for obj, type_name in objects:
+            engine.world_model.add_object(obj, type_name)
+        for function, function_args, value in values:
+            engine.world_model.set(function, *function_args, value=value)
         world = _WorldTrace()
         engine.world_model.on_change(world.touch)
 
+        lockstep = served is not None and bool(served.lockstep)
+        world_down = [False]
+
         def report(now: float) -> None:
+            if lockstep:
+                _lockstep_tick(served, args.name, world_down, stop)
             if stepped is not None:
                 stepped(wall_seconds(last_step))  # a simulated robot moves on as the wall clock did
             if trace is not None and world.changed and now - world.at >= WORLD_TRACE_GAP:
@@ -390,7 +460,8 @@ def _run(
 
         if args.json:
             _line({"event": "started", "agent": args.name, "t": round(clock.now() - start, 3)})
-        loop = RealTimeLoop(engine, stop)
+        # in lock-step the server's step is the wait: no sleeping between ticks
+        loop = RealTimeLoop(engine, stop, sleep=_no_sleep) if lockstep else RealTimeLoop(engine, stop)
         began, began_cpu = time.monotonic(), sum(os.times()[:2])
         why = loop.run(
             until_done=args.until_done,
@@ -438,6 +509,67 @@ def _run(
     if transport.name_taken is not None:
         return 2
     return 0 if summary["status"] == "success" else 1
+
+
+_CALL = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*\(([^()]*)\)\s*=(.*)$", re.DOTALL)
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_\-]*$")
+
+
+def mission_knowledge(
+    objects: list[str], values: list[str]
+) -> tuple[list[tuple[str, str]], list[tuple[str, tuple[str, ...], object]]]:
+    """``--object NAME:TYPE`` and ``--value FUNCTION(ARGS)=VALUE`` as ``(objects, values)``.
+
+    Raises:
+        AlicaError: an item of the wrong form (the message shows the right one).
+    """
+    import yaml  # lazy: every alica command builds this parser
+
+    known: list[tuple[str, str]] = []
+    for item in objects:
+        name, sep, type_name = item.partition(":")
+        if not sep or not _NAME.match(name.strip()) or not _NAME.match(type_name.strip()):
+            raise AlicaError(f"--object: '{item}' is not NAME:TYPE, e.g. g:location")
+        known.append((name.strip(), type_name.strip()))
+    set_values: list[tuple[str, tuple[str, ...], object]] = []
+    for item in values:
+        match = _CALL.match(item)
+        names = [a.strip() for a in match.group(2).split(",")] if match and match.group(2).strip() else []
+        if match is None or not all(_NAME.match(a) for a in names):
+            raise AlicaError(f"--value: '{item}' is not FUNCTION(ARGS)=VALUE, e.g. 'pos(g)=[0, 0]'")
+        try:
+            value = yaml.safe_load(match.group(3))
+        except yaml.YAMLError:
+            raise AlicaError(f"--value: '{item}': '{match.group(3).strip()}' is not a YAML value") from None
+        if value is None or isinstance(value, dict):
+            raise AlicaError(f"--value: '{item}' gives no value; write a number, a name or a list, e.g. [0, 0]")
+        set_values.append((match.group(1), tuple(names), tuple(value) if isinstance(value, list) else value))
+    return known, set_values
+
+
+def _no_sleep(_seconds: float) -> None:
+    """The lock-step loop's wait: none (the world server's step paced the tick)."""
+
+
+def _lockstep_tick(world: Any, name: str, down: list[bool], stop: threading.Event) -> None:
+    """Tell the lock-step world server this tick is done and wait for its step.
+
+    A server that does not answer is reported once (``down``); the agent then ticks on at most once a
+    second, asking again each time, until the server steps again (or the agent is stopped).
+    """
+    from alica.worldsim.errors import WorldError
+
+    try:
+        world.tick_done(timeout=1.0 if down[0] else None)
+    except WorldError as exc:
+        if not down[0]:
+            print(f"alica agent {name}: {exc}; waiting for the world server", file=sys.stderr)
+        down[0] = True
+        stop.wait(0.2)
+    else:
+        if down[0]:
+            print(f"alica agent {name}: the world server steps again", file=sys.stderr)
+        down[0] = False
 
 
 def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:

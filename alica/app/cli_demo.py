@@ -129,6 +129,12 @@ def _add_lunar(demos: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     lunar.add_argument(
         "--no-progress", action="store_true", help="no progress line (none when standard error is not a terminal)"
     )
+    lunar.add_argument(
+        "--processes",
+        action="store_true",
+        help="one alica agent process per robot over zenoh, driving its robot in a world server this process runs "
+        "(lock-step: the same seed, the same outcome); --crash is then a kill -9 of the robot's agent",
+    )
     lunar.set_defaults(run=cmd_lunar)
 
 
@@ -195,17 +201,25 @@ def cmd_lunar(args: argparse.Namespace) -> int:
     from alica.app.demos.lunar import run_lunar, summary_lines
 
     config = lunar_config(args)
+    if args.processes and (args.gui or args.center):
+        raise AlicaError(
+            "--processes runs the world in a server without a window or a live page: leave out --gui and --center"
+        )
     session = live_session(args)
     progress = LunarProgress(sys.stderr) if sys.stderr.isatty() and not args.no_progress else None
+    out = Path(args.out) if args.out else None
     try:
-        result = run_lunar(
-            config, on_second=progress, out=Path(args.out) if args.out else None, gui=args.gui, live=session
-        )
+        if args.processes:
+            from alica.app.demos.lunar_processes import run_lunar_processes
+
+            result = run_lunar_processes(config, on_second=progress, out=out)
+        else:
+            result = run_lunar(config, on_second=progress, out=out, gui=args.gui, live=session)
     finally:
         if progress is not None:
             progress.close()
     if args.json:
-        print(json.dumps(result.as_json()))
+        print(json.dumps({**result.as_json(), **({"processes": True} if args.processes else {})}))
     else:
         print("\n".join(summary_lines(result)))
     if session is not None:

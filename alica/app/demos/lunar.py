@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     from alica.engine.agent import Observer
     from alica.prophet.tasks import CreatedTasks
     from alica.skills.mapping import LogOddsGrid
+    from alica.worldmodel.protocol import WorldModelLike
     from alica.worldsim.robots import Robot
     from alica.worldsim.world import World
 
@@ -244,9 +245,12 @@ class Operator:
 
     def read(self, team: SimulatedTeam) -> bool:
         """Update the found samples from the running agents' world models; whether ``explored`` holds."""
+        return self.read_models(engine.world_model for engine in team.running())
+
+    def read_models(self, models: Iterable[WorldModelLike]) -> bool:
+        """Update the found samples from these world models (the team's replicas); whether ``explored`` holds."""
         explored = False
-        for engine in team.running():
-            wm = engine.world_model
+        for wm in models:
             explored = explored or wm.holds("explored")
             for fact in wm.facts():
                 if fact.predicate != "found" or len(fact.args) != 1:
@@ -548,11 +552,15 @@ class _Run:
         if on_second is not None:
             on_second(self.progress(world.now(), counter))
 
+    def read(self) -> bool:
+        """The operator reads the team's world models; whether ``explored`` holds."""
+        return self.operator.read(self.team)
+
     def _operate(self, now: float) -> bool:
         """The operator's second: read, and choose once; True when the run cannot go on."""
         operator = self.operator
         known = len(operator.order)
-        explored = operator.read(self.team)
+        explored = self.read()
         if self.trace is not None:
             for name in operator.order[known:]:
                 x, y = operator.places.get(name, (math.nan, math.nan))
@@ -576,13 +584,16 @@ class _Run:
             return True
         operator.chosen = choice
         self.targets = self._world_samples(choice)
-        goal = operator.goal()
-        for engine in self.team.engines.values():
-            engine.set_problem(PROBLEM, goal=goal)
+        self.command(operator.goal(), now)
+        return False
+
+    def command(self, goal: str, now: float) -> None:
+        """Tell the team the goal of GetObjects and that the operator has chosen."""
         from alica.lang import literals
 
+        for engine in self.team.engines.values():
+            engine.set_problem(PROBLEM, goal=goal)
         self.team.set_facts(literals("chosen"), at=now)
-        return False
 
     def _world_samples(self, chosen: Sequence[str]) -> dict[str, str]:
         """Each chosen sample's simulated body: the world's sample nearest to where it was found (scoring only)."""
