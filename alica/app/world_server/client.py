@@ -246,6 +246,7 @@ class RemoteWorld:
                 self._time_version = -1
                 self._step = -1
                 self._scans.clear()
+                self._statics, self._epoch = {}, -1
             if scans is not None and state.step >= self._step:  # (a full state: its scans are of its step)
                 for n, (rays, max_range, ranges) in scans.items():
                     self._scans[n] = (state.step, rays, max_range, ranges)
