@@ -219,7 +219,7 @@ def cmd_lunar(args: argparse.Namespace) -> int:
         if progress is not None:
             progress.close()
     if args.json:
-        print(json.dumps({**result.as_json(), **({"processes": True} if args.processes else {})}))
+        print(json.dumps(result.as_json()))
     else:
         print("\n".join(summary_lines(result)))
     if session is not None:

@@ -140,6 +140,8 @@ class LunarResult:
     plan_yaml: str = ""
     crashed: list[str] = field(default_factory=list)
     replicas: dict[str, Any] = field(default_factory=dict)
+    world_server: dict[str, Any] | None = None
+    """With one process per robot: what the world server did (steps, calls, its CPU share); else ``None``."""
 
     def as_json(self) -> dict[str, Any]:
         """The summary as plain data.
@@ -165,6 +167,7 @@ class LunarResult:
             "robots": self.robots,
             "crashed": self.crashed,
             "replicas": self.replicas,
+            **({"processes": True, "world_server": self.world_server} if self.world_server is not None else {}),
         }
 
 

@@ -312,14 +312,14 @@ def run_lunar_processes(
             team = ProcessTeam(str(MISSION), roster, names, options, Path(tmp), own=own)
             base = (gx, gy)
             run = _ProcessRun(config, team, world, base, listener, counter, on_second)
-            wall = time.perf_counter()
+            wall, cpu = time.perf_counter(), time.process_time()
             team.launch()
             try:
                 server.serve(until=run.step)
             finally:
                 server.stop()
                 team.stop()  # SIGTERM: each agent prints its summary (one waiting for a step ends too)
-            wall = time.perf_counter() - wall
+            wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
             summary = team.summary(PLAN, config.seed)
             if out is not None:
                 header = trace_header(
@@ -368,6 +368,14 @@ def run_lunar_processes(
             },
             crashed=sorted(run.crashed),
             replicas=_replicas(summary, run.crashed),
+            world_server={
+                "steps": server.stats.steps,
+                "calls": server.stats.calls,
+                "refused": server.stats.refused,
+                "rejected": sum(server.stats.rejected.values()),
+                # this process: the world, its server and the operator (its zenoh threads too), of one core
+                "cpu_percent": round(100.0 * cpu / max(wall, 1e-9), 2),
+            },
         )
     finally:
         if listener is not None:
