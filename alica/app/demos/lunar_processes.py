@@ -25,9 +25,11 @@ coverage, distances) reads the simulated world, as the in-process demo's does.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import queue
 import tempfile
+import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -308,8 +310,13 @@ def run_lunar_processes(
         ]
         own = {n: ["--fact", f"handempty({n})@0"] for n in names if world.robots[n].arm is not None}
         roster = ",".join(f"{n}:{ROLES[n]}" for n in names)
-        with tempfile.TemporaryDirectory(prefix="alica-lunar-") as tmp:
-            team = ProcessTeam(str(MISSION), roster, names, options, Path(tmp), own=own)
+        with contextlib.ExitStack() as stack:
+            if out is not None:  # each agent's trace and log stay beside the merged trace
+                workdir = out / "agents"
+                workdir.mkdir(parents=True, exist_ok=True)
+            else:
+                workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="alica-lunar-")))
+            team = ProcessTeam(str(MISSION), roster, names, options, workdir, own=own)
             base = (gx, gy)
             run = _ProcessRun(config, team, world, base, listener, counter, on_second)
             wall, cpu = time.perf_counter(), time.process_time()
@@ -317,8 +324,7 @@ def run_lunar_processes(
             try:
                 server.serve(until=run.step)
             finally:
-                server.stop()
-                team.stop()  # SIGTERM: each agent prints its summary (one waiting for a step ends too)
+                _stop_serving(team, server)
             wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
             summary = team.summary(PLAN, config.seed)
             if out is not None:
@@ -383,6 +389,17 @@ def run_lunar_processes(
         if server is not None:
             server.close()
         world.close()
+
+
+def _stop_serving(team: ProcessTeam, server: WorldServer) -> None:
+    """Stop the agents while the server still steps: a lock-step agent then finishes its tick and its summary."""
+    from alica.app.processes import STOP_GRACE
+
+    stopper = threading.Thread(target=team.stop, name="stop-agents", daemon=True)  # SIGTERM, wait, collect
+    stopper.start()
+    server.serve(duration=STOP_GRACE + 5.0, until=lambda: not stopper.is_alive())
+    stopper.join()
+    server.stop()
 
 
 def _replicas(summary: dict[str, Any], crashed: set[str]) -> dict[str, Any]:
