@@ -30,6 +30,7 @@ SWITCH_INTERVAL = 0.0005
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add the ``world`` subcommand (with ``world serve``) to the ``alica`` parser."""
     from alica.app.options import add_field_options
+    from alica.app.team_keys import add_team_keys_option
 
     world = sub.add_parser(
         "world",
@@ -82,11 +83,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--frequency", type=float, default=30.0, metavar="HZ", help="world steps per simulated second (default 30)"
     )
     p.add_argument("--duration", type=float, metavar="S", help="stop after S wall seconds (default: run until stopped)")
-    p.add_argument(
-        "--insecure",
-        action="store_true",
-        help="allow endpoints beyond loopback: anyone who reaches them can read the world and drive robots",
-    )
+    add_team_keys_option(p)
     p.add_argument("--json", action="store_true", help="print the start and end lines as JSON")
     p.set_defaults(run=cmd_world_serve)
 
@@ -95,8 +92,9 @@ def cmd_world_serve(args: argparse.Namespace) -> int:
     """Run ``alica world serve``."""
     from alica.app.options import parse_roster
     from alica.app.run_skills import run_world
+    from alica.app.team_keys import team_settings
     from alica.app.world_server import WorldServer
-    from alica.comm.zenoh_transport import off_loopback
+    from alica.app.world_server.access import WORLD, world_settings
     from alica.errors import AlicaError
 
     who = "alica world serve"
@@ -105,13 +103,10 @@ def cmd_world_serve(args: argparse.Namespace) -> int:
             agents = list(parse_roster(args.agents))
         else:
             agents = ["r1", "r2"] if args.world == "blocks" else []
-        listen = list(args.listen) or ([] if args.connect else [DEFAULT_ENDPOINT])
-        beyond = off_loopback([*listen, *args.connect])
-        if beyond and not args.insecure:
-            raise AlicaError(
-                f"{who}: {', '.join(beyond)} reaches beyond this machine, and the world server has no credentials: "
-                "anyone who reaches it can drive the robots; say --insecure"
-            )
+        default = DEFAULT_ENDPOINT.replace("tcp/", "tls/") if args.team_keys else DEFAULT_ENDPOINT
+        listen = list(args.listen) or ([] if args.connect else [default])
+        team_settings(args, who, WORLD, agents, [*listen, *args.connect], args.key_prefix)  # (checks, sets args.keys)
+        settings = {} if args.keys is None else world_settings(args.keys, args.key_prefix)
         if not (args.speed > 0 and args.frequency > 0):
             raise AlicaError(f"{who}: --speed and --frequency must be > 0")
         if args.duration is not None and not args.duration > 0:
@@ -129,12 +124,13 @@ def cmd_world_serve(args: argparse.Namespace) -> int:
                 frequency=args.frequency,
                 agents=agents,
                 mode=args.mode,
+                settings=settings,
             )
             try:
                 return _serve(args, server, [*listen, *args.connect])
             finally:
                 server.close()
-    except (AlicaError, ValueError) as exc:
+    except (AlicaError, ValueError) as exc:  # (CredentialsError is an AlicaError)
         print(f"{who}: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
 

@@ -18,6 +18,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable, Iterator
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -198,6 +199,39 @@ def test_wire_refuses_what_it_cannot_check() -> None:
         wire.number(math.inf, "v")
     with pytest.raises(wire.BadPayload, match="must be a number"):
         wire.number(True, "v")
+
+
+def test_with_team_credentials_an_agent_cannot_even_ask_another_robot(tmp_path: Path) -> None:
+    from alica.app.world_server.access import WORLD, world_settings
+    from alica.comm.credentials import TeamKeys, make_keys, tls_endpoint
+
+    folder = tmp_path / "keys"
+    make_keys(folder, ["scout", "stummel", WORLD])
+    endpoint = tls_endpoint(free_endpoints(1)[0])
+    prefix = f"t{uuid.uuid4().hex[:8]}"
+    world = _lunar()
+    server = WorldServer(
+        world, listen=[endpoint], prefix=prefix, settings=world_settings(TeamKeys.load(folder, WORLD), prefix)
+    )
+    thread = threading.Thread(target=server.serve, daemon=True)
+    thread.start()
+    try:
+        own = world_settings(TeamKeys.load(folder, "scout"), prefix)
+        with RemoteWorld([endpoint], "scout", prefix=prefix, settings=own, wait=10.0) as scout:
+            robot = scout.robots["scout"]
+            robot.drive(0.2, 0.0)
+            assert robot.lidar(8).shape == (8,)
+            with pytest.raises(WorldError, match="nobody took drive of robot 'stummel'"):
+                scout.robots["stummel"].drive(1.0, 0.0)
+        with RemoteWorld([endpoint], "stummel", prefix=prefix, settings=own, wait=5.0) as liar:
+            with pytest.raises(WorldError, match="nobody took"):  # scout's keys, stummel's name
+                liar.robots["stummel"].drive(1.0, 0.0)
+        assert server.stats.refused == 0  # (refused by zenoh on arrival, before the server's own check)
+    finally:
+        server.stop()
+        thread.join(5.0)
+        server.close()
+        world.close()
 
 
 _AGENT = """

@@ -295,12 +295,18 @@ class RemoteWorld:
             )
         wait = self.timeout if timeout is None else timeout
         payload = wire.encode({"caller": self.name, "call": call, "args": dict(args)}, arrays)
+        start = time.monotonic()
         try:
             replies = self._session.get(key, payload=payload, timeout=wait)
             reply = next(iter(replies), None)
         except zenoh.ZError as exc:
             raise WorldError(f"the world server at {self._where()} cannot be asked for {what}: {exc}") from None
         if reply is None or reply.ok is None:
+            if time.monotonic() - start < 0.5 * wait:
+                raise WorldError(
+                    f"the world server at {self._where()} does not answer: nobody took {what} (the server is not "
+                    "reachable, or, with team credentials, the robot is not this agent's)"
+                )
             raise WorldError(
                 f"the world server at {self._where()} does not answer: {what} got no reply within {wait:g} s"
             )

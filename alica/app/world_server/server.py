@@ -434,6 +434,10 @@ class WorldServer:
             query.reply(query.key_expr, wire.encode({"ok": False, "error": str(exc)}))
         except (ValueError, TypeError, RuntimeError) as exc:  # WorldError is a ValueError
             query.reply(query.key_expr, wire.encode({"ok": False, "error": str(exc)[:2000]}))
+        except Exception as exc:  # (pybullet's own errors, a bug: answered and logged, never the server's end)
+            logger.exception("call %r on %s failed", frame.header.get("call"), kind)
+            reason = f"the world server failed to serve the call: {type(exc).__name__}: {exc}"
+            query.reply(query.key_expr, wire.encode({"ok": False, "error": reason[:2000]}))
         finally:
             if not held:
                 query.drop()
