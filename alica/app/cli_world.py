@@ -131,7 +131,7 @@ def cmd_world_serve(args: argparse.Namespace) -> int:
             finally:
                 server.close()
     except (AlicaError, ValueError) as exc:  # (CredentialsError is an AlicaError)
-        print(f"{who}: error: {exc}", file=sys.stderr)
+        print(f"{who}: error: {str(exc).removeprefix(f'{who}: ')}", file=sys.stderr)
         return EXIT_USAGE
 
 

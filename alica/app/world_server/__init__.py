@@ -29,6 +29,9 @@ The client's public API::
 * ``world.clock`` (``now()``), ``world.lockstep``, ``world.period``,
   ``world.tick_done(timeout=None) -> float`` (the new simulated time), ``world.close()``;
   usable as a context manager.
+* With the team's credentials, pass ``settings=world_settings(TeamKeys.load(DIR, NAME), prefix)``
+  (:func:`alica.app.world_server.access.world_settings`) and ``tls/`` endpoints; the server runs
+  as the member ``world`` (``alica world serve --team-keys DIR``).
 * **Exceptions**: every call and read raises
   :class:`~alica.worldsim.errors.WorldError` with the reason: no server when
   opening ("no world server at ... answered within 5 s"), a server that is gone
@@ -40,7 +43,17 @@ The client's public API::
 
 from __future__ import annotations
 
+from alica.app.world_server.access import world_settings
 from alica.app.world_server.client import RemoteArm, RemoteClock, RemoteRobot, RemoteThing, RemoteWorld
 from alica.app.world_server.server import ServerStats, WorldServer
 
-__all__ = ["RemoteArm", "RemoteClock", "RemoteRobot", "RemoteThing", "RemoteWorld", "ServerStats", "WorldServer"]
+__all__ = [
+    "RemoteArm",
+    "RemoteClock",
+    "RemoteRobot",
+    "RemoteThing",
+    "RemoteWorld",
+    "ServerStats",
+    "WorldServer",
+    "world_settings",
+]
