@@ -28,7 +28,7 @@ from alica.app.world_server import RemoteWorld, WorldServer, wire
 from alica.comm.zenoh_transport import free_endpoints, zenoh_config
 from alica.worldsim.errors import WorldError
 from alica.worldsim.interface import RobotWorld
-from alica.worldsim.scenarios import lunar
+from alica.worldsim.scenarios import blocksworld, lunar
 from alica.worldsim.world import World
 
 
@@ -114,6 +114,37 @@ def test_the_arm_of_a_remote_robot_reads_its_own_writes() -> None:
         arm.open()
         scene = arm.planning_scene()  # the agent's own kinematic model
         assert np.allclose(scene.base_pose()[0], arm.base_pose()[0])
+
+
+def _run_skill(world: RemoteWorld, robot: str, name: str, params: dict[str, object], ticks: int) -> str:
+    """Run a shipped skill on the remote robot, one tick per lock-step; its status and reason."""
+    from alica.skills.testing import SkillSession, resolve_registry
+
+    session = SkillSession(name, world, robot, params, resolve_registry(None, (), "test"))  # type: ignore[arg-type]
+    for _ in range(ticks):
+        if session.tick():
+            break
+        world.tick_done(timeout=5.0)
+    result = session.result()
+    return f"{result.status}: {result.reason}"
+
+
+def test_shipped_skills_run_on_a_remote_robot_as_on_a_local_one() -> None:
+    with (
+        _served(_lunar(), lockstep=True, frequency=10.0) as (_server, endpoint, prefix),
+        RemoteWorld([endpoint], "scout", prefix=prefix) as world,
+    ):
+        assert _run_skill(world, "scout", "MoveToPosition", {"goal": [4.0, 3.0]}, 300).startswith("success")
+        x, y, _ = world.robots["scout"].pose
+        assert math.hypot(x - 4.0, y - 3.0) < 0.5
+    with (
+        _served(blocksworld([["a", "b"], ["c"]], agents=1), lockstep=True, frequency=10.0) as (_s, endpoint, prefix),
+        RemoteWorld([endpoint], "r1", prefix=prefix) as world,
+    ):
+        assert _run_skill(world, "r1", "Unstack", {"object": "b", "from": "a"}, 600).startswith("success")
+        assert ("holding", "r1", "b") in world.blocks_facts()
+        assert _run_skill(world, "r1", "Putdown", {"object": "b"}, 600).startswith("success")
+        assert {("ontable", "b"), ("handempty", "r1")} <= world.blocks_facts()
 
 
 def _lockstep_run(seed: int, steps: int) -> tuple[tuple[float, float, float], float, list[float]]:
