@@ -47,6 +47,7 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
@@ -134,6 +135,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="the operator sets facts in this agent's world model T seconds after the start (repeatable)",
     )
     p.add_argument(
+        "--goal",
+        action="append",
+        default=[],
+        metavar="PROBLEM=FORMULA",
+        help="the operator's goal of a planning problem from the start, e.g. 'GetObjects=at(a, g)' (repeatable)",
+    )
+    p.add_argument(
         "--object",
         action="append",
         default=[],
@@ -186,6 +194,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         help="drive this agent's robot in a world served by alica world serve at this zenoh endpoint, e.g. "
         "tcp/127.0.0.1:7448; the agent then runs on the world's simulated time (in lock-step with the other "
         "agents when the server was started with --lockstep)",
+    )
+    p.add_argument(
+        "--perception",
+        choices=("blocks",),
+        help="with --world or --robot: blocks writes the blocks-world facts (on, ontable, clear, holding, handempty) "
+        "and the blocks' places into this agent's world model every 0.2 s from the world's state; a stand-in for "
+        "an overhead camera, as in alica run --world blocks",
     )
     add_engine_options(p)
     p.add_argument("--trace", metavar="FILE", help="write this agent's JSON Lines trace (in an existing folder)")
@@ -257,6 +272,15 @@ def cmd_agent(args: argparse.Namespace) -> int:
     roles = agent_roles(library, agents, args.roleset, {args.name: "--role"} if args.role is not None else None)
     facts = [timed("--fact", text) for text in args.fact]
     args.knowledge = mission_knowledge(args.object, args.value)
+    args.goals = []
+    for item in args.goal:
+        problem, sep, goal = (part.strip() for part in item.partition("="))
+        if not sep or not problem or not goal:
+            raise AlicaError(f"--goal: '{item}' is not PROBLEM=FORMULA, e.g. 'GetObjects=at(a, g)'")
+        if problem not in library.problems:
+            known = ", ".join(sorted(library.problems)) or "none"
+            raise AlicaError(f"--goal: no planning problem named '{problem}' in {args.plan}; problems: {known}")
+        args.goals.append((problem, goal))
     plugin = robot_plugin(args, agents)
     if plugin is not None and args.world is not None:
         raise AlicaError("--robot and --world both give the agent its robot: choose one")
@@ -273,6 +297,8 @@ def cmd_agent(args: argparse.Namespace) -> int:
         **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints, args.key_prefix),
         **_zenoh_settings(args.zenoh),
     }
+    if args.perception is not None and plugin is None and args.world is None:
+        raise AlicaError(f"--perception {args.perception} reads the robot's world: give --world or --robot too")
     if args.world is not None:
         return _run_in_served_world(args, library, plan, roles, wiring, facts, settings)
     if plugin is None:
@@ -420,7 +446,11 @@ def _run(
         last_step = [time.monotonic()]
         status = ["running"]
 
+        perceive = _perception(args.perception, engine, robot_world)
+
         def operator(now: float) -> None:
+            if perceive is not None:
+                perceive()
             while pending and now >= start + pending[0][0]:
                 _, literals_now = pending.pop(0)
                 for positive, pred, fact_args in literals_now:
@@ -429,6 +459,8 @@ def _run(
                 for command in feed.commands():
                     apply_command(engine, command)
 
+        for problem, goal in args.goals:
+            engine.set_problem(problem, goal=goal)
         objects, values = args.knowledge
         for obj, type_name in objects:
             engine.world_model.add_object(obj, type_name)
@@ -545,6 +577,28 @@ def mission_knowledge(
             raise AlicaError(f"--value: '{item}' gives no value; write a number, a name or a list, e.g. [0, 0]")
         set_values.append((match.group(1), tuple(names), tuple(value) if isinstance(value, list) else value))
     return known, set_values
+
+
+def _perception(kind: str | None, engine: AgentEngine, world: RobotWorld | None) -> Callable[[], None] | None:
+    """``--perception``: a hook writing what the world shows into this agent's world model before each tick."""
+    if kind is None or world is None:
+        return None
+    from alica.worldsim.scenarios import blocks_perception
+
+    hook = blocks_perception()
+
+    class _Alone:  # the one agent of this process, as the perception hook reads a team
+        def __init__(self) -> None:
+            self.world = world
+
+        def now(self) -> float:
+            return engine.now()
+
+        def running(self) -> list[AgentEngine]:
+            return [engine]
+
+    alone: Any = _Alone()  # (typed for the simulator's World; it reads only the robot interface of it)
+    return lambda: hook(alone)
 
 
 def _no_sleep(_seconds: float) -> None:

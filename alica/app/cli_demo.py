@@ -74,6 +74,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         action="store_true",
         help="no progress bar (there is none when standard error is not a terminal)",
     )
+    b.add_argument(
+        "--processes",
+        action="store_true",
+        help="one alica agent process per team robot over zenoh, driving its robot in a world server this process "
+        "runs (lock-step: the same seed, the same outcome); --crash is then a kill -9 of the robot's agent, "
+        "--recover a restart; no opponents",
+    )
     b.set_defaults(run=cmd_blocksworld)
     _add_lunar(demos)
 
@@ -341,17 +348,20 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         time_limit=args.time_limit,
     )
     actions = fault_actions(args.crash, args.recover, args.robots)
+    if args.processes and (args.gui or args.center):
+        raise AlicaError(
+            "--processes runs the world in a server without a window or a live page: leave out --gui and --center"
+        )
     session = live_session(args)
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
+    out = Path(args.out) if args.out else None
     try:
-        result = run_demo(
-            config,
-            on_second=progress,
-            actions=actions,
-            out=Path(args.out) if args.out else None,
-            gui=args.gui,
-            live=session,
-        )
+        if args.processes:
+            from alica.app.demos.blocks_processes import run_demo_processes
+
+            result = run_demo_processes(config, on_second=progress, actions=actions, out=out)
+        else:
+            result = run_demo(config, on_second=progress, actions=actions, out=out, gui=args.gui, live=session)
     finally:
         if progress is not None:
             progress.close()

@@ -10,6 +10,7 @@ robot when the run has no world.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from typing import TYPE_CHECKING, Any
@@ -25,7 +26,7 @@ from alica.app.timed import timed as _timed
 from alica.errors import AlicaError
 
 if TYPE_CHECKING:
-    from collections.abc import Callable
+    from collections.abc import Callable, Iterator
 
     import uvicorn
 
@@ -387,22 +388,17 @@ def _run_processes(
     With ``--center`` (``session``), this process serves the team's live page
     (:mod:`alica.app.center.team_feed`) from before the agents start until SIGTERM after they ended.
     """
-    import tempfile
-    from pathlib import Path
-
-    from alica.app.processes import ProcessTeam
 
     unsupported = [
         option
         for option, used in (
-            ("--world", args.world is not None),
             ("--ticks", args.ticks is not None),
             ("--show-tree", args.show_tree),
             ("--loss", args.loss > 0),
             ("--delay", args.delay > 0),
             ("--jitter", args.jitter > 0),
             ("--trace-messages", args.trace_messages),
-            ("--speed", args.speed != 1.0),
+            ("--speed", args.speed != 1.0 and args.world is None),
         )
         if used
     ]
@@ -445,7 +441,35 @@ def _run_processes(
     options += engine_arguments(args)
     keys = _team_keys(args, names, session is not None)
     if keys is not None:
+        if args.world is not None:
+            raise AlicaError("--team-keys with --world: the world server does not take team credentials yet")
         options += ["--team-keys", args.team_keys]
+    with contextlib.ExitStack() as stack:
+        if args.world is not None:
+            endpoint = stack.enter_context(_served_world(args, names))
+            options += ["--world", endpoint]
+            if args.world == "blocks":
+                options += ["--perception", "blocks"]
+        return _launch_processes(args, plan, names, wiring, header, library, session, options, keys, faults)
+
+
+def _launch_processes(
+    args: argparse.Namespace,
+    plan: str,
+    names: list[str],
+    wiring: SkillWiring,
+    header: dict[str, Any] | None,
+    library: PlanLibrary | None,
+    session: LiveSession | None,
+    options: list[str],
+    keys: TeamKeys | None,
+    faults: list[Fault],
+) -> int:
+    import tempfile
+    from pathlib import Path
+
+    from alica.app.processes import ProcessTeam
+
     with tempfile.TemporaryDirectory(prefix="alica-run-") as tmp:
         team = ProcessTeam(
             args.plan,
@@ -477,7 +501,7 @@ def _run_processes(
         summary = team.summary(plan, args.seed)
         if args.trace:
             team.trace(Path(args.trace), header)
-    summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": None}
+    summary["skills"] = {"real": wiring.real, "stand_ins": wiring.stand_ins, "world": args.world}
     if args.robot:
         summary["skills"]["robot"] = args.robot
     for agent in summary["agents"].values():
@@ -514,6 +538,40 @@ class _TerminateAsInterrupt:
         if self._previous is not None:
             signal.signal(signal.SIGTERM, self._previous)
             self._previous = None
+
+
+@contextlib.contextmanager
+def _served_world(args: argparse.Namespace, names: list[str]) -> Iterator[str]:
+    """``alica run --processes --world``: the world in a server on loopback, serving from a thread; its endpoint.
+
+    Lock-step (the agents' ticks pace simulated time) unless ``--speed X`` asks for a free-running world.
+    """
+    import threading
+
+    from alica.app.run_skills import run_world
+    from alica.app.world_server import WorldServer
+    from alica.comm.zenoh_transport import free_endpoints
+
+    with run_world(args, sorted(names)) as (world, _perception):
+        assert world is not None
+        endpoint = free_endpoints(1)[0]
+        server = WorldServer(
+            world,
+            listen=[endpoint],
+            prefix="alica",
+            lockstep=args.speed == 1.0,
+            speed=args.speed,
+            frequency=args.frequency,
+            agents=names,
+        )
+        serving = threading.Thread(target=server.serve, name="world-server", daemon=True)
+        serving.start()
+        try:
+            yield endpoint
+        finally:
+            server.stop()
+            serving.join(timeout=5.0)
+            server.close()
 
 
 def _team_keys(args: argparse.Namespace, names: list[str], center: bool) -> TeamKeys | None:

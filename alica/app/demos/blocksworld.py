@@ -95,6 +95,10 @@ class DemoResult:
     crashed: list[str] = field(default_factory=list)
     steps: dict[str, int] = field(default_factory=dict)
     plans: int = 0
+    processes: bool = False
+    """Whether the team ran as one process per robot around a world server (``--processes``)."""
+    reason: str = ""
+    """With processes: why the run ended early, if it did (no agent left, one hangs)."""
 
     @property
     def steps_executed(self) -> int:
@@ -125,6 +129,7 @@ class DemoResult:
             "start": self.start,
             "goal": self.goal,
             "crashed": self.crashed,
+            **({"processes": True, "reason": self.reason} if self.processes else {}),
         }
 
 

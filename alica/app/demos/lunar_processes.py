@@ -29,7 +29,6 @@ import contextlib
 import math
 import queue
 import tempfile
-import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -49,6 +48,7 @@ from alica.app.demos.lunar import (
     _Run,
     check_config,
 )
+from alica.app.demos.served import stalled, stop_serving
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
 
@@ -62,10 +62,6 @@ if TYPE_CHECKING:
     from alica.worldmodel import WorldModel
     from alica.worldsim.world import World
 
-#: Wall seconds the run waits for the first step (every agent started and connected) before it gives up.
-START_WAIT_S = 60.0
-#: Wall seconds without a step after which a lock-step run gives up (an agent hangs).
-STALL_S = 30.0
 #: The name of the operator's session on the team's network (it listens; it is not in the team's roster).
 OPERATOR = "operator"
 
@@ -200,13 +196,7 @@ class _ProcessRun(_Run):
         now = world.now()
         self.processes.exited()
         if now == self.seen:  # no step since the last look
-            waited = time.monotonic() - self.stepped_at
-            if self.processes.all_down():
-                self.ended = "every agent process ended"
-            elif now == 0.0 and waited > START_WAIT_S:
-                self.ended = f"the agents did not all start within {START_WAIT_S:g} s"
-            elif now > 0.0 and waited > STALL_S:
-                self.ended = f"no step for {STALL_S:g} s: an agent does not finish its tick"
+            self.ended = stalled(now, time.monotonic() - self.stepped_at, self.processes.all_down())
             return bool(self.ended)
         self.seen, self.stepped_at = now, time.monotonic()
         while self.timed and now >= self.timed[0][0]:
@@ -324,7 +314,7 @@ def run_lunar_processes(
             try:
                 server.serve(until=run.step)
             finally:
-                _stop_serving(team, server)
+                stop_serving(team, server)
             wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
             summary = team.summary(PLAN, config.seed)
             if out is not None:
@@ -389,17 +379,6 @@ def run_lunar_processes(
         if server is not None:
             server.close()
         world.close()
-
-
-def _stop_serving(team: ProcessTeam, server: WorldServer) -> None:
-    """Stop the agents while the server still steps: a lock-step agent then finishes its tick and its summary."""
-    from alica.app.processes import STOP_GRACE
-
-    stopper = threading.Thread(target=team.stop, name="stop-agents", daemon=True)  # SIGTERM, wait, collect
-    stopper.start()
-    server.serve(duration=STOP_GRACE + 5.0, until=lambda: not stopper.is_alive())
-    stopper.join()
-    server.stop()
 
 
 def _replicas(summary: dict[str, Any], crashed: set[str]) -> dict[str, Any]:

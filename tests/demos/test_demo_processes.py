@@ -1,10 +1,10 @@
-"""``alica demo lunar --processes``: a world server and one ``alica agent`` process per robot (issue 38).
+"""``alica demo lunar|blocksworld --processes``: a world server and one ``alica agent`` process per robot (issue 38).
 
 Each run is a fresh ``alica`` process (as a user starts it) that runs the
-world server and starts three agent processes; a run on the small field takes
-about a minute and a half of wall time, so the two runs of the same seed go at
-once. Lock-step makes their outcome the same: the same samples found, chosen
-and delivered.
+world server and starts one agent process per robot; a lunar run on the small
+field takes about a minute and a half of wall time, so the two runs of the
+same seed go at once. Lock-step makes their outcome the same: the same samples
+found, chosen and delivered; the same goal reached.
 """
 
 from __future__ import annotations
@@ -25,9 +25,10 @@ LIMIT = 900.0
 """Wall seconds a run may take here before the test fails (a run takes about 100 s on a busy machine)."""
 
 
-def _start(*extra: str) -> subprocess.Popen[str]:
-    argv = [sys.executable, "-m", "alica.app.cli", "demo", "lunar", "--processes", *SMALL, "--json", "--no-progress"]
-    return subprocess.Popen([*argv, *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def _start(*extra: str, demo: str = "lunar") -> subprocess.Popen[str]:
+    argv = [sys.executable, "-m", "alica.app.cli", "demo", demo, "--processes", "--json", "--no-progress"]
+    small = SMALL if demo == "lunar" else []
+    return subprocess.Popen([*argv, *small, *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
 def _result(run: subprocess.Popen[str]) -> dict[str, Any]:
@@ -75,15 +76,36 @@ def test_a_robot_whose_agent_is_killed_crashes_and_the_others_finish_the_mission
     assert set(result["replicas"]["found"]) == {"scout", "amparo"}
 
 
+def test_the_blocks_world_runs_as_processes_with_a_crash_and_a_recovery(tmp_path: Path) -> None:
+    runs = [
+        _start("--out", str(tmp_path), demo="blocksworld"),
+        _start("--crash", "r2@5", "--recover", "r2@10", demo="blocksworld"),
+    ]
+    nominal, faulty = (_result(run) for run in runs)
+    for result in (nominal, faulty):
+        assert result["success"] and result["processes"] is True, (result, result["_stderr"][-2000:])
+        assert result["satisfied"] == result["goal_literals"] and result["reason"] == ""
+        assert "Traceback" not in result["_stderr"]
+    assert nominal["steps_executed"] >= nominal["plan_length"] - 1  # a step under way at the goal may not count
+    assert faulty["crashed"] == []  # r2 came back
+    assert {p.name for p in tmp_path.iterdir()} >= {"trace.jsonl", "initial.png", "final.png", "agents"}
+    fault_events = [
+        e for e in map(json.loads, (tmp_path / "trace.jsonl").read_text().splitlines()) if e.get("event") == "fault"
+    ]
+    assert fault_events == []  # the nominal run's trace has no fault
+
+
 @pytest.mark.parametrize(
-    ("argv", "message"),
+    ("demo", "argv", "message"),
     [
-        (["--gui"], "leave out --gui and --center"),
-        (["--loss", "0.1"], "--loss only work in the in-process demo"),
-        (["--partition", "scout|stummel,amparo@5"], "--partition only work in the in-process demo"),
+        ("lunar", ["--gui"], "leave out --gui and --center"),
+        ("lunar", ["--loss", "0.1"], "--loss only work in the in-process demo"),
+        ("lunar", ["--partition", "scout|stummel,amparo@5"], "--partition only work in the in-process demo"),
+        ("blocksworld", ["--opponents", "1"], "opponents run only in the in-process demo"),
+        ("blocksworld", ["--gui"], "leave out --gui and --center"),
     ],
 )
-def test_what_only_the_in_process_demo_does_is_refused_with_a_clear_error(argv, message, capsys) -> None:
-    assert main(["demo", "lunar", "--processes", *argv, "--no-progress"]) == 1
+def test_what_only_the_in_process_demo_does_is_refused_with_a_clear_error(demo, argv, message, capsys) -> None:
+    assert main(["demo", demo, "--processes", *argv, "--no-progress"]) == 1
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err, err
