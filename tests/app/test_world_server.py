@@ -147,28 +147,54 @@ def test_shipped_skills_run_on_a_remote_robot_as_on_a_local_one() -> None:
         assert {("ontable", "b"), ("handempty", "r1")} <= world.blocks_facts()
 
 
-def _lockstep_run(seed: int, steps: int) -> tuple[tuple[float, float, float], float, list[float]]:
-    with (
-        _served(_lunar(seed), lockstep=True, agents=["scout"]) as (_server, endpoint, prefix),
-        RemoteWorld([endpoint], "scout", prefix=prefix) as world,
-    ):
-        assert world.lockstep
-        robot, t0 = world.robots["scout"], world.now()
-        scans = []
-        for k in range(steps):
-            robot.drive(0.5, (-0.6, 0.0, 0.9)[k % 3])
-            scans.append(robot.lidar(36))  # (streamed from the second tick on)
-            world.tick_done(timeout=5.0)
-        assert world.now() == pytest.approx(t0 + steps * world.period)
-        assert not np.array_equal(scans[0], scans[-1])
-        return robot.pose, world.now() - t0, robot.lidar(36).tolist()
+Outcome = dict[str, tuple[tuple[float, float, float], list[float], list[int]]]
+
+
+def _lockstep_run(seed: int, steps: int) -> tuple[Outcome, float]:
+    """Two agents, each in a thread of its own, drive, scan and look every tick; what each ended with."""
+    agents = {"scout": (0.5, (-0.6, 0.0, 0.9)), "stummel": (0.3, (0.4, -0.2))}
+    outcome: Outcome = {}
+    with _served(_lunar(seed), lockstep=True, agents=list(agents)) as (_server, endpoint, prefix):
+        worlds = {name: RemoteWorld([endpoint], name, prefix=prefix) for name in agents}
+        t0 = worlds["scout"].now()
+        failed: list[BaseException] = []
+
+        def agent(name: str) -> None:
+            world, (v, turns) = worlds[name], agents[name]
+            robot = world.robots[name]
+            try:
+                for k in range(steps):
+                    robot.drive(v, turns[k % len(turns)])
+                    scan = robot.lidar(36)  # (streamed from the second tick on)
+                    picture = robot.camera(width=16, height=12) if k % 5 == 0 else None
+                    if picture is not None:
+                        outcome.setdefault(name, (robot.pose, [], []))[2].append(int(picture.rgb.sum()))
+                    world.tick_done(timeout=5.0)
+                pictures = outcome.get(name, ((0.0, 0.0, 0.0), [], []))[2]
+                outcome[name] = (robot.pose, scan.tolist(), pictures)
+            except BaseException as exc:
+                failed.append(exc)
+
+        threads = [threading.Thread(target=agent, args=(name,)) for name in agents]
+        try:
+            for t in threads:
+                t.start()
+            for t in threads:
+                t.join(30.0)
+        finally:
+            for world in worlds.values():
+                world.close()
+        assert not failed, failed
+        elapsed = worlds["scout"].period * steps
+        assert all(world.now() == pytest.approx(t0 + elapsed) for world in worlds.values())
+    return outcome, elapsed
 
 
 def test_lock_step_repeats_with_the_same_seed() -> None:
-    first = _lockstep_run(3, 25)
-    second = _lockstep_run(3, 25)
+    first, elapsed = _lockstep_run(3, 25)
+    second, _ = _lockstep_run(3, 25)
     assert first == second
-    assert first[0] != (1.5, 0.0, 0.0)
+    assert first["scout"][0] != (1.5, 0.0, 0.0) and elapsed > 0.8
 
 
 def test_a_robot_answers_only_its_own_agent() -> None:

@@ -28,13 +28,15 @@ never used from two threads.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import queue
 import threading
 import time
+import zlib
 from collections import Counter
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Self
 
@@ -139,6 +141,7 @@ class WorldServer:
         self._ticks: dict[str, list[zenoh.Query]] = {}
         self._static: dict[str, dict[str, Any]] = {}
         self._streams: dict[str, tuple[int, float | None]] = {}
+        self._draws: dict[str, tuple[int, int]] = {}
         self._static_names: frozenset[str] = frozenset()
         self._epoch = 0
         self._lock = threading.RLock()
@@ -258,12 +261,36 @@ class WorldServer:
             with self._lock:
                 state = self._state_json(objects=True)
         scans: dict[str, np.ndarray] = {}
-        for robot, (n, max_range) in self._streams.items():
-            scans[f"scan/{robot}"] = np.asarray(self.world.robots[robot].lidar(n, max_range), dtype=np.float64)
+        for robot, (n, max_range) in sorted(self._streams.items()):
+            with self._own_noise(robot):
+                scans[f"scan/{robot}"] = np.asarray(self.world.robots[robot].lidar(n, max_range), dtype=np.float64)
         state["scans"] = {robot: [n, max_range] for robot, (n, max_range) in self._streams.items()}
         frame = wire.encode({"ok": True, **state}, scans)
         self._publisher.put(frame)
         return frame
+
+    @contextlib.contextmanager
+    def _own_noise(self, robot: str) -> Iterator[None]:
+        """In lock-step, a sensor's noise for ``robot`` drawn from a generator of its own for this step and call.
+
+        Agents' sensor calls in one step arrive in any order; drawing each from the world's one
+        generator would make the noise depend on that order. Seeded by the world's seed, the step,
+        the robot and the call's number in the step, a run repeats whatever the order.
+        """
+        if not self.lockstep:
+            yield
+            return
+        step = self.stats.steps
+        last, count = self._draws.get(robot, (step, 0))
+        count = count + 1 if last == step else 1
+        self._draws[robot] = (step, count)
+        world = self.world
+        saved = world.rng
+        world.rng = np.random.default_rng([world.seed & 0xFFFFFFFF, step, zlib.crc32(robot.encode()), count])
+        try:
+            yield
+        finally:
+            world.rng = saved
 
     # -- state ---------------------------------------------------------------------------------------------
 
@@ -528,7 +555,8 @@ class WorldServer:
         if call == "lidar":
             n = wire.integer(args.get("n_rays"), "n_rays", 1, MAX_RAYS)
             max_range = wire.optional_number(args.get("max_range"), "max_range", 0.0, 1e4)
-            ranges = np.asarray(robot.lidar(n, max_range), dtype=np.float64)
+            with self._own_noise(robot.name):
+                ranges = np.asarray(robot.lidar(n, max_range), dtype=np.float64)
             self._streams[robot.name] = (n, max_range)  # (from now on cast at every step)
             return {}, {"ranges": ranges}
         if call == "camera_pose":
@@ -555,15 +583,16 @@ class WorldServer:
                 raise BadPayload("type", "window must be [u0, v0, u1, v1]")
             u0, v0, u1, v1 = (wire.integer(v, "window", 0, 4096) for v in window)
             win = (u0, v0, u1, v1)
-        image = robot.camera(
-            width=width,
-            height=height,
-            fov=wire.optional_number(args.get("fov"), "fov", 0.0, 4.0),
-            far=wire.optional_number(args.get("far"), "far", 0.0, 1e4),
-            pan=wire.number(args.get("pan", 0.0), "pan", -10.0, 10.0),
-            believed=wire.flag(args.get("believed", False), "believed"),
-            window=win,
-        )
+        with self._own_noise(robot.name):
+            image = robot.camera(
+                width=width,
+                height=height,
+                fov=wire.optional_number(args.get("fov"), "fov", 0.0, 4.0),
+                far=wire.optional_number(args.get("far"), "far", 0.0, 1e4),
+                pan=wire.number(args.get("pan", 0.0), "pan", -10.0, 10.0),
+                believed=wire.flag(args.get("believed", False), "believed"),
+                window=win,
+            )
         header = {
             "intrinsics": list(image.intrinsics),
             "time": image.time,
