@@ -1,9 +1,11 @@
 """The world server: one pybullet world, its robots served over zenoh to agents in other processes.
 
-One thread (the one that calls :meth:`WorldServer.serve`) owns the world:
-zenoh's callbacks only put what arrives (queries, agents' liveliness) on a
-queue, and the serving thread takes it off between world steps, so pybullet is
-never used from two threads.
+One thread (the one that calls :meth:`WorldServer.serve`) owns the world: it
+steps it, casts the sensors and serves the calls that touch pybullet, taking
+them off a queue that zenoh's callbacks fill. The calls that only set a
+command (:data:`FAST_CALLS`: drive, stop, set_estimate, set_bumped) are served
+at once on zenoh's thread, under a lock the world's thread holds while it
+steps, so a drive command does not wait for a camera picture.
 
 * **Calls.** Each robot has a queryable ``P/world/robot/NAME/call``; the world
   one ``P/world/call`` (see :mod:`alica.app.world_server.wire`). A robot
@@ -12,7 +14,10 @@ never used from two threads.
   robot call carries the robot's state after the call, so the agent reads its
   own writes (an arm told to follow a path is busy at once).
 * **State.** After each step the server publishes the time, every robot's
-  pose, estimate, flags and arm, and every object's geometry and pose.
+  pose, estimate, flags and arm, the movable objects' geometry and pose (the
+  static ones are in the answer to ``state``), and the lidar scans agents
+  asked for: once an agent asked for a scan, its robot's lidar is cast with
+  those settings at every step.
 * **Time.** Free-running (the default) steps ``1/frequency`` simulated seconds
   every ``1/(frequency*speed)`` wall seconds. Lock-step steps once every
   connected agent has said it finished its tick (the ``tick`` call, answered

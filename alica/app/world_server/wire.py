@@ -9,8 +9,8 @@ builds only dicts, lists, strings, numbers and numpy arrays of a listed dtype.
 
 Every frame received is checked before use (:func:`decode`): its size
 (:data:`MAX_FRAME`, :data:`MAX_HEADER`), the JSON (no ``NaN`` or ``Infinity``;
-nesting deeper than the interpreter's recursion limit is refused), the arrays' dtypes and shapes against the bytes present.
-The values are then checked by the one who reads them, with the helpers here
+nesting deeper than the interpreter's recursion limit is refused), the
+arrays' dtypes and shapes against the bytes present. The values are then checked by the one who reads them, with the helpers here
 (:func:`number`, :func:`integer`, :func:`name`, ...), each raising
 :class:`BadPayload` with a reason a log can count.
 
@@ -18,9 +18,11 @@ Keys, under the team's key prefix ``P``:
 
 * ``P/world/alive``: the server's liveliness token;
 * ``P/world/agent/NAME``: an agent's liveliness token (its robot is crashed when it leaves);
-* ``P/world/call``: world calls (``info``, ``blocker``, ``obstacles``, ``blocks_facts``, ``state``, ``tick``);
+* ``P/world/call``: world calls (``info``, ``state``, ``obstacles``, ``blocker``, ``blocks_facts``, ``mesh``,
+  ``tick``);
 * ``P/world/robot/NAME/call``: calls on robot ``NAME`` (only its own agent's are served);
-* ``P/world/state``: the state published after each world step.
+* ``P/world/state``: the state published after each world step (with the lidar scans asked for, as arrays
+  ``scan/NAME``).
 """
 
 from __future__ import annotations
