@@ -230,11 +230,19 @@ def test_a_malformed_payload_is_counted_and_refused_not_fatal() -> None:
                 answer = wire.decode(replies[0].ok.payload.to_bytes()).header
                 assert answer["ok"] is False and "malformed" in answer["error"]
             assert sum(server.stats.rejected.values()) == len(bad)
-            session.put(wire.state_key(prefix), b"\xff" * 9)  # garbage where clients listen
+            own = free_endpoints(1)[0]
+            with RemoteWorld([endpoint], "scout", prefix=prefix, listen=[own]) as world:  # the server still serves
+                world.robots["scout"].drive(0.1, 0.0)
+                liar = zenoh.open(zenoh_config((own,), (), "peer", 2.0, None))  # (a peer of the client's)
+                time.sleep(0.3)
+                forged = wire.encode({"server": 1, "version": 2**40, "step": 0, "t": -5.0, "robots": {}})
+                for garbage in (b"\xff" * 9, forged):  # where clients listen
+                    liar.put(wire.state_key(prefix), garbage)
+                liar.close()
+                assert _until(lambda: sum(world.rejected.values()) == 2)
+                assert world.now() >= 0 and world.robots["scout"].pose is not None
         finally:
             session.close()
-        with RemoteWorld([endpoint], "scout", prefix=prefix) as world:  # the server still serves
-            world.robots["scout"].drive(0.1, 0.0)
 
 
 def test_wire_refuses_what_it_cannot_check() -> None:
