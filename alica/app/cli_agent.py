@@ -284,12 +284,15 @@ def cmd_agent(args: argparse.Namespace) -> int:
     plugin = robot_plugin(args, agents)
     if plugin is not None and args.world is not None:
         raise AlicaError("--robot and --world both give the agent its robot: choose one")
+    if args.perception is not None and plugin is None and args.world is None:
+        raise AlicaError(f"--perception {args.perception} reads the robot's world: give --world or --robot too")
     wiring = skill_wiring(
         registry,
         plan_skills(library, plan),
         world=plugin is not None or args.world is not None,
         stand_ins=args.stand_ins,
         plan=plan,
+        robots="pass --world ENDPOINT (a world server: alica world serve) or --robot PLUGIN (a robot driver)",
     )
     members = agents if args.agents else None
     endpoints = [*args.connect, *args.listen]
@@ -297,8 +300,6 @@ def cmd_agent(args: argparse.Namespace) -> int:
         **team_settings(args, f"alica agent {args.name}", args.name, members, endpoints, args.key_prefix),
         **_zenoh_settings(args.zenoh),
     }
-    if args.perception is not None and plugin is None and args.world is None:
-        raise AlicaError(f"--perception {args.perception} reads the robot's world: give --world or --robot too")
     if args.world is not None:
         return _run_in_served_world(args, library, plan, roles, wiring, facts, settings)
     if plugin is None:
@@ -359,7 +360,7 @@ def _run(
 
     # a served world's robot lives in the server's simulated time: the agent runs on it (from its time 0)
     served: Any = robot_world if callable(getattr(robot_world, "tick_done", None)) else None
-    clock: Clock = served.clock if served is not None else SystemClock()
+    clock: Clock = _LastKnownTime(served.clock) if served is not None else SystemClock()
     if served is not None:
         start = 0.0
     else:
@@ -599,6 +600,33 @@ def _perception(kind: str | None, engine: AgentEngine, world: RobotWorld | None)
 
     alone: Any = _Alone()  # (typed for the simulator's World; it reads only the robot interface of it)
     return lambda: hook(alone)
+
+
+class _LastKnownTime:
+    """A served world's time that never raises and never goes back.
+
+    While the server does not answer it is the time the server last had: time stands still for the agent
+    (its skills fail, each with the reason) until a server steps again. A new server starts from its own
+    time 0; the agent's time goes on from where it stood.
+    """
+
+    def __init__(self, clock: Clock) -> None:
+        self._clock = clock
+        self._last = 0.0
+        self._offset = 0.0
+
+    def now(self) -> float:
+        from alica.worldsim.errors import WorldError
+
+        try:
+            value = self._clock.now() + self._offset
+        except WorldError:
+            return self._last  # the server is gone: its time stands still for this agent
+        if value < self._last:  # a new server started again from its time 0: time goes on from here
+            self._offset += self._last - value
+            value = self._last
+        self._last = value
+        return value
 
 
 def _no_sleep(_seconds: float) -> None:

@@ -68,8 +68,18 @@ class SkillWiring:
     stand_ins: list[str]
 
 
+#: How ``alica run`` gives its skills a robot (the end of skill_wiring's message).
+RUN_ROBOTS = "pass --world blocks or --world lunar, or --robot PLUGIN (a robot driver)"
+
+
 def skill_wiring(
-    registry: SkillRegistry, skills: Sequence[str], *, world: bool, stand_ins: bool, plan: str = "the plan"
+    registry: SkillRegistry,
+    skills: Sequence[str],
+    *,
+    world: bool,
+    stand_ins: bool,
+    plan: str = "the plan",
+    robots: str = RUN_ROBOTS,
 ) -> SkillWiring:
     """Decide for each skill of a run whether it runs for real or as a stand-in.
 
@@ -98,7 +108,7 @@ def skill_wiring(
         if worldless:
             problems.append(
                 f"{plan} uses skills that act on a robot and the run has no world: {', '.join(worldless)}; "
-                "pass --world blocks or --world lunar (or --stand-ins to script them)"
+                f"{robots} (or --stand-ins to script them)"
             )
         if problems:
             raise AlicaError("; and ".join(problems))
