@@ -61,6 +61,7 @@ from alica.errors import AlicaError
 if TYPE_CHECKING:
     from alica.allocation import AgentSpec
     from alica.app.run_skills import SkillWiring
+    from alica.clock import Clock
     from alica.comm.zenoh_transport import ZenohTransport
     from alica.engine import AgentEngine
     from alica.engine.agent import Observer
@@ -348,7 +349,7 @@ def _run(
     from alica.allocation import AgentSpec, assign_roles
     from alica.app.robot_plugin import is_simulated, wall_seconds
     from alica.app.trace_sources import plan_path_names
-    from alica.clock import Clock, SystemClock
+    from alica.clock import SystemClock
     from alica.comm.zenoh_transport import ZenohTransport
     from alica.engine import AgentEngine, JsonlTrace, SkillBinder, pick_roleset, trace_header
     from alica.engine.realtime import RealTimeLoop
