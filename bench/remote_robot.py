@@ -13,6 +13,8 @@ process of its own; agents are other processes, each with a
    read of its pose, as a navigating agent does. The CPU share (process time
    over wall time, :func:`time.process_time`) of the server and of each agent,
    and the latency of their calls under that load (after the first :data:`WARM_UP` ticks).
+3. ``lockstep``: the server in lock-step, three agents each ticking as fast as
+   they can (drive, scan, ``tick_done``): steps per wall second.
 
 The server's interpreter switches threads every 0.5 ms (``sys.setswitchinterval``, as
 ``alica world serve`` sets it), so a call is not held up behind the world's thread for the
@@ -39,7 +41,7 @@ ROBOTS = ("scout", "stummel", "amparo")
 SWITCH_INTERVAL = 0.0005
 
 
-def _server(conn: mpc.Connection, endpoint: str, prefix: str, seconds: float) -> None:
+def _server(conn: mpc.Connection, endpoint: str, prefix: str, lockstep: bool) -> None:
     import sys
 
     from alica.app.world_server import WorldServer
@@ -47,7 +49,7 @@ def _server(conn: mpc.Connection, endpoint: str, prefix: str, seconds: float) ->
 
     sys.setswitchinterval(SWITCH_INTERVAL)
     world = lunar(seed=0)
-    server = WorldServer(world, listen=[endpoint], prefix=prefix, frequency=30.0)
+    server = WorldServer(world, listen=[endpoint], prefix=prefix, frequency=30.0, lockstep=lockstep)
     try:
         conn.send("ready")
         while True:
@@ -56,8 +58,10 @@ def _server(conn: mpc.Connection, endpoint: str, prefix: str, seconds: float) ->
             order = conn.recv()
             if order == "quit":
                 break
+            if order == "done":
+                continue
             steps, cpu, wall = server.stats.steps, time.process_time(), time.monotonic()
-            server.serve(duration=float(order))
+            server.serve(duration=float(order), until=conn.poll)  # (until the agents are done)
             conn.send(
                 {
                     "cpu": time.process_time() - cpu,
@@ -91,6 +95,13 @@ def _agent(conn: mpc.Connection, endpoint: str, prefix: str, name: str, mode: st
                 t = time.perf_counter()
                 robot.lidar(360)
                 lidar.append(time.perf_counter() - t)
+        elif mode == "lockstep":
+            for k in range(int(amount)):
+                t = time.perf_counter()
+                robot.drive(0.05 * math.sin(0.1 * k), 0.3 * math.cos(0.05 * k))
+                robot.lidar(360)
+                world.tick_done()
+                drive.append(time.perf_counter() - t)  # (a whole tick: drive, scan, wait for the step)
         else:
             period, due, k = 1.0 / 30.0, start, 0
             while time.monotonic() - start < amount:
@@ -133,7 +144,7 @@ def _run(
     endpoint = free_endpoints(1)[0]
     prefix = f"bench{uuid.uuid4().hex[:6]}"
     near, far = ctx.Pipe()
-    server = ctx.Process(target=_server, args=(far, endpoint, prefix, seconds), daemon=True)
+    server = ctx.Process(target=_server, args=(far, endpoint, prefix, mode == "lockstep"), daemon=True)
     server.start()
     procs: list[mp.process.BaseProcess] = [server]
     try:
@@ -158,6 +169,7 @@ def _run(
             if not a.poll(seconds + 120.0):
                 raise RuntimeError("an agent did not finish")
             results.append(a.recv())
+        near.send("done")
         if not near.poll(seconds + 30.0):
             raise RuntimeError("the world server did not report")
         served = near.recv()
@@ -211,6 +223,18 @@ def main() -> None:
     print(
         f"\nAll calls under load: p50 {_pct(every, 0.5):.2f} ms, p99 {_pct(every, 0.99):.2f} ms "
         f"(goal p99 <= {GOAL_P99_MS:g} ms: {_mark(_pct(every, 0.99))}); mean {1e3 * statistics.fmean(every):.2f} ms."
+    )
+
+    ticks = 100 if args.quick else 300
+    served, results = _run("lockstep", ROBOTS, ticks, 120.0)
+    wall = max(r["wall"] for r in results)
+    print(f"\n## Lock-step: three agents, {ticks} ticks each (drive + lidar(360) + tick_done), 30 Hz world\n")
+    print("| steps | wall s | steps per wall second | simulated / wall | tick p50 ms | tick p99 ms |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: |")
+    every = [x for r in results for x in r["drive"]]
+    print(
+        f"| {ticks} | {wall:.2f} | {ticks / wall:.1f} | {ticks / 30.0 / wall:.2f}x | {_pct(every, 0.5):.2f} | "
+        f"{_pct(every, 0.99):.2f} |"
     )
 
 
