@@ -326,8 +326,13 @@ def _run_in_served_world(
     from alica.app.world_server import RemoteWorld
     from alica.worldsim.errors import WorldError
 
+    world_zenoh = None
+    if args.keys is not None:  # the world's own access control: this agent reaches only its robot
+        from alica.app.world_server.access import world_settings
+
+        world_zenoh = world_settings(args.keys, args.key_prefix)
     try:
-        world = RemoteWorld([args.world], args.name, prefix=args.key_prefix, settings=settings or None)
+        world = RemoteWorld([args.world], args.name, prefix=args.key_prefix, settings=world_zenoh)
     except (WorldError, ValueError) as exc:
         raise AlicaError(f"alica agent {args.name} --world {args.world}: {exc}") from None
     try:

@@ -441,8 +441,6 @@ def _run_processes(
     options += engine_arguments(args)
     keys = _team_keys(args, names, session is not None)
     if keys is not None:
-        if args.world is not None:
-            raise AlicaError("--team-keys with --world: the world server does not take team credentials yet")
         options += ["--team-keys", args.team_keys]
     with contextlib.ExitStack() as stack:
         if args.world is not None:
@@ -545,6 +543,8 @@ def _served_world(args: argparse.Namespace, names: list[str]) -> Iterator[str]:
     """``alica run --processes --world``: the world in a server on loopback, serving from a thread; its endpoint.
 
     Lock-step (the agents' ticks pace simulated time) unless ``--speed X`` asks for a free-running world.
+    With ``--team-keys`` the server is the member ``world`` of the team's credentials (TLS, and the world's
+    access control: each agent reaches only its own robot).
     """
     import threading
 
@@ -552,9 +552,16 @@ def _served_world(args: argparse.Namespace, names: list[str]) -> Iterator[str]:
     from alica.app.world_server import WorldServer
     from alica.comm.zenoh_transport import free_endpoints
 
+    settings = None
+    endpoint = free_endpoints(1)[0]
+    if args.team_keys is not None:  # the server is the member "world" of the team's credentials
+        from alica.app.world_server.access import WORLD, world_settings
+        from alica.comm.credentials import TeamKeys, tls_endpoint
+
+        settings = world_settings(TeamKeys.load(args.team_keys, WORLD), "alica")
+        endpoint = tls_endpoint(endpoint)
     with run_world(args, sorted(names)) as (world, _perception):
         assert world is not None
-        endpoint = free_endpoints(1)[0]
         server = WorldServer(
             world,
             listen=[endpoint],
@@ -563,6 +570,7 @@ def _served_world(args: argparse.Namespace, names: list[str]) -> Iterator[str]:
             speed=args.speed,
             frequency=args.frequency,
             agents=names,
+            settings=settings,
         )
         serving = threading.Thread(target=server.serve, name="world-server", daemon=True)
         serving.start()

@@ -176,3 +176,14 @@ def test_mission_values_never_fail_other_than_with_a_clear_error(text) -> None:
         mission_knowledge([text], [text])
     except AlicaError as exc:
         assert "--object" in str(exc) or "--value" in str(exc)
+
+
+def test_with_the_teams_credentials_the_world_server_is_the_member_world(tmp_path: Path, capfd) -> None:
+    keys = tmp_path / "keys"
+    assert main(["team", "keys", "--out", str(keys), "scout", "stummel", "amparo", "world"]) == 0
+    plan = str(plans_dir() / "examples" / "formation.yaml")
+    argv = ["run", plan, "--agents", "scout:Robot,stummel:Robot,amparo:Robot", "--processes", "--world", "lunar"]
+    code = main([*argv, "--team-keys", str(keys), "--time-limit", "120", "--json"])
+    out = capfd.readouterr().out
+    summary = json.loads(out[out.index("{") :])
+    assert code == 0 and summary["success"] and summary["skills"]["world"] == "lunar", summary
