@@ -158,6 +158,7 @@ class RemoteWorld:
                 except WorldError:
                     if time.monotonic() >= end:
                         raise
+                    time.sleep(0.05)  # (its token came before its queryables)
             if time.monotonic() >= end:
                 raise WorldError(
                     f"no world server at {self._where()} answered within {wait:g} s: start one with "
@@ -181,6 +182,9 @@ class RemoteWorld:
 
     def _describe(self, info: Mapping[str, Any]) -> None:
         robots = wire.mapping(info.get("robots"), "robots", 1000)
+        meshes = info.get("meshes", [])
+        if not isinstance(meshes, list) or len(meshes) > 100_000:
+            raise BadPayload("type", "meshes must be a list of object names")
         with self._lock:
             self._info = {
                 "server": wire.integer(info.get("server"), "server", 0, 2**63),
@@ -188,7 +192,7 @@ class RemoteWorld:
                 "bounds": wire.numbers(info.get("bounds"), "bounds", 4),
                 "period": wire.number(info.get("period"), "period", 0.0, 10.0),
                 "lockstep": wire.flag(info.get("lockstep"), "lockstep"),
-                "meshes": {wire.name(m, "mesh") for m in info.get("meshes", []) if isinstance(m, str)},
+                "meshes": {wire.name(m, "mesh") for m in meshes},
             }
             for robot, entry in robots.items():
                 wire.name(robot, "robot name")
