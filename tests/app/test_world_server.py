@@ -355,7 +355,7 @@ def test_a_dead_server_gives_a_clear_world_error_and_the_client_reconnects() -> 
         assert time.monotonic() - start < 3.5
         with pytest.raises(WorldError, match="does not answer"):
             _ = robot.pose
-        server = WorldServer(world, listen=[endpoint], prefix=prefix)  # it comes back
+        server = _reopen(world, endpoint, prefix)  # it comes back
         thread = threading.Thread(target=server.serve, daemon=True)
         thread.start()
 
@@ -374,6 +374,18 @@ def test_a_dead_server_gives_a_clear_world_error_and_the_client_reconnects() -> 
         thread.join(5.0)
         server.close()
         world.close()
+
+
+def _reopen(world: World, endpoint: str, prefix: str) -> WorldServer:
+    """A new server on the endpoint a closed one left (the port may take a moment to be free again)."""
+    end = time.monotonic() + 10.0
+    while True:
+        try:
+            return WorldServer(world, listen=[endpoint], prefix=prefix)
+        except WorldError:
+            if time.monotonic() > end:
+                raise
+            time.sleep(0.1)
 
 
 def test_alica_world_serve_in_a_process_serves_a_lock_step_world() -> None:

@@ -150,6 +150,7 @@ class WorldServer:
         self._static_names: frozenset[str] = frozenset()
         self._epoch = 0
         self._lock = threading.RLock()
+        self._closed = False
         try:
             self._session = zenoh.open(zenoh_config(tuple(connect), tuple(listen), mode, lease, settings))
         except zenoh.ZError as exc:
@@ -218,6 +219,9 @@ class WorldServer:
     def close(self) -> None:
         """Leave: the token goes (clients see the server gone), the session closes. The world stays open."""
         self._stop.set()
+        if self._closed:
+            return
+        self._closed = True
         for queries in self._ticks.values():
             for q in queries:
                 q.drop()
