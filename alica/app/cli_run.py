@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import sys
 from typing import TYPE_CHECKING, Any
 
@@ -552,6 +553,8 @@ def _served_world(args: argparse.Namespace, names: list[str]) -> Iterator[str]:
     from alica.app.world_server import WorldServer
     from alica.comm.zenoh_transport import free_endpoints
 
+    if not (args.speed > 0 and math.isfinite(args.speed)):
+        raise AlicaError(f"--speed must be a positive number of simulated seconds per wall second, got {args.speed}")
     settings = None
     endpoint = free_endpoints(1)[0]
     if args.team_keys is not None:  # the server is the member "world" of the team's credentials

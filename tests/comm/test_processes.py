@@ -114,7 +114,7 @@ def test_ctrl_c_stops_every_agent_process(tmp_path):
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--speed", "2"], "--speed only work in the simulated run"),  # (with --world: a free-running world server)
+        (["--trace-messages"], "--trace-messages only work in the simulated run"),
         (["--loss", "0.1"], "--loss only work in the simulated run"),
         (["--crash", "nobody@3"], "no agent named 'nobody'"),
     ],

@@ -153,10 +153,12 @@ def live_session(args: argparse.Namespace) -> Any:
     """The run's :class:`~alica.app.center.live.LiveSession` with ``--center``, else ``None``.
 
     Raises:
-        AlicaError: ``--speed`` or ``--review`` without ``--center``, or a speed that is not positive.
+        AlicaError: ``--speed`` (but with ``--processes --world``: the world server's speed) or ``--review``
+            without ``--center``, or a speed that is not positive.
     """
     if not args.center:
-        if args.speed != 1.0 or getattr(args, "review", False):
+        served = getattr(args, "processes", False) and getattr(args, "world", None) is not None
+        if (args.speed != 1.0 and not served) or getattr(args, "review", False):
             raise AlicaError("--speed and --review need --center: they are settings of the control center's live run")
         return None
     from alica.app.center.live import LiveSession
