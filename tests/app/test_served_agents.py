@@ -187,3 +187,46 @@ def test_with_the_teams_credentials_the_world_server_is_the_member_world(tmp_pat
     out = capfd.readouterr().out
     summary = json.loads(out[out.index("{") :])
     assert code == 0 and summary["success"] and summary["skills"]["world"] == "lunar", summary
+
+
+def test_a_partition_between_an_agent_and_its_world_server_is_a_robot_that_does_not_answer(tmp_path: Path) -> None:
+    """The agent reaches the server through a relay; cutting it fails the drive within a bounded wait, healing it
+    lets the agent drive on (the server lives on meanwhile: free-running, its robot stopped where it was)."""
+    from alica.comm.relay import LinkRelay
+
+    plan = tmp_path / "trip.yaml"
+    plan.write_text(TRIP, encoding="utf-8")
+    (endpoint,) = free_endpoints(1)
+    trace = tmp_path / "scout.jsonl"
+    processes: list[subprocess.Popen] = []
+    relay = None
+    try:
+        processes.append(_serve(endpoint, tmp_path / "server.log"))
+        relay = LinkRelay(endpoint)
+        agent = subprocess.Popen(
+            [*ALICA, "agent", str(plan), "--name", "scout", "--agents", "scout:Scout", "--world", relay.endpoint]
+            + ["--json", "--time-limit", "90", "--until-done", "--trace", str(trace)],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        processes.append(agent)
+        assert _wait_for(lambda: trace.exists() and '"running"' in trace.read_text(), 60), "the drive never started"
+        time.sleep(1.0)
+        cut_at = time.monotonic()
+        relay.cut()
+        assert _wait_for(lambda: '"failure"' in trace.read_text(), 20), "the drive did not fail when cut off"
+        assert time.monotonic() - cut_at < 15.0  # a bounded wait: the zenoh lease and a call's time-out
+        assert agent.poll() is None
+        relay.heal()
+        out, err = agent.communicate(timeout=90)
+    finally:
+        for process in processes:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+        if relay is not None:
+            relay.close()
+    summary = json.loads(out.strip().splitlines()[-1])
+    assert summary["status"] == "success", (summary, err[-2000:])
+    assert "Traceback" not in err
