@@ -19,11 +19,13 @@ __all__ = [
     "GRASP",
     "HELD",
     "NAMES",
+    "PLACED",
     "TRIED_SIDES",
     "Aligned",
     "GraspCount",
     "GraspedNames",
     "Held",
+    "Placed",
     "Retreat",
     "TriedSides",
 ]
@@ -71,6 +73,14 @@ class Aligned:
     pose: tuple[float, float, float]
 
 
+@dataclass(frozen=True, slots=True)
+class Placed:
+    """Where MoveArmToPlace set ``object`` down (the arm's place point, as the robot believes it)."""
+
+    object: str
+    place: tuple[float, float]
+
+
 @dataclass(slots=True)
 class GraspedNames:
     """The world object each name a plan gave Grasp stands for (perception's names for samples)."""
@@ -84,3 +94,4 @@ ARM_RETREAT: ScratchSlot[Retreat] = ScratchSlot("arm_retreat", Retreat, "Grasp o
 TRIED_SIDES: ScratchSlot[TriedSides] = ScratchSlot("tried_sides", TriedSides, "Grasp")
 ALIGNED: ScratchSlot[Aligned] = ScratchSlot("aligned", Aligned, "AlignWithObject")
 NAMES: ScratchSlot[GraspedNames] = ScratchSlot("names", GraspedNames, "Grasp")
+PLACED: ScratchSlot[Placed] = ScratchSlot("placed", Placed, "MoveArmToPlace")

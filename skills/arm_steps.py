@@ -45,15 +45,18 @@ from alica.skills.arm_scratch import (
     GRASP,
     HELD,
     NAMES,
+    PLACED,
     TRIED_SIDES,
     Aligned,
     GraspCount,
     GraspedNames,
     Held,
+    Placed,
     Retreat,
     TriedSides,
 )
 from alica.skills.arm_world import REACH, find_object, place_area, write_held, write_placed, write_released
+from alica.skills.close_look import GROUND_CUT, look_at
 from alica.skills.handling import PLACE_TOLERANCE, SETTLE, ArmSkill, Phase, Pickup, Putdown
 from alica.skills.team_poses import holders
 from alica.skills.world_skill import WorldSkill, distance, number_param
@@ -119,8 +122,14 @@ class AlignWithObject(ArmSkill):
             self.approach.tried_sides = list(tried.sides)
 
     def site(self) -> tuple[float, float]:
-        """Where the object is: the world model's estimate, else the world's."""
+        """Where the object is: the robot's close look, else the world model's estimate, else the world's."""
+        if self.sighting is not None:
+            return self.sighting.xy
         return self.resolve_position(self.param("object"))
+
+    def expected_xy(self) -> tuple[float, float]:
+        """Where the object should be (:meth:`site`)."""
+        return self.site()
 
     def standoff(self) -> float:
         """The ``standoff`` parameter; by default the arm's reach ahead of its mount."""
@@ -135,9 +144,21 @@ class AlignWithObject(ArmSkill):
         return self.tolerance
 
     def approached(self) -> Status:
-        """Facing the object: succeed when the distance is right, else drive again."""
-        x, y, _ = self.robot.estimate
+        """Facing the object: look at it; succeed when the distance is right, else drive again.
+
+        The close look (:meth:`~alica.skills.handling.ArmSkill.look`) measures
+        where the sample stands; when that is more than ``tolerance`` from
+        where the robot aligned to (the team's detection, or a sample that
+        slipped out of the hand and fell), the robot tells the team
+        (``pos(object)``) and drives again.
+        """
+        before = self.site()
+        self.look()
         site = self.site()
+        moved = distance(before, site) > self.tolerance
+        if moved and self.world_model is not None:
+            self.world_model.set("pos", self.object_label(), value=(round(site[0], 3), round(site[1], 3)))
+        x, y, _ = self.robot.estimate
         gap = distance((x, y), site)
         wanted = self.standoff()
         if abs(gap - wanted) <= self.tolerance + 1e-9:
@@ -344,9 +365,10 @@ class MoveArmToPlace(Putdown):
         return None
 
     def finished(self) -> Status:
-        """Hand the retreat on."""
+        """Hand the retreat and the place on."""
         ARM_RETREAT.put(_scratch(self), Retreat(self.robot.name, self._retreat))
         x, y, _ = self.place_top()
+        PLACED.put(_scratch(self), Placed(self.object_label(), (float(x), float(y))))
         return self.succeed(f"{self.object_label()} at its place ({x:.2f}, {y:.2f})")
 
 
@@ -434,11 +456,16 @@ class ValidateGrip(WorldSkill):
 class VerifyPlaced(WorldSkill):
     """Check that the gripper is empty and ``object`` lies on the ground at ``target``.
 
-    At a position it must lie within :data:`~alica.skills.handling.PLACE_TOLERANCE`;
-    in an area such as the collection point ``pos(g)``, inside it; without a
-    target, anywhere on the ground. On success ``onground(object)``,
-    ``handempty(self)``, ``at(object, place)`` for a named place, and the
-    object's new ``pos(object)`` are written.
+    The robot looks with its own camera (:func:`alica.skills.close_look.look_at`)
+    where MoveArmToPlace set the object down (``scratch["placed"]``; else
+    where the team saw it, ``pos(object)``; else the arm's place point straight
+    ahead): the container it sees there, its bottom
+    at the local ground, is the object. At a position it must lie within
+    :data:`~alica.skills.handling.PLACE_TOLERANCE`; in an area such as the
+    collection point ``pos(g)``, inside it; without a target, anywhere on the
+    ground. On success ``onground(object)``, ``handempty(self)``,
+    ``at(object, place)`` for a named place, and the object's new
+    ``pos(object)`` (where the camera saw it) are written.
     """
 
     def setup(self, **kwargs: Any) -> None:
@@ -457,10 +484,25 @@ class VerifyPlaced(WorldSkill):
         holder = holders(self.team_model).get(name)  # the team's holding facts
         if holder is not None and holder != self.robot.name:
             return self.fail(f"{name} is in the gripper of robot '{holder}'")
-        low, _ = obj.aabb()
-        x, y = (float(v) for v in obj.position()[:2])
-        if float(low[2]) > ON_GROUND:
-            return self.fail(f"{name} does not lie on the ground: its bottom is {float(low[2]):.2f} m high")
+        placed = PLACED.get(_scratch(self))
+        known = self.world_model.lookup("pos", (name,)) if self.world_model is not None else None
+        if placed is not None and placed.object == name:
+            where = placed.place
+        elif isinstance(known, (tuple, list)) and len(known) >= 2:  # not put down by this robot: where the team saw it
+            where = (float(known[0]), float(known[1]))
+        else:  # the arm's place point straight ahead
+            rx, ry, ryaw = self.robot.estimate
+            ahead = REACH + (float(self.robot.arm.mount_offset[0]) if self.robot.arm is not None else 0.0)
+            where = (rx + ahead * math.cos(ryaw), ry + ahead * math.sin(ryaw))
+        size = float(obj.size) if obj.kind == "sample" else float(obj.size or 0.1)
+        radius = float(obj.radius) if obj.radius else 0.5 * size
+        seen = look_at(self.robot, where, size=size, radius=radius)
+        if seen is None:
+            return self.fail(f"the camera sees no {name} where it was put down ({where[0]:.2f}, {where[1]:.2f})")
+        x, y = seen.xy
+        bottom = seen.bottom - seen.ground - GROUND_CUT
+        if bottom > ON_GROUND:
+            return self.fail(f"{name} does not lie on the ground: its bottom is {bottom:.2f} m high")
         target = self.param("target")
         if target is not None:
             area = place_area(self, target)

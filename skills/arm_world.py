@@ -20,6 +20,8 @@ from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 ASSOCIATION = 0.3
 #: Horizontal distance from the arm's base at which the arm works best.
 REACH = 0.55
+#: The footprint radius (m) counted for a sample the team knows of (a container's radius and some room).
+SAMPLE_ROOM = 0.05
 
 
 def mount_ahead(robot: MobileRobot) -> float:
@@ -49,12 +51,19 @@ def place_area(skill: WorldSkill, target: object) -> tuple[float, float, float] 
 
 
 def area_spots(
-    world: RobotWorld, robot: MobileRobot, area: tuple[float, float, float], room: float
+    world: RobotWorld,
+    robot: MobileRobot,
+    area: tuple[float, float, float],
+    room: float,
+    taken: list[tuple[float, float, float]] | None = None,
 ) -> list[tuple[float, float]]:
     """Free spots (``room`` metres around them) in a round ``area``: its centre first, then further out.
 
     The spots are the centre and two rings of eight, at a third and two thirds
-    of the radius; on a ring the spots nearest to ``robot`` come first.
+    of the radius; on a ring the spots nearest to ``robot`` come first. Free
+    means clear of the discs ``taken`` (``(x, y, radius)``: what the team knows
+    lies or stands there, :func:`known_discs`); without them, clear of
+    everything in the world (a known layout: the blocks world's overhead camera).
     """
     cx, cy, radius = area
     x, y, _ = robot.estimate
@@ -65,7 +74,34 @@ def area_spots(
             for k in range(8)
         ]
         spots += sorted(ring, key=lambda spot: distance(spot, (x, y)))
+    if taken is not None:
+        return [
+            spot for spot in spots if all(math.hypot(spot[0] - tx, spot[1] - ty) >= room + tr for tx, ty, tr in taken)
+        ]
     return [spot for spot in spots if world.blocker(spot[0], spot[1], room) is None]
+
+
+def known_discs(skill: WorldSkill, skip: str = "") -> list[tuple[float, float, float]]:
+    """What the team knows lies or stands on the ground, as ``(x, y, radius)``.
+
+    The samples the team's perception found (objects of type ``Sample`` with a
+    ``pos``; those put down carry the ``pos`` VerifyPlaced measured), but
+    ``skip`` (the one the robot holds), with :data:`SAMPLE_ROOM`; and the
+    teammates' shared poses (:mod:`alica.skills.team_poses`).
+    """
+    from alica.skills.team_poses import teammate_discs
+
+    wm = skill.world_model
+    out = teammate_discs(skill)
+    if wm is None:
+        return out
+    for name in wm.objects("Sample"):
+        if name == skip:
+            continue
+        known = wm.lookup("pos", (name,))
+        if isinstance(known, (tuple, list)) and len(known) >= 2:
+            out.append((float(known[0]), float(known[1]), SAMPLE_ROOM))
+    return out
 
 
 def find_object(skill: WorldSkill, name: object) -> WorldThing:

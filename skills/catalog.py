@@ -289,7 +289,7 @@ def _manipulation(registry: SkillRegistry) -> None:
             "where it should lie (a position, or an area such as pos(g)); by default anywhere on the ground",
             required=False,
         ),
-        doc="check that the gripper is empty and the object lies at its place",
+        doc="check that the gripper is empty and, with a look of the robot's camera, that the object lies at its place",
         capabilities=("gripper",),
         implementation=f"{steps}:VerifyPlaced",
     )

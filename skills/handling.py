@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from enum import StrEnum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from py_trees.common import Status
@@ -42,18 +42,21 @@ from alica.skills.arm_world import (
     area_spots,
     find_object,
     inside_field,
+    known_discs,
     mount_ahead,
     place_area,
     write_held,
     write_placed,
     write_released,
 )
+from alica.skills.close_look import Sighting, in_arm_frame, look_at
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
 from alica.skills.team_poses import holders
 from alica.skills.world_skill import WorldSkill, distance
 from alica.worldsim.arm_interface import ArmPlanningScene, RobotArm
 from alica.worldsim.errors import WorldError
+from alica.worldsim.geometry import Box
 from alica.worldsim.interface import WorldThing
 
 if TYPE_CHECKING:
@@ -120,6 +123,8 @@ class ArmSkill(WorldSkill):
         self.approach = Approach(self)
         self.motion = ArmMotion()
         self.job: Job | None = None
+        #: The close look's measurement of the sample to grasp (:meth:`look`); None before it, and for blocks.
+        self.sighting: Sighting | None = None
 
     def setup(self, **kwargs: Any) -> None:
         """Find the robot; it needs an arm (when :attr:`needs_arm`)."""
@@ -150,9 +155,64 @@ class ArmSkill(WorldSkill):
         return str(self.param("object"))
 
     def site(self) -> tuple[float, float]:
-        """Where the work happens, for the approach."""
-        position = self.target_object().position()
+        """Where the work happens, for the approach: where the robot believes the object is (:meth:`expected_xy`)."""
+        return self.expected_xy()
+
+    def expected_xy(self) -> tuple[float, float]:
+        """Where the robot believes the object to grasp lies.
+
+        A sample: the close look's measurement (:meth:`look`), else the team's
+        detection ``pos(object)`` in the world model. A block, or a sample
+        without ``pos(object)`` in a world whose layout is known (a skill run
+        alone): the object's place in the world, the stand-in for the blocks
+        world's overhead camera.
+        """
+        obj = self.target_object()
+        if obj.kind == "sample":
+            if self.sighting is not None:
+                return self.sighting.xy
+            wm = self.world_model
+            known = wm.lookup("pos", (self.object_label(),)) if wm is not None else None
+            if isinstance(known, (tuple, list)) and len(known) >= 2:
+                return float(known[0]), float(known[1])
+        position = obj.position()
         return float(position[0]), float(position[1])
+
+    def look(self) -> None:
+        """Before planning a grasp of a sample: a close look with the robot's camera at where it should lie.
+
+        The measurement (:func:`alica.skills.close_look.look_at`) replaces the
+        detection for the site and the grasp; when the camera sees nothing
+        there, the last measurement (or the detection) stays.
+        """
+        if not self.grasps:
+            return
+        obj = self.target_object()
+        if obj.kind != "sample" or not obj.radius:
+            return
+        seen = look_at(self.robot, self.expected_xy(), size=float(obj.size), radius=float(obj.radius))
+        if seen is not None:
+            self.sighting = seen
+
+    def grasp_target(self) -> tuple[Box, Literal["box", "cylinder"]]:
+        """The object to grasp as the arm planner's box, and how to grasp it.
+
+        A sample: as the close look measured it (:meth:`look`), or standing
+        upright at the detection when the camera saw nothing. A block: its box
+        in the world (the overhead camera's stand-in).
+        """
+        obj = self.target_object()
+        if obj.kind == "sample" and obj.radius:
+            size, radius = float(obj.size), float(obj.radius)
+            seen = self.sighting
+            if seen is None:
+                x, y = self.expected_xy()
+                seen = Sighting(x, y, 0.0, size, 0.0, True, 0.0, 0)
+            arm = self.robot.arm
+            if arm is not None:  # measured from the robot: relative to the arm's base, where the arm plans
+                seen = in_arm_frame(seen, self.robot.estimate, arm.mount_offset, arm.base_pose())
+            return seen.box(obj.name, size, radius), ("cylinder" if seen.upright else "box")
+        return object_box(obj), grasp_shape(obj)
 
     def check_before(self) -> str | None:
         """Why the skill cannot start now, or None."""
@@ -169,8 +229,8 @@ class ArmSkill(WorldSkill):
         from alica.skills.manipulation import PlacePlan, plan_pickup, plan_place
 
         if self.grasps:
-            obj = self.target_object()
-            return plan_pickup(scene, object_box(obj), q, rng=rng, kind=grasp_shape(obj))
+            box, kind = self.grasp_target()
+            return plan_pickup(scene, box, q, rng=rng, kind=kind)
         held = held_object_box(self.arm, scene, q)  # the object in the tool's frame
         if held is None:
             return PlacePlan(False, None, None, None, None, [], "the object is tilted in the hand")
@@ -242,6 +302,7 @@ class ArmSkill(WorldSkill):
         self.approach = Approach(self)
         self.motion = ArmMotion()
         self.job = None
+        self.sighting = None
         self.settle_until = 0.0
         self.np_rng = np.random.default_rng(self.context.rng.randrange(2**31) if self.context is not None else 0)
 
@@ -311,6 +372,7 @@ def _plan(skill: ArmSkill) -> Status:
     if skill.job is None and arm.busy:
         return skill.running("waiting for the arm to come back")
     if skill.job is None:
+        skill.look()  # a sample: where the camera sees it now, before each plan (a failed grasp may have moved it)
         crowded = skill.target_object() if skill.grasps and skill.last_attempt() else None
         scene = planning_scene(arm, skill.world.objects, skill.scene_exclusions(), crowded)
         skill.job = skill.jobs.submit(skill.plan, scene, np.asarray(arm.q(), dtype=float), skill.np_rng)
@@ -477,7 +539,7 @@ class Putdown(ArmSkill):
         spots = (
             blocks_rules.putdown_spots(self.world, self.robot)
             if area is None
-            else area_spots(self.world, self.robot, area, AREA_ROOM)
+            else area_spots(self.world, self.robot, area, AREA_ROOM, self._known_taken())
         )
         for spot in spots:
             if not any(distance(spot, old) < blocks_rules.PUTDOWN_ROOM for old in tried):
@@ -487,6 +549,16 @@ class Putdown(ArmSkill):
         x, y, yaw = self.robot.estimate
         ahead = REACH + mount_ahead(self.robot)
         return x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)  # nothing free: straight ahead (the check fails)
+
+    def _known_taken(self) -> list[tuple[float, float, float]] | None:
+        """In a mission that maps, what the team knows lies or stands in the area (:func:`known_discs`); else None.
+
+        Without a team map the layout counts as known (the blocks world, a skill
+        run alone) and the spots are checked against the world's objects.
+        """
+        if not self.mapping_mission():
+            return None
+        return known_discs(self, skip=self.object_label())
 
     def _retry(self, reason: str) -> Status:
         """Try another spot on the next attempt (when no target was given)."""
@@ -504,7 +576,13 @@ class Putdown(ArmSkill):
         if self.arm.held is not None:
             return f"{obj.name} is still in the hand"
         x, y, _ = self.place_top()
-        here = obj.position()
+        if obj.kind == "sample" and obj.radius:  # the robot looks where it put the sample down
+            seen = look_at(self.robot, (x, y), size=float(obj.size), radius=float(obj.radius))
+            if seen is None:
+                return f"the camera sees no {obj.name} where it was put down ({x:.2f}, {y:.2f})"
+            here: tuple[float, ...] = seen.xy
+        else:  # a block: the overhead camera's stand-in
+            here = tuple(float(v) for v in obj.position())
         if math.hypot(here[0] - x, here[1] - y) > PLACE_TOLERANCE:
             return f"{obj.name} lies at ({here[0]:.2f}, {here[1]:.2f}), not at ({x:.2f}, {y:.2f})"
         write_released(self, self.object_label())
