@@ -58,6 +58,13 @@ def _serve(endpoint: str, log: Path) -> subprocess.Popen[bytes]:
         )
 
 
+def _agent(plan: Path, world: str, trace: Path) -> subprocess.Popen[str]:
+    """Scout's agent on the trip, its robot at the world server ``world``; done when the trip is."""
+    argv = [*ALICA, "agent", str(plan), "--name", "scout", "--agents", "scout:Scout", "--world", world]
+    argv += ["--json", "--time-limit", "90", "--until-done", "--trace", str(trace)]
+    return subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
 def _wait_for(check, seconds: float) -> bool:
     end = time.monotonic() + seconds
     while time.monotonic() < end:
@@ -75,13 +82,7 @@ def test_a_dead_world_server_fails_the_skill_with_a_reason_and_the_agent_goes_on
     processes: list[subprocess.Popen] = []
     try:
         processes.append(_serve(endpoint, tmp_path / "server.log"))
-        agent = subprocess.Popen(
-            [*ALICA, "agent", str(plan), "--name", "scout", "--agents", "scout:Scout", "--world", endpoint]
-            + ["--json", "--time-limit", "90", "--until-done", "--trace", str(trace)],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        agent = _agent(plan, endpoint, trace)
         processes.append(agent)
         assert _wait_for(lambda: trace.exists() and '"running"' in trace.read_text(), 60), "the drive never started"
         time.sleep(1.0)
@@ -203,13 +204,7 @@ def test_a_partition_between_an_agent_and_its_world_server_is_a_robot_that_does_
     try:
         processes.append(_serve(endpoint, tmp_path / "server.log"))
         relay = LinkRelay(endpoint)
-        agent = subprocess.Popen(
-            [*ALICA, "agent", str(plan), "--name", "scout", "--agents", "scout:Scout", "--world", relay.endpoint]
-            + ["--json", "--time-limit", "90", "--until-done", "--trace", str(trace)],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.PIPE,
-            text=True,
-        )
+        agent = _agent(plan, relay.endpoint, trace)
         processes.append(agent)
         assert _wait_for(lambda: trace.exists() and '"running"' in trace.read_text(), 60), "the drive never started"
         time.sleep(1.0)

@@ -418,16 +418,7 @@ def run_lunar(
             replans=counter.replans,
             plans=len(counter.plans),
             messages=team.network.stats.sent,
-            robots={
-                name: {
-                    "role": ROLES[name],
-                    "tasks": len(counter.tasks.get(name, set())),
-                    "steps": counter.steps.get(name, 0),
-                    "distance_m": round(run.distance[name], 2),
-                    "crashed": name in team.crashed,
-                }
-                for name in config.robots
-            },
+            robots=run.robots_json(counter, team.crashed),
             plan_yaml=plan_yaml,
             crashed=sorted(team.crashed),
             replicas=replica_views(team),
@@ -621,6 +612,20 @@ class _Run:
             if math.hypot(x - self.base[0], y - self.base[1]) <= DELIVERED_WITHIN and z < 0.3:
                 out.append(name)
         return out
+
+    def robots_json(self, counter: StepCounter, crashed: Iterable[str]) -> dict[str, dict[str, Any]]:
+        """Each robot's part of the result: role, tasks and steps of generated plans, distance, crashed."""
+        out = set(crashed)
+        return {
+            name: {
+                "role": ROLES[name],
+                "tasks": len(counter.tasks.get(name, set())),
+                "steps": counter.steps.get(name, 0),
+                "distance_m": round(self.distance[name], 2),
+                "crashed": name in out,
+            }
+            for name in self.config.robots
+        }
 
     def team_map(self) -> LogOddsGrid | None:
         from alica.app.trace_world import team_grid

@@ -352,15 +352,8 @@ def run_lunar_processes(
             plans=len(counter.plans),
             messages=int(summary["messages"]["sent"]),
             robots={
-                name: {
-                    "role": ROLES[name],
-                    "tasks": len(counter.tasks.get(name, set())),
-                    "steps": counter.steps.get(name, 0),
-                    "distance_m": round(run.distance[name], 2),
-                    "crashed": name in run.crashed,
-                    "cpu_percent": agents[name].get("cpu_percent"),
-                }
-                for name in names
+                name: {**robot, "cpu_percent": agents[name].get("cpu_percent")}
+                for name, robot in run.robots_json(counter, run.crashed).items()
             },
             crashed=sorted(run.crashed),
             replicas=_replicas(summary, run.crashed),
