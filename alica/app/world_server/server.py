@@ -189,13 +189,14 @@ class WorldServer:
     # -- life ----------------------------------------------------------------------------------------------
 
     def serve(self, duration: float | None = None, until: Callable[[], bool] | None = None) -> None:
-        """Serve until :meth:`stop`, for ``duration`` wall seconds, or until ``until()`` is true (checked each step)."""
+        """Serve until :meth:`stop`, for ``duration`` wall seconds, or until ``until()`` is true.
+
+        ``until`` is asked after each step, and at least every 50 ms.
+        """
         end = math.inf if duration is None else time.monotonic() + duration
-        next_step = time.monotonic()
+        next_step = asked = time.monotonic()
         self._publish()
         while not self._stop.is_set() and time.monotonic() < end:
-            if until is not None and until():
-                break
             now = time.monotonic()
             wait = 0.05 if self.lockstep else max(0.0, next_step - now)
             try:
@@ -204,13 +205,20 @@ class WorldServer:
                 pass
             else:
                 self._handle(kind, item)
+            stepped = False
             if self.lockstep:
                 if self._all_ticked():
                     self._step_lockstep()
+                    stepped = True
             elif time.monotonic() >= next_step:
                 self._step()
+                stepped = True
                 next_step += self.period / self.speed
                 next_step = max(next_step, time.monotonic() - 2 * self.period / self.speed)  # no catch-up burst
+            if until is not None and (stepped or time.monotonic() - asked >= 0.05):
+                asked = time.monotonic()
+                if until():
+                    break
 
     def stop(self) -> None:
         """Make :meth:`serve` return (from any thread)."""
