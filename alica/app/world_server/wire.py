@@ -37,6 +37,8 @@ from typing import Any
 
 import numpy as np
 
+from alica.worldsim.errors import WorldError
+
 __all__ = [
     "MAX_FRAME",
     "MAX_HEADER",
@@ -65,8 +67,9 @@ _NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_\-.]*$")
 _LEN = struct.Struct("<I")
 
 
-class BadPayload(ValueError):
-    """A frame or a value in it that is refused.
+class BadPayload(WorldError):
+    """A frame or a value in it that is refused (a :class:`~alica.worldsim.errors.WorldError`, so a client's
+    caller sees a malformed answer as the world's error).
 
     Args:
         reason: a short word for counting (``size``, ``json``, ``type``, ``range``, ``array``, ...).
