@@ -60,7 +60,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "r1,r2); in lock-step the first step waits for them all",
     )
     p.add_argument(
-        "--listen", action="append", default=[], metavar="ENDPOINT", help=f"listen here (default {DEFAULT_ENDPOINT})"
+        "--listen",
+        action="append",
+        default=[],
+        metavar="ENDPOINT",
+        help=f"listen here, repeatable (default {DEFAULT_ENDPOINT}; tls/... with --team-keys)",
     )
     p.add_argument("--connect", action="append", default=[], metavar="ENDPOINT", help="connect here (repeatable)")
     p.add_argument("--mode", choices=("peer", "client"), default="peer", help="zenoh mode (default peer)")
@@ -77,7 +81,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         type=float,
         default=1.0,
         metavar="X",
-        help="free-running: simulated seconds per wall second (default 1)",
+        help="free-running: simulated seconds per wall second (default 1; lock-step runs as fast as the agents tick)",
     )
     p.add_argument(
         "--frequency", type=float, default=30.0, metavar="HZ", help="world steps per simulated second (default 30)"
