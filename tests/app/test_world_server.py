@@ -98,6 +98,9 @@ def test_a_client_drives_its_robot_and_reads_its_sensors() -> None:
             assert rock.footprint() is not None and rock.world_mesh() is not None
             assert world.ground_truth_obstacles()
             assert world.blocker(*world.objects[rock.name].position()[:2], 0.1) == f"rock '{rock.name}'"
+            assert not world.lockstep
+            with pytest.raises(WorldError, match="not in lock-step"):
+                world.tick_done()
 
 
 def test_the_arm_of_a_remote_robot_reads_its_own_writes() -> None:
