@@ -23,7 +23,7 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import DeferredJobs, Jobs
-from alica.skills.team_poses import share_pose, team_pose
+from alica.skills.team_poses import share_pose
 from alica.worldmodel.protocol import WorldModelLike
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 
@@ -187,7 +187,6 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         it, what falls back to the world:
 
         * the skill's own robot: its pose *estimate* (what the robot knows of itself);
-        * a teammate: the pose it shared (:mod:`alica.skills.team_poses`);
         * any object or robot of the world, when the world's layout counts as
           known: no world model, or one without a team map (the blocks world,
           a skill run alone, ``alica skill run``).
@@ -212,10 +211,6 @@ class WorldSkill(py_trees.behaviour.Behaviour):
             if self._robot is not None and name == self._robot.name:
                 x, y, _ = self._robot.estimate
                 return float(x), float(y)
-            if self._world is not None and name in self._world.robots:
-                shared = team_pose(self.team_model, self._world, name)  # where the teammate said it is
-                if shared is not None:
-                    return shared.x, shared.y
             if self.mapping_mission():
                 raise SkillError(
                     f"skill '{self.name}': the world model has no pos({name}) (in a mission that maps, positions "
