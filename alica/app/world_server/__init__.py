@@ -5,7 +5,7 @@ pybullet world and serves each robot over zenoh (:mod:`.server`); an agent in
 another process opens the world with :class:`RemoteWorld` (:mod:`.client`) and
 hands it to its skills, which cannot tell it from a local
 :class:`~alica.worldsim.world.World`. The message format and its checks are in
-:mod:`.wire`.
+:mod:`.wire`; the robots, arms and objects of a remote world in :mod:`.remote`.
 
 The client's public API::
 
@@ -44,7 +44,8 @@ The client's public API::
 from __future__ import annotations
 
 from alica.app.world_server.access import world_settings
-from alica.app.world_server.client import RemoteArm, RemoteClock, RemoteRobot, RemoteThing, RemoteWorld
+from alica.app.world_server.client import RemoteClock, RemoteWorld
+from alica.app.world_server.remote import RemoteArm, RemoteRobot, RemoteThing
 from alica.app.world_server.server import ServerStats, WorldServer
 
 __all__ = [
