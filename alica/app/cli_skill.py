@@ -65,7 +65,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "with --robot, the name the factory gets (default robot)",
     )
     r.add_argument(
-        "--role", default="", help="with --robot: the role the factory gets (the unicycle takes its kind from it)"
+        "--role",
+        help="with --robot: the role the factory gets (the unicycle takes its kind from it; default: none)",
     )
     add_robot_options(r)
     r.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
@@ -142,7 +143,7 @@ def _run(args: argparse.Namespace, registry: SkillRegistry, spec: SkillSpec, par
         ) from None
     if plugin is not None and args.world is not None:
         raise AlicaError("--robot and --world both give the robot: choose one")
-    world: Any = _world(args) if plugin is None else _plugged(plugin, args.robot_name or "robot", args.role)
+    world: Any = _world(args) if plugin is None else _plugged(plugin, args.robot_name or "robot", args.role or "")
     try:
         robot = args.robot_name or ("robot" if plugin is not None else None)
         if robot is None:
