@@ -15,9 +15,12 @@ steps, so a drive command does not wait for a camera picture.
   own writes (an arm told to follow a path is busy at once).
 * **State.** After each step the server publishes the time, every robot's
   pose, estimate, flags and arm, the movable objects' geometry and pose (the
-  static ones are in the answer to ``state``), and the lidar scans agents
-  asked for: once an agent asked for a scan, its robot's lidar is cast with
-  those settings at every step.
+  static ones are in the answer to ``state``), and, free-running, the lidar
+  scans agents asked for: once an agent asked for a scan, its robot's lidar is
+  cast with those settings at every step. In lock-step a scan is cast only on
+  request (the agent's tick waits for it anyway, and skills ask for a scan a
+  few times a second at most: casting every robot's at every step cost the
+  world server most of its time).
 * **Time.** Free-running (the default) steps ``1/frequency`` simulated seconds
   every ``1/(frequency*speed)`` wall seconds. Lock-step steps once every
   connected agent has said it finished its tick (the ``tick`` call, answered
@@ -574,7 +577,8 @@ class WorldServer:
             max_range = wire.optional_number(args.get("max_range"), "max_range", 0.0, 1e4)
             with self._own_noise(robot.name):
                 ranges = np.asarray(robot.lidar(n, max_range), dtype=np.float64)
-            self._streams[robot.name] = (n, max_range)  # (from now on cast at every step)
+            if not self.lockstep:  # free-running: from now on cast at every step, for reads without a round trip
+                self._streams[robot.name] = (n, max_range)
             return {}, {"ranges": ranges}
         if call == "camera_pose":
             at = args.get("pose")
