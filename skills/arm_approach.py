@@ -131,7 +131,8 @@ class Approach:
         others = teammate_discs(skill, margin=STANDOFF_MARGIN)  # the poses teammates shared
         others += [(rx, ry, rr + STANDOFF_MARGIN) for rx, ry, rr in reservations.reserved(skill)]
         # the motion planner's own check of a goal (static obstacles, blocks, other robots)
-        checker = robot_checker(skill.world, robot, skill.world_model, skill.team_model).with_robots(others)
+        checker = robot_checker(skill.world, robot, skill.world_model, skill.team_model, skill.team_belief)
+        checker = checker.with_robots(others)
         for k in range(STANDOFF_TRIES):
             turn = ((k + 1) // 2) * (1 if k % 2 else -1) * (2.0 * math.pi / STANDOFF_TRIES)
             angle = heading + turn

@@ -481,7 +481,7 @@ class VerifyPlaced(WorldSkill):
         obj = find_object(self, self.param("object"))
         if arm.held is not None:
             return self.fail(f"the gripper still holds {_label(self, arm.held)}")
-        holder = holders(self.team_model).get(name)  # the team's holding facts
+        holder = holders(self.team_model, self.team_belief).get(name)  # the team's holding facts
         if holder is not None and holder != self.robot.name:
             return self.fail(f"{name} is in the gripper of robot '{holder}'")
         placed = PLACED.get(_scratch(self))

@@ -411,7 +411,9 @@ def _grip_or_release(skill: ArmSkill) -> str | None:
         skill.motion.release(arm)
         return None
     obj = skill.target_object()
-    holder = holders(skill.team_model).get(obj.name)  # what the team says; the gripper tells the rest
+    holder = holders(skill.team_model, skill.team_belief).get(
+        obj.name
+    )  # what the team says; the gripper tells the rest
     if holder is not None and holder != skill.robot.name:
         return f"{obj.name} was taken by robot '{holder}' before the grip"
     refusal = skill.before_grip(obj)

@@ -47,7 +47,7 @@ from py_trees.common import Status
 
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import Job
-from alica.skills.team_poses import teammates
+from alica.skills.team_poses import BeliefLike, teammates
 from alica.skills.world_skill import WorldSkill, distance, world_cache
 from alica.worldmodel.protocol import WorldModelLike
 from alica.worldsim.interface import MobileRobot, RobotWorld
@@ -151,6 +151,7 @@ def robot_checker(
     robot: MobileRobot,
     world_model: WorldModelLike | None = None,
     team_model: WorldModelLike | None = None,
+    belief: BeliefLike | None = None,
 ) -> GridChecker:
     """:func:`planning_checker` for ``robot``; in map mode without the cells of the robots' bodies.
 
@@ -169,7 +170,7 @@ def robot_checker(
     x, y, _ = robot.estimate
     bodies = [(x, y, radius + BODY_MARGIN)]
     team = team_model if team_model is not None else world_model
-    bodies += [(p.x, p.y, p.radius + BODY_MARGIN) for p in teammates(team, world, robot.name)]
+    bodies += [(p.x, p.y, p.radius + BODY_MARGIN) for p in teammates(team, world, robot.name, belief=belief)]
     return checker.with_cleared_disks(bodies)
 
 
@@ -351,7 +352,7 @@ class MoveToPosition(WorldSkill):
         In map mode without the robots' bodies' cells, and with what the robot
         bumped into on this drive (:meth:`_remember_bump`).
         """
-        checker = robot_checker(self.world, self.robot, self.map_source, self.team_model)
+        checker = robot_checker(self.world, self.robot, self.map_source, self.team_model, self.team_belief)
         if self.bumps:
             reach = checker.robot_radius + checker.margin + BUMP_RADIUS
             checker = checker.with_blocked_disks(np.array(self.bumps), reach)
@@ -397,7 +398,7 @@ class MoveToPosition(WorldSkill):
 
     def _others(self) -> list[tuple[float, float, float]]:
         """The teammates' bodies as ``(x, y, radius)``, from the poses they shared (:mod:`alica.skills.team_poses`)."""
-        return [p.disc for p in teammates(self.team_model, self.world, self.robot.name)]
+        return [p.disc for p in self.teammates()]
 
     def _replan(self) -> None:
         """Plan again to the target; in map mode the drivable point near the goal is sought again (the map changed)."""

@@ -23,10 +23,14 @@ What is not avoided:
 
 * a teammate that never shared (it ran no world skill, and the application
   does not share for it): the skills do not know it is there;
-* a teammate whose last share is older than :data:`STALE_AFTER` seconds: it
-  may have moved anywhere since. A robot that crashed stops sharing; its body
-  is still where it stopped, and in a mission that maps the team map shows it
-  (teammates' lidar sees it), which the driving skills plan around.
+* a teammate whose last share is older than :data:`STALE_AFTER` seconds while
+  the team believes it alive: it may have moved anywhere since.
+
+A teammate the team believes lost (it has a role, and ``alive(r)`` no longer
+holds in the agent's belief: crashed, or cut off) stops sharing, but its body
+stays where it stopped: its last pose is avoided however old
+(:func:`teammates` with a ``belief``). Its gripper opened when it lost power,
+so it holds nothing (:func:`holders`).
 
 A skill run without a world model (a skill test, an opponent's inner skill,
 ``alica skill run``) shares into a table kept per world instead, which every
@@ -55,9 +59,11 @@ __all__ = [
     "SHARE_PERIOD",
     "SHARE_TURN",
     "STALE_AFTER",
+    "BeliefLike",
     "TeamPose",
     "forget_local",
     "holders",
+    "lost",
     "publish_pose",
     "share_pose",
     "team_pose",
@@ -128,8 +134,7 @@ class _Skill(Protocol):
     def world(self) -> RobotWorld: ...
     @property
     def robot(self) -> MobileRobot: ...
-    @property
-    def team_model(self) -> WorldModelLike | None: ...
+    def teammates(self) -> list[TeamPose]: ...
 
 
 #: Poses shared without a world model, per world: robot -> pose.
@@ -199,13 +204,32 @@ def share_pose(
     return True
 
 
+class BeliefLike(Protocol):
+    """What the team's belief answers here: ``role(r)`` and ``alive(r)`` (the engine's agent belief)."""
+
+    def lookup(self, name: str, args: tuple[object, ...]) -> object | None: ...
+
+
+def lost(belief: BeliefLike | None, robot: str) -> bool:
+    """Whether ``belief`` counts ``robot`` as a teammate (it has a role) that is no longer alive."""
+    if belief is None:
+        return False
+    return belief.lookup("role", (robot,)) is not None and not belief.lookup("alive", (robot,))
+
+
 def teammates(
-    world_model: WorldModelLike | None, world: RobotWorld, me: str, *, max_age: float = STALE_AFTER
+    world_model: WorldModelLike | None,
+    world: RobotWorld,
+    me: str,
+    *,
+    max_age: float = STALE_AFTER,
+    belief: BeliefLike | None = None,
 ) -> list[TeamPose]:
     """The poses the other robots shared, no older than ``max_age`` seconds, sorted by name.
 
-    A robot that never shared, or whose last share is older, is not listed
-    (see the module's docstring).
+    A robot that never shared, or whose last share is older, is not listed,
+    unless ``belief`` counts it lost (:func:`lost`): its body lies where it
+    last said (see the module's docstring).
     """
     now = float(world.now())
     if world_model is None:
@@ -217,27 +241,29 @@ def teammates(
         if name == me:
             continue
         pose = team_pose(world_model, world, name)
-        if pose is not None and now - pose.time <= max_age:
+        if pose is not None and (now - pose.time <= max_age or lost(belief, name)):
             out.append(pose)
     return out
 
 
 def teammate_discs(skill: _Skill, *, margin: float = 0.0) -> list[tuple[float, float, float]]:
     """The skill's robot's teammates as ``(x, y, radius + margin)`` discs (:func:`teammates`)."""
-    return [(p.x, p.y, p.radius + margin) for p in teammates(skill.team_model, skill.world, skill.robot.name)]
+    return [(p.x, p.y, p.radius + margin) for p in skill.teammates()]
 
 
-def holders(world_model: WorldModelLike | None) -> dict[str, str]:
+def holders(world_model: WorldModelLike | None, belief: BeliefLike | None = None) -> dict[str, str]:
     """Object -> the robot that holds it, from the team's ``holding(robot, object)`` facts.
 
     The arm skills write ``holding`` when a grip succeeds and retract it when
     the object is let go (:func:`alica.skills.arm_world.write_held`); without a
-    world model nothing is known of the teammates' grippers (an empty dict).
+    world model nothing is known of the teammates' grippers (an empty dict). A
+    robot ``belief`` counts lost (:func:`lost`) holds nothing: its gripper
+    opened when it lost power.
     """
     if world_model is None:
         return {}
     out: dict[str, str] = {}
     for fact in world_model.facts():
-        if fact.predicate == "holding" and len(fact.args) == 2:
+        if fact.predicate == "holding" and len(fact.args) == 2 and not lost(belief, str(fact.args[0])):
             out[str(fact.args[1])] = str(fact.args[0])
     return out

@@ -42,7 +42,7 @@ from py_trees.common import Status
 from alica.skills import reservations
 from alica.skills.handling import inside_field
 from alica.skills.navigation import DriveToFreeSpace, lying_sites
-from alica.skills.team_poses import holders, teammates
+from alica.skills.team_poses import holders
 from alica.skills.world_skill import distance
 
 #: Radii (m) of the rings around a step's work site where a robot waits for its turn.
@@ -98,7 +98,7 @@ class WaitAside(DriveToFreeSpace):
         here = self._here()
         radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
         found: list[tuple[float, tuple[float, float]]] = []
-        held = holders(self.team_model)
+        held = holders(self.team_model, self.team_belief)
         for label in value.split():
             obj = self.world.objects.get(label)
             if obj is None or label in held or (self.robot.arm is not None and self.robot.arm.held is obj):
@@ -203,8 +203,8 @@ class WaitAside(DriveToFreeSpace):
 
     def _holders(self) -> list[tuple[float, float]]:
         """Where the other robots that hold something stand: they need room to put it down."""
-        holding = set(holders(self.team_model).values())
-        return [(p.x, p.y) for p in teammates(self.team_model, self.world, self.robot.name) if p.robot in holding]
+        holding = set(holders(self.team_model, self.team_belief).values())
+        return [(p.x, p.y) for p in self.teammates() if p.robot in holding]
 
     def _others(self) -> list[tuple[float, float, float]]:
         """The other robots, with the points teammates reserved as robots standing there (for the path too).

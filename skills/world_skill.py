@@ -23,7 +23,7 @@ from py_trees.common import Status
 from alica.errors import SkillError
 from alica.skills.context import SkillContextLike
 from alica.skills.jobs import DeferredJobs, Jobs
-from alica.skills.team_poses import share_pose
+from alica.skills.team_poses import BeliefLike, TeamPose, share_pose, teammates
 from alica.worldmodel.protocol import WorldModelLike
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 
@@ -167,6 +167,15 @@ class WorldSkill(py_trees.behaviour.Behaviour):
         :attr:`world_model`.
         """
         return self.team_source if self.team_source is not None else self.world_model
+
+    def teammates(self) -> list[TeamPose]:
+        """The poses the robot's teammates shared (:func:`alica.skills.team_poses.teammates`, with the agent's belief)."""
+        return teammates(self.team_model, self.world, self.robot.name, belief=self.team_belief)
+
+    @property
+    def team_belief(self) -> BeliefLike | None:
+        """The agent's belief (who is alive), or None outside an engine."""
+        return self.context.belief if self.context is not None else None
 
     def write(self, positive: bool, pred: str, *args: object) -> None:
         """Write an outcome fact to the world model, when there is one."""

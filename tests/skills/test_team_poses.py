@@ -186,3 +186,35 @@ def test_a_drive_past_a_teammate_that_shared_keeps_clear_of_it(two_robots):
     radii = world.robots["r1"].spec.radius + world.robots["r2"].spec.radius
     assert closest[0] > radii  # never touched
     assert not any(fact.predicate == team_poses.SHARERS for fact in run.facts)  # the team's traffic is not the skill's
+
+
+class _Belief:
+    """Who has a role, and who is alive."""
+
+    def __init__(self, roles, alive):
+        self.roles, self.alive = set(roles), set(alive)
+
+    def lookup(self, name, args):
+        if name == "role":
+            return "Role" if args[0] in self.roles else None
+        if name == "alive":
+            return args[0] in self.alive
+        return None
+
+
+def test_a_lost_teammates_last_pose_is_avoided_however_old():
+    """A crashed robot stops sharing, but its body lies where it last said."""
+    world = _World()
+    wm = WorldModel("r1")
+    share_pose(wm, world, _Robot("r2", estimate=(2.0, 0.0, 0.0)))  # type: ignore[arg-type]
+    world.t = 10 * STALE_AFTER
+    assert teammates(wm, world, "r1", belief=_Belief({"r1", "r2"}, {"r1", "r2"})) == []  # type: ignore[arg-type]
+    (seen,) = teammates(wm, world, "r1", belief=_Belief({"r1", "r2"}, {"r1"}))  # type: ignore[arg-type]
+    assert seen.robot == "r2" and seen.x == 2.0
+
+
+def test_a_lost_teammate_holds_nothing():
+    wm = WorldModel("r1")
+    wm.assert_fact("holding", "r2", "s1")
+    assert holders(wm, _Belief({"r1", "r2"}, {"r1", "r2"})) == {"s1": "r2"}
+    assert holders(wm, _Belief({"r1", "r2"}, {"r1"})) == {}  # its gripper opened when it lost power
