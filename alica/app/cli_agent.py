@@ -479,7 +479,11 @@ def _run(
         lockstep = served is not None and bool(served.lockstep)
         world_down = [False]
 
+        share = _pose_sharing(engine, robot_world, args.name)
+
         def report(now: float) -> None:
+            if share is not None:
+                share()
             if lockstep:
                 _lockstep_tick(served, args.name, world_down, stop)
             if stepped is not None:
@@ -584,6 +588,24 @@ def mission_knowledge(
             raise AlicaError(f"--value: '{item}' gives no value; write a number, a name or a list, e.g. [0, 0]")
         set_values.append((match.group(1), tuple(names), tuple(value) if isinstance(value, list) else value))
     return known, set_values
+
+
+def _pose_sharing(engine: AgentEngine, world: RobotWorld | None, name: str) -> Callable[[], None] | None:
+    """After each tick the agent shares its robot's pose estimate with the team (throttled), as robots do."""
+    if world is None or name not in world.robots:
+        return None
+    from alica.skills.team_poses import share_pose
+    from alica.worldsim.errors import WorldError
+
+    robot = world.robots[name]
+
+    def share() -> None:
+        try:
+            share_pose(engine.world_model, world, robot)
+        except WorldError:
+            pass  # a served robot that does not answer: nothing to share now
+
+    return share
 
 
 def _perception(kind: str | None, engine: AgentEngine, world: RobotWorld | None) -> Callable[[], None] | None:

@@ -321,6 +321,10 @@ def _run_team(
         perception=perception,
         agent_worlds=None if robots is None else robots.worlds,
     )
+    if world is not None or robots is not None:
+        from alica.app.run_skills import share_poses
+
+        team.after_tick(share_poses(team))
     sinks = [s for s in (trace, hub) if s is not None]
     if sinks and world is not None:
         sample = WorldTrace(

@@ -7,7 +7,7 @@ import contextlib
 import dataclasses
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from alica.errors import AlicaError
 from alica.lang.skills import SkillRegistry, SkillSpec
@@ -181,4 +181,23 @@ def run_world(
             world.close()
 
 
-__all__ = ["SkillWiring", "needs_world", "plan_skills", "run_world", "skill_wiring"]
+def share_poses(team: SimulatedTeam) -> Callable[[float], None]:
+    """A hook for ``team.after_tick``: each running agent shares its robot's pose estimate, as robots do.
+
+    A robot broadcasts where it believes it is whatever it runs; its world skills share too, but an
+    agent that runs none (one waiting for its task) would otherwise be known to its teammates only as
+    cells of their map. :func:`alica.skills.team_poses.share_pose` throttles the writes.
+    """
+    from alica.skills.team_poses import share_pose
+
+    def share(_now: float) -> None:
+        for engine in team.running():
+            world: Any = team.agent_worlds.get(engine.name, team.world)
+            robot = world.robots.get(engine.name) if world is not None else None
+            if robot is not None:
+                share_pose(engine.world_model, world, robot)
+
+    return share
+
+
+__all__ = ["SkillWiring", "needs_world", "plan_skills", "run_world", "share_poses", "skill_wiring"]

@@ -224,6 +224,7 @@ def run_demo(
     Raises:
         AlicaError: a bad configuration.
     """
+    from alica.app.run_skills import share_poses
     from alica.app.trace_world import WorldTrace, tee, world_header
     from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
@@ -306,6 +307,7 @@ def run_demo(
             alive=lambda name: name not in team.crashed and (rivals is None or name not in rivals.crashed),
         )
         sample(world.now())
+    share = share_poses(team)  # every team robot tells its team where it believes it is
     wall = time.perf_counter()
     next_report = 0.0
     satisfied = 0
@@ -317,6 +319,7 @@ def run_demo(
                 rivals.tick_agents()
             world.step(settings.period)
             now = world.now()
+            share(now)
             if sample is not None:
                 sample(now)
             if live is not None:

@@ -325,6 +325,7 @@ def run_lunar(
     Raises:
         AlicaError: a bad configuration.
     """
+    from alica.app.run_skills import share_poses
     from alica.app.trace_world import MAP_EVERY, WorldTrace, tee, world_header
     from alica.engine import JsonlTrace, SimulatedTeam, trace_header
     from alica.io import load_library
@@ -369,6 +370,7 @@ def run_lunar(
             observers=watchers,
             world=world,
         )
+        team.after_tick(share_poses(team))  # every robot tells the team where it believes it is
         base = world.objects[BASE].position()
         _mission_knowledge(team, world, (float(base[0]), float(base[1])))
         for crash in config.crashes:
