@@ -67,7 +67,7 @@ SKEW = datetime.timedelta(seconds=300)
 
 _NAME = re.compile(r"[^/*$?#\s]+")
 _DNS_LABEL = re.compile(r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,61}[A-Za-z0-9])?")
-_MESSAGES = (
+ZENOH_MESSAGES = (
     "put",
     "delete",
     "declare_subscriber",
@@ -533,7 +533,7 @@ class TeamKeys:
             )
         ca, cert, key = (str(p.resolve()) for p in (self.ca, self.cert, self.key))
         acl = self._viewer_acl(prefix) if self.name == self.center else self._member_acl(prefix)
-        acl["rules"].append(_rule("egress", "egress", _MESSAGES, ["**"]))
+        acl["rules"].append(_rule("egress", "egress", ZENOH_MESSAGES, ["**"]))
         acl["subjects"].append({"id": "everyone"})  # (a subject of no attributes: every link)
         acl["policies"].append({"id": "egress", "rules": ["egress"], "subjects": ["everyone"]})
         return {

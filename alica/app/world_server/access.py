@@ -22,6 +22,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from alica.comm.credentials import ZENOH_MESSAGES
+
 if TYPE_CHECKING:
     from alica.comm.credentials import TeamKeys
 
@@ -30,17 +32,6 @@ __all__ = ["WORLD", "world_settings"]
 WORLD = "world"
 """The world server's name in the team's credentials."""
 
-_EVERY = (
-    "put",
-    "delete",
-    "declare_subscriber",
-    "query",
-    "declare_queryable",
-    "reply",
-    "liveliness_token",
-    "declare_liveliness_subscriber",
-    "liveliness_query",
-)
 _DECLARATIONS = ("declare_subscriber", "declare_queryable", "declare_liveliness_subscriber", "liveliness_query")
 
 
@@ -64,7 +55,7 @@ def world_settings(keys: TeamKeys, prefix: str) -> dict[str, object]:
     agents = sorted(keys.members - {WORLD})
     rules = [
         _rule("declarations", _DECLARATIONS, [f"{p}/world/**"]),
-        _rule("egress", _EVERY, ["**"], flow="egress"),
+        _rule("egress", ZENOH_MESSAGES, ["**"], flow="egress"),
     ]
     subjects: list[dict[str, object]] = [
         {"id": "everyone"},
