@@ -316,7 +316,7 @@ def _fenced_main(seed: int, limit: float, out: Path) -> None:
     ("seed", "limit"),
     [
         pytest.param(3, LIMIT, id="seed3"),
-        pytest.param(1, 60.0, id="seed1"),
+        pytest.param(1, 90.0, id="seed1"),  # (about 55 s while the team had the simulator's poses, 60 s since)
     ],
 )
 def test_an_unreachable_sample_ends_in_the_alternative_plan_not_a_hang(tmp_path, seed, limit):
