@@ -181,7 +181,9 @@ def test_bad_plug_ins_and_options_get_a_clear_error(drivers, argv, message, capf
     assert "Traceback" not in err
 
 
-def test_a_crash_stops_the_plug_ins_robot(capfd):
+def test_a_crash_stops_the_plug_ins_robot(tmp_path, capfd):
+    room = tmp_path / "room.txt"  # 12 m x 12 m, walls only: the formation's spots are all free
+    room.write_text("\n".join(["#" * 48] + ["#" + "." * 46 + "#"] * 46 + ["#" * 48]), encoding="utf-8")
     code, summary = run_json(
         [
             "run",
@@ -190,6 +192,8 @@ def test_a_crash_stops_the_plug_ins_robot(capfd):
             "r1:Robot,r2:Robot,r3:Robot",
             "--robot",
             "unicycle",
+            "--robot-option",
+            f"map={room}",
             "--robot-option",
             "origin=-6,-6",
             "--robot-option",
