@@ -12,7 +12,11 @@ Skills: any skill that needs no robot; with ``--robot PLUGIN`` (a robot
 driver, :mod:`alica.app.robot_plugin`) the skills that act on a robot too; with
 ``--stand-ins`` scripted stand-ins for the others. A simulated driver (one
 whose world has ``step(seconds)``) is moved on by the wall time between two
-ticks; a hardware driver runs on its own.
+ticks; a hardware driver runs on its own. With ``--world ENDPOINT`` the robot
+is a remote one of a world server (``alica world serve``,
+:mod:`alica.app.world_server`): the agent then runs on the server's simulated
+time (``--time-limit`` and the times of ``--fact`` are simulated seconds
+since the world's start), in lock-step when the server is.
 
 With ``--json`` it prints one JSON object per line on standard output: a
 ``status`` line whenever its root plan's status changes, and a ``summary``
