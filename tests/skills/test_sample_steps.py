@@ -297,10 +297,12 @@ def test_the_pickup_and_putdown_plans_fetch_a_sample_in_the_engine(tmp_path, rob
         world.close()
 
 
-@pytest.mark.parametrize(("slips", "attempts"), [(1, 2), (3, 3)])
-def test_the_pickup_plan_retries_after_a_slip_and_gives_up_after_three_attempts(tmp_path, slips, attempts):
+def _slips_main(slips: int, tmp_path: Path) -> dict[str, Any]:
+    """FetchA with the grasp slipping ``slips`` times, until it succeeds or the Pickup plan fails: what happened."""
+    from alica.skills.motion import configure_ompl
     from alica.worldsim.faults import set_grasp_slip
 
+    configure_ompl(0)  # a fresh process: OMPL's one generator gets its seed before any planner exists
     team, world, spot = _fetch(tmp_path, "stummel", "Stummel")
     try:
         arm, wm = world.robots["stummel"].arm, team.engines["stummel"].world_model
@@ -317,12 +319,51 @@ def test_the_pickup_plan_retries_after_a_slip_and_gives_up_after_three_attempts(
                 if dropped == slips:
                     set_grasp_slip(world, 0.0)
         summary = team.summary()
-        assert dropped == slips and wm.get("attempts", "stummel") == attempts
-        if slips < 3:
-            assert summary["success"], summary
-            assert wm.holds("at", "a", "g") and engine.stats["repairs"] == 0
-        else:
-            assert engine.stats["repairs"] == 1 and not wm.holds("holding", "stummel", "a"), summary
-            assert arm.held is None and math.dist(_xy(world.objects["a"]), spot) < 0.3  # it lies where it fell
+        return {
+            "dropped": dropped,
+            "attempts": wm.get("attempts", "stummel"),
+            "success": bool(summary["success"]),
+            "summary": {k: v for k, v in summary["agents"]["stummel"].items() if k in ("status", "path", "reason")},
+            "at_g": wm.holds("at", "a", "g"),
+            "repairs": engine.stats["repairs"],
+            "holding": wm.holds("holding", "stummel", "a"),
+            "held": arm.held is not None,
+            "from_spot": math.dist(_xy(world.objects["a"]), spot),
+        }
     finally:
         world.close()
+
+
+@pytest.mark.parametrize(("slips", "attempts"), [(1, 2), (3, 3)])
+def test_the_pickup_plan_retries_after_a_slip_and_gives_up_after_three_attempts(tmp_path, slips, attempts):
+    # in a fresh process: OMPL's generator is per process, so in the test session the run would follow the
+    # tests that ran before it
+    import json
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [sys.executable, str(Path(__file__)), "slips", str(slips), str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    run = json.loads(done.stdout.strip().splitlines()[-1])
+    assert run["dropped"] == slips and run["attempts"] == attempts, run
+    if slips < 3:
+        assert run["success"], run
+        assert run["at_g"] and run["repairs"] == 0, run
+    else:
+        assert run["repairs"] == 1 and not run["holding"], run
+        assert not run["held"] and run["from_spot"] < 0.3, run  # it lies where it fell
+
+
+if __name__ == "__main__":  # a run of the slip test, in a fresh process
+    import json
+    import sys
+
+    if len(sys.argv) != 4 or sys.argv[1] != "slips":
+        sys.exit("usage: test_sample_steps.py slips N OUT")
+    print(json.dumps(_slips_main(int(sys.argv[2]), Path(sys.argv[3]))))
