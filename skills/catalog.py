@@ -480,6 +480,11 @@ def _facts(registry: SkillRegistry) -> None:
         "candidate_pos", 1, "candidate_pos(c): the position [x, y] of candidate c (DetectCircles)"
     )
     registry.declare_function(
+        "found_at",
+        1,
+        "found_at(s): when sample s was first found, in simulated seconds (ClassifySample, FuzzyDLClassify)",
+    )
+    registry.declare_function(
         "sample_kind", 1, "sample_kind(s): the kind of sample s, e.g. green-black-red (ClassifySample)"
     )
 

@@ -6,7 +6,7 @@ from typing import Any
 
 from alica.worldmodel.protocol import WorldModelLike
 
-__all__ = ["dropped_samples", "seen_on_the_ground", "stale_verdicts"]
+__all__ = ["dropped_samples", "report_found", "seen_on_the_ground", "stale_verdicts"]
 
 
 def seen_on_the_ground(wm: WorldModelLike, sample: str) -> None:
@@ -18,6 +18,21 @@ def seen_on_the_ground(wm: WorldModelLike, sample: str) -> None:
     for fact in list(wm.facts()):
         if fact.predicate == "holding" and len(fact.args) == 2 and str(fact.args[1]) == sample:
             wm.retract_fact("holding", *fact.args)
+
+
+def report_found(wm: WorldModelLike, sample: str, now: float) -> None:
+    """Write what a perception skill that recognised ``sample`` on the ground knows.
+
+    ``found(sample)`` and ``onground(sample)`` (the planning domain's fact), the time it was
+    first found as ``found_at(sample)`` (simulated seconds; kept when it is seen again, so the
+    operator can order the samples by when the team found them, not by when their facts
+    reached it), and no ``holding(r, sample)`` (:func:`seen_on_the_ground`).
+    """
+    if wm.get("found_at", sample) is None:
+        wm.set("found_at", sample, value=round(now, 3))
+    wm.assert_fact("found", sample)
+    wm.assert_fact("onground", sample)
+    seen_on_the_ground(wm, sample)
 
 
 def dropped_samples(wm: WorldModelLike | None, belief: Any) -> list[tuple[str, str, tuple[float, float]]]:

@@ -58,7 +58,7 @@ from alica.skills.pointcloud import (
     fit_cylinder,
     ransac_plane,
 )
-from alica.skills.sample_facts import seen_on_the_ground
+from alica.skills.sample_facts import report_found
 from alica.skills.world_skill import WorldSkill
 from alica.worldmodel.protocol import WorldModelLike
 
@@ -549,9 +549,7 @@ class FuzzyDLClassify(PipelineSkill):
             wm.add_object(d.sample, SAMPLE_TYPE)
             wm.set("pos", d.sample, value=(round(d.position[0], 3), round(d.position[1], 3)))
             wm.set("confidence", d.sample, value=round(d.confidence, 3))
-            wm.assert_fact("found", d.sample)
-            wm.assert_fact("onground", d.sample)  # seen standing on the ground (the planning domain's fact)
-            seen_on_the_ground(wm, d.sample)
+            report_found(wm, d.sample, self.context.now() if self.context is not None else 0.0)
 
     def _retract(self, known: list[tuple[str, tuple[float, float]]], seen: set[str]) -> list[str]:
         """Retract ``found(s)`` of known samples in clear view within ``retract_range`` that were not seen."""

@@ -37,7 +37,7 @@ from py_trees.common import Status
 
 from alica.errors import SkillError
 from alica.skills.jobs import Job
-from alica.skills.sample_facts import seen_on_the_ground, stale_verdicts
+from alica.skills.sample_facts import report_found, stale_verdicts
 from alica.skills.vision2d_data import (
     BLOBS,
     CANDIDATES,
@@ -572,9 +572,7 @@ class ClassifySample(_Pipeline):
             wm.set("sample_kind", name, value=kind)
             wm.set("pos", name, value=position)
             wm.set("confidence", name, value=confidence)
-            wm.assert_fact("found", name)
-            wm.assert_fact("onground", name)  # seen standing on the ground (the planning domain's fact)
-            seen_on_the_ground(wm, name)
+            report_found(wm, name, self.now())
             wm.retract_fact("candidate", candidate.id)
             wm.add_object(name, "Sample")
         self.memory.verdicts[candidate.id] = name

@@ -227,7 +227,11 @@ def test_the_log_shows_events_as_lines_and_hides_poses_and_map_payloads(lunar_tr
         )
         assert text == "  12.30 s  scout     transition Explore -> Return in Mission"
         _slide_to(page, "max")
-        page.wait_for_function("document.getElementById('log-body').rows.length > 10", timeout=10_000)
+        # the log is drawn once the state at the new time arrives (a fetch): wait for every event but poses and the header,
+        # the newest 500 at most (the rows of the start time, drawn before, are fewer)
+        events = [json.loads(line) for line in lunar_trace.read_text(encoding="utf-8").splitlines() if line.strip()]
+        expected = min(500, sum(1 for e in events if e["event"] not in ("pose", "trace")))  # not the header either
+        page.wait_for_function(f"document.querySelectorAll('#log-body tr.past').length === {expected}", timeout=10_000)
         rows = page.locator("#log-body tr.past")
         kinds = set(rows.evaluate_all("(rs) => rs.map((r) => r.dataset.kind)"))
         assert "pose" not in kinds and {"transition", "map"} <= kinds

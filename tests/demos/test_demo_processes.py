@@ -69,7 +69,9 @@ def test_the_mission_runs_as_processes_and_the_same_seed_repeats_its_outcome(tmp
 
 @pytest.mark.slow
 def test_a_robot_whose_agent_is_killed_crashes_and_the_others_finish_the_mission() -> None:
-    result = _result(_start("--crash", "stummel@10"))
+    # the kill lands at a world time the lock-step does not fix (the crash is the point), so runs differ: 122 to 188 s of
+    # simulated time in five runs here, and one that did not deliver within 300 s: a longer limit for the recovery
+    result = _result(_start("--crash", "stummel@10", "--time-limit", "450"))
     assert result["crashed"] == ["stummel"] and result["robots"]["stummel"]["crashed"]
     assert result["success"], (result["reason"], result["_stderr"][-2000:])
     assert result["robots"]["amparo"]["steps"] > 0  # Amparo carried what Stummel could not

@@ -242,7 +242,8 @@ class Operator:
         self.wanted = goal_samples(config.goal) if config.goal is not None else []
         self.found: dict[str, str] = {}
         self.places: dict[str, tuple[float, float]] = {}
-        self.order: list[str] = []
+        self.order: list[str] = []  # the found samples, by when they were found (found_at), then name
+        self.found_at: dict[str, float] = {}
         self.chosen: list[str] = []
         self.reason = ""
 
@@ -266,6 +267,11 @@ class Operator:
                 self.found[name] = str(kind) if kind is not None else self.found.get(name, "")
                 if isinstance(place, (tuple, list)) and len(place) == 2:
                     self.places[name] = (float(place[0]), float(place[1]))
+                when = wm.get("found_at", name)
+                if isinstance(when, (int, float)):
+                    self.found_at[name] = min(float(when), self.found_at.get(name, math.inf))
+        if not self.chosen:  # by when the team found them (then name), not by when their facts arrived (messages race)
+            self.order.sort(key=lambda s: (self.found_at[s], s) if s in self.found_at else (math.inf, ""))
         return explored
 
     def choose(self, explored: bool) -> list[str] | None:
@@ -556,10 +562,10 @@ class _Run:
     def _operate(self, now: float) -> bool:
         """The operator's second: read, and choose once; True when the run cannot go on."""
         operator = self.operator
-        known = len(operator.order)
+        known = set(operator.order)
         explored = self.read()
         if self.trace is not None:
-            for name in operator.order[known:]:
+            for name in (name for name in operator.order if name not in known):
                 x, y = operator.places.get(name, (math.nan, math.nan))
                 self.trace(
                     {
