@@ -139,7 +139,9 @@ def test_an_opponent_blocked_everywhere_it_stands_drives_elsewhere_for_room():
         feedback = [t["feedback"] for t in run.trace]
         assert any("looking for room" in f for f in feedback)
         # it put b somewhere at last (it goes on acting afterwards, so at the timeout it may hold a block again)
-        placed = [label for label, outcome, _ in behaviour.outcomes if outcome == "success" and label[:3] in ("Put", "Sta")]
+        placed = [
+            label for label, outcome, _ in behaviour.outcomes if outcome == "success" and label[:3] in ("Put", "Sta")
+        ]
         assert placed and placed[0] in ("Putdown(b)", "Stack(b, c)"), behaviour.outcomes
         assert math.dist(world.robots["o1"].pose[:2], (x, y)) > 0.5
 
