@@ -26,6 +26,7 @@ from alica.comm import QoS, Transport
 from alica.engine.allocate import Allocator
 from alica.engine.behaviours import SkillBinder
 from alica.engine.belief import AgentBelief
+from alica.engine.carry_over import CarryOver
 from alica.engine.child import ChildFactory, PlanDecision
 from alica.engine.conditions import Formulas
 from alica.engine.config import EngineConfig
@@ -34,6 +35,7 @@ from alica.engine.hosting import Children
 from alica.engine.launch import Launcher
 from alica.engine.node import NodeParts, PlanNode
 from alica.engine.parts import AgentContext
+from alica.engine.reload import Loaded, Reloads
 from alica.engine.slot import Repairs
 from alica.engine.solving import Solving
 from alica.engine.status import ChildStatus
@@ -121,6 +123,8 @@ class AgentEngine:
         }
         self.formulas = Formulas(registry, on_error=lambda text, why: self.emit("warning", formula=text, message=why))
         self.team = TeamView(name, roster, self.now(), self.config.team_timeout)
+        self.reloads = Reloads(name, library, self.config, self.team, self.emit)
+        """The team's agreement on the plan library (hot reload, :mod:`alica.engine.reload`)."""
         self.own = FactBase()
         self.belief = AgentBelief(name, world_model, self.team, self.own, self.now)
         self.scratch: dict[str, object] = {}
@@ -185,6 +189,8 @@ class AgentEngine:
             payload = envelope.payload
             if topic == TEAM_TOPIC and isinstance(payload, TeamMessage):
                 changed, revived = self.team.integrate(payload, now)
+                if payload.sender in self.team.mates:
+                    self.reloads.hear(payload.sender, payload.library, payload.proposed, payload.adopt)
                 if changed:
                     self.tree.moved()
                 if revived:
@@ -253,6 +259,9 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self.tree.invalidate_all()
+        due = self.reloads.due(now)
+        if due is not None:
+            self._adopt(due, now)
         self.world_model.refresh()  # values whose time to live ran out
         if self._world_changed:
             # utilities with summands read the world: allocate those plans again
@@ -280,6 +289,54 @@ class AgentEngine:
         delta = self.world_model.take_delta()
         if delta is not None:
             self._publish(WORLD_TOPIC, delta, QoS.RELIABLE)
+
+    # -- hot reload ---------------------------------------------------------
+
+    def reload(self, library: PlanLibrary) -> str:
+        """Adopt ``library`` with the team: at the tick every agent adopts it (see :mod:`alica.engine.reload`).
+
+        The agent goes on with the library it runs until the team agrees; its plan tree is
+        then carried over (:mod:`alica.engine.carry_over`) and the world model is untouched.
+
+        Returns:
+            The new library's digest (the running one's when nothing changed).
+
+        Raises:
+            AlicaError: the library cannot run here: it has no plan named as the root plan,
+                or it reaches an element no child runtime is configured for.
+        """
+        root = self.root_plan.name
+        if root not in library.plans:
+            raise AlicaError(
+                f"the new plans have no plan named '{root}', the root plan this agent runs: not reloaded "
+                f"(plans: {', '.join(sorted(library.plans)) or 'none'})"
+            )
+        self.children.check(library, root)
+        digest = self.reloads.propose(library, self.now())
+        self.tree.news = True  # tell the team now
+        return digest
+
+    def _adopt(self, loaded: Loaded, now: float) -> None:
+        """Switch to a library the team agreed on, carrying the plan tree over."""
+        old = self.reloads.digest
+        library = loaded.library
+        self.reloads.adopted(loaded)
+        self.library = library
+        self.root_plan = library.plans[self.root_plan.name]
+        base = self.generated.base
+        self.generated.rebase(library.rolesets.get(base.name, base))
+        self.skills.forget(loaded.changes.names("behaviour"))
+        carry = CarryOver(self.tree, loaded.changes, now, self.emit)
+        carry.apply(library, self.root)
+        self.tree.news = True
+        self.emit(
+            "reload",
+            status="adopted",
+            library=old,
+            adopted=loaded.digest,
+            changes=loaded.changes.describe(),
+            restarted=carry.restarted,
+        )
 
     def _start_root(self, now: float) -> None:
         node = self.allocator.start(None, (self.root_plan,), {"self": self.name}, now)
@@ -391,7 +448,17 @@ class AgentEngine:
             return
         tree.news = False
         self._last_broadcast = now
-        message = TeamMessage(self.name, now, self.role, tuple(tree.claims(self.root)), tree.authority(now))
+        reloads = self.reloads
+        message = TeamMessage(
+            self.name,
+            now,
+            self.role,
+            tuple(tree.claims(self.root)),
+            tree.authority(now),
+            reloads.digest,
+            reloads.proposed,
+            reloads.adopt,
+        )
         self._publish(TEAM_TOPIC, message, QoS.BEST_EFFORT)
 
     # -- trace --------------------------------------------------------------

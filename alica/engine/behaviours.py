@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import logging
 import random
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -118,6 +118,11 @@ class SkillBinder:
         self.registry = registry
         self.fallback = fallback
         self._cache: dict[str, SkillFactory] = {}
+
+    def forget(self, names: Iterable[str]) -> None:
+        """Bind the behaviours ``names`` again when they next start (their skill may have changed: a hot reload)."""
+        for name in names:
+            self._cache.pop(name, None)
 
     def factory(self, behaviour: Behaviour) -> SkillFactory:
         """The factory that builds ``behaviour``.

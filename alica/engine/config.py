@@ -54,6 +54,10 @@ class EngineConfig:
             leaves the state, nothing is retried and nothing fails upwards; a failed
             root plan ends the agent's mission. A plan restarted for want of
             teammates is not a failure and is restarted either way.
+        reload_lead: seconds from the leader's announcement that the whole team has a
+            new plan library to the tick at which every agent adopts it (hot reload,
+            :mod:`alica.engine.reload`); longer than a team message takes to arrive,
+            so that the agents switch at the same tick.
     """
 
     frequency: float = 30.0
@@ -72,6 +76,7 @@ class EngineConfig:
     children: Mapping[type, ChildKind] = field(default_factory=dict, hash=False)
     review: bool = False
     auto_failure_handling: bool = True
+    reload_lead: float = 0.5
 
     def __post_init__(self) -> None:
         positive = {
@@ -80,6 +85,7 @@ class EngineConfig:
             "team_timeout": self.team_timeout,
             "cycle_window": self.cycle_window,
             "authority_min": self.authority_min,
+            "reload_lead": self.reload_lead,
         }
         for name, value in positive.items():
             if value <= 0:

@@ -40,6 +40,11 @@ class GeneratedPlans:
             self.pins[plan.name] = pins
         self.roleset = self._with_priorities()
 
+    def rebase(self, base: RoleSet) -> None:
+        """The team's role set changed (a hot reload): allocate with ``base`` and the generated priorities."""
+        self.base = base
+        self.roleset = self._with_priorities()
+
     def unregister(self, name: str) -> None:
         """Forget a generated plan."""
         self.plans.pop(name, None)

@@ -200,7 +200,15 @@ class Children:
             self._factories.append((element_type, factory))
             if topic is not None:
                 self.routes[topic] = factory
-        for where, element in reachable_elements(agent.library, root):
+        self.check(agent.library, root)
+
+    def check(self, library: PlanLibrary, root: str) -> None:
+        """Whether every element the plan tree of ``root`` reaches in ``library`` can run here.
+
+        Raises:
+            AlicaError: an element no child kind is configured for (named, with where it is).
+        """
+        for where, element in reachable_elements(library, root):
             if not isinstance(element, (Behaviour, Plan, PlanType)) and self.factory(type(element)) is None:
                 raise AlicaError(missing_kind_message(element, where))
 

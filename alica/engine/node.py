@@ -347,20 +347,25 @@ class PlanNode:
             self.dirty = True  # free now: maybe needed for another task
         parts.tree.changed()
         for ref in model.children:
-            try:
-                env, unsolved = parts.launch.bind(self, ref), ""
-            except NoSolution as exc:
-                env, unsolved = {"self": me}, str(exc)
-            slot = Slot(self, ref, env)
-            self.slots.append(slot)
-            if unsolved:
-                slot.fail_unsolved(unsolved)  # a status the plan reacts to ('failed'), not an exception
-            elif slot.is_behaviour:
-                slot.runner = parts.launch.runner(slot)
-                slot.status = slot.runner.status
-                parts.solved.track(slot)
-            else:
-                slot.start(now)
+            self.slots.append(self.start_child(ref, now))
+
+    def start_child(self, ref: ChildRef, now: float) -> Slot:
+        """Start child ``ref`` of the current state (its variables bound now); the caller keeps the slot."""
+        parts = self.parts
+        try:
+            env, unsolved = parts.launch.bind(self, ref), ""
+        except NoSolution as exc:
+            env, unsolved = {"self": parts.ctx.name}, str(exc)
+        slot = Slot(self, ref, env)
+        if unsolved:
+            slot.fail_unsolved(unsolved)  # a status the plan reacts to ('failed'), not an exception
+        elif slot.is_behaviour:
+            slot.runner = parts.launch.runner(slot)
+            slot.status = slot.runner.status
+            parts.solved.track(slot)
+        else:
+            slot.start(now)
+        return slot
 
     def _leave_state(self) -> None:
         for slot in self.slots:

@@ -352,6 +352,31 @@ class SimulatedTeam:
         for observer in self.observers:
             observer(record)
 
+    def reload(self, library: PlanLibrary) -> str:
+        """Every running agent loads ``library`` and the team adopts it at one tick (hot reload).
+
+        The agents go on with the plans they run until they agree
+        (:mod:`alica.engine.reload`); a crashed agent that is restarted later
+        starts with ``library`` (a restarted robot reads the files it has).
+
+        Returns:
+            The new library's digest.
+
+        Raises:
+            AlicaError: the library cannot run (no plan named as the root plan, say); nothing changed.
+        """
+        running = self.running()
+        for engine in running:  # every check first: no agent proposes a library another refuses
+            if self.plan not in library.plans:
+                raise AlicaError(
+                    f"the new plans have no plan named '{self.plan}', the team's root plan: not reloaded "
+                    f"(plans: {', '.join(sorted(library.plans)) or 'none'})"
+                )
+            engine.children.check(library, self.plan)
+        digests = {engine.reload(library) for engine in running}
+        self.library = library
+        return digests.pop() if digests else ""
+
     def set_goal(self, problem: str, goal: str) -> None:
         """The operator sets the goal of planning problem ``problem`` on every agent (crashed ones too): the leader replans.
 

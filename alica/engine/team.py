@@ -68,6 +68,12 @@ class TeamMessage:
     role: str
     claims: tuple[Claim, ...]
     authority: tuple[AuthorityClaim, ...] = ()
+    library: str = ""
+    """The digest of the plan library the sender runs (hot reload: :mod:`alica.engine.reload`)."""
+    proposed: str = ""
+    """The digest of the newest library the sender loaded and waits to adopt with its team (``""``: none)."""
+    adopt: tuple[str, float] | None = None
+    """The leader's announcement: the team adopts library ``adopt[0]`` at its first tick at or after ``adopt[1]``."""
 
 
 @dataclass(slots=True)

@@ -61,6 +61,12 @@ class PlanTree:
         """Give the tree what its nodes work with (the engine does, once, after making the parts)."""
         self._parts = parts
 
+    def use(self, library: PlanLibrary) -> None:
+        """Read plans from ``library`` from now on (a hot reload; the nodes are carried over by the caller)."""
+        self.library = library
+        self._transitions.clear()
+        self.changed()
+
     # -- nodes ---------------------------------------------------------
 
     def new_node(self, key: PlanKey, slot: Slot | None, plan: Plan, env: dict[str, object], now: float) -> PlanNode:
