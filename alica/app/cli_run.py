@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 from alica.app.center.cli import add_live_options, live_session
 from alica.app.engine_options import add_engine_options, engine_arguments, engine_settings
 from alica.app.options import add_time_limit, check_output, parse_roster, time_limit
+from alica.app.plan_watch import add_watch_option
 from alica.app.robot_plugin import add_robot_options
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.team_keys import add_team_keys_option
@@ -147,6 +148,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--crash is then a kill -9, --recover a restart, --partition cuts the links between groups; "
         "times are wall seconds; with --center this process serves the team's live page",
     )
+    add_watch_option(
+        p,
+        "the team adopts a valid one at one tick and goes on where it is (hot reload), an invalid one is reported "
+        "and the team goes on unchanged; a simulated run then goes at --speed times the wall clock (default 1)",
+    )
     add_team_keys_option(p, insecure=False)
     p.set_defaults(run=cmd_run)
 
@@ -166,6 +172,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.ticks is not None and args.ticks < 0:
         raise AlicaError(f"--ticks must be >= 0, got {args.ticks}")
     time_limit(args)
+    if args.watch and not (args.speed > 0 and not math.isnan(args.speed)):
+        raise AlicaError(f"--speed must be a positive number of simulated seconds per wall second, got {args.speed}")
     if args.trace:
         check_output(args.trace, "--trace", make_folders=True)  # before any agent starts, not after the run
     session = live_session(args)
@@ -196,6 +204,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.processes:
         header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
         return _run_processes(args, plan, list(agents), wiring, header, library, session)
+    args.load_plans = lambda: load_entry(args.plan, Loader(skills=registry))[0]  # --watch, the center's reload
     if plugin is not None:
         return _run_plugged(args, library, plan, roles, wiring, plugin, session)
     with run_world(args, sorted(agents)) as (world, perception):
@@ -298,6 +307,10 @@ def _run_team(
         observers.append(
             lambda e: changed.add(e["agent"]) if e["event"] in ("transition", "allocation", "repair") else None
         )
+    if args.watch or session is not None:
+        from alica.app.plan_watch import print_reloads
+
+        observers.append(print_reloads)
     team = SimulatedTeam(
         library,
         plan,
@@ -348,9 +361,21 @@ def _run_team(
     for text in args.fact:
         what, at, _ = _timed("--fact", text)
         team.set_facts(literals(what), at=at)
+    if args.watch or session is not None:  # --watch, and the control center's reload action
+        from alica.app.plan_watch import PlanWatch, TeamReloads
+
+        reloads = TeamReloads(PlanWatch(args.plan, library, args.load_plans), team, observers)
+        if args.watch:
+            team.after_tick(reloads.look)
+        if session is not None:
+            session.reloads = reloads
     if session is not None:  # the operator's actions run and the wall clock catches up between two ticks
         session.pace(team)
         team.after_tick(lambda now: session.pace(team))
+    elif args.watch:  # an edit lands while the run goes on
+        from alica.app.pacing import WallPace
+
+        team.after_tick(WallPace(args.speed))
     try:
         if args.show_tree:
             _run_showing(team, args, changed, running_tree)
@@ -444,6 +469,8 @@ def _run_processes(
     if args.review:
         options.append("--review")
     options += engine_arguments(args)
+    if args.watch:
+        options.append("--watch")
     keys = _team_keys(args, names, session is not None)
     if keys is not None:
         options += ["--team-keys", args.team_keys]

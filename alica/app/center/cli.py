@@ -138,7 +138,7 @@ def add_live_options(parser: Any, review: bool = False) -> None:
         type=float,
         default=1.0,
         metavar="X",
-        help="with --center: simulated seconds per wall second (default 1; inf: as fast as possible)",
+        help="with --center or --watch: simulated seconds per wall second (default 1; inf: as fast as possible)",
     )
     if review:
         group.add_argument(
@@ -158,8 +158,9 @@ def live_session(args: argparse.Namespace) -> Any:
     """
     if not args.center:
         served = getattr(args, "processes", False) and getattr(args, "world", None) is not None
-        if (args.speed != 1.0 and not served) or getattr(args, "review", False):
-            raise AlicaError("--speed and --review need --center: they are settings of the control center's live run")
+        watched = getattr(args, "watch", False) and not getattr(args, "processes", False)
+        if (args.speed != 1.0 and not (served or watched)) or getattr(args, "review", False):
+            raise AlicaError("--speed and --review need --center (or --speed --watch): they are settings of a live run")
         return None
     from alica.app.center.live import LiveSession
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 from typing import Any, TextIO
 
 from alica.app.center.team_view import TeamView
+from alica.app.pacing import WallPace
 from alica.errors import AlicaError
 from alica.model import PlanLibrary
 
@@ -194,7 +195,9 @@ class LiveSession:
         self.out = out
         self.hub: LiveHub | None = None
         self.server: Any = None
-        self._start: tuple[float, float] | None = None
+        self.reloads: Any = None
+        """The run's :class:`~alica.app.plan_watch.TeamReloads`: the page's reload action loads the plan files."""
+        self._pace = WallPace(speed)
 
     def start(self, header: dict[str, Any], library: PlanLibrary) -> LiveHub:
         """Serve the page for a run with this trace header; the hub returned is the run's observer.
@@ -218,15 +221,7 @@ class LiveSession:
         self.hub.run_commands(team)
         now = team.now()
         self.hub.tick(now)
-        wall = time.monotonic()
-        if self._start is None:
-            self._start = (wall, now)
-            return
-        ahead = self._start[0] + (now - self._start[1]) / self.speed - wall
-        if ahead > 0:
-            time.sleep(ahead)  # the wall clock catches up with simulated time (a live run, not a test's wait)
-        elif ahead < -1.0:  # far behind (a slow tick): keep the pace from here instead of rushing
-            self._start = (wall, now)
+        self._pace(now)
 
     def finish(self, summary: dict[str, Any]) -> None:
         """The run is over: the page shows ``summary``; then serve until Ctrl-C or SIGTERM."""
