@@ -56,6 +56,7 @@ from typing import TYPE_CHECKING, Any
 
 from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.options import add_time_limit, check_output, time_limit
+from alica.app.plan_watch import PlanWatch, TeamReloads, add_watch_option
 from alica.app.robot_plugin import add_robot_options
 from alica.app.skill_options import add_skills_option
 from alica.app.team_keys import add_team_keys_option, team_settings
@@ -125,6 +126,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     add_team_keys_option(p)
     p.add_argument("--frequency", type=float, default=30.0, metavar="HZ", help="engine ticks per second (default 30)")
+    add_watch_option(
+        p,
+        "the agent proposes a valid one to its team and adopts it at the tick the team agrees on (hot reload: "
+        "the team switches only when every live agent has the same plans), an invalid one is reported",
+    )
     p.add_argument("--seed", type=int, default=0, help="seed of the agent's random choices (default 0)")
     p.add_argument(
         "--start-at",
@@ -263,6 +269,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
         check_output(args.trace, "--trace", make_folders=False)
     registry = skill_registry(args)
     library, entry = load_entry(args.plan, Loader(skills=registry))
+    args.load_plans = lambda: load_entry(args.plan, Loader(skills=registry))[0]  # --watch, the center's reload
     plan = args.root
     if plan is None:
         roots = [r for r in root_plans(library, entry, None) if r in library.plans]
@@ -400,7 +407,7 @@ def _run(
     sinks: list[Observer] = [trace] if trace is not None else []
 
     def observe(event: dict[str, Any]) -> None:
-        record = {**event, "t": round(event["t"] - start, 6)}  # seconds since the start
+        record = _since_start(event, start)
         for sink in sinks:
             sink(record)
 
@@ -458,17 +465,25 @@ def _run(
         status = ["running"]
 
         perceive = _perception(args.perception, engine, robot_world)
+        reloads = TeamReloads(
+            PlanWatch(args.plan, library, args.load_plans),
+            engine,
+            [lambda event: engine.emit("reload", status="invalid", errors=event["errors"])],
+        )
+        engine.observers.append(_reload_output(args.json, start))
 
         def operator(now: float) -> None:
             if perceive is not None:
                 perceive()
+            if args.watch:
+                reloads.look()
             while pending and now >= start + pending[0][0]:
                 _, literals_now = pending.pop(0)
                 for positive, pred, fact_args in literals_now:
                     (engine.world_model.assert_fact if positive else engine.world_model.retract_fact)(pred, *fact_args)
             if feed is not None:
                 for command in feed.commands():
-                    apply_command(engine, command)
+                    apply_command(engine, command, reloads.reload)
 
         for problem, goal in args.goals:
             engine.set_problem(problem, goal=goal)
@@ -686,7 +701,9 @@ def _lockstep_tick(world: Any, name: str, down: list[bool], stop: threading.Even
         down[0] = False
 
 
-def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:
+def apply_command(
+    engine: AgentEngine, command: dict[str, Any], reload: Callable[[], dict[str, Any]] | None = None
+) -> None:
     """Apply one operator's command from a control center (:class:`alica.comm.center_feed.CenterFeed`) to ``engine``.
 
     The same checks as in a simulated team (:class:`alica.engine.runner.SimulatedTeam`): a goal or a
@@ -695,7 +712,8 @@ def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:
     ``operator`` event with ``applied: true`` (so a process team's merged trace holds the operator's actions).
 
     Commands: ``{"what": "goal", "problem", "goal"}``; ``{"what": "facts", "facts": [[positive, predicate,
-    [args]], ...]}``; ``{"what": "decision", "problem", "generation", "action", "order", "pins"}``.
+    [args]], ...]}``; ``{"what": "decision", "problem", "generation", "action", "order", "pins"}``;
+    ``{"what": "reload"}`` (the agent loads its plan files again with ``reload`` and proposes them to its team).
     """
     from alica.engine import PlanDecision
     from alica.lang import literal_text
@@ -740,6 +758,11 @@ def apply_command(engine: AgentEngine, command: dict[str, Any]) -> None:
             described = decision.describe()
             what_done = described.pop("action")
             engine.emit("operator", what=what_done, problem=problem, generation=generation, applied=True, **described)
+        elif what == "reload":
+            if reload is None:
+                raise ValueError("this agent cannot load its plan files again")
+            outcome = reload()
+            engine.emit("operator", what="reload", applied=bool(outcome.get("ok")), **outcome)
         else:
             raise ValueError(f"no such operator's command: {what!r}")
     except (AlicaError, ValueError, TypeError) as exc:
@@ -786,6 +809,32 @@ def _digest(world_model: WorldModel) -> str:
     import hashlib
 
     return hashlib.blake2b(world_model.dumps().encode("utf-8"), digest_size=8).hexdigest()
+
+
+def _since_start(event: dict[str, Any], start: float) -> dict[str, Any]:
+    """A trace event with its times in seconds since the start (``t``, and a reload's ``at``)."""
+    record = {**event, "t": round(event["t"] - start, 6)}
+    if isinstance(event.get("at"), float) and event.get("event") == "reload":
+        record["at"] = round(event["at"] - start, 6)
+    return record
+
+
+def _reload_output(as_json: bool, start: float) -> Callable[[dict[str, Any]], None]:
+    """An observer that shows the agent's reload events: JSON lines with ``--json``, else lines on standard error."""
+    from alica.app.plan_watch import reload_line
+
+    def show(event: dict[str, Any]) -> None:
+        if event.get("event") != "reload":
+            return
+        record = _since_start(event, start)
+        if as_json:
+            _line(record)
+            return
+        line = reload_line(record)
+        if line is not None:
+            print(f"{record['t']:8.2f} s  {line}", file=sys.stderr, flush=True)
+
+    return show
 
 
 def _line(record: dict[str, Any]) -> None:

@@ -153,11 +153,12 @@ def invalid_event(now: float, invalid: Invalid, agent: str = "-") -> dict[str, A
 
 
 class TeamReloads:
-    """What ``--watch`` and the control center's reload action do to a simulated team.
+    """What ``--watch`` and the control center's reload action do to a team, or to one agent.
 
     Args:
         watch: the team's plan files.
-        team: the simulated team (:meth:`SimulatedTeam.reload <alica.engine.runner.SimulatedTeam.reload>`).
+        team: the simulated team (:meth:`SimulatedTeam.reload <alica.engine.runner.SimulatedTeam.reload>`), or
+            one agent's engine (``alica agent``: :meth:`AgentEngine.reload <alica.engine.agent.AgentEngine.reload>`).
         observers: the run's trace observers (an ``invalid`` event goes to them).
     """
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any, Literal
 
+from alica.app.plan_watch import reload_line
 from alica.comm.faults import describe_fault
 from alica.comm.relay import LinkRelay
 from alica.comm.zenoh_transport import free_endpoints
@@ -72,6 +73,8 @@ class _Agent:
     incarnation: int = 0
     status: str = "starting"
     summaries: list[dict[str, Any]] = field(default_factory=list)
+    reloads: list[dict[str, Any]] = field(default_factory=list)
+    """The agent's reload events (``alica agent --watch``), as its lines said them."""
     traces: list[Path] = field(default_factory=list)
     log: IO[str] | None = None
     reader: threading.Thread | None = None
@@ -196,6 +199,11 @@ class ProcessTeam:
                     agent.status = str(record.get("status"))
                 elif record.get("event") == "summary":
                     agent.summaries.append(record)
+                elif record.get("event") == "reload":
+                    agent.reloads.append(record)
+                    line = reload_line(record)
+                    if line is not None:
+                        print(f"{record.get('t', 0.0):8.2f} s  {line}", file=sys.stderr, flush=True)
 
     def run(
         self,
@@ -440,6 +448,10 @@ class ProcessTeam:
             },
             "world_models_agree": len(set(digests.values())) <= 1,
             "faults": [describe_fault(f) for f in self.faults if f["fault"] != "heal"],
+            "reloads": sorted(
+                (r for a in self.agents.values() for r in a.reloads),
+                key=lambda r: (r.get("t", 0.0), r.get("agent", "")),
+            ),
         }
 
     @staticmethod
