@@ -296,7 +296,10 @@ def _run_team(
     reasons = _Reasons()
     observers: list[Observer] = [reasons]
     header = _trace_header(args, library, plan, roles, world) if args.trace or args.center else None
-    trace = JsonlTrace(args.trace, header=header) if args.trace else None
+    # a live run's trace (--watch, --center) is written through line by line, for whoever follows it
+    trace = (
+        JsonlTrace(args.trace, header=header, line_buffered=args.watch or session is not None) if args.trace else None
+    )
     if trace is not None:
         observers.append(trace)
     hub = session.start(header, library) if session is not None and header is not None else None
