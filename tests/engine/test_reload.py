@@ -200,3 +200,42 @@ def test_a_lost_announcement_is_repeated_and_the_late_agent_switches_when_it_hea
     sim.run(ticks=60)
     assert {e["agent"] for e in trace.of("reload", status="adopted")} == {"a", "b"}
     assert where(sim, "a", 1) == ("Default", "Passed") and where(sim, "b", 1) == ("Default", "Passed")
+
+
+def _with(library, **changes):
+    """``library`` with its first document's sections changed (an edit of the shipped files, in memory)."""
+    from dataclasses import replace
+
+    from alica.model import PlanLibrary
+
+    documents = list(library.documents)
+    index = next(i for i, d in enumerate(documents) if any(getattr(d, k) for k in changes))
+    documents[index] = replace(documents[index], **{k: f(getattr(documents[index], k)) for k, f in changes.items()})
+    return PlanLibrary(tuple(documents))
+
+
+def test_a_generated_plan_stays_valid_when_its_problem_is_unchanged_and_is_made_again_when_it_changed():
+    from dataclasses import replace
+
+    from alica.model import Behaviour
+    from tests.prophet.blocks_team import BlockSkills, blocks_team, child_plan, events, goal_holds, run_until
+
+    skills = BlockSkills(ticks=6)
+    sim, rec = blocks_team(["r1", "r2"], skills, planner_expansions=1)
+    sim.tick()
+    run_until(sim, lambda: all((child_plan(sim, a) or "").startswith("StackBlocks_g1v") for a in ("r1", "r2")))
+    generated = child_plan(sim, "r1")
+    # an unrelated edit: a behaviour added; the running generated plan goes on
+    sim.reload(_with(sim.library, behaviours=lambda b: (*b, Behaviour("Wave", "Idle"))))
+    run_until(sim, lambda: len(events(rec, "reload", status="adopted")) == 2)
+    assert child_plan(sim, "r1") == generated and child_plan(sim, "r2") == generated
+    assert len(events(rec, "planner", what="started")) == 1 and events(rec, "replan") == []
+    # the problem changed (its replanning period): its runtime starts again, the leader plans anew
+    sim.reload(_with(sim.library, problems=lambda ps: tuple(replace(p, update_time=p.update_time + 1) for p in ps)))
+    run_until(sim, lambda: len(events(rec, "reload", status="adopted")) == 4)
+    adopted = events(rec, "reload", status="adopted", agent="r1")[-1]
+    assert adopted["changes"] == {"changed": ["problem StackBlocks"]}
+    assert adopted["restarted"] == ["BlocksWorldMission/Stacking/StackBlocks"]
+    summary = sim.run(until_done=True, max_time=120)
+    assert len(events(rec, "planner", what="started")) == 2
+    assert summary["success"] and goal_holds(sim, "r1")
