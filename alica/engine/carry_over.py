@@ -11,6 +11,7 @@ The tree is walked from the root; names decide what is the same:
   allocated again;
 * a state that is gone sends the agent to the initial state of its entry point
   (a ``reload`` trace note says so);
+* a plan whose synchronisations changed starts their handshakes again;
 * in the state the agent stays in, a child whose reference (name, bindings) and
   element are unchanged keeps running: a behaviour keeps its skill, a plan its
   node (carried over in turn), a planning problem its runtime and generated plan.
@@ -70,6 +71,8 @@ class CarryOver:
         node.plan = new
         if _allocation_changed(old, new):
             node.invalidate()
+        if old.synchronisations != new.synchronisations:
+            node.parts.syncs.drop(node.key)  # their handshakes start again, with the new settings
         entry_points = {ep.name for ep in new.entry_points}
         for agent, (ep, _state) in list(node.believed.items()):
             if ep is not None and ep not in entry_points:
