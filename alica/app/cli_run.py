@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     from alica.allocation import AgentSpec
     from alica.app.center.live import LiveHub, LiveSession
     from alica.app.center.team_feed import CommandLoop
+    from alica.app.plan_watch import PlanWatch
     from alica.app.processes import Fault, ProcessTeam
     from alica.app.robot_plugin import PluggedRobots, RobotPlugin
     from alica.app.run_skills import SkillWiring
@@ -372,6 +373,8 @@ def _run_team(
             team.after_tick(reloads.look)
         if session is not None:
             session.reloads = reloads
+            if session.hub is not None:  # the page's plan trees follow the library the team adopts
+                reloads.offers.append(session.hub.offer)
     if session is not None:  # the operator's actions run and the wall clock catches up between two ticks
         session.pace(team)
         team.after_tick(lambda now: session.pace(team))
@@ -662,8 +665,26 @@ class _ProcessCenter:
 
         s = self.session
         self.feed.start = self.team.start
-        hub, self.server, self.loop = start_live(self.feed, self.header, self.library, s.host, s.port, s.token, s.out)
+        hub, self.server, self.loop = start_live(
+            self.feed, self.header, self.library, s.host, s.port, s.token, s.out, plans=self._plans()
+        )
         self.hub = hub
+
+    def _plans(self) -> PlanWatch | None:
+        """The team's plan files as this process reads them, for the page's reload action and plan trees.
+
+        Loaded with the skill modules and plan folders the header records (as the page's trees are), so
+        the library's digest is the one the agents compute from the same files.
+        """
+        from alica.app.plan_entry import load_entry
+        from alica.app.plan_watch import PlanWatch
+        from alica.app.trace_sources import viewer_sources
+
+        if self.library is None:
+            return None
+        sources = viewer_sources(self.header)
+        plan = self.team.plan
+        return PlanWatch(plan, self.library, lambda: load_entry(plan, sources.loader())[0])
 
     def started(self, count: int, at: float) -> None:
         """Every agent process is up: connect to the team (the clock counts from the team's launch)."""

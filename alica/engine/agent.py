@@ -259,7 +259,10 @@ class AgentEngine:
             for who in lost:
                 self.emit("team", change="lost", who=who)
             self.tree.invalidate_all()
+        announced = self.reloads.adopt
         due = self.reloads.due(now)
+        if self.reloads.adopt is not announced:
+            self.tree.news = True  # the leader's announcement goes out in this tick's team message
         if due is not None:
             self._adopt(due, now)
         self.world_model.refresh()  # values whose time to live ran out

@@ -8,9 +8,16 @@ loop (:meth:`LiveSession.start`). :class:`LiveHub` sits between them:
   with the wall time it happened at, folded into the team's view (the same
   fold a replay uses, :class:`~alica.app.center.team_view.TeamView`) and
   handed to the server's listeners;
-* the operator's actions (a goal, facts, a decision on a proposed plan) are
-  callables queued by the server and run by :meth:`LiveSession.pace` on the team's
-  thread between two ticks, so the team is never touched from two threads.
+* the operator's actions (a goal, facts, a decision on a proposed plan, a
+  reload of the plan files) are callables queued by the server and run by
+  :meth:`LiveSession.pace` on the team's thread between two ticks, so the team
+  is never touched from two threads;
+* it serves the plan trees the pages draw, and follows a hot reload
+  (:mod:`alica.engine.reload`): the libraries given to the team are offered
+  to it (:meth:`LiveHub.offer`, kept by digest), and when a ``reload`` event
+  says an agent ``adopted`` one, the hub serves that library's trees from then
+  on and says so in its status (``plans``: the digest whose trees it serves),
+  so every page fetches them again and redraws.
 """
 
 from __future__ import annotations
@@ -33,12 +40,18 @@ from alica.app.center.team_view import TeamView
 from alica.app.pacing import WallPace
 from alica.errors import AlicaError
 from alica.model import PlanLibrary
+from alica.model.digest import library_digest
 
 CLOCK_EVERY = 0.2
 """Wall seconds between two updates that only move the pages' clock on (events are pushed as they come)."""
 
 Command = Callable[[Any], Any]
 """An operator's action: called with the team on the team's thread; what it returns goes back to the page."""
+
+KEEP_OFFERED = 8
+"""Libraries offered to a hub that it keeps until one is adopted (the newest)."""
+
+NO_TREES: dict[str, Any] = {"trees": {}, "agents": {}, "notes": []}
 
 
 @dataclass(eq=False)
@@ -56,19 +69,31 @@ class LiveHub:
     Args:
         header: the run's trace header (:func:`alica.engine.trace_header`): plans, root, agents, world.
         view: the team's state, folded event by event.
+        library: the library the team starts with, when known: its digest names the first trees served.
     """
 
-    def __init__(self, header: dict[str, Any], view: TeamView) -> None:
+    def __init__(self, header: dict[str, Any], view: TeamView, library: PlanLibrary | None = None) -> None:
         self.header = header
         self.view = view
         self.events: list[dict[str, Any]] = []
         self.walls: list[float] = []
         """The wall time (``time.time()``) at which each event reached the hub."""
-        self.status: dict[str, Any] = {"running": True, "t": 0.0, "summary": None}
+        self.status: dict[str, Any] = {
+            "running": True,
+            "t": 0.0,
+            "summary": None,
+            "plans": library_digest(library) if library is not None else None,
+        }
+        """Whether the team runs, its time, its summary once over, and ``plans``: the digest of the library whose
+        plan trees the hub serves (``None``: the plan files', digest not known)."""
+        self._trees: dict[str, Any] = dict(NO_TREES)
+        self._notes: list[str] = []
+        self._offered: dict[str, PlanLibrary] = {}
+        self._wanted: str | None = None
         self._lock = threading.Lock()
         self._listeners: set[Listener] = set()
         self._commands: queue.Queue[tuple[Command, concurrent.futures.Future[Any]]] = queue.Queue()
-        self._snapshot: tuple[tuple[int, float, bool], str] = ((-1, -1.0, True), "")
+        self._snapshot: tuple[tuple[int, float, bool, str | None], str] = ((-1, -1.0, True, None), "")
         self._clock_told = -math.inf
 
     # -- the team's side -------------------------------------------------
@@ -80,7 +105,45 @@ class LiveHub:
             self.view.apply(copy)
             self.events.append(copy)
             self.walls.append(time.time())
+            adopted = copy.get("adopted")
+            if copy.get("event") == "reload" and copy.get("status") == "adopted" and isinstance(adopted, str):
+                self._adopted(adopted)
         self._wake()
+
+    def offer(self, library: PlanLibrary) -> None:
+        """A library given to the team (:attr:`TeamReloads.offers <alica.app.plan_watch.TeamReloads.offers>`):
+        its trees are served once an agent says it adopted it (at once, if one said so already)."""
+        digest = library_digest(library)
+        with self._lock:
+            self._offered.pop(digest, None)
+            self._offered[digest] = library
+            while len(self._offered) > KEEP_OFFERED:
+                del self._offered[next(iter(self._offered))]
+            if self._wanted == digest:
+                self._adopted(digest)
+        self._wake(force=True)
+
+    def missing(self) -> str | None:
+        """The digest an agent adopted and no library offered has (a team of processes loads it then)."""
+        with self._lock:
+            return self._wanted
+
+    def _adopted(self, digest: str) -> None:
+        """An agent adopted ``digest``: serve its trees if it was offered, else wait for it (under the lock)."""
+        if digest == self.status["plans"]:
+            self._wanted = None
+            return
+        library = self._offered.get(digest)
+        if library is None:
+            self._wanted = digest
+            return
+        from alica.app.center.plan_view import entry_states, trace_trees
+
+        trees = trace_trees(self.header, ".", loaded=([library], []))
+        self._trees = {**trees, "notes": [*self._notes, *trees["notes"]]}
+        self.view.entries = entry_states([library])
+        self.status["plans"] = digest
+        self._wanted = None
 
     def tick(self, now: float) -> None:
         """The team's time moved on to ``now``; pages hear of it at most :data:`CLOCK_EVERY` wall seconds apart."""
@@ -117,6 +180,18 @@ class LiveHub:
 
     # -- the server's side -----------------------------------------------
 
+    def serve_trees(self, trees: dict[str, Any]) -> None:
+        """The plan trees to serve until a reload (:func:`~alica.app.center.plan_view.trace_trees`'s shape);
+        their notes stay with the trees of every later library."""
+        with self._lock:
+            self._trees = dict(trees)
+            self._notes = list(trees.get("notes") or [])
+
+    def trees(self) -> dict[str, Any]:
+        """The plan trees served now, with ``plans``: the digest of their library (``None``: not known)."""
+        with self._lock:
+            return {**self._trees, "plans": self.status["plans"]}
+
     def submit(self, command: Command) -> concurrent.futures.Future[Any]:
         """Queue an operator's action for the team's thread; the future holds its result or its error."""
         future: concurrent.futures.Future[Any] = concurrent.futures.Future()
@@ -148,7 +223,7 @@ class LiveHub:
     def snapshot_json(self) -> str:
         """The team's state now as JSON (computed once per change, shared by every page)."""
         with self._lock:
-            key = (len(self.events), float(self.status["t"]), bool(self.status["running"]))
+            key = (len(self.events), float(self.status["t"]), bool(self.status["running"]), self.status["plans"])
             if self._snapshot[0] != key:
                 state = self.view.snapshot()
                 state["t"] = max(float(state.get("t") or 0.0), key[1])
@@ -209,11 +284,33 @@ class LiveSession:
         from alica.app.center.plan_view import entry_states
         from alica.app.center.server import live_app, serve_in_thread
 
-        self.hub = LiveHub(header, TeamView(header, entries=entry_states([library])))
+        self.hub = LiveHub(header, TeamView(header, entries=entry_states([library])), library)
         self.server = serve_in_thread(
-            live_app(self.hub, problems(library), self.token), self.host, self.port, self.token, self.out
+            live_app(self.hub, problems(library), self.token, reload=self.reload),
+            self.host,
+            self.port,
+            self.token,
+            self.out,
         )
         return self.hub
+
+    def reload(self, team: Any) -> dict[str, Any]:
+        """The operator's reload action (on the team's thread): the plan files are loaded again and given to the team.
+
+        Returns:
+            ``{"ok": True, "digest": ...}`` (the team adopts the library when every agent has it), or
+            ``{"ok": False, "errors": ["file:line:col: ...", ...]}`` (the team goes on with its plans).
+
+        Raises:
+            AlicaError: this run has no plan files to load again (a demo builds its plans itself).
+        """
+        if self.reloads is None:
+            raise AlicaError(
+                "this run cannot load its plan files again: its plans were not loaded from files the center "
+                "watches (alica run PLAN --center can reload)"
+            )
+        result: dict[str, Any] = self.reloads.reload()
+        return result
 
     def pace(self, team: Any) -> None:
         """After a tick: the operator's actions run, the page learns the time, the wall clock catches up."""

@@ -234,8 +234,19 @@ def _update(kind: str, events: list[dict[str, Any]], walls: list[float], count: 
     )
 
 
+NO_RELOAD = (
+    "this control center cannot load the team's plan files again: it was started without them "
+    "(alica run PLAN --center and alica run --processes --center can reload)"
+)
+
+
 def live_app(
-    hub: LiveHub, known: dict[str, dict[str, Any]], token: str, trees: dict[str, Any] | None = None
+    hub: LiveHub,
+    known: dict[str, dict[str, Any]],
+    token: str,
+    trees: dict[str, Any] | None = None,
+    *,
+    reload: Callable[[Any], dict[str, Any]] | None = None,
 ) -> Starlette:
     """The app of a live team: the page, ``/ws`` (events and state as they happen), and the operator's API.
 
@@ -243,8 +254,13 @@ def live_app(
         hub: the running team's events and command queue.
         known: the planning problems the operator may set goals for (:func:`operator.problems`).
         token: the access token.
-        trees: the agents' plan trees; by default from the header's plan files (as the run's command
-            line named them), loaded with the header's skill modules and plan folders.
+        trees: the agents' plan trees before any reload (the hub serves them, then those of each library the
+            team adopts); by default from the header's plan files (as the run's command line named them),
+            loaded with the header's skill modules and plan folders.
+        reload: the operator's reload action, called with the team on the team's thread (``POST /api/reload``):
+            it loads the plan files again and gives them to the team (:meth:`LiveSession.reload
+            <alica.app.center.live.LiveSession.reload>`, :meth:`RemoteTeam.reload
+            <alica.app.center.team_feed.RemoteTeam.reload>`); without, the action says why it cannot.
     """
 
     if trees is None:
@@ -254,6 +270,7 @@ def live_app(
         sources = viewer_sources(hub.header)
         trees = trace_trees(hub.header, Path.cwd() / "live", sources.loader)
         trees["notes"] = [*sources.notes, *trees["notes"]]
+    hub.serve_trees(trees)
 
     def meta() -> dict[str, Any]:
         plans = hub.header.get("plans") or []
@@ -264,7 +281,8 @@ def live_app(
             "agents": sorted(hub.header.get("agents") or {}),
             "problems": known,
             "status": hub.status,
-            "plan_notes": trees["notes"],
+            "plan_notes": hub.trees()["notes"],
+            "reload": reload is not None,
         }
 
     async def page(request: Request) -> Response:
@@ -277,7 +295,7 @@ def live_app(
         return Response(hub.snapshot_json(), media_type="application/json")
 
     async def plan_trees(request: Request) -> Response:
-        return JSONResponse(trees)
+        return JSONResponse(hub.trees())
 
     async def events(request: Request) -> Response:
         try:
@@ -376,6 +394,15 @@ def live_app(
             return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
         return await act(lambda team: team.decide_plan(problem, generation, choice))
 
+    async def reload_plans(request: Request) -> Response:
+        try:
+            await body(request)  # nothing to say but the request's shape: a JSON object, as every action
+        except AlicaError as exc:
+            return JSONResponse({"ok": False, "error": str(exc)}, status_code=400)
+        if reload is None:
+            return JSONResponse({"ok": False, "error": NO_RELOAD}, status_code=409)
+        return await act(reload)
+
     routes = [
         Route("/", page),
         Route("/api/meta", meta_route),
@@ -386,6 +413,7 @@ def live_app(
         Route("/api/goal", goal, methods=["POST"]),
         Route("/api/facts", facts, methods=["POST"]),
         Route("/api/decide", decide, methods=["POST"]),
+        Route("/api/reload", reload_plans, methods=["POST"]),
         WebSocketRoute("/ws", feed),
         Route("/static/{name}", _static_file),
     ]

@@ -14,7 +14,12 @@ a simulated run serves:
 * :class:`RemoteTeam` is what the operator's actions act on: it checks them
   like a simulated team does, publishes them to the agents (each applies them
   between two ticks on its own thread) and puts the ``operator`` event into
-  the hub.
+  the hub. Its reload sends ``{"what": "reload"}``: each agent loads its own
+  files again and proposes them to its team. Where the center can read the
+  plan files too (``alica run --processes --center``), it loads them itself
+  and offers the library to the hub, so the page's plan trees follow once the
+  agents' events say they adopted it; the :class:`CommandLoop` loads them again
+  when the agents adopt a library the center was not offered (``--watch``).
 * :func:`serve_team` is ``alica center --team``: it waits (bounded) for a
   first agent to answer, serves the page, and runs the operator's actions
   and the clock until Ctrl-C or SIGTERM.
@@ -37,8 +42,11 @@ from alica.app.center.team_view import TeamView
 from alica.engine import PlanDecision
 from alica.errors import AlicaError
 from alica.lang.walk import literal_text
+from alica.model import PlanLibrary
+from alica.model.digest import library_digest
 
 if TYPE_CHECKING:
+    from alica.app.plan_watch import Invalid, PlanWatch
     from alica.comm.credentials import TeamKeys
 
 TICK = 0.1
@@ -58,11 +66,14 @@ class RemoteTeam:
         feed: the team's feed (its link publishes, its hub takes the ``operator`` events).
         problems: the planning problems the plan file has (``None``: the plan file did not load;
             then the agents alone check the problem's name).
+        plans: the team's plan files as this process reads them (``None``: it does not; a reload then
+            leaves the page's plan trees as they are).
     """
 
-    def __init__(self, feed: TeamFeed, problems: Iterable[str] | None) -> None:
+    def __init__(self, feed: TeamFeed, problems: Iterable[str] | None, plans: PlanWatch | None = None) -> None:
         self.feed = feed
         self.problems = None if problems is None else set(problems)
+        self.plans = plans
 
     def now(self) -> float:
         """Seconds since the team's start."""
@@ -103,6 +114,43 @@ class RemoteTeam:
         details = decision.describe()
         self._send({"what": "decision", "problem": problem, "generation": int(generation), **details})
         self._operator(str(details.pop("action")), problem=problem, generation=generation, **details)
+
+    def reload(self) -> dict[str, Any]:
+        """Every agent loads its plan files again and proposes them to its team (the operator's reload action).
+
+        Returns:
+            What the plan files are as this process reads them: ``{"ok": True, "digest": ...}`` (offered to the
+            hub: the page's plan trees switch when the agents adopt it), ``{"ok": False, "errors": [...]}``
+            (each agent reports its own in a ``reload`` event), or ``{"ok": True, "digest": None}`` when this
+            process does not read them; ``sent`` names the agents the command went to.
+
+        Raises:
+            AlicaError: no agent of the team is reached.
+        """
+        self._send({"what": "reload"})
+        self._operator("reload")
+        sent = sorted(self.feed.link.alive)
+        loaded = self.load_plans()
+        if loaded is None:
+            return {"ok": True, "digest": None, "sent": sent}
+        if isinstance(loaded, PlanLibrary):
+            return {"ok": True, "digest": library_digest(loaded), "sent": sent}
+        return {"ok": False, "errors": list(loaded.errors), "sent": sent}
+
+    def load_plans(self) -> PlanLibrary | Invalid | None:
+        """Load the plan files as this process reads them; a valid library is offered to the hub.
+
+        Returns:
+            The library, what is wrong with the files (:class:`~alica.app.plan_watch.Invalid`), or ``None``
+            when this process does not read them.
+        """
+        if self.plans is None:
+            return None
+        loaded = self.plans.reload()
+        hub = self.feed.hub
+        if isinstance(loaded, PlanLibrary) and hub is not None:
+            hub.offer(loaded)
+        return loaded
 
     def _operator(self, what: str, **fields: Any) -> None:
         self.feed.put({"t": round(self.now(), 6), "agent": "operator", "event": "operator", "what": what, **fields})
@@ -240,18 +288,27 @@ def load_problems(header: Mapping[str, Any], skills: Sequence[str] = ()) -> tupl
 
 
 class CommandLoop:
-    """A thread that runs the operator's queued actions on a :class:`RemoteTeam` and moves the pages' clock on."""
+    """A thread that runs the operator's queued actions on a :class:`RemoteTeam` and moves the pages' clock on.
+
+    When the agents adopt a library the hub was not offered (they reloaded on their own, ``--watch``), it
+    loads the plan files once for that digest (:meth:`RemoteTeam.load_plans`), so the trees follow.
+    """
 
     def __init__(self, hub: LiveHub, team: RemoteTeam) -> None:
         self.hub = hub
         self.team = team
         self.stop = threading.Event()
         self.thread = threading.Thread(target=self._run, name="alica-center-commands", daemon=True)
+        self._looked: str | None = None
 
     def _run(self) -> None:
         while not self.stop.wait(TICK):
             self.hub.run_commands(self.team)
             self.hub.tick(self.team.now())
+            missing = self.hub.missing()
+            if missing is not None and missing != self._looked:
+                self._looked = missing
+                self.team.load_plans()
 
     def start(self) -> CommandLoop:
         self.thread.start()
@@ -271,11 +328,13 @@ def start_live(
     token: str,
     out: TextIO,
     skills: Sequence[str] = (),
+    plans: PlanWatch | None = None,
 ) -> tuple[LiveHub, Any, CommandLoop]:
     """Serve the live page for ``feed``'s team: the hub (fed from then on), the server, the loop of commands.
 
     Args:
         skills: skill modules to load the plan trees with besides those the header records (``--skills``).
+        plans: the team's plan files as this process reads them (:class:`RemoteTeam`'s ``plans``).
     """
     from alica.app.center.operator import problems
     from alica.app.center.plan_view import entry_states, trace_trees
@@ -283,13 +342,16 @@ def start_live(
     from alica.app.trace_sources import viewer_sources
 
     known = problems(library) if library is not None else {}
-    hub = LiveHub(header, TeamView(header, entries=entry_states([library] if library is not None else [])))
+    hub = LiveHub(header, TeamView(header, entries=entry_states([library] if library is not None else [])), library)
     sources = viewer_sources(header, skills)
     trees = trace_trees(header, Path.cwd() / "team", sources.loader)  # the plan files as the agents named them
     trees["notes"] = [*sources.notes, *trees["notes"]]
-    server = serve_in_thread(live_app(hub, known, token, trees), host, port, token, out)
+    remote = RemoteTeam(feed, known if library is not None else None, plans)
+    server = serve_in_thread(
+        live_app(hub, known, token, trees, reload=lambda team: team.reload()), host, port, token, out
+    )
     feed.attach(hub)
-    loop = CommandLoop(hub, RemoteTeam(feed, known if library is not None else None)).start()
+    loop = CommandLoop(hub, remote).start()
     return hub, server, loop
 
 

@@ -1,12 +1,13 @@
 // The live page: a WebSocket brings a running team's events and state; the operator sets goals and facts,
-// and accepts, declines or changes the plans the leader proposes.
+// accepts, declines or changes the plans the leader proposes, and reloads the plan files. The plan trees follow
+// a reload: when the state says the hub serves another library's trees (status.plans), they are fetched again.
 "use strict";
 (function () {
   const $ = (id) => document.getElementById(id);
   const V = window.AlicaViews;
   const MAX_LOG = 500;
   const PAINT_MS = 50;  // the page is drawn at most 20 times a second
-  let meta = null, state = null, trees = null, count = 0;
+  let meta = null, state = null, trees = null, count = 0, fetchingTrees = false;
   const events = [], tracks = {}, edits = {};
   let proposals = {}, running = {}, checkSeq = 0;
   let queued = [], queuedWalls = [], painting = false, lastPaint = 0;  // events (and their hub wall times) not drawn yet
@@ -103,7 +104,25 @@
     }
     if (state.world === "blocks" && changed("blocks", state.objects)) { V.blocks($("blocks-body"), state, meta); }
     if (trees && (agentsChanged || !drawn.trees)) { V.trees($("trees-body"), state, trees); drawn.trees = true; }
+    showPlans();
     showProposals();
+  }
+
+  // The library whose trees the hub serves; when it is another than the trees drawn (a reload was adopted),
+  // the trees are fetched again and drawn at once.
+  function showPlans() {
+    const served = state.status && state.status.plans;
+    $("plans").textContent = served ? "plans " + served : "";
+    if (!served || !trees || trees.plans === served || fetchingTrees) { return; }
+    fetchingTrees = true;
+    call("api/trees").then((answer) => {
+      if (answer.status === 200) {
+        trees = answer.body;
+        drawn.trees = false;
+        $("trees-body").dataset.plans = trees.plans || "";
+        if (state) { V.trees($("trees-body"), state, trees); drawn.trees = true; }
+      }
+    }).finally(() => { fetchingTrees = false; });
   }
 
   // -- the operator ----------------------------------------------------------
@@ -149,6 +168,34 @@
     const answer = await call("api/decide", payload);
     note(answer.body.ok ? action + " sent for generation " + p.generation : "refused: " + answer.body.error,
       !answer.body.ok);
+  }
+
+  // The reload action: the plan files are loaded again; the page shows the new library's digest, or the errors
+  // with file, line and column (the team then goes on with the plans it runs).
+  async function reloadPlans() {
+    const box = $("reload-result");
+    $("reload").disabled = true;
+    try {
+      const answer = await call("api/reload", {});
+      const result = answer.body.result || {};
+      box.hidden = false;
+      if (!answer.body.ok) {
+        box.className = "check bad";
+        box.textContent = "not reloaded: " + answer.body.error;
+      } else if (result.ok) {
+        box.className = "check ok";
+        box.textContent = (result.digest ? "plans " + result.digest + " loaded" : "reload sent") +
+          (result.sent ? " (sent to " + result.sent.join(", ") + ")" : "") +
+          ": the team switches to them at one tick once every agent has them";
+      } else {
+        box.className = "check bad";
+        box.textContent = "the plan files do not load; the team goes on with the plans it runs:\n" +
+          (result.errors || []).join("\n");
+      }
+      box.dataset.outcome = answer.body.ok ? (result.ok ? "ok" : "invalid") : "refused";
+    } finally {
+      $("reload").disabled = false;
+    }
   }
 
   function move(problem, at, by) {
@@ -242,6 +289,7 @@
       const first = Object.values(meta.problems)[0];
       if (first && !$("goal").value) { $("goal").value = first.goal; }
       if (first) { checkGoal(); } else { $("goal").disabled = true; }
+      if (!meta.reload) { $("reload").title = "this control center cannot load the team's plan files again"; }
     }
     data.events.forEach(take);
     count = data.count;
@@ -291,11 +339,12 @@
 
   async function start() {
     const answer = await call("api/trees");
-    if (answer.status === 200) { trees = answer.body; }
+    if (answer.status === 200) { trees = answer.body; $("trees-body").dataset.plans = trees.plans || ""; }
     $("goal").addEventListener("input", checkGoal);
     $("problem").addEventListener("change", checkGoal);
     $("set-goal").addEventListener("click", setGoal);
     $("set-facts").addEventListener("click", setFacts);
+    $("reload").addEventListener("click", reloadPlans);
     $("filter").addEventListener("input", refilter);
     $("raw").addEventListener("change", relog);
     connect();

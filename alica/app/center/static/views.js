@@ -7,7 +7,8 @@
 //   trees(box, snapshot, trees)         each agent's plan tree (GET /api/trees), its plans and states highlighted
 //   log(tbody, events, filter, t, raw)  the events up to t (all without t), newest first, filtered by text; each a
 //                                       line of text (eventText); pose rows and map payloads only with raw
-//   eventText(event, raw)               one event as one line: "12.30 s  scout  transition Explore -> Return"
+//   eventText(event, raw)               one event as one line: "12.30 s  scout  transition Explore -> Return",
+//                                       "3.10 s  a  reload adopted dc5a… -> 0e03… (changed plan Gate)"
 //   placeLabels(items)                  label boxes that do not overlap (the map's greedy label placement)
 //   scaleLength(width)                  a round length in metres for a scale bar on a field this wide
 "use strict";
@@ -379,6 +380,28 @@
   function why(text) { return text ? ": " + text : ""; }
   function where(e) { return e.plan ? " in " + e.plan : e.key ? " in " + e.key : ""; }
 
+  // A library's digest, cut short for a line (the row's tooltip has all of it).
+  function digest(d) { return d ? String(d).slice(0, 4) + "\u2026" : "?"; }
+  // What a reload changed: "changed plan Gate; added plan Check".
+  function changes(e) {
+    const list = Object.entries(e.changes || {}).filter(([, keys]) => Array.isArray(keys) && keys.length);
+    return list.length ? " (" + list.map(([what, keys]) => what + " " + keys.join(", ")).join("; ") + ")" : "";
+  }
+
+  // A hot reload's events (alica.engine.reload): proposed, agreed, waiting, adopted, invalid, and its notes.
+  function reloadText(e) {
+    switch (e.status) {
+      case "proposed": return "reload proposed " + digest(e.library) + " -> " + digest(e.proposed) + changes(e);
+      case "agreed": return "reload agreed on " + digest(e.proposed) + " at t=" + Number(e.at).toFixed(2);
+      case "waiting": return "reload waiting: " + Object.entries(e.differ || {}).map(([a, d]) => a + " has " + digest(d)).join(", ") +
+        " (not " + digest(e.proposed) + "; the team goes on with " + digest(e.library) + ")";
+      case "adopted": return "reload adopted " + digest(e.library) + " -> " + digest(e.adopted) + changes(e) +
+        (e.restarted && e.restarted.length ? " restarted " + e.restarted.join(", ") : "");
+      case "invalid": return "reload invalid: " + (e.errors || []).join("; ");
+      default: return "reload " + (e.key ? e.key + ": " : "") + (e.note || e.status || "");
+    }
+  }
+
   // What each kind of event says, without its time and agent (the fields it leaves out follow as k=v unless noted).
   const TEXTS = {
     transition: (e) => "transition " + e.source + " -> " + e.target + where(e),
@@ -400,6 +423,7 @@
       (Array.isArray(e.origin) ? " from (" + e.origin.map(num).join(", ") + ")" : "") + (raw ? rest(e, ["width", "height", "resolution", "origin"], true) : ""),
     operator: (e, raw) => "operator " + (e.what || "facts") + rest(e, ["what"], raw),
     planner: (e, raw) => "planner " + e.what + " " + e.key + rest(e, ["what", "key"], raw),
+    reload: reloadText,
   };
 
   // One event as one line of text: "12.30 s  scout  transition Explore -> Return in Mission".
