@@ -40,34 +40,10 @@ from alica.app.pacing import WallPace
 from alica.app.plan_watch import PlanWatch, TeamReloads
 from alica.engine import EngineConfig, SimulatedTeam
 from alica.io import Loader, load_library
+from alica.io.loader import plans_dir
 from alica.model.digest import library_digest
 
-PLAN = """alica: 1
-tasks: [Default]
-rolesets:
-  - name: Crew
-    roles:
-      - name: Worker
-        priorities: {Default: 0.5}
-predicates: [go/0]
-behaviours:
-  - {name: Keep, skill: Idle}
-  - {name: Hold, skill: Idle}
-plans:
-  - name: Gate
-    entry_points: [{task: Default, state: Waiting, min: 1, max: "*"}]
-    states:
-      - name: Waiting
-        children: [Hold]
-        transitions:
-          - {to: Passed, condition: "go"}
-      - {name: Passed, kind: success}
-  - name: Top
-    entry_points: [{task: Default, state: Work, min: 1, max: "*"}]
-    states:
-      - name: Work
-        children: [Gate, Keep]
-"""
+PLAN = (plans_dir() / "examples" / "gate.yaml").read_text(encoding="utf-8")  # the hot-reload example
 WAIT = 'condition: "go"}'
 
 

@@ -17,37 +17,11 @@ from pathlib import Path
 from typing import Any
 
 from alica.comm.zenoh_transport import free_endpoints
+from tests.conftest import PLANS
 
-PLAN = """alica: 1
-tasks: [Default]
-rolesets:
-  - name: Crew
-    roles:
-      - name: Worker
-        priorities: {Default: 0.5}
-predicates: [go/0]
-behaviours:
-  - {name: Keep, skill: Idle}
-  - {name: Hold, skill: Idle}
-plans:
-  - name: Gate
-    entry_points: [{task: Default, state: Waiting, min: 1, max: "*"}]
-    states:
-      - name: Waiting
-        children: [Hold]
-        transitions:
-          - {to: Passed, condition: "go"}
-      - {name: Passed, kind: success}
-  - name: Top
-    entry_points: [{task: Default, state: Work, min: 1, max: "*"}]
-    states:
-      - name: Work
-        children: [Gate, Keep]
-        transitions:
-          - {to: Done, condition: "succeeded(Gate)"}
-      - {name: Done, kind: success}
-"""
+PLAN = (PLANS / "examples" / "gate.yaml").read_text(encoding="utf-8")  # the hot-reload example
 WAIT = 'condition: "go"}'
+WAIT_LINE = next(number for number, line in enumerate(PLAN.splitlines(), 1) if WAIT in line)
 HOLDS = 'condition: "true"}'
 TYPO = 'condition: "og"}'
 LIMIT = 60.0  # wall seconds any one run may take here
@@ -139,7 +113,7 @@ def test_a_watched_simulated_run_takes_an_edited_condition_on_both_agents_at_one
     assert json.loads(out)["success"]
     events = _events(trace)
     invalid = [e for e in events if e["event"] == "reload" and e["status"] == "invalid"]
-    assert len(invalid) == 1 and f"{plan}:19:" in invalid[0]["errors"][0] and "unknown predicate 'og'" in err
+    assert len(invalid) == 1 and f"{plan}:{WAIT_LINE}:" in invalid[0]["errors"][0] and "unknown predicate 'og'" in err
     adopted = [e for e in events if e["event"] == "reload" and e["status"] == "adopted"]
     assert {e["agent"] for e in adopted} == {"a", "b"} and len({e["t"] for e in adopted}) == 1
     assert adopted[0]["changes"] == {"changed": ["plan Gate"]} and adopted[0]["restarted"] == []
