@@ -92,6 +92,7 @@ class Reloads:
         self.mates: dict[str, tuple[str, str]] = {}
         """Teammate -> (the library it runs, the one it proposes), from its latest team message."""
         self._differ: dict[str, str] = {}
+        self._heard: dict[str, tuple[object, object]] = {}
 
     @property
     def proposed(self) -> str:
@@ -114,6 +115,9 @@ class Reloads:
 
     def hear(self, sender: str, library: object, proposed: object, adopt: object) -> None:
         """A teammate's team message: what it runs and proposes, and the leader's announcement."""
+        if adopt is None and self._heard.get(sender) == (library, proposed):
+            return  # (most messages: nothing new to check)
+        self._heard[sender] = (library, proposed)
         self.mates[sender] = (_digest_field(library), _digest_field(proposed))
         announced = _adopt_field(adopt)
         if announced is not None and announced[0] in self.loaded and announced != self.adopt:
@@ -125,6 +129,8 @@ class Reloads:
 
     def due(self, now: float) -> Loaded | None:
         """Called every tick: the library to adopt now, if any (the leader announces here)."""
+        if not self.loaded:
+            return None  # (every tick but a reload's)
         wanted = self.proposed
         if wanted and self.leads() and (self.adopt is None or self.adopt[0] != wanted):
             differ = self._differing(wanted)
