@@ -189,8 +189,6 @@ class AgentEngine:
             payload = envelope.payload
             if topic == TEAM_TOPIC and isinstance(payload, TeamMessage):
                 changed, revived = self.team.integrate(payload, now)
-                if payload.sender in self.team.mates:
-                    self.reloads.hear(payload.sender, payload.library, payload.proposed, payload.adopt)
                 if changed:
                     self.tree.moved()
                 if revived:

@@ -89,10 +89,7 @@ class Reloads:
         """Libraries loaded and not adopted yet, oldest first; the newest is proposed."""
         self.adopt: tuple[str, float] | None = None
         """The latest announcement heard or made: adopt this digest at this time."""
-        self.mates: dict[str, tuple[str, str]] = {}
-        """Teammate -> (the library it runs, the one it proposes), from its latest team message."""
         self._differ: dict[str, str] = {}
-        self._heard: dict[str, tuple[object, object]] = {}
 
     @property
     def proposed(self) -> str:
@@ -113,15 +110,21 @@ class Reloads:
         self.emit("reload", status="proposed", library=self.digest, proposed=digest, changes=changes.describe())
         return digest
 
-    def hear(self, sender: str, library: object, proposed: object, adopt: object) -> None:
-        """A teammate's team message: what it runs and proposes, and the leader's announcement."""
-        if adopt is None and self._heard.get(sender) == (library, proposed):
-            return  # (most messages: nothing new to check)
-        self._heard[sender] = (library, proposed)
-        self.mates[sender] = (_digest_field(library), _digest_field(proposed))
-        announced = _adopt_field(adopt)
-        if announced is not None and announced[0] in self.loaded and announced != self.adopt:
-            self.adopt = announced
+    def mate(self, name: str) -> tuple[str, str]:
+        """What teammate ``name``'s latest team message says it runs and proposes (``""``: nothing valid)."""
+        mate = self.team.mates.get(name)
+        if mate is None:
+            return "", ""
+        return _digest_field(mate.library), _digest_field(mate.proposed)
+
+    def _hear_announcements(self) -> None:
+        """Take a teammate's announcement of a library this agent has loaded (the team messages hold them)."""
+        for mate in self.team.mates.values():
+            if mate.adopt is None or not mate.alive:
+                continue
+            announced = _adopt_field(mate.adopt)
+            if announced is not None and announced[0] in self.loaded and announced != self.adopt:
+                self.adopt = announced
 
     def leads(self) -> bool:
         """Whether this agent leads the agreement (the alive agent with the lowest name)."""
@@ -130,7 +133,8 @@ class Reloads:
     def due(self, now: float) -> Loaded | None:
         """Called every tick: the library to adopt now, if any (the leader announces here)."""
         if not self.loaded:
-            return None  # (every tick but a reload's)
+            return None  # (every tick but a reload's: the team messages' fields are read only now)
+        self._hear_announcements()
         wanted = self.proposed
         if wanted and self.leads() and (self.adopt is None or self.adopt[0] != wanted):
             differ = self._differing(wanted)
@@ -165,7 +169,7 @@ class Reloads:
         for mate in self.team.alive():
             if mate == self.name:
                 continue
-            library, proposed = self.mates.get(mate, ("", ""))
+            library, proposed = self.mate(mate)
             if digest not in (library, proposed):
                 out[mate] = proposed or library or "unknown"
         return out

@@ -89,6 +89,11 @@ class Teammate:
     changed_at: float = float("-inf")
     departed_at: float = float("-inf")
     """When the transport last reported it gone (its liveliness token vanished)."""
+    library: object = ""
+    proposed: object = ""
+    adopt: object = None
+    """The plan library it runs and proposes, and its announcement, as its latest message said (unchecked: the
+    reader checks them, :mod:`alica.engine.reload`)."""
 
 
 class TeamView:
@@ -165,6 +170,7 @@ class TeamView:
             return set(), False
         revived = self.heard(message.sender, message.sent_at, now)
         mate.authority = message.authority
+        mate.library, mate.proposed, mate.adopt = message.library, message.proposed, message.adopt
         new = {c.key: c for c in message.claims}
         old = mate.claims or {}
         mate.claims = new
