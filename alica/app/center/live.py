@@ -16,8 +16,8 @@ loop (:meth:`LiveSession.start`). :class:`LiveHub` sits between them:
   (:mod:`alica.engine.reload`): the libraries given to the team are offered
   to it (:meth:`LiveHub.offer`, kept by digest), and when a ``reload`` event
   says an agent ``adopted`` one, the hub serves that library's trees from then
-  on and says so in its status (``plans``: the digest whose trees it serves),
-  so every page fetches them again and redraws.
+  on and says so in its snapshot (``plans``: the digest whose trees it
+  serves), so every page fetches them again and redraws.
 """
 
 from __future__ import annotations
@@ -78,14 +78,10 @@ class LiveHub:
         self.events: list[dict[str, Any]] = []
         self.walls: list[float] = []
         """The wall time (``time.time()``) at which each event reached the hub."""
-        self.status: dict[str, Any] = {
-            "running": True,
-            "t": 0.0,
-            "summary": None,
-            "plans": library_digest(library) if library is not None else None,
-        }
-        """Whether the team runs, its time, its summary once over, and ``plans``: the digest of the library whose
-        plan trees the hub serves (``None``: the plan files', digest not known)."""
+        self.status: dict[str, Any] = {"running": True, "t": 0.0, "summary": None}
+        self.plans: str | None = library_digest(library) if library is not None else None
+        """The digest of the library whose plan trees the hub serves (``None``: the plan files', digest not known);
+        the snapshot's ``plans``."""
         self._trees: dict[str, Any] = dict(NO_TREES)
         self._notes: list[str] = []
         self._offered: dict[str, PlanLibrary] = {}
@@ -130,7 +126,7 @@ class LiveHub:
 
     def _adopted(self, digest: str) -> None:
         """An agent adopted ``digest``: serve its trees if it was offered, else wait for it (under the lock)."""
-        if digest == self.status["plans"]:
+        if digest == self.plans:
             self._wanted = None
             return
         library = self._offered.get(digest)
@@ -142,7 +138,7 @@ class LiveHub:
         trees = trace_trees(self.header, ".", loaded=([library], []))
         self._trees = {**trees, "notes": [*self._notes, *trees["notes"]]}
         self.view.entries = entry_states([library])
-        self.status["plans"] = digest
+        self.plans = digest
         self._wanted = None
 
     def tick(self, now: float) -> None:
@@ -190,7 +186,7 @@ class LiveHub:
     def trees(self) -> dict[str, Any]:
         """The plan trees served now, with ``plans``: the digest of their library (``None``: not known)."""
         with self._lock:
-            return {**self._trees, "plans": self.status["plans"]}
+            return {**self._trees, "plans": self.plans}
 
     def submit(self, command: Command) -> concurrent.futures.Future[Any]:
         """Queue an operator's action for the team's thread; the future holds its result or its error."""
@@ -223,11 +219,12 @@ class LiveHub:
     def snapshot_json(self) -> str:
         """The team's state now as JSON (computed once per change, shared by every page)."""
         with self._lock:
-            key = (len(self.events), float(self.status["t"]), bool(self.status["running"]), self.status["plans"])
+            key = (len(self.events), float(self.status["t"]), bool(self.status["running"]), self.plans)
             if self._snapshot[0] != key:
                 state = self.view.snapshot()
                 state["t"] = max(float(state.get("t") or 0.0), key[1])
                 state["status"] = dict(self.status)
+                state["plans"] = self.plans
                 self._snapshot = (key, json.dumps(state))
             return self._snapshot[1]
 
@@ -281,12 +278,13 @@ class LiveSession:
             AlicaError: the address cannot be bound.
         """
         from alica.app.center.operator import problems
-        from alica.app.center.plan_view import entry_states
+        from alica.app.center.plan_view import entry_states, trace_trees
         from alica.app.center.server import live_app, serve_in_thread
 
         self.hub = LiveHub(header, TeamView(header, entries=entry_states([library])), library)
+        trees = trace_trees(header, ".", loaded=([library], []))  # the plans the team runs, as this run loaded them
         self.server = serve_in_thread(
-            live_app(self.hub, problems(library), self.token, reload=self.reload),
+            live_app(self.hub, problems(library), self.token, trees, reload=self.reload),
             self.host,
             self.port,
             self.token,

@@ -344,7 +344,10 @@ def start_live(
     known = problems(library) if library is not None else {}
     hub = LiveHub(header, TeamView(header, entries=entry_states([library] if library is not None else [])), library)
     sources = viewer_sources(header, skills)
-    trees = trace_trees(header, Path.cwd() / "team", sources.loader)  # the plan files as the agents named them
+    if plans is not None and library is not None:  # this process started the team: the plans as it loaded them
+        trees = trace_trees(header, Path.cwd() / "team", loaded=([library], []))
+    else:  # the plan files as the agents named them
+        trees = trace_trees(header, Path.cwd() / "team", sources.loader)
     trees["notes"] = [*sources.notes, *trees["notes"]]
     remote = RemoteTeam(feed, known if library is not None else None, plans)
     server = serve_in_thread(

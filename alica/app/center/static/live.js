@@ -1,6 +1,6 @@
 // The live page: a WebSocket brings a running team's events and state; the operator sets goals and facts,
 // accepts, declines or changes the plans the leader proposes, and reloads the plan files. The plan trees follow
-// a reload: when the state says the hub serves another library's trees (status.plans), they are fetched again.
+// a reload: when the state says the hub serves another library's trees (state.plans), they are fetched again.
 "use strict";
 (function () {
   const $ = (id) => document.getElementById(id);
@@ -111,7 +111,7 @@
   // The library whose trees the hub serves; when it is another than the trees drawn (a reload was adopted),
   // the trees are fetched again and drawn at once.
   function showPlans() {
-    const served = state.status && state.status.plans;
+    const served = state.plans;
     $("plans").textContent = served ? "plans " + served : "";
     if (!served || !trees || trees.plans === served || fetchingTrees) { return; }
     fetchingTrees = true;
