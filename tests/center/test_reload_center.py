@@ -345,3 +345,60 @@ def test_the_trees_of_a_watched_team_of_processes_follow_an_edit_without_the_act
         live.until_state(lambda state: state.get("plans") == adopted["adopted"], timeout=20.0)
         status, trees = live.request("api/trees")
         assert status == 200 and _gate_states(trees) == ["Waiting", "Passed", "Extra"]
+
+
+def test_a_center_that_joined_a_team_reloads_it_and_its_trees_follow(tmp_path: Path) -> None:
+    pytest.importorskip("zenoh", reason="a team of processes talks over zenoh")
+    import subprocess
+    import sys
+    import time
+
+    from alica.comm.zenoh_transport import free_endpoints
+    from tests.center.live_run import Live, stop
+    from tests.center.test_team_feed import _Lines
+
+    (tmp_path / "team.yaml").write_text(TEAM, encoding="utf-8")
+    endpoints, start = free_endpoints(2), repr(time.time())
+    processes: list[subprocess.Popen[str]] = []
+
+    def spawn(*argv: str) -> subprocess.Popen[str]:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "alica.app.cli", *argv],
+            cwd=tmp_path,  # the header names team.yaml as the agents' command lines did: the center reads it here
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+            bufsize=1,
+        )
+        processes.append(process)
+        return process
+
+    try:
+        for index, name in enumerate(("a", "b")):
+            argv = ["agent", "team.yaml", "--agents", "a:Worker,b:Worker", "--name", name, "--start-at", start]
+            argv += ["--listen", endpoints[index], "--time-limit", "120", "--json"]
+            argv += ["--connect", endpoints[0]] if index else []
+            assert json.loads(_Lines(spawn(*argv)).line(30))["event"] == "started"
+        center = spawn("center", "--team", endpoints[0], "--port", "0", "--token", TOKEN)
+        url = _Lines(center).line(30).strip()
+        assert url.startswith("http://127.0.0.1:"), url
+        live = Live(url, center)
+        try:
+            live.connect()
+            for agent in ("a", "b"):
+                live.until(lambda e, agent=agent: e.get("agent") == agent and e.get("event") == "allocation")
+            first = live.state["plans"]
+            assert first is not None  # the center loaded the header's plan file
+            (tmp_path / "team.yaml").write_text(with_extra(), encoding="utf-8")
+            status, answer = live.request("api/reload", {})
+            assert status == 200 and answer["result"]["ok"], answer
+            digest = answer["result"]["digest"]
+            assert digest != first and sorted(answer["result"]["sent"]) == ["a", "b"]
+            live.until(lambda e: e.get("event") == "reload" and e.get("status") == "adopted" and e["adopted"] == digest)
+            live.until_state(lambda state: state.get("plans") == digest, timeout=20.0)
+            assert _gate_states(live.request("api/trees")[1]) == ["Waiting", "Passed", "Extra"]
+        finally:
+            live.stack.close()
+    finally:
+        for process in processes:
+            stop(process)

@@ -328,9 +328,8 @@ def plan_roots(trace_path: str | Path) -> list[Path]:
     return roots
 
 
-def _load_library(
-    given: str, trace_path: str | Path, make_loader: Callable[[], Loader] = Loader
-) -> tuple[PlanLibrary | None, str]:
+def find_plan_file(given: str, trace_path: str | Path) -> tuple[Path | None, str]:
+    """The file a header's plan file names, among those the center may read (:func:`plan_roots`), or why none."""
     roots = plan_roots(trace_path)
     candidates = [p for p in plan_candidates(given, trace_path) if any(p.resolve().is_relative_to(r) for r in roots)]
     if not candidates:
@@ -342,8 +341,17 @@ def _load_library(
     if not tried:
         where = " or ".join(str(p) for p in candidates)
         return None, f"plan file {given} not found (looked for {where}): no plan tree from it"
+    return tried[0], ""
+
+
+def _load_library(
+    given: str, trace_path: str | Path, make_loader: Callable[[], Loader] = Loader
+) -> tuple[PlanLibrary | None, str]:
+    path, why = find_plan_file(given, trace_path)
+    if path is None:
+        return None, why
     try:
-        return make_loader().load(tried[0]), ""
+        return make_loader().load(path), ""
     except (AlicaError, OSError, ValueError) as exc:
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         return None, f"plan file {given} does not load: {first}"

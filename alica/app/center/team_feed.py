@@ -16,7 +16,8 @@ a simulated run serves:
   between two ticks on its own thread) and puts the ``operator`` event into
   the hub. Its reload sends ``{"what": "reload"}``: each agent loads its own
   files again and proposes them to its team. Where the center can read the
-  plan files too (``alica run --processes --center``), it loads them itself
+  plan files too (``alica run --processes --center``; ``alica center --team`` when
+  the header's plan file loads), it loads them itself
   and offers the library to the hub, so the page's plan trees follow once the
   agents' events say they adopted it; the :class:`CommandLoop` loads them again
   when the agents adopt a library the center was not offered (``--watch``).
@@ -287,6 +288,30 @@ def load_problems(header: Mapping[str, Any], skills: Sequence[str] = ()) -> tupl
     return library, sources.notes
 
 
+def header_plans(
+    header: Mapping[str, Any], library: PlanLibrary | None, skills: Sequence[str] = ()
+) -> PlanWatch | None:
+    """The plan file the agents' header names, as :func:`load_problems` found it, for the reload action.
+
+    ``None`` when it did not load (``library`` is ``None``): the reload then only goes to the agents.
+
+    Raises:
+        SkillPluginError: a module of ``skills`` cannot be loaded.
+    """
+    from alica.app.center.plan_view import find_plan_file
+    from alica.app.plan_watch import PlanWatch
+    from alica.app.trace_sources import viewer_sources
+
+    files = header.get("plans")
+    if library is None or not isinstance(files, list) or not files:
+        return None
+    path, _ = find_plan_file(str(files[0]), Path.cwd() / "team")
+    if path is None:
+        return None
+    sources = viewer_sources(header, skills)
+    return PlanWatch(path, library, lambda: sources.loader().load(path))
+
+
 class CommandLoop:
     """A thread that runs the operator's queued actions on a :class:`RemoteTeam` and moves the pages' clock on.
 
@@ -393,7 +418,8 @@ def serve_team(
         assert feed.header is not None
         header = dict(feed.header)
         library, notes = load_problems(header, skills)
-        hub, server, loop = start_live(feed, header, library, host, port, token, out, skills)
+        plans = header_plans(header, library, skills)
+        hub, server, loop = start_live(feed, header, library, host, port, token, out, skills, plans)
         for note in notes:
             hub({"t": round(feed.now(), 6), "agent": "-", "event": "note", "message": note})
             print(f"alica center: {note}", file=sys.stderr, flush=True)
