@@ -84,7 +84,7 @@ def test_a_second_reload_of_the_same_files_changes_nothing(tmp_path):
 
 def test_an_added_state_and_a_changed_utility_move_the_allocation(tmp_path):
     plans = """
-predicates: [go/0]
+functions: [bias/2]
 behaviours:
   - {name: Keep, skill: Work}
   - {name: Help, skill: Wait}
@@ -101,21 +101,28 @@ plans:
     lib = library(tmp_path, plans)
     keep, help_ = scripted(["running"]), scripted(["running"])
     sim, trace = team(lib, "Split", {"w": "Worker"}, {"Work": keep, "Wait": help_})
+    sim.engines["w"].own.set("bias", "w", "Help", value=1.0)  # what the world says: w is the one to help
+    sim.engines["w"].own.set("bias", "w", "Work", value=0.0)
     sim.run(ticks=5)
-    assert where(sim, "w") == ("Work", "Working")  # Worker: Work 0.9 over Help 0.4
-    # the edit: a new state Resting the Help task goes to, and a summand that makes Help worth more than Work
+    assert where(sim, "w") == ("Work", "Working")  # by priority alone: Worker has Work 0.9, Help 0.4
+    # the edit: the utility reads the bias now (Help 0.2 * 0.4 + 0.8 * 1 against Work 0.2 * 0.9), and a new
+    # state Resting follows Helping
     edited = plans.replace(
+        "    utility: {priority_weight: 1.0, threshold: 0.05}",
+        "    utility:\n      priority_weight: 0.2\n      threshold: 0.05\n"
+        '      summands: [{name: Bias, weight: 0.8, expression: "bias(self, task)"}]',
+    ).replace(
         "      - {name: Helping, children: [Help]}",
         "      - {name: Helping, children: [Help], transitions: [{to: Resting, condition: 'true'}]}\n"
         "      - {name: Resting, children: [Help]}",
-    ).replace("{task: Work, state: Working, min: 0, max: 1}", "{task: Work, state: Working, min: 0, max: 0}")
+    )
     new = _load(tmp_path, "v2", edited)
-    changes = library_changes(lib, new)
-    assert changes.changed == ("plan Split",)
+    assert library_changes(lib, new).changed == ("plan Split",)
     sim.reload(new)
     sim.run(ticks=15)
-    assert where(sim, "w") == ("Help", "Resting")
     assert trace.of("reload", status="adopted")
+    assert trace.of("allocation", agent="w")[-1]["entries"] == {"w": "Help"}
+    assert where(sim, "w") == ("Help", "Resting")
 
 
 def test_a_removed_state_sends_the_agent_to_its_entry_state_with_a_note(tmp_path):
