@@ -9,6 +9,7 @@ Every wait is bounded (Playwright's ``wait_for_*``, the WebSocket's deadlines).
 from __future__ import annotations
 
 import json
+import re
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -402,3 +403,56 @@ def test_a_center_that_joined_a_team_reloads_it_and_its_trees_follow(tmp_path: P
     finally:
         for process in processes:
             stop(process)
+
+
+@pytest.mark.optional
+def test_a_replay_shows_each_kind_of_reload_event_as_a_line(tmp_path: Path) -> None:
+    import contextlib
+
+    from tests.center.test_browser import _browser_or_skip, _page, _serve, _slide_to
+
+    _browser_or_skip()
+    old, new = "dc5abc3e56d5c033", "0e03a1f4c2b7d955"
+    header = {"t": 0.0, "agent": "-", "event": "trace", "format": "alica-trace", "version": 2}
+    header["agents"] = {"a": {"role": "Worker", "plan": "Top"}, "b": {"role": "Worker", "plan": "Top"}}
+    reload = {"agent": "a", "event": "reload"}
+    events = [
+        header,
+        {**reload, "t": 1.0, "agent": "-", "status": "invalid", "errors": ["team.yaml:19:38: error: unknown 'gox'"]},
+        {
+            **reload,
+            "t": 2.0,
+            "status": "proposed",
+            "library": old,
+            "proposed": new,
+            "changes": {"changed": ["plan Gate"]},
+        },
+        {**reload, "t": 2.5, "status": "waiting", "library": old, "proposed": new, "differ": {"b": old}},
+        {**reload, "t": 3.0, "status": "agreed", "proposed": new, "at": 3.5},
+        {
+            **reload,
+            "t": 3.5,
+            "status": "adopted",
+            "library": old,
+            "adopted": new,
+            "changes": {"changed": ["plan Gate"]},
+        },
+        {**reload, "t": 3.5, "key": "Top/Work/Gate", "note": "state Gone was removed: the agent goes to Waiting"},
+    ]
+    trace = tmp_path / "reload.jsonl"
+    trace.write_text("".join(json.dumps(e) + "\n" for e in events), encoding="utf-8")
+    with contextlib.contextmanager(_serve)("--trace", str(trace)) as url, _page(url, 1280, 900) as page:
+        _slide_to(page, "max")
+        page.wait_for_function(
+            "document.querySelectorAll('#log-body tr[data-kind=reload]').length === 6", timeout=10_000
+        )
+        rows = page.locator("#log-body tr[data-kind=reload]").all_inner_texts()
+        lines = [re.sub(r"^\s*[\d.]+ s  \S+\s+", "", row) for row in rows]  # without the time and the agent
+    assert lines[::-1] == [
+        "reload invalid: team.yaml:19:38: error: unknown 'gox'",
+        "reload proposed dc5a\u2026 -> 0e03\u2026 (changed plan Gate)",
+        "reload waiting: b has dc5a\u2026 (not 0e03\u2026; the team goes on with dc5a\u2026)",
+        "reload agreed on 0e03\u2026 at t=3.50",
+        "reload adopted dc5a\u2026 -> 0e03\u2026 (changed plan Gate)",
+        "reload Top/Work/Gate: state Gone was removed: the agent goes to Waiting",
+    ]
