@@ -52,6 +52,7 @@ KEEP_OFFERED = 8
 """Libraries offered to a hub that it keeps until one is adopted (the newest)."""
 
 NO_TREES: dict[str, Any] = {"trees": {}, "agents": {}, "notes": []}
+"""The plan trees a hub serves before it is given any (:meth:`LiveHub.serve_trees`)."""
 
 
 @dataclass(eq=False)

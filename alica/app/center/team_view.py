@@ -125,7 +125,7 @@ class TeamView:
         """An independent copy (the map, which is replaced and never changed, is shared)."""
         other = TeamView.__new__(TeamView)
         other.roles = self.roles
-        other.entries = self.entries  # never changed
+        other.entries = self.entries  # replaced after a reload (LiveHub), never changed in place
         other.world = self.world
         other.bounds = self.bounds
         other.keep_tracks = self.keep_tracks
