@@ -175,9 +175,18 @@ class TeamReloads:
         if result is not None:
             self.apply(result)
 
-    def reload(self) -> dict[str, Any]:
-        """Load the files now and give the team the result (the control center's reload action)."""
-        return self.apply(self.watch.reload())
+    def reload(self, *, by_operator: bool = False) -> dict[str, Any]:
+        """Load the files now and give the team the result (the control center's reload action).
+
+        With ``by_operator`` the run's trace gets the operator's action too (an ``operator`` event, agent
+        ``operator``, ``what: reload``, with the outcome), as the center's other actions do.
+        """
+        outcome = self.apply(self.watch.reload())
+        if by_operator:
+            event = {"t": round(self.team.now(), 6), "agent": "operator", "event": "operator", "what": "reload"}
+            for observer in self.observers:
+                observer({**event, **outcome})
+        return outcome
 
     def apply(self, result: PlanLibrary | Invalid) -> dict[str, Any]:
         """Give the team a library, or report files that do not load; returns what happened as JSON data."""

@@ -201,9 +201,9 @@ class ProcessTeam:
                     agent.summaries.append(record)
                 elif record.get("event") == "reload":
                     agent.reloads.append(record)
-                    line = reload_line(record)
-                    if line is not None:
-                        print(f"{record.get('t', 0.0):8.2f} s  {line}", file=sys.stderr, flush=True)
+                    said = reload_line(record)
+                    if said is not None:
+                        print(f"{record.get('t', 0.0):8.2f} s  {said}", file=sys.stderr, flush=True)
 
     def run(
         self,

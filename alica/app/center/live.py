@@ -308,7 +308,7 @@ class LiveSession:
                 "this run cannot load its plan files again: its plans were not loaded from files the center "
                 "watches (alica run PLAN --center can reload)"
             )
-        result: dict[str, Any] = self.reloads.reload()
+        result: dict[str, Any] = self.reloads.reload(by_operator=True)
         return result
 
     def pace(self, team: Any) -> None:
