@@ -27,37 +27,9 @@ from alica.io import Loader
 from alica.model import PlanLibrary
 from alica.model.digest import library_digest
 from tests.center.live_run import TOKEN, live_run
+from tests.conftest import PLANS
 
-TEAM = """\
-alica: 1
-tasks: [Default]
-rolesets:
-  - name: Crew
-    roles:
-      - name: Worker
-        priorities: {Default: 0.5}
-predicates: [go/0]
-behaviours:
-  - {name: Keep, skill: Idle}
-  - {name: Hold, skill: Idle}
-plans:
-  - name: Gate
-    entry_points: [{task: Default, state: Waiting, min: 1, max: "*"}]
-    states:
-      - name: Waiting
-        children: [Hold]
-        transitions:
-          - {to: Passed, condition: "go"}
-      - {name: Passed, kind: success}
-  - name: Top
-    entry_points: [{task: Default, state: Work, min: 1, max: "*"}]
-    states:
-      - name: Work
-        children: [Gate, Keep]
-        transitions:
-          - {to: Done, condition: "succeeded(Gate)"}
-      - {name: Done, kind: success}
-"""
+TEAM = (PLANS / "examples" / "gate.yaml").read_text(encoding="utf-8")  # the hot-reload example
 """Two workers wait in Gate's Waiting on ``go``, which nothing sets: the run goes on until it is stopped."""
 
 WAITING = '          - {to: Passed, condition: "go"}\n'
