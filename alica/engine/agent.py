@@ -306,6 +306,18 @@ class AgentEngine:
             AlicaError: the library cannot run here: it has no plan named as the root plan,
                 or it reaches an element no child runtime is configured for.
         """
+        self.check_library(library)
+        digest = self.reloads.propose(library, self.now())
+        self.tree.news = True  # tell the team now
+        return digest
+
+    def check_library(self, library: PlanLibrary) -> None:
+        """Whether this agent could run ``library``.
+
+        Raises:
+            AlicaError: it has no plan named as the agent's root plan, or it reaches an element no
+                child runtime is configured for.
+        """
         root = self.root_plan.name
         if root not in library.plans:
             raise AlicaError(
@@ -313,9 +325,6 @@ class AgentEngine:
                 f"(plans: {', '.join(sorted(library.plans)) or 'none'})"
             )
         self.children.check(library, root)
-        digest = self.reloads.propose(library, self.now())
-        self.tree.news = True  # tell the team now
-        return digest
 
     def _adopt(self, loaded: Loaded, now: float) -> None:
         """Switch to a library the team agreed on, carrying the plan tree over."""

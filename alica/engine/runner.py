@@ -367,12 +367,7 @@ class SimulatedTeam:
         """
         running = self.running()
         for engine in running:  # every check first: no agent proposes a library another refuses
-            if self.plan not in library.plans:
-                raise AlicaError(
-                    f"the new plans have no plan named '{self.plan}', the team's root plan: not reloaded "
-                    f"(plans: {', '.join(sorted(library.plans)) or 'none'})"
-                )
-            engine.children.check(library, self.plan)
+            engine.check_library(library)
         digests = {engine.reload(library) for engine in running}
         self.library = library
         return digests.pop() if digests else ""

@@ -59,7 +59,17 @@ class FakeRos2:
         self.domain = domain
         self.received: list[Received] = []
         self._lock = threading.Lock()
-        self._handles: list[object] = []
+        self._events = threading.Condition()
+        self._generation = 0
+        """Moves on with every sample and every token that comes or goes: :meth:`wait` wakes on it."""
+        self._handles: list[object] = [
+            self.session.liveliness().declare_subscriber(f"@ros2_lv/{domain}/**", lambda _sample: self._moved())
+        ]
+
+    def _moved(self) -> None:
+        with self._events:
+            self._generation += 1
+            self._events.notify_all()
 
     def subscribe(self, key: str, *, history: bool = False) -> None:
         """Subscribe to a data key, e.g. ``0/robot1/pose/geometry_msgs::msg::dds_::PoseStamped_/*``."""
@@ -70,6 +80,7 @@ class FakeRos2:
             gid = raw[17 : 17 + raw[16]]
             with self._lock:
                 self.received.append(Received(str(sample.key_expr), sample.payload.to_bytes(), sequence, stamp, gid))
+            self._moved()
 
         if history:
             self._handles.append(
@@ -105,11 +116,18 @@ class FakeRos2:
         return found
 
     def wait(self, condition: Callable[[], bool], timeout: float = 5.0) -> bool:
+        """Whether ``condition`` holds within ``timeout`` s: looked at again whenever a sample or a token arrives."""
         deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
+        while True:
+            with self._events:
+                seen = self._generation
             if condition():
                 return True
-            time.sleep(0.02)
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return False
+            with self._events:
+                self._events.wait_for(lambda: self._generation != seen, remaining)
         return condition()
 
     def close(self) -> None:

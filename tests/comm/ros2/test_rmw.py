@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Iterator
 
@@ -144,7 +145,7 @@ def test_a_published_pose_reaches_the_fake_node_with_key_attachment_and_payload(
     deadline = time.monotonic() + 5
     while not fake.received and time.monotonic() < deadline:  # the subscription may take a moment to match
         publisher.put(payload, timestamp_ns=1000)
-        time.sleep(0.05)
+        fake.wait(lambda: bool(fake.received), 0.05)
     first = len(fake.received)
     assert first >= 1
     publisher.put(payload, timestamp_ns=2000)
@@ -199,7 +200,13 @@ def test_a_latched_message_reaches_a_late_subscriber(net: tuple[Ros2Node, FakeRo
 def test_a_subscriber_receives_and_drops_malformed_attachments(net: tuple[Ros2Node, FakeRos2]) -> None:
     node, fake = net
     got: list[tuple[bytes, tuple[int, int, bytes] | None]] = []
-    node.subscribe("goal", "std_msgs::msg::dds_::String_", "TypeHashNotSupported", lambda p, m: got.append((p, m)))
+    arrived = threading.Event()
+
+    def take(payload: bytes, meta: tuple[int, int, bytes] | None) -> None:
+        got.append((payload, meta))
+        arrived.set()
+
+    node.subscribe("goal", "std_msgs::msg::dds_::String_", "TypeHashNotSupported", take)
     assert fake.wait(lambda: any(e.type_hash == "TypeHashNotSupported" for e in fake.endpoints()))
     key = "0/robot1/goal/std_msgs::msg::dds_::String_/TypeHashNotSupported"
     deadline = time.monotonic() + 5
@@ -207,7 +214,7 @@ def test_a_subscriber_receives_and_drops_malformed_attachments(net: tuple[Ros2No
     while not got and time.monotonic() < deadline:
         sequence += 1
         fake.put(key, b"\x00\x01\x00\x00goal", fake_attachment(sequence, 42, GID))
-        time.sleep(0.05)
+        arrived.wait(0.05)  # wakes as soon as it arrives
     assert got and got[0] == (b"\x00\x01\x00\x00goal", (sequence, 42, GID))
     count = len(got)
     fake.put(key, b"bad", b"\x01\x02\x03")
