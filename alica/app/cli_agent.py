@@ -44,6 +44,7 @@ the agent stops (time limit, Ctrl-C, SIGTERM), 2 wrong usage.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import re
@@ -58,6 +59,7 @@ from alica.app.engine_options import add_engine_options, engine_settings
 from alica.app.options import add_time_limit, check_output, time_limit
 from alica.app.plan_watch import PlanWatch, TeamReloads, add_watch_option
 from alica.app.robot_plugin import add_robot_options
+from alica.app.ros2_options import add_ros2_options, check_ros2, ros2_output
 from alica.app.skill_options import add_skills_option
 from alica.app.team_keys import add_team_keys_option, team_settings
 from alica.app.timed import timed
@@ -132,6 +134,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "the team switches only when every live agent has the same plans), an invalid one is reported",
     )
     p.add_argument("--seed", type=int, default=0, help="seed of the agent's random choices (default 0)")
+    add_ros2_options(p)
     p.add_argument(
         "--start-at",
         type=float,
@@ -267,6 +270,7 @@ def cmd_agent(args: argparse.Namespace) -> int:
             ) from None
     if args.trace:
         check_output(args.trace, "--trace", make_folders=False)
+    check_ros2(args)
     registry = skill_registry(args)
     library, entry = load_entry(args.plan, Loader(skills=registry))
     args.load_plans = lambda: load_entry(args.plan, Loader(skills=registry))[0]  # --watch, the center's reload
@@ -442,7 +446,10 @@ def _run(
             raise
         sinks.append(feed)
     fallback = default_fallback(args.seed, registry=wiring.registry) if args.stand_ins else None
+    closing = contextlib.ExitStack()
     try:
+        # --ros2, --record: stamped with the clock's time (the wall clock's epoch seconds; a served world's seconds)
+        ros2 = closing.enter_context(ros2_output(args))
         world_model = WorldModel(args.name, clock=clock, relay=False)
         engine = AgentEngine(
             args.name,
@@ -499,10 +506,14 @@ def _run(
         world_down = [False]
 
         share = _pose_sharing(engine, robot_world, args.name)
+        own_robot = robot_world.robots.get(args.name) if robot_world is not None else None
+        publish = ros2.attach_agent(engine, own_robot, library) if ros2 is not None else None
 
         def report(now: float) -> None:
             if share is not None:
                 share()
+            if publish is not None:
+                publish(now)
             if lockstep:
                 _lockstep_tick(served, args.name, world_down, stop)
             if stepped is not None:
@@ -551,6 +562,7 @@ def _run(
             world_facts=[str(fact) for fact in engine.world_model.facts()],
         )
     finally:
+        closing.close()
         if feed is not None:
             feed.close()
         transport.close()

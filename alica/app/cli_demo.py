@@ -23,6 +23,7 @@ from alica.app.options import (
     parse_roster,
     time_limit,
 )
+from alica.app.ros2_options import add_ros2_options, check_ros2, ros2_arguments, ros2_output
 from alica.app.timed import add_fault_options, add_network_options, partition, timed
 from alica.errors import AlicaError
 
@@ -69,6 +70,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     b.add_argument("--json", action="store_true", help="print the summary as JSON")
     b.add_argument("--gui", action="store_true", help="show the pybullet window")
     add_live_options(b)
+    add_ros2_options(b)
     b.add_argument(
         "--no-progress",
         action="store_true",
@@ -133,6 +135,7 @@ def _add_lunar(demos: argparse._SubParsersAction[argparse.ArgumentParser]) -> No
     lunar.add_argument("--json", action="store_true", help="print the summary as JSON")
     lunar.add_argument("--gui", action="store_true", help="show the pybullet window")
     add_live_options(lunar)
+    add_ros2_options(lunar)
     lunar.add_argument(
         "--no-progress", action="store_true", help="no progress line (none when standard error is not a terminal)"
     )
@@ -212,6 +215,7 @@ def cmd_lunar(args: argparse.Namespace) -> int:
         raise AlicaError(
             "--processes runs the world in a server without a window or a live page: leave out --gui and --center"
         )
+    check_ros2(args)
     session = live_session(args)
     progress = LunarProgress(sys.stderr) if sys.stderr.isatty() and not args.no_progress else None
     out = Path(args.out) if args.out else None
@@ -219,9 +223,10 @@ def cmd_lunar(args: argparse.Namespace) -> int:
         if args.processes:
             from alica.app.demos.lunar_processes import run_lunar_processes
 
-            result = run_lunar_processes(config, on_second=progress, out=out)
+            result = run_lunar_processes(config, on_second=progress, out=out, ros2=ros2_arguments(args))
         else:
-            result = run_lunar(config, on_second=progress, out=out, gui=args.gui, live=session)
+            with ros2_output(args) as ros2:
+                result = run_lunar(config, on_second=progress, out=out, gui=args.gui, live=session, ros2=ros2)
     finally:
         if progress is not None:
             progress.close()
@@ -352,6 +357,7 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         raise AlicaError(
             "--processes runs the world in a server without a window or a live page: leave out --gui and --center"
         )
+    check_ros2(args)
     session = live_session(args)
     progress = Progress(sys.stderr, args.time_limit) if sys.stderr.isatty() and not args.no_progress else None
     out = Path(args.out) if args.out else None
@@ -359,9 +365,12 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         if args.processes:
             from alica.app.demos.blocks_processes import run_demo_processes
 
-            result = run_demo_processes(config, on_second=progress, actions=actions, out=out)
+            result = run_demo_processes(config, on_second=progress, actions=actions, out=out, ros2=ros2_arguments(args))
         else:
-            result = run_demo(config, on_second=progress, actions=actions, out=out, gui=args.gui, live=session)
+            with ros2_output(args) as ros2:
+                result = run_demo(
+                    config, on_second=progress, actions=actions, out=out, gui=args.gui, live=session, ros2=ros2
+                )
     finally:
         if progress is not None:
             progress.close()

@@ -21,6 +21,7 @@ from alica.app.engine_options import add_engine_options, engine_arguments, engin
 from alica.app.options import add_time_limit, check_output, parse_roster, time_limit
 from alica.app.plan_watch import add_watch_option
 from alica.app.robot_plugin import add_robot_options
+from alica.app.ros2_options import add_ros2_options, check_ros2, ros2_arguments, ros2_output
 from alica.app.skill_options import add_lunar_options, add_skills_option
 from alica.app.team_keys import add_team_keys_option
 from alica.app.timed import add_fault_options, add_network_options, partition
@@ -155,6 +156,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "and the team goes on unchanged; a simulated run then goes at --speed times the wall clock (default 1)",
     )
     add_team_keys_option(p, insecure=False)
+    add_ros2_options(p)
     p.set_defaults(run=cmd_run)
 
 
@@ -177,6 +179,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise AlicaError(f"--speed must be a positive number of simulated seconds per wall second, got {args.speed}")
     if args.trace:
         check_output(args.trace, "--trace", make_folders=True)  # before any agent starts, not after the run
+    check_ros2(args)
     session = live_session(args)
     if args.center and args.show_tree:
         raise AlicaError("--center shows the team in a web page; it does not go with --show-tree")
@@ -206,10 +209,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         header = _trace_header(args, library, plan, roles, None) if args.trace or args.center else None
         return _run_processes(args, plan, list(agents), wiring, header, library, session)
     args.load_plans = lambda: load_entry(args.plan, Loader(skills=registry))[0]  # --watch, the center's reload
-    if plugin is not None:
-        return _run_plugged(args, library, plan, roles, wiring, plugin, session)
-    with run_world(args, sorted(agents)) as (world, perception):
-        return _run_team(args, library, plan, roles, wiring, world, perception, session)
+    with ros2_output(args) as args.ros2_output:  # --ros2, --record: the team's topics after every tick
+        if plugin is not None:
+            return _run_plugged(args, library, plan, roles, wiring, plugin, session)
+        with run_world(args, sorted(agents)) as (world, perception):
+            return _run_team(args, library, plan, roles, wiring, world, perception, session)
 
 
 def _run_plugged(
@@ -353,6 +357,8 @@ def _run_team(
         )
         sample(team.now())
         team.after_tick(sample)
+    if args.ros2_output is not None:
+        args.ros2_output.attach_team(team, library)
     for text in args.crash:
         who, at, _ = _timed("--crash", text)
         team.crash(who, at=at)
@@ -516,6 +522,7 @@ def _launch_processes(
             relays=bool(args.partition),
             deadline=args.time_limit,
             tls=keys is not None,
+            per_incarnation=ros2.for_agent if (ros2 := ros2_arguments(args)) is not None else None,
         )
         live = _ProcessCenter(session, team, header, library, keys) if session is not None else None
         interrupted = False

@@ -18,6 +18,7 @@ from types import FrameType
 from typing import TYPE_CHECKING
 
 from alica.app.plan_entry import EXIT_OK, EXIT_USAGE
+from alica.app.ros2_options import add_ros2_options, ros2_output
 
 if TYPE_CHECKING:
     from alica.app.world_server import WorldServer
@@ -89,6 +90,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument("--duration", type=float, metavar="S", help="stop after S wall seconds (default: run until stopped)")
     add_team_keys_option(p)
     p.add_argument("--json", action="store_true", help="print the start and end lines as JSON")
+    add_ros2_options(p, record=False)
     p.set_defaults(run=cmd_world_serve)
 
 
@@ -108,6 +110,8 @@ def cmd_world_serve(args: argparse.Namespace) -> int:
         else:
             agents = ["r1", "r2"] if args.world == "blocks" else []
         default = DEFAULT_ENDPOINT.replace("tcp/", "tls/") if args.team_keys else DEFAULT_ENDPOINT
+        if args.ros2 and default == args.ros2_router:  # rmw_zenohd listens there: the world takes the next port
+            default = default.replace(":7447", ":7448")
         listen = list(args.listen) or ([] if args.connect else [default])
         team_settings(args, who, WORLD, agents, [*listen, *args.connect], args.key_prefix)  # (checks, sets args.keys)
         settings = {} if args.keys is None else world_settings(args.keys, args.key_prefix)
@@ -170,7 +174,8 @@ def _serve(args: argparse.Namespace, server: WorldServer, endpoints: list[str]) 
     # rather than the default 5 ms keeps a drive command's answer within a few milliseconds.
     sys.setswitchinterval(SWITCH_INTERVAL)
     try:
-        server.serve(duration=args.duration)
+        with ros2_output(args) as ros2:  # --ros2: /clock and each robot's true pose, node alica_world
+            server.serve(duration=args.duration, until=ros2.attach_world(world) if ros2 is not None else None)
     finally:
         for s, handler in previous.items():
             signal.signal(s, handler)

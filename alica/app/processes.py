@@ -109,8 +109,11 @@ class ProcessTeam:
         own: dict[str, list[str]] | None = None,
         deadline: float | None = None,
         tls: bool = False,
+        per_incarnation: Callable[[str, int], list[str]] | None = None,
     ) -> None:
         self.plan = plan
+        self.per_incarnation = per_incarnation
+        """Options of an agent's process that change with each start (``--record``'s folder), by name and count."""
         self.deadline = deadline
         self.roster = agents
         self.options = list(options)
@@ -170,6 +173,7 @@ class ProcessTeam:
             "--json",
             *self.options,
             *self.own.get(agent.name, ()),
+            *(self.per_incarnation(agent.name, agent.incarnation) if self.per_incarnation is not None else ()),
             "--parent-pipe",
             "0",  # its standard input: end of file when this process is gone
         ]

@@ -159,7 +159,7 @@ def test_a_users_own_factory_plugs_in_by_module_and_name(drivers, capfd):
 @pytest.mark.parametrize(
     ("argv", "message"),
     [
-        (["--robot", "no_such_driver"], "no installed robot plug-in of that name (installed: unicycle"),
+        (["--robot", "no_such_driver"], "no installed robot plug-in of that name (installed: ros2, unicycle"),
         (["--robot", "my_driver:missing"], "module 'my_driver' has no 'missing'"),
         (["--robot", "my_driver:broken"], "making robot 'r1' failed: RuntimeError: no robot on /dev/ttyUSB0"),
         (["--robot", "my_driver:nothing"], "returned a int, which does not offer the robot interface"),

@@ -41,6 +41,7 @@ from alica.errors import AlicaError
 
 if TYPE_CHECKING:
     from alica.app.processes import ProcessTeam
+    from alica.app.ros2_options import Ros2Arguments
 
 
 class _Look:
@@ -94,8 +95,12 @@ def run_demo_processes(
     on_second: Callable[[float, int, int, int], None] | None = None,
     actions: Iterable[tuple[float, Callable[[Any], None]]] = (),
     out: Path | None = None,
+    ros2: Ros2Arguments | None = None,
 ) -> DemoResult:
     """Run the blocks-world demo once with one ``alica agent`` process per team robot (see the module docstring).
+
+    ``ros2`` (``--ros2``, ``--record``) is passed on to every agent: each is a ROS 2 node of its own, and
+    records into its own rosbag2 folder.
 
     Args:
         config: what to run (no opponents).
@@ -154,7 +159,14 @@ def run_demo_processes(
             else:
                 workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="alica-blocks-")))
             roster = ",".join(f"{n}:Manipulator" for n in names)
-            team = ProcessTeam(str(MISSION), roster, names, options, workdir)
+            team = ProcessTeam(
+                str(MISSION),
+                roster,
+                names,
+                options,
+                workdir,
+                per_incarnation=ros2.for_agent if ros2 is not None else None,
+            )
             look = _Look(world, team, wanted, config.time_limit, pending, on_second, counter)
             wall = time.perf_counter()
             team.launch()

@@ -32,6 +32,7 @@ from alica.io.loader import plans_dir
 
 if TYPE_CHECKING:
     from alica.app.center.live import LiveSession
+    from alica.app.ros2_output import Ros2Output
     from alica.engine import SimulatedTeam
     from alica.engine.agent import Observer
 
@@ -208,6 +209,7 @@ def run_demo(
     out: Path | None = None,
     gui: bool = False,
     live: LiveSession | None = None,
+    ros2: Ros2Output | None = None,
 ) -> DemoResult:
     """Run the demo in simulated time.
 
@@ -220,6 +222,8 @@ def run_demo(
             ``final.png``) and the generated plan (``plan.yaml``).
         gui: show the pybullet window.
         live: the control center of the run (``--center``): it serves the page and paces the run.
+        ros2: where the robots' ROS 2 topics go (``--ros2``, ``--record``; :mod:`alica.app.ros2_output`),
+            after every tick in simulated time; the caller closes it.
 
     Raises:
         AlicaError: a bad configuration.
@@ -308,6 +312,7 @@ def run_demo(
         )
         sample(world.now())
     share = share_poses(team)  # every team robot tells its team where it believes it is
+    publish = ros2.attach_team(team, library, hook=False) if ros2 is not None else None
     wall = time.perf_counter()
     next_report = 0.0
     satisfied = 0
@@ -322,6 +327,8 @@ def run_demo(
             share(now)
             if sample is not None:
                 sample(now)
+            if publish is not None:
+                publish(now)
             if live is not None:
                 live.pace(team)
             facts = perception.facts

@@ -42,6 +42,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from alica.app.center.live import LiveSession
+    from alica.app.ros2_output import Ros2Output
     from alica.engine import SimulatedTeam
     from alica.engine.agent import Observer
     from alica.prophet.tasks import CreatedTasks
@@ -309,6 +310,7 @@ def run_lunar(
     gui: bool = False,
     prepare_world: Callable[[World], None] | None = None,
     live: LiveSession | None = None,
+    ros2: Ros2Output | None = None,
 ) -> LunarResult:
     """Run the lunar mission once (see the module docstring).
 
@@ -327,6 +329,8 @@ def run_lunar(
             field is built and before the team exists, to change it (add rocks, move a sample...);
             for tests and experiments.
         live: the control center of the run (``--center``): it serves the page and paces the run.
+        ros2: where the robots' ROS 2 topics go (``--ros2``, ``--record``; :mod:`alica.app.ros2_output`),
+            after every tick in simulated time; the caller closes it.
 
     Raises:
         AlicaError: a bad configuration.
@@ -391,6 +395,8 @@ def run_lunar(
             sample = WorldTrace(tee(sinks), world, alive=lambda name: name not in team.crashed, team_map=run.team_map)
             sample(team.now())
             team.after_tick(sample)
+        if ros2 is not None:
+            ros2.attach_team(team, library)
         if live is not None:
             team.after_tick(lambda now: live.pace(team))
         wall = time.perf_counter()

@@ -54,6 +54,7 @@ from alica.io.loader import plans_dir
 
 if TYPE_CHECKING:
     from alica.app.processes import ProcessTeam
+    from alica.app.ros2_options import Ros2Arguments
     from alica.app.world_server import WorldServer
     from alica.comm.center_feed import CenterLink
     from alica.comm.zenoh_transport import ZenohTransport
@@ -238,8 +239,12 @@ def run_lunar_processes(
     out: Path | None = None,
     prefix: str = "alica",
     lockstep: bool = True,
+    ros2: Ros2Arguments | None = None,
 ) -> LunarResult:
     """Run the lunar mission once with one ``alica agent`` process per robot (see the module docstring).
+
+    ``ros2`` (``--ros2``, ``--record``) is passed on to every agent: each is a ROS 2 node of its own, and
+    records into its own rosbag2 folder.
 
     Raises:
         AlicaError: a bad configuration, or one the processes cannot run (network loss, delay, partitions).
@@ -306,7 +311,15 @@ def run_lunar_processes(
                 workdir.mkdir(parents=True, exist_ok=True)
             else:
                 workdir = Path(stack.enter_context(tempfile.TemporaryDirectory(prefix="alica-lunar-")))
-            team = ProcessTeam(str(MISSION), roster, names, options, workdir, own=own)
+            team = ProcessTeam(
+                str(MISSION),
+                roster,
+                names,
+                options,
+                workdir,
+                own=own,
+                per_incarnation=ros2.for_agent if ros2 is not None else None,
+            )
             base = (gx, gy)
             run = _ProcessRun(config, team, world, base, listener, counter, on_second)
             wall, cpu = time.perf_counter(), time.process_time()

@@ -22,6 +22,7 @@ _COMMON: dict[str, str] = {
     "builtin_interfaces/msg/Duration": _STAMP,
     "std_msgs/msg/Header": "builtin_interfaces/Time stamp\nstring frame_id\n",
     "std_msgs/msg/String": "string data\n",
+    "rosgraph_msgs/msg/Clock": "builtin_interfaces/Time clock\n",
     "std_msgs/msg/ColorRGBA": "float32 r\nfloat32 g\nfloat32 b\nfloat32 a\n",
     "geometry_msgs/msg/Point": _XYZ64,
     "geometry_msgs/msg/Point32": "float32 x\nfloat32 y\nfloat32 z\n",

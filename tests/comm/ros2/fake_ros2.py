@@ -46,13 +46,13 @@ def demangle(chunk: str) -> str:
 
 
 class FakeRos2:
-    """The ROS 2 side of the tests: a zenoh peer connecting to ``connect``."""
+    """The ROS 2 side of the tests: a zenoh peer connecting to ``connect``, or listening on ``listen`` (a router's place)."""
 
-    def __init__(self, connect: str, domain: int = 0) -> None:
+    def __init__(self, connect: str | None, domain: int = 0, *, listen: str | None = None) -> None:
         config = zenoh.Config()
         config.insert_json5("mode", '"peer"')
-        config.insert_json5("connect/endpoints", f'["{connect}"]')
-        config.insert_json5("listen/endpoints", "[]")
+        config.insert_json5("connect/endpoints", f'["{connect}"]' if connect is not None else "[]")
+        config.insert_json5("listen/endpoints", f'["{listen}"]' if listen is not None else "[]")
         config.insert_json5("scouting/multicast/enabled", "false")
         config.insert_json5("scouting/gossip/enabled", "false")
         self.session = zenoh.open(config)

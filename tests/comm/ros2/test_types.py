@@ -40,6 +40,7 @@ EXPECTED = {
     "std_msgs/msg/ColorRGBA",
     "std_msgs/msg/Header",
     "std_msgs/msg/String",
+    "rosgraph_msgs/msg/Clock",
     "tf2_msgs/msg/TFMessage",
     "visualization_msgs/msg/Marker",
     "visualization_msgs/msg/MarkerArray",
