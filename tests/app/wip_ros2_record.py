@@ -78,14 +78,14 @@ def test_a_bag_folder_that_is_not_empty_is_refused_before_the_run(tmp_path: Path
     folder = tmp_path / "bag"
     folder.mkdir()
     (folder / "keep.txt").write_text("mine")
-    assert main(["demo", "lunar", "--record", str(folder), *SMALL_LUNAR]) == 2
+    assert main(["demo", "lunar", "--record", str(folder), *SMALL_LUNAR]) == 1
     err = capsys.readouterr().err
     assert "exists and is not empty" in err and (folder / "keep.txt").read_text() == "mine"
 
 
 @pytest.mark.parametrize("domain", ["-1", "233"])
 def test_a_domain_out_of_range_is_a_clear_error(domain: str, tmp_path: Path, capsys: Any) -> None:
-    assert main(["demo", "lunar", "--record", str(tmp_path / "b"), "--ros2-domain", domain, *SMALL_LUNAR]) == 2
+    assert main(["demo", "lunar", "--record", str(tmp_path / "b"), "--ros2-domain", domain, *SMALL_LUNAR]) == 1
     assert "--ros2-domain must be a ROS 2 domain id from 0 to 232" in capsys.readouterr().err
 
 
