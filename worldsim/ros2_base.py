@@ -58,7 +58,7 @@ from alica.worldsim.errors import WorldError
 from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.interface import MobileRobot, RobotWorld, WorldThing
 from alica.worldsim.robot_specs import ROBOT_KINDS, RobotSpec
-from alica.worldsim.unicycle import OccupancyMap
+from alica.worldsim.unicycle import OccupancyMap, option_numbers
 
 if TYPE_CHECKING:
     import zenoh
@@ -556,7 +556,7 @@ def make_robot(name: str, role: str, options: Mapping[str, str]) -> Ros2BaseWorl
     if not spec.lidar_range > 0:
         raise ValueError("option lidar_range: must be > 0 metres")
     occupancy = None
-    origin = _numbers(options, "origin", "0,0", "x,y")
+    origin = option_numbers(options, "origin", "0,0", "x,y")
     if "map" in options:
         try:
             lines = Path(options["map"]).read_text(encoding="utf-8").splitlines()
@@ -567,7 +567,7 @@ def make_robot(name: str, role: str, options: Mapping[str, str]) -> Ros2BaseWorl
             occupancy = OccupancyMap.from_rows(rows, number("resolution", 0.25), (origin[0], origin[1]))
         except ValueError as exc:
             raise ValueError(f"option map: {exc}") from None
-    box = _numbers(options, "bounds", ",".join(f"{v:g}" for v in DEFAULT_BOUNDS), "xmin,ymin,xmax,ymax")
+    box = option_numbers(options, "bounds", ",".join(f"{v:g}" for v in DEFAULT_BOUNDS), "xmin,ymin,xmax,ymax")
     if not (box[0] < box[2] and box[1] < box[3]):
         raise ValueError(f"option bounds: xmin < xmax and ymin < ymax, got '{options['bounds']}'")
     timeout = number("timeout", 1.0, 0.0)
@@ -605,18 +605,6 @@ def make_robot(name: str, role: str, options: Mapping[str, str]) -> Ros2BaseWorl
 def _close_session(session: zenoh.Session) -> None:
     close: Callable[[], object] = session.close  # zenoh's stubs leave close() untyped
     close()
-
-
-def _numbers(options: Mapping[str, str], key: str, default: str, shape: str) -> list[float]:
-    """The comma-separated finite numbers of option ``key`` (as many as ``shape`` names)."""
-    text = options.get(key, default)
-    try:
-        values = [float(v) for v in text.split(",")]
-    except ValueError:
-        values = []
-    if len(values) != shape.count(",") + 1 or not all(math.isfinite(v) for v in values):
-        raise ValueError(f"option {key}: '{text}' is not {shape} ({shape.count(',') + 1} numbers)")
-    return values
 
 
 if TYPE_CHECKING:  # mypy checks that the driver satisfies the robot interface

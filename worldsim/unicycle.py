@@ -394,12 +394,12 @@ def make_robot(name: str, role: str, options: Mapping[str, str]) -> UnicycleWorl
         except (OSError, UnicodeDecodeError) as exc:
             raise ValueError(f"option map: cannot read '{options['map']}': {exc}") from None
         rows = [row for row in rows if row]
-    origin = _numbers(options, "origin", "0,0", "x,y")
+    origin = option_numbers(options, "origin", "0,0", "x,y")
     try:
         occupancy = OccupancyMap.from_rows(rows, number("resolution", 0.25), (origin[0], origin[1]))
     except ValueError as exc:
         raise ValueError(f"option map: {exc}") from None
-    pose = _numbers(options, "pose", f"{origin[0] + 1:g},{origin[1] + 1:g},0", "x,y,yaw")
+    pose = option_numbers(options, "pose", f"{origin[0] + 1:g},{origin[1] + 1:g},0", "x,y,yaw")
     kind = options.get("kind") or (role.lower() if role.lower() in ROBOT_KINDS else "scout")
     if kind not in ROBOT_KINDS:
         raise ValueError(f"option kind: no robot kind '{kind}'; kinds: {', '.join(sorted(ROBOT_KINDS))}")
@@ -414,7 +414,7 @@ def make_robot(name: str, role: str, options: Mapping[str, str]) -> UnicycleWorl
     return world
 
 
-def _numbers(options: Mapping[str, str], key: str, default: str, shape: str) -> list[float]:
+def option_numbers(options: Mapping[str, str], key: str, default: str, shape: str) -> list[float]:
     """The comma-separated finite numbers of option ``key`` (as many as ``shape`` names)."""
     text = options.get(key, default)
     try:
