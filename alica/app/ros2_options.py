@@ -130,7 +130,8 @@ def ros2_arguments(args: argparse.Namespace) -> Ros2Arguments | None:
     options += ("--ros2-domain", str(args.ros2_domain), "--ros2-distro", args.ros2_distro)
     folder = Path(record) if record is not None else None
     if folder is not None:
-        if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
-            raise AlicaError(f"--record: {folder} exists and is not empty: choose a new folder or remove this one")
+        from alica.comm.ros2.bag import check_bag_folder
+
+        check_bag_folder(folder)
         folder.mkdir(parents=True, exist_ok=True)
     return Ros2Arguments(options, folder)

@@ -39,6 +39,16 @@ def _qos_yaml(*, latched: bool, reliable: bool, depth: int) -> str:
     return yaml.safe_dump([profile], sort_keys=False).strip()
 
 
+def check_bag_folder(folder: Path) -> None:
+    """Refuse a bag folder that exists and is not empty (a recording never mixes with other files).
+
+    Raises:
+        AlicaError: it exists and is not an empty folder.
+    """
+    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+        raise AlicaError(f"bag folder {folder} exists and is not empty: choose a new folder or remove this one")
+
+
 class BagWriter:
     """Write one rosbag2 folder; use as a context manager.
 
@@ -55,10 +65,7 @@ class BagWriter:
         self.folder = Path(folder)
         if distro not in _VERSIONS:
             raise AlicaError(f"unknown ROS 2 distro {distro!r}: choose one of {sorted(_VERSIONS)}")
-        if self.folder.exists() and (not self.folder.is_dir() or any(self.folder.iterdir())):
-            raise AlicaError(
-                f"bag folder {self.folder} exists and is not empty: choose a new folder or remove this one"
-            )
+        check_bag_folder(self.folder)
         self.folder.mkdir(parents=True, exist_ok=True)
         self.distro = distro
         self._name = f"{self.folder.name}_0.mcap"
