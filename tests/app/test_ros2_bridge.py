@@ -87,6 +87,8 @@ def test_diagnostics_say_each_plan_its_task_and_state() -> None:
     )
     assert {kv.key: kv.value for kv in first.values}["task"] == "Explore"
     assert (second.level, second.message) == (2, "Fetch: idle")
+    (idle,) = _decoded(DIAGNOSTICS.typename, diagnostic_array(4.0, "scout", [])).status
+    assert (idle.level, idle.name, idle.message) == (0, "alica/scout", "no plan running")
 
 
 class _View:

@@ -85,8 +85,8 @@ def test_an_agent_process_shows_its_plans_in_the_graph(ros: tuple[FakeRos2, str]
     fake, endpoint = ros
     fake.subscribe("0/scout/diagnostics/*/*")
     (listen,) = free_endpoints(1)
-    plan = ROOT / "plans" / "examples" / "formation.yaml"
-    argv = [sys.executable, "-m", "alica.app.cli", "agent", str(plan), "--name", "scout", "--agents", "scout"]
+    plan = ROOT / "plans" / "examples" / "gate.yaml"
+    argv = [sys.executable, "-m", "alica.app.cli", "agent", str(plan), "--name", "scout", "--agents", "scout:Worker"]
     argv += ["--listen", listen, "--stand-ins", "--time-limit", "4", "--json"]
     argv += ["--ros2", "--ros2-router", endpoint, "--ros2-distro", "humble", "--record", str(tmp_path / "bag")]
     agent = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -98,7 +98,9 @@ def test_an_agent_process_shows_its_plans_in_the_graph(ros: tuple[FakeRos2, str]
     assert agent.returncode in (0, 1), err
     assert json.loads(out.splitlines()[-1])["name"] == "scout"
     humble = get_typestore(Stores.ROS2_HUMBLE)
-    status = humble.deserialize_cdr(fake.received[0].payload, "diagnostic_msgs/msg/DiagnosticArray").status
+    arrays = [humble.deserialize_cdr(r.payload, "diagnostic_msgs/msg/DiagnosticArray") for r in fake.received]
+    status = arrays[-1].status
+    assert status[0].message.startswith("Top: ")
     assert status[0].name == "alica/scout/" + status[0].name.split("/", 2)[2] and status[0].hardware_id == "scout"
     assert fake.received[0].key.endswith("/TypeHashNotSupported")
     assert fake.received[0].timestamp_ns > 1.7e18  # the wall clock's epoch nanoseconds
@@ -114,7 +116,7 @@ def test_a_world_server_publishes_the_clock_and_true_poses(ros: tuple[FakeRos2, 
     argv += ["--listen", listen, "--duration", "4", "--size", "16", "--ros2", "--ros2-router", endpoint]
     server = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
-        assert fake.wait(lambda: ("", "/", "alica_world") in fake.nodes(), 60)
+        assert fake.wait(lambda: ("", "", "alica_world") in fake.nodes(), 60)  # the root namespace is written "%"
         assert fake.wait(lambda: {r.key.split("/")[1] for r in fake.received} == {"clock", "scout"}, 30)
     finally:
         _out, err = server.communicate(timeout=60)
