@@ -133,3 +133,17 @@ def test_a_team_of_processes_gives_each_agent_its_own_bag_folder(tmp_path: Path)
     ]
     assert passed.for_agent("scout", 2)[-1] == str(tmp_path / "bags" / "scout.2")  # a restart records anew
     assert ros2_arguments(Namespace(ros2=False, record=None, ros2_domain=0)) is None
+
+
+def test_alica_run_with_processes_records_one_bag_per_agent(tmp_path: Path) -> None:
+    folder = tmp_path / "bags"
+    plan = Path(__file__).resolve().parents[2] / "plans" / "examples" / "gate.yaml"
+    argv = [sys.executable, "-m", "alica.app.cli", "run", str(plan), "--agents", "scout:Worker,stummel:Worker"]
+    argv += ["--processes", "--time-limit", "4", "--record", str(folder), "--ros2-distro", "humble"]
+    done = subprocess.run(argv, capture_output=True, text=True, timeout=120)
+    assert done.returncode in (0, 1) and "error" not in done.stderr, done.stderr  # 1: the plan is still running
+    assert sorted(p.name for p in folder.iterdir()) == ["scout", "stummel"]
+    for robot in ("scout", "stummel"):
+        messages = _read(folder / robot, "humble")
+        statuses = [s for _, array in messages[f"/{robot}/diagnostics"] for s in array.status]
+        assert any(s.message == "Top: Work" and s.hardware_id == robot for s in statuses), statuses
