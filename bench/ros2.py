@@ -1,10 +1,10 @@
 """What ``--ros2`` costs: CPU per agent at 30 Hz, and the publish latency on loopback.
 
-**CPU.** The lunar demo (seed 1, the small field) runs three times in this process:
+**CPU.** The lunar demo (seed 1, the small field) runs three times, each in a process of its own:
 without ROS 2, with ``--ros2`` (a live node per robot publishing to a subscriber in
 another process, which decodes every message), and with ``--record`` (a rosbag2
-folder). Every run of one seed does the same work, so the difference in this
-process's CPU time (all threads: zenoh's too) is what ROS 2 adds. It is given per
+folder). Every run of one seed does the same work, so the difference in the
+run's CPU time (all threads: zenoh's too) is what ROS 2 adds. It is given per
 agent and per simulated second at 30 Hz, which is the share of one core an agent
 at 30 Hz in real time spends on it. The time spent inside the publishing hook is
 measured separately.
@@ -21,6 +21,7 @@ Run: ``.venv/bin/python bench/ros2.py [--messages 300] [--time-limit 60]``
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import statistics
 import subprocess
@@ -80,58 +81,74 @@ def _cpu() -> float:
     return user + system
 
 
-def cpu_table(time_limit: float) -> None:
-    """The lunar demo without ROS 2, with --ros2 and with --record: CPU per agent per simulated second at 30 Hz."""
+def _lunar_run(mode: str, time_limit: float, endpoint: str, bag: str) -> dict[str, float]:
+    """One lunar run (in a process of its own, see :func:`cpu_table`): CPU, wall and the hook's CPU."""
     from alica.app.demos.lunar import LunarConfig, run_lunar
 
     config = LunarConfig(size=16.0, rocks=6, samples=2, seed=1, time_limit=time_limit)
+    output = None
+    if mode == "ros2":
+        output = Ros2Output(live=True, router=endpoint)
+    elif mode == "record":
+        output = Ros2Output(record=Path(bag))
+    hook = [0.0]
+    if output is not None:
+        attach = output.attach_team
+
+        def timed_attach(team: Any, library: Any, **_kw: Any) -> Any:
+            inner = attach(team, library, hook=False)
+
+            def after(now: float) -> None:
+                began = time.process_time()
+                inner(now)
+                hook[0] += time.process_time() - began
+
+            team.after_tick(after)
+            return after
+
+        output.attach_team = timed_attach  # type: ignore[method-assign]
+    cpu, wall = _cpu(), time.perf_counter()
+    result = run_lunar(config, ros2=output)
+    if output is not None:
+        output.close()
+    cpu, wall = _cpu() - cpu, time.perf_counter() - wall
+    return {"sim": result.sim_time_s, "wall": wall, "cpu": cpu, "hook": hook[0], "found": float(len(result.found))}
+
+
+def cpu_table(time_limit: float) -> None:
+    """The lunar demo without ROS 2, with --ros2 and with --record: CPU per agent per simulated second at 30 Hz.
+
+    Each run is a process of its own: OMPL seeds its generator once per process, so only runs in fresh
+    processes repeat a seed's work exactly (the summary's found samples and simulated time say whether they did).
+    """
     rows = []
     base = None
     for mode in ("none", "ros2", "record"):
         (endpoint,) = free_endpoints(1)
         listener = _subscriber(endpoint, "decode") if mode == "ros2" else None
         with tempfile.TemporaryDirectory() as tmp:
-            output = None
-            if mode == "ros2":
-                output = Ros2Output(live=True, router=endpoint)
-            elif mode == "record":
-                output = Ros2Output(record=Path(tmp) / "bag")
-            hook = [0.0]
-            if output is not None:
-                attach = output.attach_team
-
-                def timed_attach(team: Any, library: Any, *, hook_: list[float] = hook, **kw: Any) -> Any:
-                    inner = attach(team, library, hook=False)
-
-                    def after(now: float) -> None:
-                        began = time.process_time()
-                        inner(now)
-                        hook_[0] += time.process_time() - began
-
-                    team.after_tick(after)
-                    return after
-
-                output.attach_team = timed_attach  # type: ignore[method-assign]
-            cpu, wall = _cpu(), time.perf_counter()
-            result = run_lunar(config, ros2=output)
-            cpu, wall = _cpu() - cpu, time.perf_counter() - wall
-            if output is not None:
-                output.close()
-            size = sum(f.stat().st_size for f in (Path(tmp) / "bag").glob("*")) if mode == "record" else 0
+            bag = Path(tmp) / "bag"
+            argv = [sys.executable, __file__, "--child", mode, "--time-limit", str(time_limit)]
+            done = subprocess.run([*argv, "--router", endpoint, "--bag", str(bag)], capture_output=True, text=True)
+            if done.returncode != 0:
+                raise RuntimeError(f"the {mode} run failed: {done.stderr[-2000:]}")
+            run = json.loads(done.stdout.splitlines()[-1])
+            size = sum(f.stat().st_size for f in bag.glob("*")) if mode == "record" else 0
         if listener is not None:
             listener.communicate("", timeout=30)
-        agent_seconds = 3 * result.sim_time_s
+        agent_seconds = 3 * run["sim"]
         if base is None:
-            base = cpu / agent_seconds
-        extra = cpu / agent_seconds - base
-        rows.append((mode, result.sim_time_s, wall, cpu, 100 * extra, 100 * hook[0] / agent_seconds, size))
+            base = run["cpu"] / agent_seconds
+        extra = run["cpu"] / agent_seconds - base
+        in_hook = 100 * run["hook"] / agent_seconds
+        rows.append((mode, run["sim"], int(run["found"]), run["wall"], run["cpu"], 100 * extra, in_hook, size))
     print("\n## CPU of --ros2 per agent (lunar demo, seed 1, 16 m field, 3 agents at 30 Hz)\n")
-    print(
-        "| output | sim s | wall s | CPU s | extra CPU per agent at 30 Hz, % of a core | in the hook, % | bag bytes |"
-    )
-    print("|---|---|---|---|---|---|---|")
-    for mode, sim, wall, cpu, extra, in_hook, size in rows:
-        print(f"| {mode} | {sim:.1f} | {wall:.1f} | {cpu:.1f} | {extra:.2f} | {in_hook:.2f} | {size or '-'} |")
+    print("| output | sim s | found | wall s | CPU s | extra CPU per agent, % of a core | in the hook, % | bag bytes |")
+    print("|---|---|---|---|---|---|---|---|")
+    for mode, sim, found, wall, cpu, extra, hook_share, size in rows:
+        print(
+            f"| {mode} | {sim:.1f} | {found} | {wall:.1f} | {cpu:.1f} | {extra:.2f} | {hook_share:.2f} | {size or '-'} |"
+        )
 
 
 def _messages() -> dict[str, tuple[str, bytes]]:
@@ -223,7 +240,13 @@ def main() -> None:
     parser.add_argument("--messages", type=int, default=300, help="messages of each kind for the latency (default 300)")
     parser.add_argument("--time-limit", type=float, default=60.0, help="simulated seconds of the lunar runs")
     parser.add_argument("--skip-cpu", action="store_true", help="only the latency and encoding tables")
+    parser.add_argument("--child", choices=("none", "ros2", "record"), help=argparse.SUPPRESS)
+    parser.add_argument("--router", help=argparse.SUPPRESS)
+    parser.add_argument("--bag", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.child:
+        print(json.dumps(_lunar_run(args.child, args.time_limit, args.router, args.bag)))
+        return
     encode_table()
     latency_table(args.messages)
     if not args.skip_cpu:
