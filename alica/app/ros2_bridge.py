@@ -214,7 +214,13 @@ def diagnostic_array(t: float, robot: str, plans: Iterable[Mapping[str, str]]) -
             }
         )
     if not status:  # no plan runs (e.g. waiting for team mates): say so rather than publish an empty array
-        idle = {"level": _OK, "name": f"alica/{robot}", "message": "no plan running", "hardware_id": robot, "values": []}
+        idle = {
+            "level": _OK,
+            "name": f"alica/{robot}",
+            "message": "no plan running",
+            "hardware_id": robot,
+            "values": [],
+        }
         status.append(idle)
     return {"header": _header(t, ""), "status": status}
 
