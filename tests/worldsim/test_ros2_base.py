@@ -301,7 +301,9 @@ def test_move_to_position_drives_the_fake_base_to_the_goal_through_the_driver(ba
         assert len(lockstep.path) > 20 and not base.robot.bumped
         # Around the block (x 2.25..3.25, y 2..3), not through it: the centre keeps well clear of the block. The
         # follower may cut a corner by a few centimetres of the planner's margin, so this is not the full radius.
-        clearance = min(math.hypot(max(2.25 - px, 0.0, px - 3.25), max(2.0 - py, 0.0, py - 3.0)) for px, py, _ in lockstep.path)
+        clearance = min(
+            math.hypot(max(2.25 - px, 0.0, px - 3.25), max(2.0 - py, 0.0, py - 3.0)) for px, py, _ in lockstep.path
+        )
         assert clearance > 0.15, clearance
         assert world.dropped == 0 and len(base.twists) > 20  # the skill drove the base by cmd_vel
     finally:
