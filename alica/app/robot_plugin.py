@@ -68,7 +68,7 @@ def add_robot_options(parser: argparse._ActionsContainer) -> None:
         metavar="MODULE[:FACTORY]",
         help="run the skills on a robot driver of your own: FACTORY (default make_robot) of MODULE, or an installed "
         f"plug-in of the entry-point group {ENTRY_POINT_GROUP} by name (shipped: unicycle, a kinematic unicycle with "
-        "a simulated lidar on a 2-D map)",
+        "a simulated lidar on a 2-D map; ros2, a ROS 2 mobile base over rmw_zenoh, see docs/ros2.md)",
     )
     parser.add_argument(
         "--robot-option",
