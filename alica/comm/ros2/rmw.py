@@ -275,9 +275,8 @@ class Ros2Node:
         self._ids += 1
         return self._ids
 
-    def _endpoint(
-        self, kind: str, topic: str, dds_type: str, type_hash: str, qos: Qos
-    ) -> tuple[str, int, zenoh.LivelinessToken]:
+    def _endpoint(self, kind: str, topic: str, dds_type: str, type_hash: str, qos: Qos) -> tuple[str, str]:
+        """The endpoint's topic key expression and its liveliness token's (declared by the caller)."""
         if self._closed:
             raise RuntimeError(f"node {self.name!r} is closed")
         fqn = fully_qualified(self.namespace, topic)
@@ -296,11 +295,12 @@ class Ros2Node:
             qos,
             self.enclave,
         )
-        return topic_key(self.domain, fqn, dds_type, type_hash), entity, self.session.liveliness().declare_token(token)
+        return topic_key(self.domain, fqn, dds_type, type_hash), token
 
     def publisher(self, topic: str, dds_type: str, type_hash: str, qos: Qos = DEFAULT) -> Ros2Publisher:
         """A publisher on ``topic`` (relative to the namespace without a leading ``/``), with its ``MP`` token."""
-        key, _, token = self._endpoint("MP", topic, dds_type, type_hash, qos)
+        key, token_key = self._endpoint("MP", topic, dds_type, type_hash, qos)
+        token = self.session.liveliness().declare_token(token_key)
         gid = os.urandom(GID_SIZE)
         publisher = Ros2Publisher(self, key, qos, gid, token)
         self._publishers.append(publisher)
@@ -320,7 +320,7 @@ class Ros2Node:
         A sample with a malformed attachment or a payload over :data:`MAX_PAYLOAD` is dropped and
         counted in :attr:`dropped`; an exception from ``callback`` is logged, not raised.
         """
-        key, _, token = self._endpoint("MS", topic, dds_type, type_hash, qos)
+        key, token_key = self._endpoint("MS", topic, dds_type, type_hash, qos)
 
         def on_sample(sample: zenoh.Sample) -> None:
             try:
@@ -349,6 +349,9 @@ class Ros2Node:
             )
         else:
             subscriber = self.session.declare_subscriber(key, on_sample)
+        # the token after the subscription: a publisher that sees it may publish at once, and the session sends
+        # its declarations in order, so the router knows the subscription first
+        token = self.session.liveliness().declare_token(token_key)
         self._subscribers.append((subscriber, token))
 
     def close(self) -> None:

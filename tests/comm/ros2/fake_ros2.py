@@ -92,7 +92,9 @@ class FakeRos2:
             self._handles.append(self.session.declare_subscriber(key, on_sample))
 
     def put(self, key: str, payload: bytes, attachment: bytes | None) -> None:
-        self.session.put(key, payload, attachment=attachment)
+        """Publish as a reliable ROS 2 publisher keeping all samples does: blocking, never dropping, when the
+        network is congested (a burst of 100 from a test on a loaded machine must all arrive)."""
+        self.session.put(key, payload, attachment=attachment, congestion_control=zenoh.CongestionControl.BLOCK)
 
     def tokens(self) -> list[str]:
         replies = self.session.liveliness().get(f"@ros2_lv/{self.domain}/**", timeout=2.0)
