@@ -35,6 +35,10 @@ TSV (of a run stopped early, say).
 
 Run: ``.venv/bin/python bench/planners.py [--domains blocks,rovers] [--limit N] [--jobs 1] [--quick] [--benchmarks DIR]``
 
+With ``--suite large`` (issue 41) generated problems larger than the suite's, ours and lama-first with their peak
+memory (:mod:`bench.planners_large`): ``.venv/bin/python bench/planners.py --suite large [--domains logistics]
+[--limit N] [--time-limit 60]``.
+
 or: ``.venv/bin/python bench/planners.py --suite ipc [--domains a,b] [--limit N] [--time-limit 30]
 [--anytime-budget 10] [--skip-anytime] [--skip-fd] [--report-only] [--benchmarks DIR]``
 """
@@ -111,6 +115,8 @@ class Outcome:
     cost: float | None = None
     valid: str = "-"
     note: str = ""
+    peak_mb: float | None = None
+    expansions: int | None = None
 
     @property
     def solved(self) -> bool:
@@ -127,6 +133,7 @@ class Proc:
     out: str
     err: str
     timed_out: bool
+    peak_mb: float | None = None
 
 
 @dataclass
@@ -161,8 +168,18 @@ def compile_bytecode() -> None:
         compileall.compile_dir(str(ROOT / folder), quiet=1)
 
 
-def run_process(command: Sequence[str], cwd: Path, timeout: float) -> Proc:
-    """Run ``command`` in its own process group; kill the whole group after ``timeout`` wall seconds."""
+def run_process(command: Sequence[str], cwd: Path, timeout: float, peak: bool = False) -> Proc:
+    """Run ``command`` in its own process group; kill the whole group after ``timeout`` wall seconds.
+
+    With ``peak``, through :mod:`bench.peak_rss`, which reports the largest resident set of the
+    command's processes (``Proc.peak_mb``).
+    """
+    report = None
+    if peak:
+        handle, name = tempfile.mkstemp(prefix="bench-peak-", suffix=".txt")
+        os.close(handle)
+        report = Path(name)
+        command = [sys.executable, str(ROOT / "bench" / "peak_rss.py"), str(report), "--", *command]
     start = time.perf_counter()
     with subprocess.Popen(
         list(command),
@@ -183,10 +200,17 @@ def run_process(command: Sequence[str], cwd: Path, timeout: float) -> Proc:
             out, err = process.communicate()
             timed_out = True
         wall = time.perf_counter() - start
-    return Proc(process.returncode, wall, out, err, timed_out)
+    peak_mb = wall_s = None
+    if report is not None:
+        with contextlib.suppress(OSError, ValueError):
+            peak_kb, wall_s = report.read_text(encoding="utf-8").split()
+            peak_mb = int(peak_kb) / 1024
+            wall = float(wall_s)
+        report.unlink(missing_ok=True)
+    return Proc(process.returncode, wall, out, err, timed_out, peak_mb)
 
 
-def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Outcome:
+def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False, peak: bool = False) -> Outcome:
     """``alica plan --json``: the plan it printed, validated again here."""
     command = [
         sys.executable,
@@ -201,18 +225,20 @@ def run_ours(job: Job, limit: float, tasks: Tasks, anytime: bool = False) -> Out
     ]
     if anytime:
         command.append("--anytime")
-    proc = run_process(command, ROOT, limit + GRACE_S)
+    proc = run_process(command, ROOT, limit + GRACE_S, peak)
     if proc.timed_out:
-        return Outcome(job, proc.wall_s, "killed")
+        return Outcome(job, proc.wall_s, "killed", peak_mb=proc.peak_mb)
     if proc.code != 0:
         status = {3: "unsolvable", 4: "timeout"}.get(proc.code or 0, f"exit {proc.code}")
-        return Outcome(job, proc.wall_s, status, note=_json_error(proc.out) or _last_line(proc.err))
+        note = _json_error(proc.out) or _last_line(proc.err)
+        return Outcome(job, proc.wall_s, status, note=note, peak_mb=proc.peak_mb)
     summary = json.loads(proc.out)
     steps = parse_plan("\n".join(summary["plan"])).steps
-    return _validated(Outcome(job, proc.wall_s, "ok"), steps, tasks, claimed=summary["cost"])
+    outcome = Outcome(job, proc.wall_s, "ok", peak_mb=proc.peak_mb, expansions=summary.get("expansions"))
+    return _validated(outcome, steps, tasks, claimed=summary["cost"])
 
 
-def run_fd(job: Job, limit: float, tasks: Tasks) -> Outcome:
+def run_fd(job: Job, limit: float, tasks: Tasks, peak: bool = False) -> Outcome:
     """Fast Downward's driver with lama-first, in a temporary folder; the plan file, validated."""
     driver = find_driver()
     if driver is None:
@@ -230,7 +256,7 @@ def run_fd(job: Job, limit: float, tasks: Tasks) -> Outcome:
             str(job.domain_file),
             str(job.problem_file),
         ]
-        proc = run_process(command, Path(tmp), limit + GRACE_S)
+        proc = run_process(command, Path(tmp), limit + GRACE_S, peak)
         plan_file = Path(tmp) / "sas_plan"
         if not plan_file.exists():
             status = (
@@ -238,9 +264,11 @@ def run_fd(job: Job, limit: float, tasks: Tasks) -> Outcome:
                 if proc.timed_out
                 else {10: "unsolvable", 11: "unsolvable", 23: "timeout"}.get(proc.code or 0, f"exit {proc.code}")
             )
-            return Outcome(job, proc.wall_s, status, note=_last_line(proc.err))
+            return Outcome(job, proc.wall_s, status, note=_last_line(proc.err), peak_mb=proc.peak_mb)
         plan = parse_plan(plan_file.read_text(encoding="utf-8"), "sas_plan")
-    return _validated(Outcome(job, proc.wall_s, "ok"), plan.steps, tasks, claimed=plan.cost)
+    expanded = re.findall(r"Expanded (\d+) state", proc.out)
+    outcome = Outcome(job, proc.wall_s, "ok", peak_mb=proc.peak_mb, expansions=int(expanded[-1]) if expanded else None)
+    return _validated(outcome, plan.steps, tasks, claimed=plan.cost)
 
 
 def run_pyperplan(job: Job, limit: float, tasks: Tasks) -> Outcome:
@@ -715,9 +743,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
         "--suite",
-        choices=("classic", "ipc"),
+        choices=("classic", "ipc", "large"),
         default="classic",
-        help="classic: pddl/ of the benchmark sets (blocks, rovers); ipc: the 26 domains of their ipc/ (default classic)",
+        help="classic: pddl/ of the benchmark sets (blocks, rovers); ipc: the 26 domains of their ipc/; large: "
+        "problems generated larger than those (bench/large_problems.py) on ipc/'s domains (default classic)",
     )
     add_benchmarks_option(parser)
     parser.add_argument(
@@ -745,6 +774,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="ipc: no runs, the tables from build/bench/ipc_runs.tsv (e.g. of a run stopped early)",
     )
     args = parser.parse_args(argv)
+    if args.suite == "large":
+        from bench import planners_large
+
+        use_benchmarks(args.benchmarks)
+        compile_bytecode()
+        args.time_limit = 60.0 if args.time_limit is None else args.time_limit
+        return planners_large.main(args, benchmark_set(args.benchmarks, "ipc"))
     if not args.report_only:
         benchmark_set(args.benchmarks, "ipc" if args.suite == "ipc" else "pddl")
         use_benchmarks(args.benchmarks)

@@ -35,11 +35,11 @@ from typing import TYPE_CHECKING
 
 from alica.prophet.planner import Done, Improved, Limits, Plan, PlanStatus, PlanStep, SearchEvent
 from alica.prophet.search.astar import astar
+from alica.prophet.search.compiled_lama import first_plan
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
 from alica.prophet.search.jit import SwitchingFF
-from alica.prophet.search.lama import lama_search
 from alica.prophet.search.landmarks import LandmarkCount
 from alica.prophet.search.neighbourhood import neighbourhood
 from alica.prophet.search.postprocess import improve
@@ -172,7 +172,7 @@ def search_task(
             ff = relaxed.ff
         else:
             ff = SwitchingFF(relaxed, relaxed.ff_unit, relaxed.r_unit)  # every operator 1
-        ops, _exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=first.weight, seed=first.seed)
+        ops, _exhausted = yield from first_plan(ct, relaxed, ff, lmcount, stats, weight=first.weight, seed=first.seed)
     else:
         evaluate: Evaluator = {"ff": relaxed.ff, "ff_add_unit": relaxed.ff_add_unit, "ff_cost": relaxed.ff_cost}[
             first.heuristic

@@ -12,9 +12,15 @@ actions applicable in the state, in the pure-Python extraction's order.
 from __future__ import annotations
 
 import numba
+import numpy as np
 
 SHIFT = 24
 LOW = (1 << SHIFT) - 1
+DEBRUIJN_MUL = np.uint64(0x03F79D71B4CB0A89)
+DEBRUIJN = np.zeros(64, dtype=np.int64)
+"""The bit index of ``low`` (a power of two) is ``DEBRUIJN[(low * DEBRUIJN_MUL) >> 58]``."""
+for _i in range(64):
+    DEBRUIJN[((1 << _i) * 0x03F79D71B4CB0A89 >> 58) & 63] = _i
 BIG = 1 << 38
 """Unreached (costs stay far below it; fact ids below 2**SHIFT)."""
 
@@ -146,3 +152,167 @@ def extract(state, goals, sup, pre_ptr, pre_idx, cost, unit, used, done, out):
             if not done[p]:
                 stack.append(p)
     return h, n_out
+
+
+@numba.njit(cache=True, nogil=True)
+def _levels(
+    state,
+    is_goal,
+    npre,
+    pre_of_ptr,
+    pre_of_idx,
+    add_ptr,
+    add_idx,
+    cost,
+    zero,
+    cost_f,
+    sup,
+    unsat,
+    acc,
+    rec,
+    head,
+    level,
+):
+    n = state.shape[0]
+    n_levels = head.shape[0]
+    goals_left = 0
+    for f in range(n):
+        cost_f[f] = BIG
+        sup[f] = -1
+        if is_goal[f] and not state[f]:
+            goals_left += 1
+    for a in range(npre.shape[0]):
+        unsat[a] = npre[a]
+        acc[a] = 0
+    n_rec = 0
+    top = 0
+    for f in range(n):
+        if state[f]:
+            cost_f[f] = 0
+            rec[n_rec, 0] = f
+            rec[n_rec, 1] = head[0]
+            head[0] = n_rec
+            n_rec += 1
+    for k in range(zero.shape[0]):
+        a = zero[k]
+        c = cost[a]
+        for j in range(add_ptr[a], add_ptr[a + 1]):
+            g = add_idx[j]
+            if c < cost_f[g]:
+                if c >= n_levels:
+                    return -1, top
+                cost_f[g] = c
+                sup[g] = a
+                rec[n_rec, 0] = g
+                rec[n_rec, 1] = head[c]
+                head[c] = n_rec
+                n_rec += 1
+                if c > top:
+                    top = c
+    if goals_left == 0:
+        return 1, top
+    c = 0
+    while c <= top:
+        lo = n
+        hi = -1
+        r = head[c]
+        while r >= 0:
+            f = rec[r, 0]
+            if cost_f[f] == c:
+                w = f >> 6
+                level[w] |= np.uint64(1) << np.uint64(f & 63)
+                if w < lo:
+                    lo = w
+                if w > hi:
+                    hi = w
+            r = rec[r, 1]
+        for w in range(lo, hi + 1):
+            bitsw = level[w]
+            if bitsw == np.uint64(0):
+                continue
+            level[w] = np.uint64(0)
+            while bitsw != np.uint64(0):
+                low = bitsw & (~bitsw + np.uint64(1))
+                bitsw ^= low
+                f = (w << 6) | DEBRUIJN[np.int64(((low * DEBRUIJN_MUL) >> np.uint64(58)) & np.uint64(63))]
+                if is_goal[f] and not state[f]:
+                    goals_left -= 1
+                    if goals_left == 0:
+                        for w2 in range(w + 1, hi + 1):
+                            level[w2] = np.uint64(0)
+                        return 1, top
+                for k in range(pre_of_ptr[f], pre_of_ptr[f + 1]):
+                    a = pre_of_idx[k]
+                    left = unsat[a] - 1
+                    unsat[a] = left
+                    acc[a] += c
+                    if left == 0:
+                        ac = acc[a] + cost[a]
+                        for j in range(add_ptr[a], add_ptr[a + 1]):
+                            g = add_idx[j]
+                            if ac < cost_f[g]:
+                                if ac >= n_levels:
+                                    for w2 in range(w, hi + 1):
+                                        level[w2] = np.uint64(0)
+                                    return -1, top
+                                cost_f[g] = ac
+                                sup[g] = a
+                                rec[n_rec, 0] = g
+                                rec[n_rec, 1] = head[ac]
+                                head[ac] = n_rec
+                                n_rec += 1
+                                if ac > top:
+                                    top = ac
+        c += 1
+    return (1 if goals_left == 0 else 0), top
+
+
+@numba.njit(cache=True, nogil=True)
+def explore_levels(
+    state,
+    is_goal,
+    npre,
+    pre_of_ptr,
+    pre_of_idx,
+    add_ptr,
+    add_idx,
+    cost,
+    zero,
+    cost_f,
+    sup,
+    unsat,
+    acc,
+    rec,
+    head,
+    level,
+):
+    """``explore`` for costs of at least 1, with a bucket per cost level instead of the heap.
+
+    Every action costs at least 1, so nothing joins the level being processed; each level's
+    facts are taken in increasing fact id, the heap's order, so costs, supporters and the early
+    stop are the same as ``explore``'s. ``rec`` holds (fact, next) records of the pushes, ``head``
+    each level's first record (all -1 between calls), ``level`` the facts of one level as a bitset
+    (all 0 between calls). Returns 1
+    (goals reached), 0 (not reachable) or -1 (a cost past ``head``'s levels: use ``explore``).
+    """
+    code, top = _levels(
+        state,
+        is_goal,
+        npre,
+        pre_of_ptr,
+        pre_of_idx,
+        add_ptr,
+        add_idx,
+        cost,
+        zero,
+        cost_f,
+        sup,
+        unsat,
+        acc,
+        rec,
+        head,
+        level,
+    )
+    for c in range(min(top + 1, head.shape[0])):
+        head[c] = -1
+    return code
