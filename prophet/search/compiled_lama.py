@@ -13,8 +13,9 @@ It covers what LAMA's first search meets on STRIPS-like tasks: no derived predic
 when-effects, no tie-breaking seed, greedy or a weight that is a multiple of 0.5 (the keys stay
 exact integers). :func:`first_plan` runs the pure-Python search first, for as many expansions as
 would take about as long as loading numba and the kernel, and only then the compiled one, from
-the start (a deterministic switch: the same task always switches at the same expansion, so a
-simulated run that counts expansions stays the same).
+the start; where FF's estimate of the initial state (about the expansions a greedy search needs)
+is already past that budget, it starts compiled. Both rules are deterministic: the same task
+always switches at the same expansion, so a simulated run that counts expansions stays the same.
 
 Between calls of the kernel (every :data:`~alica.prophet.search.gbfs.CHECK_EVERY` expansions, or at
 the next progress event) the deadline and the memory bound of the run are checked: the memory is
@@ -26,7 +27,7 @@ from __future__ import annotations
 from collections.abc import Generator
 from typing import Any
 
-from alica.prophet.planner import Progress
+from alica.prophet.planner import LimitReached, Progress
 from alica.prophet.search.encoding import AxiomTask, CompiledTask, bits
 from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
@@ -83,9 +84,12 @@ def first_plan(
     if not eligible(ct, relaxed, weight, seed):
         return (yield from lama_search(ct, ff, lmcount, stats, weight=weight, seed=seed))
     budget = python_budget(relaxed)
-    plan, exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=weight, max_expansions=budget)
-    if plan is not None or exhausted:
-        return plan, exhausted
+    # a greedy search expands about as many states as its plan is long, which FF's estimate of the initial
+    # state guesses: past the budget, the pure-Python start would only delay the compiled search
+    if relaxed.ff_unit(ct.init)[0] < budget:
+        plan, exhausted = yield from lama_search(ct, ff, lmcount, stats, weight=weight, max_expansions=budget)
+        if plan is not None or exhausted:
+            return plan, exhausted
     return (yield from compiled_lama_search(ct, relaxed, lmcount, stats, weight=weight))
 
 
@@ -385,7 +389,11 @@ def compiled_lama_search(
             arrays.grow()
         limits = stats.limits
         if limits is not None and stats.expansions >= stats.next_check:
-            limits.check("searching", arrays.nbytes(), done=f"{stats.expansions} expansions")
+            try:
+                limits.check("searching", arrays.nbytes(), done=f"{stats.expansions} expansions")
+            except LimitReached as exc:
+                exc.expansions = stats.expansions
+                raise
         if stats.progress_due():
             yield Progress(stats.expansions)
 
