@@ -137,6 +137,7 @@ class GroundTask:
     derived: frozenset[int] = frozenset()
     relaxed_axioms: tuple[tuple[int, tuple[int, ...]], ...] = ()
     _ids: dict[str, int] = field(default_factory=dict, init=False, repr=False, compare=False)
+    _by_name: dict[str, list[GroundOperator]] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def fact_id(self, text: str) -> int:
         """The id of the fact written as ``text`` (case and spacing as in :attr:`facts`).
@@ -176,7 +177,10 @@ class GroundTask:
 
     def operator(self, name: str) -> list[GroundOperator]:
         """The operators called ``name`` (``(pick-up a)``); several when a disjunction was split."""
-        return [op for op in self.operators if op.name == name]
+        if not self._by_name and self.operators:
+            for op in self.operators:
+                self._by_name.setdefault(op.name, []).append(op)
+        return list(self._by_name.get(name, ()))
 
 
 NOT_DERIVED = "not@"

@@ -25,9 +25,12 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 from alica.errors import PlannerError
+
+if TYPE_CHECKING:
+    from alica.prophet.ground import GroundTask
 
 
 @contextmanager
@@ -276,6 +279,9 @@ class Planner(ABC):
     reads_files: bool = False
     """Whether :meth:`solve` takes the PDDL files' paths rather than the parsed domain and problem
     (a back-end that runs an outside planner on the files, such as Fast Downward)."""
+    last_ground_task: GroundTask | None = None
+    """The ground task of the last search, for a planner that grounds the task itself (``None``
+    otherwise): ``alica plan`` checks the plan on it, a cheaper check than the lifted one."""
 
     @staticmethod
     def unavailable() -> str:

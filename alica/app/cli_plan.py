@@ -29,6 +29,7 @@ from alica.errors import AlicaError
 from alica.prophet.planner import DEFAULT_MEMORY_MB, LimitReached, Limits, Plan, PlanResult, PlanStatus
 
 if TYPE_CHECKING:
+    from alica.prophet.ground import GroundTask
     from alica.prophet.pddl import Domain, Problem
     from alica.prophet.planner import Planner
 
@@ -191,7 +192,20 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
         result = planner.solve(args.domain, args.problem, anytime=args.anytime, limits=limits)
     else:
         result = planner.solve(domain, problem, anytime=args.anytime, limits=limits)
-    return _report(args, planner.name, result, lambda plan: _validated_cost(planner.name, (domain, problem), plan))
+    return _report(
+        args,
+        planner.name,
+        result,
+        lambda plan: _validated_cost(planner.name, _checked_on(planner, domain, problem), plan),
+    )
+
+
+def _checked_on(planner: Planner, domain: Domain, problem: Problem) -> GroundTask | tuple[Domain, Problem]:
+    """What a plan is validated on: the planner's own ground task when it grounded the task (each step's
+    ground operator applied with the grounding's reference semantics, derived facts recomputed by their
+    own fixpoint, not the search's), else the lifted domain and problem (as ``alica validate-plan`` does)."""
+    grounded = planner.last_ground_task
+    return (domain, problem) if grounded is None else grounded
 
 
 def _plan_parallel(args: argparse.Namespace, limits: Limits) -> int:
@@ -349,7 +363,7 @@ def _check_features(planner: Planner, domain: Domain, problem: Problem) -> None:
         )
 
 
-def _validated_cost(name: str, task: tuple[Domain, Problem], plan: Plan) -> float:
+def _validated_cost(name: str, task: GroundTask | tuple[Domain, Problem], plan: Plan) -> float:
     """The plan's cost as :func:`alica.prophet.validate.validate_plan` computes it.
 
     Raises:

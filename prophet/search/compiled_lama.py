@@ -347,6 +347,7 @@ def compiled_lama_search(
     weight: float | None = None,
     boost: int = 1000,
     max_expansions: float = INF,
+    landmark_preferred: bool = True,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """:func:`~alica.prophet.search.lama.lama_search` compiled (see the module docstring); the same results.
 
@@ -374,6 +375,7 @@ def compiled_lama_search(
             boost,
             arrays.w2,
             arrays.greedy,
+            landmark_preferred,
         )
         stats.expansions += int(sc[k.S_EXPANDED]) - before_exp
         stats.evaluations += int(sc[k.S_EVALS]) - before_eval

@@ -306,7 +306,7 @@ def add_run(which, key, start, end, parent, heads, tails, run_pos, run_end, run_
 
 
 @numba.njit(cache=True, nogil=True)
-def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy):
+def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm_pref):
     """LAMA's lazy search (see the module docstring); returns one of the codes above."""
     (
         init,
@@ -521,9 +521,10 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy):
             o = r_op[out[k]]
             if o >= 0:
                 pref[o] = True
-        lm_preferred(
-            succ, n_succ, acc, needed, pref, add_ptr, add_idx, lm_of_fact, par_ptr, par_idx, dis_of_fact, n_fact_lms
-        )
+        if lm_pref:
+            lm_preferred(
+                succ, n_succ, acc, needed, pref, add_ptr, add_idx, lm_of_fact, par_ptr, par_idx, dis_of_fact, n_fact_lms
+            )
         # the successors once, then runs of equal keys in each list (greedy: one run per list)
         start = sc[S_COUNT]
         pstart = sc[S_PREF]

@@ -57,7 +57,9 @@ class BuiltinPlanner(Planner):
             raise TypeError(
                 f"the builtin planner takes a pddl Domain and Problem, got {type(domain).__name__}, {type(problem).__name__}"
             )
+        self.last_ground_task = None
         task = ground(domain, problem, limits)
+        self.last_ground_task = task
         if limits is not None:  # the search's bitsets: per operator, masks as wide as the facts
             n_ops, n_facts = len(task.operators), len(task.facts)
             limits.check(

@@ -150,3 +150,52 @@ def test_parallel_proves_unsolvable_and_refuses_other_planners(alica, unsolvable
     assert (summary["solved"], summary["agents"]) == (False, 2) and summary["messages"] <= 3
     run = alica("plan", *rovers("p01"), "--parallel", "2", "--anytime")
     assert run.code == 1 and "--parallel runs MAGiC" in run.err
+
+
+def _psr(problem: str = "p01-s17-n2-l2-f30") -> tuple[Path, Path]:
+    from tests.conftest import benchmark_set
+
+    folder = benchmark_set("ipc") / "psr-middle"
+    return folder / "domain.pddl", folder / f"{problem}.pddl"
+
+
+def test_the_builtin_planners_plan_is_checked_on_its_ground_task(alica, monkeypatch: pytest.MonkeyPatch) -> None:
+    import alica.prophet.validate as validate
+    from alica.prophet.ground import GroundTask
+
+    checked: list[object] = []
+    original = validate.validate_plan
+
+    def spy(task: object, plan: object) -> object:
+        checked.append(task)
+        return original(task, plan)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(validate, "validate_plan", spy)
+    run = alica("plan", *_psr(), "--json")
+    assert run.code == 0, run.err
+    assert len(checked) == 1 and isinstance(
+        checked[0], GroundTask
+    )  # derived facts recomputed by the grounding's fixpoint
+    assert check_json(run.out, *_psr())["solved"]  # and the lifted check agrees
+
+
+class _Grounding(_Scripted):
+    """A back-end that grounds the task itself, then answers with a fixed plan."""
+
+    def _search(self, domain: object, problem: object, *, anytime: bool) -> Iterator[SearchEvent]:
+        from alica.prophet.ground import ground
+
+        self.last_ground_task = ground(domain, problem)  # type: ignore[arg-type]
+        yield from super()._search(domain, problem, anytime=anytime)
+
+
+def test_a_plan_that_leaves_a_derived_goal_false_is_refused_on_the_ground_task(
+    alica, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    run = alica("plan", *_psr(), "--json")
+    steps = [PlanStep(s.strip("()").split()[0], tuple(s.strip("()").split()[1:])) for s in json.loads(run.out)["plan"]]
+    short = Plan(tuple(steps[:-1]), len(steps) - 1)
+    monkeypatch.setattr(planners, "get_planner", lambda name: _Grounding(short, PlanStatus.SOLVED))
+    run = alica("plan", *_psr())
+    assert run.code == 1 and run.out == ""
+    assert "planner 'scripted' returned an invalid plan: goal" in run.err and "does not hold after the plan" in run.err
