@@ -170,11 +170,13 @@ def test_first_plan_switches_to_the_compiled_search_without_changing_the_plan(mo
         return original(*args, **kw)
 
     monkeypatch.setattr(compiled_lama, "compiled_lama_search", spy)
-    monkeypatch.setattr(compiled_lama, "python_budget", lambda _relaxed: 100)
+    budget = int(compiled_lama.EXPANSIONS_PER_STEP * relaxed.ff_unit(ct.init)[0]) + 1  # the search needs more
+    assert budget < python[1]
+    monkeypatch.setattr(compiled_lama, "python_budget", lambda _relaxed: budget)
     stats = Stats(1000)
     result, _ = drain(first_plan(ct, relaxed, relaxed.ff_unit, LandmarkCount(ct, relaxed), stats))
     assert calls == ["compiled"] and result == python[0]
-    assert stats.expansions == 101 + python[1]  # the pure-Python start is counted too
+    assert stats.expansions == budget + 1 + python[1]  # the pure-Python start is counted too
 
 
 def test_tasks_the_kernel_does_not_cover_stay_in_pure_python() -> None:
