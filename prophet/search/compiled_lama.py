@@ -194,6 +194,7 @@ class _Arrays:
             for f in bits(m):
                 dis_of_fact[f] = d
         par_ptr, par_idx = csr([ids(lm.parents[f]) for f in facts])
+        r_ptr, r_idx = csr([ids(lm.reasonable[f]) for f in facts])
         gn_ptr, gn_idx = csr([ids(lm.gn_children[f]) for f in facts] + [ids(c) for c in lm.disjunctive_children])
         dis_ptr, dis_idx = csr([bits(m) for m in lm.disjunctive])
         self.n_lm_words = max(1, (n_lms + 63) // 64)
@@ -213,6 +214,8 @@ class _Arrays:
             dis_idx,
             dis_of_fact,
             n_fact,
+            r_ptr,
+            r_idx,
         )
         # Room by the memory bound: np.zeros maps zero pages that count only once written, so the
         # arrays start as large as the bound allows and rarely grow (a growth copies)

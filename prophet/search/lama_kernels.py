@@ -173,14 +173,25 @@ def lm_progress(parent_acc, acc, words, lm_fact, par_ptr, par_idx, dis_ptr, dis_
 
 
 @numba.njit(cache=True, nogil=True)
-def lm_needed(acc, words, needed, lm_fact, lm_goal, gn_ptr, gn_idx, dis_ptr, dis_idx, n_fact_lms):
-    """Fill ``needed`` (landmark bits) and return how many: not accepted, or accepted, live and false."""
+def lm_needed(acc, words, needed, lm_fact, lm_goal, gn_ptr, gn_idx, dis_ptr, dis_idx, n_fact_lms, r_ptr, r_idx):
+    """Fill ``needed`` (landmark bits) and return how many: not accepted, accepted before a reasonable
+    predecessor, or accepted, live and false."""
     n_lms = lm_goal.shape[0]
     for k in range(needed.shape[0]):
         needed[k] = np.uint64(0)
     count = 0
     for i in range(n_lms):
         if not has(acc, i):
+            put(needed, i)
+            count += 1
+            continue
+        early = False
+        if i < n_fact_lms:
+            for j in range(r_ptr[i], r_ptr[i + 1]):
+                if not has(acc, r_idx[j]):
+                    early = True
+                    break
+        if early:
             put(needed, i)
             count += 1
             continue
@@ -363,6 +374,8 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm
         dis_idx,
         dis_of_fact,
         n_fact_lms,
+        r_ptr,
+        r_idx,
     ) = lms
     (
         pool,
@@ -502,7 +515,9 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm
         if not ok:
             continue
         h_ff, n_out = extract(state_b, goals, sup, r_pre_ptr, r_pre_idx, counted, False, used, done, out)
-        h_lm = lm_needed(acc, words, needed, lm_fact, lm_goal, gn_ptr, gn_idx, dis_ptr, dis_idx, n_fact_lms)
+        h_lm = lm_needed(
+            acc, words, needed, lm_fact, lm_goal, gn_ptr, gn_idx, dis_ptr, dis_idx, n_fact_lms, r_ptr, r_idx
+        )
         sc[S_EXPANDED] += 1
         if sc[S_EXPANDED] > max_expansions:
             return LIMIT

@@ -30,14 +30,17 @@ Orderings: ``l`` in ``label(f)`` with ``l != f`` is a *natural* ordering
 (``l`` is true strictly before ``f`` first is, in every plan); ``l`` is a
 *greedy-necessary* predecessor of ``f`` when ``l`` is a precondition of every
 relaxed action that can first achieve ``f`` (one whose preconditions' labels
-do not hold ``f``).
+do not hold ``f``); *reasonable* orderings come from the task's mutex groups
+(:meth:`Landmarks.add_reasonable`).
 
 The heuristic (LAMA's landmark count) follows the landmarks a search path
 has *accepted*: those true in the initial state, then each landmark the
 moment it becomes true while its natural predecessors are all accepted
 already (the parent's accepted set). A state's estimate is the cost of the
 landmarks not accepted plus those *required again*: accepted, false now, and
-a goal or a greedy-necessary predecessor of a landmark not accepted. With
+a goal or a greedy-necessary predecessor of a landmark not accepted, and the
+accepted ones with a reasonable predecessor not accepted yet (they will have
+to be reached again after it, as in Fast Downward's landmark count). With
 ``unit`` every landmark counts 1 (LAMA's first search); otherwise each costs
 its cheapest achiever (the cost-sum variant). Its preferred operators are
 the applicable operators that achieve a fact landmark the state needs and
@@ -53,6 +56,7 @@ from collections.abc import Sequence
 
 from alica.prophet.search.encoding import CompiledTask, bits
 from alica.prophet.search.heuristics import Relaxed
+from alica.prophet.search.mutexes import Mutexes, mutex_groups
 
 MAX_DISJUNCTION = 4
 """The most facts of a disjunctive landmark (as LAMA's)."""
@@ -109,6 +113,7 @@ class Landmarks:
     Attributes:
         mask: the landmarks as a fact bitset.
         parents: per fact, its natural predecessors among the landmarks (a bitset; 0 if none).
+        reasonable: per fact, its reasonable predecessors (a bitset; see :meth:`add_reasonable`).
         gn_children: per fact, the landmarks it is a greedy-necessary predecessor of (a bitset).
         cost: per fact, its cheapest relaxed achiever's cost (0 for facts nothing adds).
         goal_mask: the (fluent) goal facts.
@@ -133,6 +138,7 @@ class Landmarks:
         self.mask = lms
         self.goal_mask = goal
         self.parents = [0] * n
+        self.reasonable = [0] * n
         self.gn_children = [0] * n
         self.cost = [0] * n
         self.reachable = all(label[g] is not None for g in bits(goal))
@@ -242,6 +248,80 @@ class Landmarks:
         """The greedy-necessary orderings ``(before, after)`` between landmarks."""
         return [(p, f) for p in bits(self.gn_parents_mask) for f in bits(self.gn_children[p])]
 
+    def add_reasonable(self, ct: CompiledTask, mutexes: Mutexes) -> None:
+        """Reasonable orderings between fact landmarks, as LAMA's (Hoffmann, Porteous and Sebastia's rules).
+
+        ``a`` *interferes* with ``b`` when they are mutex, when every operator adding ``a`` deletes
+        ``b`` or adds a fact mutex with ``b``, or when a greedy-necessary predecessor of ``a`` is mutex
+        with ``b``: then reaching ``b`` before ``a`` means destroying ``b`` again. ``a`` is ordered
+        reasonably before ``b`` when ``b`` is a goal, or when ``b`` is a greedy-necessary predecessor
+        of a landmark that ``a`` precedes (naturally or greedy-necessarily), as Fast Downward's
+        approximation does. An ordering that would close a cycle with the others is left out. The orderings go
+        to :attr:`reasonable`; they do not hold on every plan (unlike the natural ones), so only the
+        landmark count reads them: an accepted landmark whose reasonable predecessor is not accepted
+        yet counts as needed again.
+        """
+        n = len(self.parents)
+        lms = self.mask
+        adders: list[list[int]] = [[] for _ in range(n)]
+        for op, adds in enumerate(ct.add):
+            for f in adds:
+                if lms >> f & 1:
+                    adders[f].append(op)
+        shared_add = [0] * n
+        shared_del = [0] * n
+        for f in bits(lms):
+            if adders[f]:
+                add = del_ = -1
+                for op in adders[f]:
+                    add &= ct.add_mask[op]
+                    del_ &= ct.del_mask[op]
+                shared_add[f] = add & ~(1 << f)
+                shared_del[f] = del_
+        gn_parents = [0] * n
+        for c in bits(self.gn_parents_mask):
+            for f in bits(self.gn_children[c]):
+                gn_parents[f] |= 1 << c
+
+        def interferes(a: int, b: int) -> bool:
+            return (
+                mutexes.mutex(a, b)
+                or bool(shared_del[a] >> b & 1)
+                or mutexes.with_any(b, shared_add[a])
+                or mutexes.with_any(b, gn_parents[a])
+            )
+
+        after = [self.parents[f] | self.reasonable[f] for f in range(n)]
+
+        def before(a: int, b: int) -> bool:  # whether a is (transitively) ordered before b already or b before a
+            stack, seen = [a], 1 << a
+            while stack:
+                for p in bits(after[stack.pop()]):
+                    if p == b:
+                        return True
+                    if not seen >> p & 1:
+                        seen |= 1 << p
+                        stack.append(p)
+            return False
+
+        def order(a: int, b: int) -> None:
+            if after[b] >> a & 1 or not interferes(a, b) or before(a, b):
+                return
+            self.reasonable[b] |= 1 << a
+            after[b] |= 1 << a
+
+        for b in bits(lms & self.goal_mask):
+            for a in bits(lms & ~(1 << b)):
+                order(a, b)
+        for b in bits(lms & ~self.goal_mask):
+            for c in bits(self.gn_children[b]):
+                for a in bits((self.parents[c] | gn_parents[c]) & ~(1 << b)):
+                    order(a, b)
+
+    def reasonable_orderings(self) -> list[tuple[int, int]]:
+        """The reasonable orderings ``(before, after)`` (see :meth:`add_reasonable`)."""
+        return [(p, f) for f in bits(self.mask) for p in bits(self.reasonable[f])]
+
 
 class LandmarkCount:
     """LAMA's landmark-count heuristic on a compiled task (see the module docstring).
@@ -254,11 +334,17 @@ class LandmarkCount:
         relaxed: its relaxed task.
         unit: count every landmark 1 (else its cheapest achiever's cost).
         disjunctive: find disjunctive landmarks too.
+        reasonable: order the fact landmarks reasonably too (from the task's mutex groups,
+            :mod:`~alica.prophet.search.mutexes`), as LAMA does.
     """
 
-    def __init__(self, ct: CompiledTask, relaxed: Relaxed, unit: bool = True, disjunctive: bool = True) -> None:
+    def __init__(
+        self, ct: CompiledTask, relaxed: Relaxed, unit: bool = True, disjunctive: bool = True, reasonable: bool = True
+    ) -> None:
         self.ct = ct
         self.landmarks = lm = Landmarks(relaxed, ct.init, ct.task.facts if disjunctive else None)
+        if reasonable:
+            lm.add_reasonable(ct, Mutexes(mutex_groups(ct.task), ct.n_facts))
         self.unit = unit
         n = ct.n_facts
         self._dis = [(1 << (n + k), m, lm.disjunctive_children[k]) for k, m in enumerate(lm.disjunctive)]
@@ -274,9 +360,13 @@ class LandmarkCount:
             self._dfacts |= m
             for f in bits(m):
                 self._dbit[f] = bit
-        self._cache: dict[int, int] = {}
+        self._cache: dict[int, tuple[int, int]] = {}
         self._facts = lm.mask
         self._parents = lm.parents
+        self._ordered = 0  # the landmarks with a reasonable predecessor
+        for f in bits(lm.mask):
+            if lm.reasonable[f]:
+                self._ordered |= 1 << f
         self.cost = lm.cost + lm.disjunctive_cost
         """Per landmark id, its cost in the cost-sum variant."""
 
@@ -306,11 +396,12 @@ class LandmarkCount:
             s ^= low
         return out
 
-    def _live(self, accepted: int) -> int:
-        """The accepted landmarks that would be required again if false: goals, and greedy-necessary
-        predecessors of a landmark not accepted (cached per accepted set: siblings share theirs)."""
-        live = self._cache.get(accepted)
-        if live is None:
+    def _live(self, accepted: int) -> tuple[int, int]:
+        """The accepted landmarks that would be required again if false (goals, and greedy-necessary
+        predecessors of a landmark not accepted), and those required again in any case (a reasonable
+        predecessor not accepted yet); cached per accepted set: siblings share theirs."""
+        cached = self._cache.get(accepted)
+        if cached is None:
             if len(self._cache) > CACHE_SIZE:
                 self._cache.clear()
             unaccepted = self._mask & ~accepted
@@ -322,13 +413,19 @@ class LandmarkCount:
             for bit, _m, children in self._dis:
                 if accepted & bit and children & unaccepted:
                     live |= bit
-            self._cache[accepted] = live
-        return live
+            again = 0
+            reasonable = self.landmarks.reasonable
+            for f in bits(accepted & self._ordered):
+                if reasonable[f] & unaccepted:
+                    again |= 1 << f
+            cached = self._cache[accepted] = (live, again)
+        return cached
 
     def needed(self, state: int, accepted: int) -> int:
-        """The landmarks ``state`` still needs: not accepted, or required again (accepted, false in ``state``, live)."""
-        needed = self._mask & ~accepted
-        live = self._live(accepted)
+        """The landmarks ``state`` still needs: not accepted, required again (accepted, false in ``state``,
+        live), or accepted before a reasonable predecessor (as Fast Downward's landmark count)."""
+        live, again = self._live(accepted)
+        needed = (self._mask & ~accepted) | again
         if live:
             needed |= live & self._facts & ~state
             if live & self._dmask:

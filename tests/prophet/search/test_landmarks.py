@@ -297,3 +297,64 @@ def test_a_failing_compilation_keeps_the_pure_python_ff(monkeypatch: pytest.Monk
     states = random_states(ct, 20)
     assert [ff(s) for s in states] == [relaxed.ff_add_unit(s) for s in states]
     assert ff.compiled is None
+
+
+def test_mutex_groups_and_reasonable_orderings_of_a_blocks_task() -> None:
+    from alica.prophet.search.mutexes import Mutexes, mutex_groups
+
+    blocks = benchmark_set("pddl") / "blocks"
+    d = pddl.read_domain(blocks / "domain.pddl")
+    task = grounding.ground(d, pddl.read_problem(blocks / "probBLOCKS-6-2.pddl", d))
+    groups = [{task.facts[f] for f in g} for g in mutex_groups(task)]
+    assert {"(handempty)", "(holding a)", "(holding b)"} <= next(g for g in groups if "(handempty)" in g)
+    assert any({"(clear a)", "(holding a)", "(on b a)"} <= g for g in groups)  # what is on a
+    assert any({"(ontable a)", "(holding a)", "(on a b)"} <= g for g in groups)  # where a is
+    ct, relaxed, lmc = compiled(task)
+    mutexes = Mutexes(mutex_groups(task), ct.n_facts)
+    assert mutexes.mutex(task.fact_id("(holding a)"), task.fact_id("(handempty)"))
+    assert not mutexes.mutex(task.fact_id("(clear a)"), task.fact_id("(clear b)"))
+    reasonable = lmc.landmarks.reasonable_orderings()
+    assert reasonable and not set(reasonable) & set(lmc.landmarks.orderings())
+    for before, after in reasonable:  # each interferes: the later one would be destroyed again
+        assert lmc.landmarks.mask >> before & 1 and lmc.landmarks.mask >> after & 1
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 10**6))
+def test_mutex_groups_hold_in_every_state_of_random_walks(seed: int) -> None:
+    import random
+
+    from alica.prophet.search.mutexes import mutex_groups
+
+    blocks = benchmark_set("pddl") / "blocks"
+    d = pddl.read_domain(blocks / "domain.pddl")
+    task = grounding.ground(d, pddl.read_problem(blocks / "probBLOCKS-5-1.pddl", d))
+    groups = mutex_groups(task)
+    rng = random.Random(seed)
+    state = frozenset(task.init)
+    for _ in range(40):
+        assert all(len(g & state) <= 1 for g in groups)
+        ops = [o for o in task.operators if task.applicable(state, o)]
+        state = task.apply(state, rng.choice(ops))
+
+
+def test_the_landmark_count_is_zero_at_the_goal_with_reasonable_orderings() -> None:
+    from alica.prophet.search.lama import lama_search
+
+    blocks = benchmark_set("pddl") / "blocks"
+    d = pddl.read_domain(blocks / "domain.pddl")
+    for name in ("probBLOCKS-9-2", "probBLOCKS-8-1"):
+        ct, relaxed, lmc = compiled(grounding.ground(d, pddl.read_problem(blocks / f"{name}.pddl", d)))
+        assert lmc.landmarks.reasonable_orderings()
+        for weight in (None, 1, 3):
+            search = lama_search(ct, relaxed.ff_unit, lmc, Stats(10**9), weight=weight)
+            try:
+                while True:
+                    next(search)
+            except StopIteration as stop:
+                plan, _ = stop.value
+            state, accepted = ct.init, lmc.initial
+            for op in plan:
+                state = ct.successor(state, op)
+                accepted = lmc.progress(accepted, state)
+            assert ct.is_goal(state) and lmc.value(state, accepted) == 0
