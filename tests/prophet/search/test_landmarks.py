@@ -309,7 +309,7 @@ def test_mutex_groups_and_reasonable_orderings_of_a_blocks_task() -> None:
     assert {"(handempty)", "(holding a)", "(holding b)"} <= next(g for g in groups if "(handempty)" in g)
     assert any({"(clear a)", "(holding a)", "(on b a)"} <= g for g in groups)  # what is on a
     assert any({"(ontable a)", "(holding a)", "(on a b)"} <= g for g in groups)  # where a is
-    ct, relaxed, lmc = compiled(task)
+    ct, _relaxed, lmc = compiled(task)
     mutexes = Mutexes(mutex_groups(task), ct.n_facts)
     assert mutexes.mutex(task.fact_id("(holding a)"), task.fact_id("(handempty)"))
     assert not mutexes.mutex(task.fact_id("(clear a)"), task.fact_id("(clear b)"))
