@@ -256,8 +256,8 @@ class Inbox:
         if state is None:
             return None
         shown = state.offset.get(topic, 0) + seq
-        payload = self._payload(data, sender, topic)
         if rseq == 0:
+            payload = self._payload(data, sender, topic)
             if payload is _UNDECODABLE:
                 return None
             if shown <= state.last_seq.get(topic, 0):
@@ -274,8 +274,9 @@ class Inbox:
             return None
         stream = state.stream(topic)
         if (stream.next is not None and rseq < stream.next) or rseq in stream.held:
-            self.counts["duplicates"] += 1
+            self.counts["duplicates"] += 1  # before decoding: a duplicate is neither decoded nor counted twice
             return None
+        payload = self._payload(data, sender, topic)
         size = _size(data)
         if stream.next is None or rseq != stream.next:
             if not self._room(sender, size):

@@ -386,6 +386,18 @@ def test_an_undecodable_payload_is_counted_and_skipped_and_its_stream_goes_on():
     assert why.startswith("s on a:") and count == 1
 
 
+def test_an_undecodable_payload_that_comes_twice_is_a_duplicate_not_counted_again():
+    inbox, senders = started("s")
+    s = senders["s"]
+    a1, a2 = (s.send("a", 1.0) for _ in range(2))
+    broken = (*a1[:7], b"not a pickle")
+    for frame in (broken, broken, a2, broken):  # the network repeats it (a history answer raced the stream)
+        inbox.receive(frame, 1.0)
+    assert payloads(inbox.take()) == [("a", 2)]
+    assert inbox.counts["undecodable"] == 1 and inbox.counts["duplicates"] == 2
+    assert list(inbox.errors.values()) == [1]
+
+
 def test_its_own_frames_and_unsubscribed_topics_are_ignored():
     inbox = receiver()
     me, other = Sender("r"), Sender("s")
