@@ -200,12 +200,11 @@ def run_process(command: Sequence[str], cwd: Path, timeout: float, peak: bool = 
             out, err = process.communicate()
             timed_out = True
         wall = time.perf_counter() - start
-    peak_mb = wall_s = None
-    if report is not None:
+    peak_mb = None
+    if report is not None:  # the launcher's own wall time leaves out its start-up
         with contextlib.suppress(OSError, ValueError):
-            peak_kb, wall_s = report.read_text(encoding="utf-8").split()
-            peak_mb = int(peak_kb) / 1024
-            wall = float(wall_s)
+            peak_kb, child_wall = report.read_text(encoding="utf-8").split()
+            peak_mb, wall = int(peak_kb) / 1024, float(child_wall)
         report.unlink(missing_ok=True)
     return Proc(process.returncode, wall, out, err, timed_out, peak_mb)
 

@@ -4,18 +4,19 @@ On large tasks the pure-Python search spends its time in FF's exploration, in th
 generation and in its open lists, whose ``(key, count, state, operator, g)`` tuples hold the
 memory: logistics with 50 packages (23,000 operators) expanded about 1,000 states a second and
 took 1.5 GB. Here :func:`alica.prophet.search.lama_kernels.run` does the whole search per state:
-states packed in ``uint64`` words in a pool with a hash table, the four open lists as bucket queues of
-runs of successors (4 bytes a successor, see :mod:`~alica.prophet.search.lama_kernels`), FF and
-the landmark count over flat arrays. It gives the same plan as the pure-Python
-search (the same evaluations, the same preferred operators, the same tie-breaking: tested).
+states in a pool of 16-bit pieces with a hash table, the four open lists as bucket queues of runs
+of successors (4 bytes a successor, see :mod:`~alica.prophet.search.lama_kernels`), FF and the
+landmark count over flat arrays. It gives the same plan as the pure-Python search (the same
+evaluations, the same preferred operators, the same tie-breaking: tested).
 
 It covers what LAMA's first search meets on STRIPS-like tasks: no derived predicates, no
 when-effects, no tie-breaking seed, greedy or a weight that is a multiple of 0.5 (the keys stay
 exact integers). :func:`first_plan` runs the pure-Python search first, for as many expansions as
 would take about as long as loading numba and the kernel, and only then the compiled one, from
-the start; where :data:`EXPANSIONS_PER_STEP` times FF's estimate of the initial state (a guess of the
-expansions a greedy search needs) is already past that budget, it starts compiled. Both rules are deterministic: the same task
-always switches at the same expansion, so a simulated run that counts expansions stays the same.
+the start; where :data:`EXPANSIONS_PER_STEP` times FF's estimate of the initial state (a guess of
+the expansions a greedy search needs) is already past that budget, it starts compiled. Both rules
+are deterministic: the same task always switches at the same expansion, so a simulated run that
+counts expansions stays the same.
 
 Between calls of the kernel (every :data:`~alica.prophet.search.gbfs.CHECK_EVERY` expansions, or at
 the next progress event) the deadline and the memory bound of the run are checked: the memory is
@@ -174,7 +175,7 @@ class _Arrays:
             cf.out,
             np.zeros(n, dtype=np.bool_),
             np.zeros((cf.heap.shape[0], 2), dtype=i64),
-            np.full(LEVELS, -1, dtype=i64),
+            np.full(LEVELS + 1, -1, dtype=i64),  # the levels, then the highest the last call used
             np.zeros(n_words, dtype=np.uint64),
         )
         lm = lmcount.landmarks
@@ -365,8 +366,7 @@ def compiled_lama_search(
     arrays = _Arrays(ct, relaxed, lmcount, weight, None if stats.limits is None else stats.limits.memory_bytes)
     k = arrays.k
     sc = arrays.sc
-    limit = -1 if max_expansions == INF else int(max_expansions)
-    limit_arg = (1 << 62) if limit < 0 else limit
+    limit = (1 << 62) if max_expansions == INF else int(max_expansions)
     while True:
         before_exp, before_eval = int(sc[k.S_EXPANDED]), int(sc[k.S_EVALS])
         step = max(1, min(stats.next_check, stats.next_progress) - stats.expansions)
@@ -377,7 +377,7 @@ def compiled_lama_search(
             arrays.search(),
             sc,
             step,
-            limit_arg,
+            limit,
             boost,
             arrays.w2,
             arrays.greedy,
@@ -391,7 +391,7 @@ def compiled_lama_search(
             return None, True
         if code == k.LIMIT:
             return None, False
-        if code == k.OVERFLOW:  # keys past 2**23: the pure-Python search has no such bound
+        if code == k.OVERFLOW:  # a weighted key past the lists' keys: the pure-Python search has no such bound
             return (yield from lama_search(ct, relaxed.ff_unit, lmcount, stats, weight=weight, boost=boost))
         if code == k.GROW:
             arrays.grow()

@@ -155,7 +155,7 @@ def extract(state, goals, sup, pre_ptr, pre_idx, cost, unit, used, done, out):
 
 
 @numba.njit(cache=True, nogil=True)
-def _levels(
+def explore_levels(
     state,
     is_goal,
     npre,
@@ -169,12 +169,25 @@ def _levels(
     sup,
     unsat,
     acc,
+    heap,
     rec,
     head,
     level,
 ):
+    """``explore`` for costs of at least 1, with a bucket per cost level instead of the heap.
+
+    Every action costs at least 1, so nothing joins the level being processed; each level's
+    facts are taken in increasing fact id, the heap's order, so costs, supporters and the early
+    stop are the same as ``explore``'s. ``rec`` holds (fact, next) records of the pushes, ``head``
+    each level's first record and, last, the highest level the previous call used (its levels are
+    emptied first), ``level`` the facts of one level as a bitset (all 0 between calls). A cost past
+    the levels goes over to ``explore`` (with ``heap``). Returns whether the goals are reached.
+    """
     n = state.shape[0]
-    n_levels = head.shape[0]
+    n_levels = head.shape[0] - 1
+    for c in range(head[n_levels] + 1):
+        head[c] = -1
+    head[n_levels] = 0
     goals_left = 0
     for f in range(n):
         cost_f[f] = BIG
@@ -200,7 +213,22 @@ def _levels(
             g = add_idx[j]
             if c < cost_f[g]:
                 if c >= n_levels:
-                    return -1, top
+                    return explore(
+                        state,
+                        is_goal,
+                        npre,
+                        pre_of_ptr,
+                        pre_of_idx,
+                        add_ptr,
+                        add_idx,
+                        cost,
+                        zero,
+                        cost_f,
+                        sup,
+                        unsat,
+                        acc,
+                        heap,
+                    )
                 cost_f[g] = c
                 sup[g] = a
                 rec[n_rec, 0] = g
@@ -209,8 +237,9 @@ def _levels(
                 n_rec += 1
                 if c > top:
                     top = c
+                    head[n_levels] = top
     if goals_left == 0:
-        return 1, top
+        return True
     c = 0
     while c <= top:
         lo = n
@@ -240,7 +269,7 @@ def _levels(
                     if goals_left == 0:
                         for w2 in range(w + 1, hi + 1):
                             level[w2] = np.uint64(0)
-                        return 1, top
+                        return True
                 for k in range(pre_of_ptr[f], pre_of_ptr[f + 1]):
                     a = pre_of_idx[k]
                     left = unsat[a] - 1
@@ -254,7 +283,22 @@ def _levels(
                                 if ac >= n_levels:
                                     for w2 in range(w, hi + 1):
                                         level[w2] = np.uint64(0)
-                                    return -1, top
+                                    return explore(
+                                        state,
+                                        is_goal,
+                                        npre,
+                                        pre_of_ptr,
+                                        pre_of_idx,
+                                        add_ptr,
+                                        add_idx,
+                                        cost,
+                                        zero,
+                                        cost_f,
+                                        sup,
+                                        unsat,
+                                        acc,
+                                        heap,
+                                    )
                                 cost_f[g] = ac
                                 sup[g] = a
                                 rec[n_rec, 0] = g
@@ -263,56 +307,6 @@ def _levels(
                                 n_rec += 1
                                 if ac > top:
                                     top = ac
+                                    head[n_levels] = top
         c += 1
-    return (1 if goals_left == 0 else 0), top
-
-
-@numba.njit(cache=True, nogil=True)
-def explore_levels(
-    state,
-    is_goal,
-    npre,
-    pre_of_ptr,
-    pre_of_idx,
-    add_ptr,
-    add_idx,
-    cost,
-    zero,
-    cost_f,
-    sup,
-    unsat,
-    acc,
-    rec,
-    head,
-    level,
-):
-    """``explore`` for costs of at least 1, with a bucket per cost level instead of the heap.
-
-    Every action costs at least 1, so nothing joins the level being processed; each level's
-    facts are taken in increasing fact id, the heap's order, so costs, supporters and the early
-    stop are the same as ``explore``'s. ``rec`` holds (fact, next) records of the pushes, ``head``
-    each level's first record (all -1 between calls), ``level`` the facts of one level as a bitset
-    (all 0 between calls). Returns 1
-    (goals reached), 0 (not reachable) or -1 (a cost past ``head``'s levels: use ``explore``).
-    """
-    code, top = _levels(
-        state,
-        is_goal,
-        npre,
-        pre_of_ptr,
-        pre_of_idx,
-        add_ptr,
-        add_idx,
-        cost,
-        zero,
-        cost_f,
-        sup,
-        unsat,
-        acc,
-        rec,
-        head,
-        level,
-    )
-    for c in range(min(top + 1, head.shape[0])):
-        head[c] = -1
-    return code
+    return goals_left == 0

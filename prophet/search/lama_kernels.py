@@ -23,7 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from alica.prophet.search.ff_kernels import DEBRUIJN, DEBRUIJN_MUL, explore, explore_levels, extract
+from alica.prophet.search.ff_kernels import DEBRUIJN, DEBRUIJN_MUL, explore_levels, extract
 
 # return codes
 FOUND, EXHAUSTED, LIMIT, PAUSE, GROW, OVERFLOW = 0, 1, 2, 3, 4, 5
@@ -477,7 +477,7 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm
         for f in range(n_facts):
             state_b[f] = has(words, f)
         sc[S_EVALS] += 1
-        ok = explore_levels(
+        reached = explore_levels(
             state_b,
             is_goal,
             npre,
@@ -491,28 +491,12 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm
             sup,
             unsat,
             acc_a,
+            fheap,
             rec,
             head,
             level,
         )
-        if ok < 0:  # a cost past the levels: the heap has no such bound
-            ok = explore(
-                state_b,
-                is_goal,
-                npre,
-                pre_of_ptr,
-                pre_of_idx,
-                r_add_ptr,
-                r_add_idx,
-                r_cost,
-                zero,
-                cost_f,
-                sup,
-                unsat,
-                acc_a,
-                fheap,
-            )
-        if not ok:
+        if not reached:
             continue
         h_ff, n_out = extract(state_b, goals, sup, r_pre_ptr, r_pre_idx, counted, False, used, done, out)
         h_lm = lm_needed(

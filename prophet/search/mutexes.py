@@ -41,9 +41,9 @@ def _parse(fact: str) -> tuple[str, tuple[str, ...]]:
     return parts[0], tuple(parts[1:])
 
 
-def candidates(task: GroundTask) -> list[frozenset[Atom]]:
-    """The candidates the operators propose (see the module docstring), in a fixed order."""
-    parsed = [_parse(f) for f in task.facts]
+def candidates(task: GroundTask, parsed: Sequence[tuple[str, tuple[str, ...]]]) -> list[frozenset[Atom]]:
+    """The candidates the operators propose (see the module docstring), in a fixed order; ``parsed`` holds
+    each fact's predicate and arguments."""
     seen: dict[str, int] = {}
     found: dict[frozenset[Atom], None] = {}
     for op in task.operators:
@@ -140,7 +140,7 @@ def mutex_groups(task: GroundTask) -> list[frozenset[int]]:
         return []
     parsed = [_parse(f) for f in task.facts]
     out: dict[frozenset[int], None] = {}
-    todo = candidates(task)
+    todo = candidates(task, parsed)
     tried: set[frozenset[Atom]] = set(todo)
     while todo and len(tried) <= MAX_CANDIDATES:
         candidate = todo.pop(0)

@@ -18,13 +18,10 @@ from alica.prophet.search.compiled_lama import compiled_lama_search, eligible, f
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.heuristics import Relaxed
-from alica.prophet.search.jit import available
 from alica.prophet.search.lama import lama_search
 from alica.prophet.search.landmarks import LandmarkCount
 from tests.conftest import benchmark_set
 from tests.prophet.search.helpers import GroundOperator, GroundTask, check_plan
-
-pytestmark = pytest.mark.skipif(not available(), reason="numba is not installed")
 
 
 def drain(search: Generator[Progress, None, Any]) -> tuple[Any, list[int]]:
@@ -202,3 +199,12 @@ def test_a_search_longer_than_the_budget_starts_compiled(monkeypatch: pytest.Mon
     stats = Stats(1000)
     result, _ = drain(first_plan(ct, relaxed, relaxed.ff_unit, LandmarkCount(ct, relaxed), stats))
     assert result == python[0] and stats.expansions == python[1]  # no pure-Python start
+
+
+def test_ff_past_its_cost_levels_goes_over_to_the_heap_and_the_search_stays_the_same(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(compiled_lama, "LEVELS", 3)  # depot's h_add costs go far past 3
+    ct = ipc_task("depot", "p03")
+    python, compiled = both(ct)
+    assert compiled == python
