@@ -10,7 +10,8 @@ or to a time limit and returns a :class:`PlanResult`.
 deadline on a clock and a memory bound. Whoever does work that can grow with
 the input (the PDDL reader, the grounding, the search) calls
 :meth:`Limits.check` every so many items; past the deadline, or when the
-estimated size passes the bound, it raises :class:`LimitReached`, whose
+estimated size passes the bound (with ``whole_process``, also when the
+process's resident memory does), it raises :class:`LimitReached`, whose
 message names the stage. :meth:`Planner.search` turns it into a final
 ``Done`` (``TIMEOUT`` or ``MEMORY``), so a caller stepping the search never
 sees the exception.
@@ -19,6 +20,9 @@ sees the exception.
 from __future__ import annotations
 
 import gc
+import os
+import resource
+import sys
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable, Iterator
@@ -89,6 +93,20 @@ DEFAULT_MEMORY_MB = 2048
 """The memory bound of planning when none is given (``alica plan``, the runtime's planning)."""
 
 
+RESIDENT_EVERY_S = 0.01
+"""Seconds between two reads of the process's resident memory by :meth:`Limits.check`."""
+
+
+def resident_bytes() -> int:
+    """This process's resident memory now (Linux: ``/proc/self/statm``); elsewhere its peak so far."""
+    try:
+        with open("/proc/self/statm", "rb") as f:
+            return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+        return int(peak if sys.platform == "darwin" else peak * 1024)  # bytes on macOS, KiB elsewhere
+
+
 class LimitReached(PlannerError):
     """A planning limit was reached.
 
@@ -122,6 +140,10 @@ class Limits:
         bounds_search: whether the deadline also bounds the search (checked every few expansions); False
             when it bounds reading and grounding only and the caller budgets the search between its
             events (the runtime plans a little every tick, in simulated time).
+        whole_process: whether the memory bound holds for the whole process's resident memory
+            (measured, at most every :data:`RESIDENT_EVERY_S`), not only for the stages' estimates:
+            ``alica plan``, a process that only plans. The runtime plans inside a robot's process
+            and bounds the estimates.
     """
 
     seconds: float | None = None
@@ -129,6 +151,9 @@ class Limits:
     clock: Callable[[], float] = time.monotonic
     deadline: float | None = field(default=None)
     bounds_search: bool = True
+    whole_process: bool = False
+    _resident: int = field(default=0, repr=False)
+    _resident_at: float = field(default=float("-inf"), repr=False)
 
     def __post_init__(self) -> None:
         if self.deadline is None and self.seconds is not None:
@@ -139,6 +164,24 @@ class Limits:
         """The memory bound in bytes."""
         return None if self.memory_mb is None else self.memory_mb * 1024 * 1024
 
+    def resident(self) -> int:
+        """The process's resident bytes (read at most every :data:`RESIDENT_EVERY_S`); 0 unless ``whole_process``."""
+        if not self.whole_process:
+            return 0
+        now = time.monotonic()
+        if now - self._resident_at >= RESIDENT_EVERY_S:
+            self._resident, self._resident_at = resident_bytes(), now
+        return self._resident
+
+    def room_bytes(self) -> float | None:
+        """What a stage may still allocate under the bound (``None`` without one): the bound, less the
+        process's resident memory with ``whole_process``."""
+        bound = self.memory_bytes
+        if bound is None or not self.whole_process:
+            return bound
+        self._resident_at = float("-inf")
+        return max(0.0, bound - self.resident())
+
     def remaining(self) -> float | None:
         """Seconds left before the deadline (0 when past), ``None`` without one."""
         return None if self.deadline is None else max(0.0, self.deadline - self.clock())
@@ -148,7 +191,8 @@ class Limits:
         return self.deadline is not None and self.clock() >= self.deadline
 
     def check(self, stage: str, estimate_bytes: float = 0.0, done: str = "", reserve: float = 0.0) -> None:
-        """Raise :class:`LimitReached` past the deadline, or when ``estimate_bytes`` passes the bound.
+        """Raise :class:`LimitReached` past the deadline, or when ``estimate_bytes`` passes the bound
+        (with ``whole_process``, also when the process's resident memory does).
 
         Args:
             stage: what is running, for the message (``grounding``).
@@ -158,9 +202,12 @@ class Limits:
         """
         bound = self.memory_bytes
         more = f" ({done})" if done else ""
-        if bound is not None and estimate_bytes > bound:
+        if bound is not None and max(estimate_bytes, self.resident()) > bound:
+            what = f"the process needs more than {self.memory_mb:g} MB while {stage}{more}"
+            if estimate_bytes > bound:
+                what = f"{stage} needs more than {self.memory_mb:g} MB{more}"
             raise LimitReached(
-                f"{stage} needs more than {self.memory_mb:g} MB{more}; raise --memory-limit or make the problem smaller",
+                f"{what}; raise --memory-limit or make the problem smaller",
                 stage,
                 "memory",
             )

@@ -10,8 +10,9 @@ Exit codes: 0 solved (the plan is valid), 1 input error or a failed planner
 unsolvable, 4 time or memory limit reached without a plan.
 
 ``--time-limit`` covers reading, grounding and search; ``--memory-limit``
-bounds the estimated size of the parse, the grounding and the search's
-tables. A limit reached prints one line on standard error naming the stage
+bounds the process's resident memory while it reads, grounds and searches
+(measured, and checked against the estimated size of what a stage is about
+to build); with ``--parallel`` it bounds each agent's search. A limit reached prints one line on standard error naming the stage
 (``alica: time limit 10 s reached while grounding (...)``) and exits 4.
 """
 
@@ -84,7 +85,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         type=_megabytes,
         default=float(DEFAULT_MEMORY_MB),
         metavar="MB",
-        help=f"the estimated memory planning may use, in MB (default {DEFAULT_MEMORY_MB})",
+        help=f"the resident memory this planning process may use, in MB (default {DEFAULT_MEMORY_MB})",
     )
     p.add_argument(
         "--anytime", action="store_true", help="keep improving the plan until the time limit or a proven optimum"
@@ -139,7 +140,7 @@ def cmd_plan(args: argparse.Namespace) -> int:
     from alica.prophet.pddl import PddlError
 
     start = time.monotonic()
-    limits = Limits(args.time_limit, args.memory_limit)
+    limits = Limits(args.time_limit, args.memory_limit, whole_process=True)
     if args.planner is None and Path(args.domain).suffix.lower() not in PLAN_FILE_SUFFIXES:
         args.planner = "builtin"
     try:

@@ -171,7 +171,7 @@ def search_task(
             # far better (optical-telegraphs p02: 522 expansions against 5,176; the other derived domains alike)
             ff = relaxed.ff
         else:
-            ff = SwitchingFF(relaxed, relaxed.ff_unit, relaxed.r_unit)  # every operator 1
+            ff = SwitchingFF(relaxed, relaxed.ff_unit, relaxed.r_unit, limits=stats.limits)  # every operator 1
         ops, _exhausted = yield from first_plan(ct, relaxed, ff, lmcount, stats, weight=first.weight, seed=first.seed)
     else:
         evaluate: Evaluator = {"ff": relaxed.ff, "ff_add_unit": relaxed.ff_add_unit, "ff_cost": relaxed.ff_cost}[

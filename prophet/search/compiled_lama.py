@@ -16,7 +16,9 @@ would take about as long as loading numba and the kernel, and only then the comp
 the start; where :data:`EXPANSIONS_PER_STEP` times FF's estimate of the initial state (a guess of
 the expansions a greedy search needs) is already past that budget, it starts compiled. Both rules
 are deterministic: the same task always switches at the same expansion, so a simulated run that
-counts expansions stays the same.
+counts expansions stays the same. One more rule holds where the memory bound covers the whole
+process (``alica plan``): when the room left under it is less than what loading numba costs
+(:data:`~alica.prophet.search.jit.NUMBA_BYTES`), the pure-Python search goes on alone.
 
 Between calls of the kernel (every :data:`~alica.prophet.search.gbfs.CHECK_EVERY` expansions, or at
 the next progress event) the deadline and the memory bound of the run are checked: the memory is
@@ -25,6 +27,7 @@ the arrays' own size, which is what the search holds.
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Generator
 from typing import Any
 
@@ -32,7 +35,7 @@ from alica.prophet.planner import LimitReached, Progress
 from alica.prophet.search.encoding import AxiomTask, CompiledTask, bits
 from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
-from alica.prophet.search.jit import JIT_LOAD_S, CompiledFF, available
+from alica.prophet.search.jit import JIT_LOAD_S, NUMBA_BYTES, CompiledFF, available, room_for_numba
 from alica.prophet.search.lama import lama_search
 from alica.prophet.search.landmarks import LandmarkCount
 
@@ -85,7 +88,7 @@ def first_plan(
     seed: int | None = None,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """LAMA's first search: pure Python on small searches, compiled beyond (see the module docstring)."""
-    if not eligible(ct, relaxed, weight, seed):
+    if not eligible(ct, relaxed, weight, seed) or not room_for_numba(stats.limits):
         return (yield from lama_search(ct, ff, lmcount, stats, weight=weight, seed=seed))
     budget = python_budget(relaxed)
     # a greedy search expands several times as many states as its plan is long, which FF's estimate of the
@@ -363,7 +366,10 @@ def compiled_lama_search(
     """
     if not eligible(ct, relaxed, weight, None):
         raise ValueError("the compiled LAMA search covers STRIPS tasks without derived predicates or when-effects")
-    arrays = _Arrays(ct, relaxed, lmcount, weight, None if stats.limits is None else stats.limits.memory_bytes)
+    room = None if stats.limits is None else stats.limits.room_bytes()
+    if room is not None and stats.limits is not None and stats.limits.whole_process and "numba" not in sys.modules:
+        room = max(0.0, room - NUMBA_BYTES)
+    arrays = _Arrays(ct, relaxed, lmcount, weight, room)
     k = arrays.k
     sc = arrays.sc
     limit = (1 << 62) if max_expansions == INF else int(max_expansions)
@@ -393,15 +399,17 @@ def compiled_lama_search(
             return None, False
         if code == k.OVERFLOW:  # a weighted key past the lists' keys: the pure-Python search has no such bound
             return (yield from lama_search(ct, relaxed.ff_unit, lmcount, stats, weight=weight, boost=boost))
-        if code == k.GROW:
-            arrays.grow()
         limits = stats.limits
-        if limits is not None and stats.expansions >= stats.next_check:
+        if limits is not None and (code == k.GROW or stats.expansions >= stats.next_check):
+            # a growth copies arrays: at most what they hold, written anew beside the old ones
+            held = arrays.nbytes() + (limits.resident() if code == k.GROW else 0)
             try:
-                limits.check("searching", arrays.nbytes(), done=f"{stats.expansions} expansions")
+                limits.check("searching", held, done=f"{stats.expansions} expansions")
             except LimitReached as exc:
                 exc.expansions = stats.expansions
                 raise
+        if code == k.GROW:
+            arrays.grow()
         if stats.progress_due():
             yield Progress(stats.expansions)
 

@@ -23,14 +23,19 @@ against 75 in pure Python; on visitall (3,500) 3,600 against 360.
 from __future__ import annotations
 
 import importlib.util
+import sys
 from collections.abc import Callable, Sequence
 from time import perf_counter
 from typing import Any
 
+from alica.prophet.planner import Limits
 from alica.prophet.search.heuristics import INF, Relaxed
 
 JIT_LOAD_S = 0.65
 """What loading numba and the kernels costs a process (seconds; measured 0.6-0.7 s)."""
+NUMBA_BYTES = 140 << 20
+"""The resident memory loading numba and a kernel adds to a process (measured: 69 MB for numba's import,
+61 MB for the first call of a cached kernel: LLVM's code and tables)."""
 JIT_CALL_S = 20e-6
 """The fixed cost of one compiled evaluation (the state's conversion, the calls), seconds."""
 
@@ -50,6 +55,15 @@ def _compile() -> tuple[Any, Any]:
 def available() -> bool:
     """Whether numba can be imported here."""
     return importlib.util.find_spec("numba") is not None
+
+
+def room_for_numba(limits: Limits | None) -> bool:
+    """Whether loading numba fits under a memory bound on the whole process (``alica plan``'s):
+    :data:`NUMBA_BYTES` left, unless numba is loaded already. Without such a bound, always."""
+    if limits is None or not limits.whole_process or "numba" in sys.modules:
+        return True
+    room = limits.room_bytes()
+    return room is None or room >= NUMBA_BYTES
 
 
 class CompiledFF:
@@ -162,6 +176,8 @@ class SwitchingFF:
         python: the pure-Python evaluator it stands for (``relaxed.ff_add_unit`` or ``relaxed.ff_unit``).
         costs: the exploration's costs of that evaluator (``None``: the relaxed actions' own).
         load_s: the savings (seconds) before the switch.
+        limits: the run's limits: no switch where loading numba would pass a bound on the whole
+            process (:func:`room_for_numba`).
     """
 
     def __init__(
@@ -170,8 +186,10 @@ class SwitchingFF:
         python: Callable[[int], tuple[float, list[int]]],
         costs: Sequence[int] | None = None,
         load_s: float = JIT_LOAD_S,
+        limits: Limits | None = None,
     ) -> None:
         self.relaxed = relaxed
+        self.limits = limits
         self.python = python
         self.costs = costs
         self.compiled: CompiledFF | None = None
@@ -185,6 +203,9 @@ class SwitchingFF:
         result = self.python(state)
         self._left -= 0.95 * (perf_counter() - start) - JIT_CALL_S
         if self._left <= 0:
+            if not room_for_numba(self.limits):
+                self._left = INF
+                return result
             try:
                 compiled = CompiledFF(self.relaxed, self.costs, unit=True)
                 compiled(state)  # numba compiles (or loads) here: a failure keeps the pure-Python FF
@@ -196,4 +217,4 @@ class SwitchingFF:
         return result
 
 
-__all__ = ["JIT_CALL_S", "JIT_LOAD_S", "CompiledFF", "SwitchingFF", "available"]
+__all__ = ["JIT_CALL_S", "JIT_LOAD_S", "NUMBA_BYTES", "CompiledFF", "SwitchingFF", "available", "room_for_numba"]

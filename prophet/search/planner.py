@@ -64,7 +64,7 @@ class BuiltinPlanner(Planner):
             n_ops, n_facts = len(task.operators), len(task.facts)
             limits.check(
                 "preparing the search",
-                n_ops * (BYTES_PER_OPERATOR + 3 * n_facts // 16),
+                limits.resident() + n_ops * (BYTES_PER_OPERATOR + 3 * n_facts // 16),
                 f"{n_ops} ground operators over {n_facts} facts",
             )
         yield from search_task(

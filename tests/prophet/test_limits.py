@@ -1,8 +1,9 @@
 """Bounded planning cost: the deadline and the memory bound over reading, grounding and search; linear reading.
 
 No test times anything: the clocks are injected (a deadline already past, or a clock that
-advances one second per reading), memory is an estimate from counts, and the reader's
-speed is counted in calls.
+advances one second per reading), memory is an estimate from counts or a resident size
+the test sets, and the reader's speed is counted in calls (tests/prophet/planners/test_cli_memory.py
+measures a real process against its bound).
 """
 
 from __future__ import annotations
@@ -18,11 +19,13 @@ import pytest
 from alica.io import load_library
 from alica.model import Condition, ConditionKind
 from alica.prophet import plan_problem
+from alica.prophet import planner as planner_module
 from alica.prophet.ground import ground
 from alica.prophet.pddl import Domain, Problem, parse_domain, parse_problem
 from alica.prophet.pipeline import Found
 from alica.prophet.planner import Done, LimitReached, Limits, PlanStatus
 from alica.prophet.search.gbfs import CHECK_EVERY
+from alica.prophet.search.jit import NUMBA_BYTES, room_for_numba
 from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.world import read_world
 from tests.conftest import PLANS
@@ -226,3 +229,26 @@ def test_duplicates_are_still_found() -> None:
             "(define (domain w) (:predicates (p)) (:action a :parameters () :effect (p)) "
             "(:action a :parameters () :effect (p)))"
         )
+
+
+def test_a_bound_on_the_whole_process_counts_its_resident_memory(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(planner_module, "resident_bytes", lambda: 300 << 20)
+    estimates_only = Limits(memory_mb=200)
+    estimates_only.check("searching", 100 << 20)  # the estimate fits: the process's size is not its business
+    assert estimates_only.resident() == 0 and estimates_only.room_bytes() == 200 << 20
+    whole = Limits(memory_mb=200, whole_process=True)
+    with pytest.raises(LimitReached, match=r"^the process needs more than 200 MB while searching \(5 expansions\)"):
+        whole.check("searching", 100 << 20, done="5 expansions")
+    roomy = Limits(memory_mb=1000, whole_process=True)
+    roomy.check("searching", 100 << 20)
+    assert roomy.room_bytes() == 700 << 20
+
+
+def test_numba_is_loaded_only_where_it_fits_under_a_bound_on_the_process(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(planner_module, "resident_bytes", lambda: 100 << 20)
+    monkeypatch.delitem(sys.modules, "numba", raising=False)
+    assert room_for_numba(None) and room_for_numba(Limits(memory_mb=150))  # estimates only: no rule
+    assert not room_for_numba(Limits(memory_mb=150, whole_process=True))
+    assert room_for_numba(Limits(memory_mb=100 + NUMBA_BYTES / 2**20, whole_process=True))
+    monkeypatch.setitem(sys.modules, "numba", object())  # loaded already: nothing more to spend
+    assert room_for_numba(Limits(memory_mb=150, whole_process=True))

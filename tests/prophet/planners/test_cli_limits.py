@@ -19,13 +19,6 @@ def files(tmp_path: Path) -> Iterator[tuple[Path, Path]]:
     yield domain, problem
 
 
-def test_alica_plan_memory_limit_in_grounding_exits_4_with_the_stage(alica: Callable[..., Run], files) -> None:
-    run = alica("plan", *files, "--memory-limit", "20")
-    assert run.code == 4, run.err
-    assert run.err.startswith("alica: grounding needs more than 20 MB (") and len(run.err.splitlines()) == 1
-    assert "; no plan: memory limit reached" in run.out and "Traceback" not in run.err
-
-
 def test_alica_plan_memory_limit_in_reading_exits_4_with_json(alica: Callable[..., Run], files) -> None:
     run = alica("plan", *files, "--memory-limit", "0.01", "--json")
     assert run.code == 4
