@@ -35,7 +35,7 @@ from typing import TYPE_CHECKING
 
 from alica.prophet.planner import Done, Improved, Limits, Plan, PlanStatus, PlanStep, SearchEvent
 from alica.prophet.search.astar import astar
-from alica.prophet.search.compiled_lama import first_plan
+from alica.prophet.search.compiled_lama import compiled_lama_search, first_plan
 from alica.prophet.search.encoding import CompiledTask, compile_task
 from alica.prophet.search.gbfs import Stats, lazy_search
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
@@ -53,6 +53,8 @@ NEIGHBOURHOOD_LIMITS: tuple[int, int] = (500, 4000)
 """The first and the largest state limit of the neighbourhood rounds after each plan."""
 RESTART_BUDGET = 20
 """The expansion budget of each restart, in multiples of the first search's expansions."""
+COMPILED_RESTART_WEIGHTS: tuple[float, ...] = (5, 3, 2, 1)
+"""The weights of the compiled restarts (LAMA's search, FF and the landmark count)."""
 FIRST_HEURISTICS: tuple[str, ...] = ("lama", "ff", "ff_add_unit", "ff_cost")
 """The heuristics the first search may use (methods of :class:`~alica.prophet.search.heuristics.Relaxed`)."""
 
@@ -163,6 +165,7 @@ def search_task(
         return
     relaxed = Relaxed(ct)
     first = FirstSearch() if first is None else first
+    lmcount: LandmarkCount | None = None
     if first.heuristic == "lama":
         lmcount = LandmarkCount(ct, relaxed)
         ff: Evaluator
@@ -190,10 +193,18 @@ def search_task(
     windows = Windows(ct)
     best = yield from _windows(ct, windows, best, ct.plan_cost(best), stats, QUICK_WINDOW_STATES)
     best_cost = ct.plan_cost(best)
-    for evaluate, weight in _restarts(ct, relaxed):
-        ops, _exhausted = yield from lazy_search(
-            ct, evaluate, stats, weight=weight, max_expansions=RESTART_BUDGET * max(100, first_expansions)
-        )
+    if stats.compiled:  # a large task: the full sweeps come before the restarts, which take long there
+        best = yield from _windows(ct, windows, best, best_cost, stats)
+        best_cost = ct.plan_cost(best)
+    restart_budget = RESTART_BUDGET * max(100, first_expansions)
+    for restart, weight in _restarts(ct, relaxed, lmcount if stats.compiled else None):
+        if isinstance(restart, str):  # "lama": the first search ran compiled, so do the restarts
+            assert lmcount is not None
+            ops, _exhausted = yield from compiled_lama_search(
+                ct, relaxed, lmcount, stats, weight=weight, max_expansions=restart_budget, bound=best_cost
+            )
+        else:
+            ops, _exhausted = yield from lazy_search(ct, restart, stats, weight=weight, max_expansions=restart_budget)
         if ops is not None:
             found = yield from _windows(ct, windows, improve(ct, ops), best_cost, stats, QUICK_WINDOW_STATES)
             found = yield from _windows(ct, windows, found, min(best_cost, ct.plan_cost(found)), stats)
@@ -234,8 +245,17 @@ def search_task(
         budget *= 2
 
 
-def _restarts(ct: CompiledTask, relaxed: Relaxed) -> list[tuple[Evaluator, float | None]]:
-    """The unbounded searches after the first plan: other heuristics and weights give other plans."""
+def _restarts(
+    ct: CompiledTask, relaxed: Relaxed, lmcount: LandmarkCount | None
+) -> list[tuple[Evaluator | str, float | None]]:
+    """The unbounded searches after the first plan: other heuristics and weights give other plans.
+
+    With ``lmcount`` (the first search ran compiled, on a large task), LAMA's search again, compiled,
+    with the weights of LAMA's own restarts and pruned by the best plan's cost: pure-Python ones
+    would not end within a few seconds there.
+    """
+    if lmcount is not None:
+        return [("lama", w) for w in COMPILED_RESTART_WEIGHTS]
     if ct.unit_cost:
         return [(relaxed.ff_add_unit, None), (relaxed.ff, 3), (relaxed.ff_add_unit, 3)]
     return [(relaxed.ff_cost, None), (relaxed.ff_cost, 3)]

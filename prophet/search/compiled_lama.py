@@ -358,6 +358,7 @@ def compiled_lama_search(
     boost: int = 1000,
     max_expansions: float = INF,
     landmark_preferred: bool = True,
+    bound: float = INF,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """:func:`~alica.prophet.search.lama.lama_search` compiled (see the module docstring); the same results.
 
@@ -372,6 +373,7 @@ def compiled_lama_search(
     arrays = _Arrays(ct, relaxed, lmcount, weight, room)
     k = arrays.k
     sc = arrays.sc
+    stats.compiled = True
     limit = (1 << 62) if max_expansions == INF else int(max_expansions)
     while True:
         before_exp, before_eval = int(sc[k.S_EXPANDED]), int(sc[k.S_EVALS])
@@ -388,6 +390,7 @@ def compiled_lama_search(
             arrays.w2,
             arrays.greedy,
             landmark_preferred,
+            (1 << 62) if bound == INF else int(bound),
         )
         stats.expansions += int(sc[k.S_EXPANDED]) - before_exp
         stats.evaluations += int(sc[k.S_EVALS]) - before_eval
@@ -398,7 +401,19 @@ def compiled_lama_search(
         if code == k.LIMIT:
             return None, False
         if code == k.OVERFLOW:  # a weighted key past the lists' keys: the pure-Python search has no such bound
-            return (yield from lama_search(ct, relaxed.ff_unit, lmcount, stats, weight=weight, boost=boost))
+            return (
+                yield from lama_search(
+                    ct,
+                    relaxed.ff_unit,
+                    lmcount,
+                    stats,
+                    weight=weight,
+                    boost=boost,
+                    max_expansions=max_expansions,
+                    landmark_preferred=landmark_preferred,
+                    bound=bound,
+                )
+            )
         limits = stats.limits
         if limits is not None and (code == k.GROW or stats.expansions >= stats.next_check):
             # a growth copies arrays: at most what they hold, written anew beside the old ones

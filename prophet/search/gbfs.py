@@ -43,6 +43,7 @@ class Stats:
         evaluations: heuristic evaluations so far.
         next_progress: the expansion count of the next ``Progress``.
         next_check: the expansion count of the next check of the limits.
+        compiled: whether a compiled search ran in this run (the anytime restarts then run compiled too).
     """
 
     progress_every: int = 1000
@@ -51,6 +52,7 @@ class Stats:
     evaluations: int = 0
     next_progress: int = 0
     next_check: int = 0
+    compiled: bool = False
 
     def __post_init__(self) -> None:
         self.progress_every = max(1, int(self.progress_every))

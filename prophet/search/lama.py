@@ -42,6 +42,7 @@ def lama_search(
     max_expansions: float = INF,
     seed: int | None = None,
     landmark_preferred: bool = True,
+    bound: float = INF,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """LAMA's lazy search with FF and the landmark count (see the module docstring).
 
@@ -54,6 +55,7 @@ def lama_search(
         boost: turns given back to the preferred lists on progress.
         max_expansions: give up after this many expansions.
         seed: shuffle each state's successors with this seed; ``None`` keeps the operators' order.
+        bound: successors whose ``g`` reaches it are not inserted (only cheaper plans are found).
 
     Returns:
         ``(plan, exhausted)`` as :func:`~alica.prophet.search.gbfs.lazy_search` does.
@@ -132,6 +134,8 @@ def lama_search(
             shuffle(successors)
         for o in successors:
             g2 = g + op_cost[o]
+            if g2 >= bound:
+                continue
             count += 1
             k_ff = h_ff if greedy else g2 + w * h_ff
             k_lm = h_lm if greedy else g2 + w * h_lm

@@ -317,8 +317,9 @@ def add_run(which, key, start, end, parent, heads, tails, run_pos, run_end, run_
 
 
 @numba.njit(cache=True, nogil=True)
-def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm_pref):
-    """LAMA's lazy search (see the module docstring); returns one of the codes above."""
+def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm_pref, bound):
+    """LAMA's lazy search (see the module docstring); returns one of the codes above. Successors whose
+    ``g`` reaches ``bound`` are not inserted (the anytime restarts' pruning)."""
     (
         init,
         goal_words,
@@ -524,6 +525,14 @@ def run(task, ff, lms, search, sc, budget, max_expansions, boost, w2, greedy, lm
             lm_preferred(
                 succ, n_succ, acc, needed, pref, add_ptr, add_idx, lm_of_fact, par_ptr, par_idx, dis_of_fact, n_fact_lms
             )
+        kept = 0  # the successors under the bound, in order
+        for k in range(n_succ):
+            if g + cost[succ[k]] < bound:
+                succ[kept] = succ[k]
+                kept += 1
+            else:
+                pref[succ[k]] = False
+        n_succ = kept
         # the successors once, then runs of equal keys in each list (greedy: one run per list)
         start = sc[S_COUNT]
         pstart = sc[S_PREF]

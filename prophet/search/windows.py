@@ -21,7 +21,7 @@ from collections.abc import Generator, Sequence
 from heapq import heappop, heappush
 
 from alica.prophet.planner import Progress
-from alica.prophet.search.encoding import AxiomTask, CompiledTask
+from alica.prophet.search.encoding import AxiomTask, CompiledTask, bits
 from alica.prophet.search.gbfs import Stats, trace
 
 WINDOW_SIZES: tuple[int, ...] = (6, 10, 16, 24, 32)
@@ -55,6 +55,8 @@ class Windows:
         self.exact = not any(ct.cond) and not (
             isinstance(ct, AxiomTask) and ct.axioms
         )  # derived facts: no swap analysis
+        self._deletes: dict[int, list[int]] = {}
+        """Per operator met so far, the facts it deletes (and does not add)."""
         self.failed: dict[tuple[int, int, frozenset[str]], tuple[int, int]] = {}
         """Window searches that found nothing: (start, needed facts, objects) -> (bound, state limit)."""
 
@@ -85,11 +87,14 @@ class Windows:
         n = len(plan)
         succ: list[list[int]] = [[] for _ in range(n)]
         waiting = [0] * n
-        for j in range(n):
-            for i in range(j):
-                if self.interferes(plan[i], plan[j]):
-                    succ[i].append(j)
-                    waiting[j] += 1
+        if any(self.ct.cond[op] for op in plan):  # a conditional effect may touch anything
+            for j in range(n):
+                for i in range(j):
+                    if self.interferes(plan[i], plan[j]):
+                        succ[i].append(j)
+                        waiting[j] += 1
+        else:
+            self._interfering_pairs(plan, succ, waiting)
         ready = [j for j in range(n) if not waiting[j]]
         order: list[int] = []
         last: frozenset[str] = frozenset()
@@ -104,6 +109,37 @@ class Windows:
                 if not waiting[k]:
                     ready.append(k)
         return order
+
+    def _interfering_pairs(self, plan: Sequence[int], succ: list[list[int]], waiting: list[int]) -> None:
+        """The pairs :meth:`interferes` finds, through the facts the actions touch (no pair of positions is
+        tried unless they share a fact): ``succ[i]`` gets each later ``j`` in order, ``waiting[j]`` counts them.
+        """
+        ct = self.ct
+        changes: dict[int, list[int]] = {}  # fact -> the positions adding or deleting it
+        needs_or_adds: dict[int, list[int]] = {}
+        deletes: dict[int, list[int]] = {}
+        for j, op in enumerate(plan):
+            dels = self._deletes.get(op)
+            if dels is None:
+                dels = self._deletes[op] = bits(ct.del_mask[op])
+            before: set[int] = set()
+            for f in ct.pre[op]:  # an earlier action adds or deletes what this one needs
+                before.update(changes.get(f, ()))
+            for f in dels:  # ... needs or adds what this one deletes
+                before.update(needs_or_adds.get(f, ()))
+            for f in ct.add[op]:  # ... deletes what this one adds
+                before.update(deletes.get(f, ()))
+            for i in sorted(before):
+                succ[i].append(j)
+            waiting[j] = len(before)
+            for f in ct.pre[op]:
+                needs_or_adds.setdefault(f, []).append(j)
+            for f in ct.add[op]:
+                changes.setdefault(f, []).append(j)
+                needs_or_adds.setdefault(f, []).append(j)
+            for f in dels:
+                changes.setdefault(f, []).append(j)
+                deletes.setdefault(f, []).append(j)
 
     # ---------------------------------------------------------------- windows
     def needs(self, plan: Sequence[int]) -> list[int]:

@@ -112,6 +112,29 @@ def test_the_compiled_search_is_the_pure_python_one_on_random_tasks(task: Ground
         check_plan(task, to_plan(ct, plan))
 
 
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(strips_tasks(), st.sampled_from([None, 2]), st.integers(1, 8))
+def test_a_cost_bound_prunes_both_searches_alike(task: GroundTask, weight: float | None, bound: int) -> None:
+    ct = compile_task(task)
+    if not ct.solvable_relaxed or not ct.pre:
+        return
+    python, compiled = both(ct, weight, every=3, bound=bound)
+    assert compiled == python
+    (plan, _exhausted), _, _ = compiled
+    if plan is not None:
+        assert ct.plan_cost(plan) < bound
+        check_plan(task, to_plan(ct, plan))
+
+
+def test_a_cost_bound_on_an_ipc_problem_finds_a_cheaper_plan_or_none_in_both() -> None:
+    ct = ipc_task("depot", "p03")
+    (first, _), _, _ = both(ct)[1]
+    python, compiled = both(ct, 3, bound=ct.plan_cost(first), max_expansions=3000)
+    assert compiled == python
+    plan = compiled[0][0]
+    assert plan is None or ct.plan_cost(plan) < ct.plan_cost(first)
+
+
 def test_an_expansion_limit_stops_both_searches_alike() -> None:
     ct = ipc_task("depot", "p03")
     python, compiled = both(ct, max_expansions=40)
