@@ -283,13 +283,21 @@ class Landmarks:
             for f in bits(self.gn_children[c]):
                 gn_parents[f] |= 1 << c
 
-        def interferes(a: int, b: int) -> bool:
-            return (
-                mutexes.mutex(a, b)
-                or bool(shared_del[a] >> b & 1)
-                or mutexes.with_any(b, shared_add[a])
-                or mutexes.with_any(b, gn_parents[a])
-            )
+        # the landmarks that interfere with b, as a bitset: mutex with b, deleting it on every way in, or adding
+        # (or needing greedily) a fact mutex with it; indexed by fact so that no pair is tried in vain
+        deleting = [0] * n  # fact -> the landmarks every adder of which deletes it
+        adding = [0] * n  # fact -> the landmarks every adder of which adds it, or with it as a gn-predecessor
+        for a in bits(lms):
+            for e in bits(shared_del[a]):
+                deleting[e] |= 1 << a
+            for e in bits(shared_add[a] | gn_parents[a]):
+                adding[e] |= 1 << a
+
+        def interfering(b: int) -> int:
+            out = mutexes.mutex_with(b) | deleting[b]
+            for e in bits(mutexes.mutex_with(b)):
+                out |= adding[e]
+            return out & ~(1 << b)
 
         after = [self.parents[f] | self.reasonable[f] for f in range(n)]
 
@@ -304,19 +312,18 @@ class Landmarks:
                         stack.append(p)
             return False
 
-        def order(a: int, b: int) -> None:
-            if after[b] >> a & 1 or not interferes(a, b) or before(a, b):
-                return
-            self.reasonable[b] |= 1 << a
-            after[b] |= 1 << a
+        def order(candidates: int, b: int) -> None:  # in increasing a: the ones added before count in before()
+            for a in bits(candidates & interfering(b)):
+                if after[b] >> a & 1 or before(a, b):
+                    continue
+                self.reasonable[b] |= 1 << a
+                after[b] |= 1 << a
 
         for b in bits(lms & self.goal_mask):
-            for a in bits(lms & ~(1 << b)):
-                order(a, b)
+            order(lms, b)
         for b in bits(lms & ~self.goal_mask):
             for c in bits(self.gn_children[b]):
-                for a in bits((self.parents[c] | gn_parents[c]) & ~(1 << b)):
-                    order(a, b)
+                order(self.parents[c] | gn_parents[c], b)
 
     def reasonable_orderings(self) -> list[tuple[int, int]]:
         """The reasonable orderings ``(before, after)`` (see :meth:`add_reasonable`)."""

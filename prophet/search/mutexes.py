@@ -186,9 +186,9 @@ class Mutexes:
         """Whether facts ``a`` and ``b`` never hold together (as far as the groups tell)."""
         return bool(self._of[a] >> b & 1)
 
-    def with_any(self, a: int, facts: int) -> bool:
-        """Whether fact ``a`` is mutex with some fact of the bitset ``facts``."""
-        return bool(self._of[a] & facts)
+    def mutex_with(self, a: int) -> int:
+        """The facts mutex with fact ``a``, as a bitset."""
+        return self._of[a]
 
 
 __all__ = ["Mutexes", "candidates", "mutex_groups"]
