@@ -11,8 +11,8 @@ from hypothesis import strategies as st
 
 from alica.prophet import ground as grounding
 from alica.prophet import pddl
-from alica.prophet.planner import LimitReached, Limits, Progress
-from alica.prophet.search import compiled_lama
+from alica.prophet.planner import Improved, LimitReached, Limits, Progress
+from alica.prophet.search import anytime, compiled_lama
 from alica.prophet.search.anytime import to_plan
 from alica.prophet.search.compiled_lama import compiled_lama_search, eligible, first_plan
 from alica.prophet.search.encoding import CompiledTask, compile_task
@@ -50,10 +50,14 @@ def both(ct: CompiledTask, weight: float | None = None, every: int = 1000, **kw:
     return runs[0], runs[1]
 
 
-def ipc_task(domain: str, problem: str) -> CompiledTask:
+def _ipc_files(domain: str, problem: str) -> tuple[pddl.Domain, pddl.Problem]:
     folder = benchmark_set("ipc") / domain
     d = pddl.read_domain(folder / "domain.pddl")
-    return compile_task(grounding.ground(d, pddl.read_problem(folder / f"{problem}.pddl", d)))
+    return d, pddl.read_problem(folder / f"{problem}.pddl", d)
+
+
+def ipc_task(domain: str, problem: str) -> CompiledTask:
+    return compile_task(grounding.ground(*_ipc_files(domain, problem)))
 
 
 @pytest.mark.parametrize(
@@ -231,3 +235,26 @@ def test_ff_past_its_cost_levels_goes_over_to_the_heap_and_the_search_stays_the_
     ct = ipc_task("depot", "p03")
     python, compiled = both(ct)
     assert compiled == python
+
+
+def test_after_a_compiled_first_search_the_anytime_restarts_run_compiled_under_the_best_cost(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    task = grounding.ground(*_ipc_files("depot", "p03"))
+    monkeypatch.setattr(compiled_lama, "python_budget", lambda _relaxed: 10)  # the first search starts compiled
+    restarts: list[tuple[float | None, float]] = []
+    original = anytime.compiled_lama_search
+
+    def spy(*args: Any, **kw: Any) -> Any:
+        restarts.append((kw["weight"], kw["bound"]))
+        return original(*args, **kw)
+
+    monkeypatch.setattr(anytime, "compiled_lama_search", spy)
+    events = list(anytime.search_task(task, anytime=True, optimal_pass=False))
+    costs = [event.plan.cost for event in events if isinstance(event, Improved)]
+    assert [w for w, _ in restarts] == list(anytime.COMPILED_RESTART_WEIGHTS)
+    assert all(bound <= costs[0] for _, bound in restarts) and restarts[-1][1] >= costs[-1]
+    assert costs == sorted(costs, reverse=True) and len(set(costs)) == len(costs)
+    for event in events:
+        if isinstance(event, Improved):
+            check_plan(task, event.plan)
