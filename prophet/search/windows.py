@@ -179,6 +179,20 @@ class Windows:
         if not most:
             return [] if start & need == need else None
         cheapest = min(cost, default=0)
+        # each operator watched by its precondition the fewest others share: a state tries only the operators
+        # whose watched fact it holds (taken in increasing k, so the search is the same as trying them all)
+        uses: dict[int, int] = {}
+        for o in ops:
+            for f in ct.pre[o]:
+                uses[f] = uses.get(f, 0) + 1
+        watch: dict[int, list[int]] = {}
+        free: list[int] = []
+        for k, o in enumerate(ops):
+            if ct.pre[o]:
+                watch.setdefault(min(ct.pre[o], key=lambda f: (uses[f], f)), []).append(k)
+            else:
+                free.append(k)
+        watched = list(watch.items())
         successor = ct.successor
         dist = {start: 0}
         parent: dict[int, tuple[int, int]] = {start: (-1, -1)}
@@ -197,10 +211,19 @@ class Windows:
             stats.expansions += 1
             if stats.progress_due():
                 yield Progress(stats.expansions)
-            for k, o in enumerate(ops):
+            tried = list(free)
+            groups = 0
+            for f, ks in watched:
+                if state >> f & 1:
+                    tried += ks
+                    groups += 1
+            if groups > 1 or (groups and free):
+                tried.sort()
+            for k in tried:
                 m = pre[k]
                 if state & m != m:
                     continue
+                o = ops[k]
                 g2 = g + cost[k]
                 if g2 >= bound:
                     continue
