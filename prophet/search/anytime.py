@@ -193,9 +193,15 @@ def search_task(
     windows = Windows(ct)
     best = yield from _windows(ct, windows, best, ct.plan_cost(best), stats, QUICK_WINDOW_STATES)
     best_cost = ct.plan_cost(best)
-    if stats.compiled:  # a large task: the full sweeps come before the restarts, which take long there
+    polished: list[int] | None = None
+    if stats.compiled:  # a large task: full sweeps and the neighbourhood come before the restarts, long there
         best = yield from _windows(ct, windows, best, best_cost, stats)
+        best, proven = yield from _polish(ct, best, stats)
+        if proven:
+            yield Done(PlanStatus.OPTIMAL, stats.expansions, "every reachable state was explored")
+            return
         best_cost = ct.plan_cost(best)
+        polished = best
     restart_budget = RESTART_BUDGET * max(100, first_expansions)
     for restart, weight in _restarts(ct, relaxed, lmcount if stats.compiled else None):
         if isinstance(restart, str):  # "lama": the first search ran compiled, so do the restarts
@@ -210,8 +216,10 @@ def search_task(
             found = yield from _windows(ct, windows, found, min(best_cost, ct.plan_cost(found)), stats)
             if ct.plan_cost(found) < best_cost:
                 best, best_cost = found, ct.plan_cost(found)
-    best = yield from _windows(ct, windows, best, best_cost, stats)
-    best, proven = yield from _polish(ct, best, stats)
+    proven = False
+    if best is not polished:
+        best = yield from _windows(ct, windows, best, best_cost, stats)
+        best, proven = yield from _polish(ct, best, stats)
     best_cost = ct.plan_cost(best)
     if proven or best_cost == 0:
         yield Done(PlanStatus.OPTIMAL, stats.expansions, "every reachable state was explored")

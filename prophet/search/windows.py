@@ -110,6 +110,13 @@ class Windows:
                     ready.append(k)
         return order
 
+    def _deleted(self, op: int) -> list[int]:
+        """The facts ``op`` deletes (and does not add)."""
+        dels = self._deletes.get(op)
+        if dels is None:
+            dels = self._deletes[op] = bits(self.ct.del_mask[op])
+        return dels
+
     def _interfering_pairs(self, plan: Sequence[int], succ: list[list[int]], waiting: list[int]) -> None:
         """The pairs :meth:`interferes` finds, through the facts the actions touch (no pair of positions is
         tried unless they share a fact): ``succ[i]`` gets each later ``j`` in order, ``waiting[j]`` counts them.
@@ -119,9 +126,7 @@ class Windows:
         needs_or_adds: dict[int, list[int]] = {}
         deletes: dict[int, list[int]] = {}
         for j, op in enumerate(plan):
-            dels = self._deletes.get(op)
-            if dels is None:
-                dels = self._deletes[op] = bits(ct.del_mask[op])
+            dels = self._deleted(op)
             before: set[int] = set()
             for f in ct.pre[op]:  # an earlier action adds or deletes what this one needs
                 before.update(changes.get(f, ()))
@@ -173,23 +178,51 @@ class Windows:
         one operator adds, times the cheapest operator cost (admissible).
         """
         ct = self.ct
-        pre = [ct.pre_mask[o] for o in ops]
+        pre_facts = [ct.pre[o] for o in ops]
+        if self.exact:
+            # the search on the facts the window's operators touch, as a small bitset: nothing else
+            # changes in it (and the rest of ``need`` already holds at ``start``, as the window's own
+            # actions reach it from there), so the states, their order and the result are the same
+            touched = sorted({f for o in ops for f in (*ct.pre[o], *ct.add[o], *self._deleted(o))})
+            slot = {f: i for i, f in enumerate(touched)}
+
+            def small(facts: Sequence[int]) -> int:
+                m = 0
+                for f in facts:
+                    m |= 1 << slot[f]
+                return m
+
+            outside = need
+            for f in touched:
+                outside &= ~(1 << f)
+            if start & outside != outside:
+                return None
+            start = sum(1 << i for i, f in enumerate(touched) if start >> f & 1)
+            need = sum(1 << i for i, f in enumerate(touched) if need >> f & 1)
+            pre_facts = [tuple(slot[f] for f in facts) for facts in pre_facts]
+            pre = [small(ct.pre[o]) for o in ops]
+            adds = [small(ct.add[o]) for o in ops]
+            dels = [small(self._deleted(o)) for o in ops]
+        else:
+            pre = [ct.pre_mask[o] for o in ops]
+            adds = [ct.add_mask[o] for o in ops]
+            dels = []
         cost = [ct.cost[o] for o in ops]
-        most = max([(ct.add_mask[o] & need).bit_count() for o in ops], default=0)
+        most = max([(a & need).bit_count() for a in adds], default=0)
         if not most:
             return [] if start & need == need else None
         cheapest = min(cost, default=0)
         # each operator watched by its precondition the fewest others share: a state tries only the operators
         # whose watched fact it holds (taken in increasing k, so the search is the same as trying them all)
         uses: dict[int, int] = {}
-        for o in ops:
-            for f in ct.pre[o]:
+        for facts in pre_facts:
+            for f in facts:
                 uses[f] = uses.get(f, 0) + 1
         watch: dict[int, list[int]] = {}
         free: list[int] = []
-        for k, o in enumerate(ops):
-            if ct.pre[o]:
-                watch.setdefault(min(ct.pre[o], key=lambda f: (uses[f], f)), []).append(k)
+        for k, facts in enumerate(pre_facts):
+            if facts:
+                watch.setdefault(min(facts, key=lambda f: (uses[f], f)), []).append(k)
             else:
                 free.append(k)
         watched = list(watch.items())
@@ -227,7 +260,7 @@ class Windows:
                 g2 = g + cost[k]
                 if g2 >= bound:
                     continue
-                nxt = successor(state, o)
+                nxt = (state & ~dels[k]) | adds[k] if dels else successor(state, o)
                 old = dist.get(nxt)
                 if old is not None and old <= g2:
                     continue
