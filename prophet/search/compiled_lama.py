@@ -41,9 +41,12 @@ from alica.prophet.search.landmarks import LandmarkCount
 
 KERNEL_LOAD_S = JIT_LOAD_S + 0.35
 """What loading the search kernel costs a process, numba's import included (seconds, from a disk cache)."""
-PYTHON_S_PER_ACTION = 0.5e-6
-"""A pure-Python expansion's cost per relaxed action (FF's exploration dominates; measured 0.2-0.75 µs)."""
-PYTHON_S_PER_EXPANSION = 60e-6
+PYTHON_S_PER_ACTION = 0.25e-6
+"""A pure-Python expansion's cost per relaxed action (FF's exploration dominates). Fitted with
+:data:`PYTHON_S_PER_EXPANSION` on eleven IPC and Rovers problems of 100-3,400 relaxed actions
+(measured 54-896 µs an expansion; the fit within 25 %, most within 10 %: Rovers p20 481 against 485,
+driverlog p08 107 against 100, freecell p05 880 against 896)."""
+PYTHON_S_PER_EXPANSION = 40e-6
 """A pure-Python expansion's fixed cost (successors, open lists, the landmark count)."""
 DEFAULT_BUDGET = 2 << 30
 """The bytes the arrays are sized for without a memory bound (mapped, not used, until written)."""
