@@ -70,6 +70,9 @@ class Feature(Enum):
     """``(increase (total-cost) n)`` effects and a ``minimize (total-cost)`` metric."""
     DERIVED_PREDICATES = "derived-predicates"
     """``(:derived ...)`` rules: predicates that are a function of the others, never in effects or ``:init``."""
+    DURATIVE_ACTIONS = "durative-actions"
+    """``(:durative-action ...)`` with a fixed or function duration, ``at start``/``over all``/``at end``
+    conditions and ``at start``/``at end`` effects; the metric ``(total-time)``, the makespan."""
 
 
 class PlanStatus(Enum):

@@ -10,11 +10,13 @@ from __future__ import annotations
 from alica.prophet.pddl.errors import PddlError
 from alica.prophet.pddl.model import (
     OBJECT,
+    TOTAL_TIME,
     Action,
     And,
     Atom,
     Axiom,
     Domain,
+    DurativeAction,
     Effect,
     Equals,
     Exists,
@@ -39,11 +41,13 @@ from alica.prophet.pddl.writer import write_domain, write_formula, write_problem
 __all__ = [
     "OBJECT",
     "SUPPORTED_REQUIREMENTS",
+    "TOTAL_TIME",
     "Action",
     "And",
     "Atom",
     "Axiom",
     "Domain",
+    "DurativeAction",
     "Effect",
     "Equals",
     "Exists",

@@ -190,6 +190,37 @@ class Action:
         return values[0]
 
 
+TOTAL_TIME = "total-time"
+"""The makespan's fluent in a metric: ``(:metric minimize (total-time))``."""
+
+
+@dataclass(frozen=True, slots=True)
+class DurativeAction:
+    """A durative action schema (PDDL 2.1 level 3, ``:durative-actions``).
+
+    Attributes:
+        name: the action name.
+        parameters: typed parameters, in order.
+        duration: ``(= ?duration d)``: a number, or a static function of the parameters read from ``:init``.
+        at_start: what must hold when it starts (``(at start ...)`` conditions).
+        over_all: what must hold while it runs, its end points excluded (``(over all ...)``).
+        at_end: what must hold when it ends (``(at end ...)``).
+        start_effect: what happens when it starts (``(at start ...)`` effects).
+        end_effect: what happens when it ends (``(at end ...)`` effects).
+        span: where ``(:durative-action`` is in its file (not part of equality).
+    """
+
+    name: str
+    parameters: tuple[TypedName, ...]
+    duration: int | float | FluentTerm
+    at_start: Formula = And(())
+    over_all: Formula = And(())
+    at_end: Formula = And(())
+    start_effect: Effect = And(())
+    end_effect: Effect = And(())
+    span: SourceSpan | None = field(default=None, compare=False)
+
+
 def top_level_parts(effect: Effect) -> list[Effect]:
     """The parts of an effect or a formula below top-level ``and``s."""
     if isinstance(effect, And):
@@ -257,6 +288,7 @@ class Domain:
         extra_requirements: declared requirement names that are no :class:`Feature`
             (``disjunctive-preconditions``, ``existential-preconditions``, ``universal-preconditions``).
         axioms: the rules of the derived predicates (``:derived``), in file order.
+        durative_actions: durative action schemas (``:durative-action``), in file order.
     """
 
     name: str
@@ -268,6 +300,7 @@ class Domain:
     actions: tuple[Action, ...] = ()
     extra_requirements: frozenset[str] = frozenset()
     axioms: tuple[Axiom, ...] = ()
+    durative_actions: tuple[DurativeAction, ...] = ()
 
     @property
     def derived(self) -> frozenset[str]:
@@ -281,6 +314,10 @@ class Domain:
     def action(self, name: str) -> Action | None:
         """The action called ``name``, or None."""
         return next((a for a in self.actions if a.name == name), None)
+
+    def durative_action(self, name: str) -> DurativeAction | None:
+        """The durative action called ``name``, or None."""
+        return next((a for a in self.durative_actions if a.name == name), None)
 
     def is_subtype(self, child: str, parent: str) -> bool:
         """Whether ``child`` is ``parent`` or below it (through any of its parents).

@@ -11,19 +11,23 @@ from __future__ import annotations
 
 from collections import Counter
 from pathlib import Path
+from typing import Any
 
 from alica.prophet.pddl.errors import PddlError
 from alica.prophet.pddl.formulas import FormulaReader, expect_list, expect_name, parse_number, parse_typed_list
 from alica.prophet.pddl.model import (
     OBJECT,
+    TOTAL_TIME,
     Action,
     And,
     Atom,
     Axiom,
     Domain,
+    DurativeAction,
     Effect,
     Equals,
     Exists,
+    FluentTerm,
     FluentValue,
     Forall,
     Formula,
@@ -64,7 +68,6 @@ _UNSUPPORTED = frozenset(
         "numeric-fluents",
         "fluents",
         "object-fluents",
-        "durative-actions",
         "duration-inequalities",
         "continuous-effects",
         "timed-initial-literals",
@@ -166,7 +169,7 @@ def _sections(source: Source, top: SList, allowed: tuple[str, ...]) -> list[SLis
     for item in top.items[2:]:
         section = expect_list(source, item, "a section '(:keyword ...)'")
         head = section.head()
-        if head in (":durative-action", ":constraints"):
+        if head == ":constraints":
             raise source.error(section.offset, f"unsupported construct '({head} ...)'")
         if head not in allowed:
             raise source.error(section.offset, f"expected one of {', '.join(allowed)}, found '{section.describe()}'")
@@ -230,45 +233,162 @@ def _declarations(
     return out
 
 
-def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
+def _keyed(source: Source, section: SList, kind: str, keys: tuple[str, ...]) -> tuple[str, list[tuple[Symbol, Node]]]:
+    """The name of ``(kind NAME :key value ...)`` and its ``(key, value)`` pairs, each key once, from ``keys``."""
     if len(section.items) < 2:
-        raise source.error(section.offset, "expected an action name after ':action'")
+        raise source.error(section.offset, f"expected an action name after '{kind}'")
     name = expect_name(source, section.items[1], "an action name")
-    parameters: tuple[TypedName, ...] = ()
-    precondition: Formula = And(())
-    effect: Effect = And(())
     items = section.items[2:]
+    pairs: list[tuple[Symbol, Node]] = []
     seen: set[str] = set()
     for index in range(0, len(items), 2):
         key = items[index]
-        if not isinstance(key, Symbol) or key.text not in (":parameters", ":precondition", ":effect"):
+        if not isinstance(key, Symbol) or key.text not in keys:
             shown = key.text if isinstance(key, Symbol) else key.describe() + " ...)"
-            raise source.error(
-                key.offset, f"expected :parameters, :precondition or :effect in '(:action {name}', found '{shown}'"
-            )
+            expected = ", ".join(keys[:-1]) + f" or {keys[-1]}"
+            raise source.error(key.offset, f"expected {expected} in '({kind} {name}', found '{shown}'")
         if key.text in seen:
-            raise source.error(key.offset, f"duplicate {key.text} in '(:action {name}'")
+            raise source.error(key.offset, f"duplicate {key.text} in '({kind} {name}'")
         seen.add(key.text)
         if index + 1 >= len(items):
-            raise source.error(key.offset, f"expected a value after {key.text} in '(:action {name}'")
-        value = items[index + 1]
+            raise source.error(key.offset, f"expected a value after {key.text} in '({kind} {name}'")
+        if key.text == ":parameters" and index != 0:
+            raise source.error(key.offset, f"expected :parameters first in '({kind} {name}'")
+        pairs.append((key, items[index + 1]))
+    return name, pairs
+
+
+def _parameters(source: Source, value: Node, reader: FormulaReader, kind: str, name: str) -> tuple[TypedName, ...]:
+    plist = expect_list(source, value, "a parameter list '(?x - type ...)'")
+    typed = parse_typed_list(source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'")
+    counts = Counter(n for (n, _), _ in typed)
+    if len(counts) < len(typed):  # the first parameter written twice, at its first place
+        pname, offset = next((n, o) for (n, _), o in typed if counts[n] > 1)
+        raise source.error(offset, f"duplicate parameter '{pname}' in '({kind} {name}'")
+    return tuple(p for p, _ in typed)
+
+
+def _action(source: Source, section: SList, reader: FormulaReader) -> Action:
+    name, pairs = _keyed(source, section, ":action", (":parameters", ":precondition", ":effect"))
+    parameters: tuple[TypedName, ...] = ()
+    precondition: Formula = And(())
+    effect: Effect = And(())
+    for key, value in pairs:
         if key.text == ":parameters":
-            if index != 0:
-                raise source.error(key.offset, f"expected :parameters first in '(:action {name}'")
-            plist = expect_list(source, value, "a parameter list '(?x - type ...)'")
-            typed = parse_typed_list(
-                source, plist.items, variables=True, types=reader.types, what=f"parameters of '{name}'"
-            )
-            counts = Counter(n for (n, _), _ in typed)
-            if len(counts) < len(typed):  # the first parameter written twice, at its first place
-                pname, offset = next((n, o) for (n, _), o in typed if counts[n] > 1)
-                raise source.error(offset, f"duplicate parameter '{pname}' in '(:action {name}'")
-            parameters = tuple(p for p, _ in typed)
+            parameters = _parameters(source, value, reader, ":action", name)
         elif key.text == ":precondition":
             precondition = _empty_or(value, lambda v, scope=dict(parameters): reader.formula(v, scope))
         else:
             effect = _empty_or(value, lambda v, scope=dict(parameters): reader.effect(v, scope))
     return Action(name, parameters, precondition, effect, span=source.span(section.offset))
+
+
+_TIMES = {"at start": 0, "over all": 1, "at end": 2}
+"""The time specifiers of a durative action's conditions, and where each goes."""
+
+
+def _durative_action(source: Source, section: SList, reader: FormulaReader) -> DurativeAction:
+    """``(:durative-action NAME :parameters (...) :duration (= ?duration d) :condition C :effect E)``."""
+    kind = ":durative-action"
+    name, pairs = _keyed(source, section, kind, (":parameters", ":duration", ":condition", ":effect"))
+    parameters: tuple[TypedName, ...] = ()
+    duration: int | float | FluentTerm | None = None
+    conditions: list[list[Formula]] = [[], [], []]
+    effects: list[list[Effect]] = [[], []]
+    for key, value in pairs:
+        scope = dict(parameters)
+        if key.text == ":parameters":
+            parameters = _parameters(source, value, reader, kind, name)
+        elif key.text == ":duration":
+            duration = _duration(source, value, reader, scope, name)
+        elif key.text == ":condition":
+            for when, body in _timed_parts(source, value, name, "condition"):
+                if when not in _TIMES:
+                    raise source.error(
+                        body.offset,
+                        f"expected (at start ...), (over all ...) or (at end ...) in the condition of '{name}'",
+                    )
+                conditions[_TIMES[when]].append(reader.formula(body, scope))
+        else:
+            for when, body in _timed_parts(source, value, name, "effect"):
+                if when not in ("at start", "at end"):
+                    raise source.error(
+                        body.offset,
+                        f"expected (at start ...) or (at end ...) in the effect of '{name}'",
+                        "continuous effects ((over all ...) in an effect) are not supported",
+                    )
+                effects[0 if when == "at start" else 1].append(reader.effect(body, scope))
+    if duration is None:
+        raise source.error(section.offset, f"expected ':duration (= ?duration d)' in '({kind} {name}'")
+
+    def joined(parts: list[Any]) -> Any:
+        return parts[0] if len(parts) == 1 else And(tuple(parts))
+
+    at_start, over_all, at_end = (joined(c) for c in conditions)
+    start_effect, end_effect = (joined(e) for e in effects)
+    return DurativeAction(
+        name,
+        parameters,
+        duration,
+        at_start,
+        over_all,
+        at_end,
+        start_effect,
+        end_effect,
+        span=source.span(section.offset),
+    )
+
+
+def _duration(
+    source: Source, value: Node, reader: FormulaReader, scope: dict[str, str], name: str
+) -> int | float | FluentTerm:
+    """``(= ?duration d)``: d a non-negative number or a function of the parameters."""
+    node = expect_list(source, value, "'(= ?duration d)'")
+    head = node.head()
+    if head in ("<=", ">=", "<", ">", "and"):
+        raise source.error(
+            node.offset, f"unsupported duration constraint '({head} ...)' in '{name}'", "write (= ?duration d)"
+        )
+    if (
+        head != "="
+        or len(node.items) != 3
+        or not isinstance(node.items[1], Symbol)
+        or node.items[1].text != "?duration"
+    ):
+        raise source.error(node.offset, f"expected '(= ?duration d)' in '{name}'")
+    amount = node.items[2]
+    if isinstance(amount, SList):
+        if amount.head() in ("+", "-", "*", "/"):
+            raise source.error(
+                amount.offset,
+                f"unsupported duration expression '({amount.head()} ...)' in '{name}'",
+                "write a number or one function, e.g. (travel-time ?from ?to)",
+            )
+        return reader.fluent(amount, scope)
+    number = parse_number(source, amount, f"the duration of '{name}'")
+    if number < 0:
+        raise source.error(amount.offset, f"negative duration {number:g} in '{name}'")
+    return number
+
+
+def _timed_parts(source: Source, value: Node, name: str, what: str) -> list[tuple[str, Node]]:
+    """The ``(at start X)``/``(over all X)``/``(at end X)`` parts of a durative action's condition or effect."""
+    if isinstance(value, SList) and not value.items:
+        return []
+    node = expect_list(source, value, f"a timed {what} '(and (at start ...) (at end ...))'")
+    parts = node.items[1:] if node.head() == "and" else [node]
+    out: list[tuple[str, Node]] = []
+    for part in parts:
+        item = expect_list(source, part, f"a timed {what} '(at start ...)'")
+        words = [i.text if isinstance(i, Symbol) else "" for i in item.items[:2]]
+        if len(item.items) != 3 or " ".join(words) not in ("at start", "over all", "at end"):
+            raise source.error(
+                item.offset,
+                f"expected (at start ...), (over all ...) or (at end ...) in the {what} of '{name}', "
+                f"found '{item.describe()}'",
+            )
+        out.append((" ".join(words), item.items[2]))
+    return out
 
 
 def _derived(source: Source, section: SList, reader: FormulaReader) -> Axiom:
@@ -348,7 +468,16 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
     if limits is not None:
         limits.check(stage)
     name = _check_header(source, top, "domain")
-    allowed = (":requirements", ":types", ":constants", ":predicates", ":functions", ":action", ":derived")
+    allowed = (
+        ":requirements",
+        ":types",
+        ":constants",
+        ":predicates",
+        ":functions",
+        ":action",
+        ":durative-action",
+        ":derived",
+    )
     features: set[Feature] = {Feature.STRIPS}
     extra: set[str] = set()
     types: dict[str, tuple[str, ...]] = {}
@@ -358,6 +487,7 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
     reader = FormulaReader(source, {}, {}, {}, types, derived=_derived_names(top))
     actions: list[Action] = []
     axioms: list[Axiom] = []
+    durative_actions: list[DurativeAction] = []
     action_names: set[str] = set()
     for section in _sections(source, top, allowed):
         head = section.head()
@@ -400,6 +530,12 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
             reader.functions.update((f.name, f) for f in functions)
         elif head == ":derived":
             axioms.append(_derived(source, section, reader))
+        elif head == ":durative-action":
+            durative = _durative_action(source, section, reader)
+            if durative.name in action_names:
+                raise source.error(section.offset, f"duplicate action '{durative.name}'")
+            action_names.add(durative.name)
+            durative_actions.append(durative)
         else:
             action = _action(source, section, reader)
             if action.name in action_names:
@@ -414,6 +550,18 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
             features |= more
             extra |= more_extra
         if any(t != OBJECT for _, t in action.parameters):
+            features.add(Feature.TYPING)
+    for durative in durative_actions:
+        features.add(Feature.DURATIVE_ACTIONS)
+        for part in (durative.at_start, durative.over_all, durative.at_end):
+            more, more_extra = formula_features(part)
+            features |= more
+            extra |= more_extra
+        for part in (durative.start_effect, durative.end_effect):
+            more, more_extra = formula_features(part, in_effect=True)
+            features |= more
+            extra |= more_extra
+        if any(t != OBJECT for _, t in durative.parameters):
             features.add(Feature.TYPING)
     for axiom in axioms:
         more, more_extra = formula_features(axiom.body)
@@ -434,6 +582,7 @@ def _parse_domain(text: str, file: str, limits: Limits | None) -> Domain:
         tuple(actions),
         frozenset(extra),
         tuple(axioms),
+        tuple(durative_actions),
     )
 
 
@@ -562,6 +711,8 @@ def _metric(source: Source, section: SList, reader: FormulaReader) -> Metric:
     expression = expect_list(source, section.items[2], "a fluent '(total-cost)' in the metric")
     if expression.head() in ("+", "-", "*", "/"):
         raise source.error(expression.offset, "unsupported construct: metric expressions other than one fluent")
+    if expression.head() == TOTAL_TIME and len(expression.items) == 1:  # the makespan: no declaration
+        return Metric(section.items[1].text, FluentTerm(TOTAL_TIME))
     return Metric(section.items[1].text, reader.fluent(expression, {}))
 
 

@@ -9,6 +9,7 @@ from alica.prophet.pddl.model import (
     Atom,
     Axiom,
     Domain,
+    DurativeAction,
     Effect,
     Equals,
     Exists,
@@ -100,6 +101,23 @@ def _action(action: Action) -> str:
     return "\n".join(lines)
 
 
+def _durative(action: DurativeAction) -> str:
+    duration = action.duration if isinstance(action.duration, FluentTerm) else _number(action.duration)
+    lines = [
+        f"  (:durative-action {action.name}",
+        f"    :parameters ({_typed(action.parameters)})",
+        f"    :duration (= ?duration {duration})",
+    ]
+    for key, parts in (
+        (":condition", (("at start", action.at_start), ("over all", action.over_all), ("at end", action.at_end))),
+        (":effect", (("at start", action.start_effect), ("at end", action.end_effect))),
+    ):
+        timed = [f"({when} {write_formula(part, 8)})" for when, part in parts if part != And(())]
+        lines.append(f"    {key} (and" + "".join(f"\n      {t}" for t in timed) + ")")
+    lines[-1] += ")"
+    return "\n".join(lines)
+
+
 def _axiom(axiom: Axiom) -> str:
     head = f"({' '.join((axiom.predicate, _typed(axiom.parameters)))})".replace(" )", ")")
     return f"  (:derived {head}\n    {write_formula(axiom.body, 4)})"
@@ -140,6 +158,7 @@ def write_domain(domain: Domain) -> str:
         parts.append(f"  (:functions\n    {decls})")
     parts.extend(_axiom(a) for a in domain.axioms)
     parts.extend(_action(a) for a in domain.actions)
+    parts.extend(_durative(a) for a in domain.durative_actions)
     return "\n".join(parts) + ")\n"
 
 
