@@ -73,7 +73,7 @@ def validate_plan(task: GroundTask | tuple[Domain, Problem], plan: Plan | Sequen
     if isinstance(task, GroundTask):
         return _validate_ground(task, steps)
     domain, problem = task
-    return _Lifted(domain, problem).validate(steps)
+    return LiftedSimulation(domain, problem).validate(steps)
 
 
 def _validate_ground(task: GroundTask, steps: tuple[PlanStep, ...]) -> ValidationResult:
@@ -98,7 +98,7 @@ def _validate_ground(task: GroundTask, steps: tuple[PlanStep, ...]) -> Validatio
     return ValidationResult(True, cost, None, "")
 
 
-class _Lifted:
+class LiftedSimulation:
     """Lifted simulation: a state is a set of ground atoms."""
 
     def __init__(self, domain: Domain, problem: Problem) -> None:
@@ -274,15 +274,9 @@ class _Lifted:
             if action is None:
                 return ValidationResult(False, cost, number, f"{where}: unknown action '{step.action}'")
             args = tuple(a.lower() for a in step.args)
-            if len(args) != len(action.parameters):
-                return ValidationResult(
-                    False, cost, number, f"{where}: expected {len(action.parameters)} arguments, found {len(args)}"
-                )
-            for arg, (param, kind) in zip(args, action.parameters, strict=True):
-                if arg not in self.objects:
-                    return ValidationResult(False, cost, number, f"{where}: unknown object '{arg}'")
-                if not self.domain.is_subtype(self.objects[arg], kind):
-                    return ValidationResult(False, cost, number, f"{where}: '{arg}' is no {kind} (parameter {param})")
+            wrong = self.wrong_arguments(action.parameters, args)
+            if wrong:
+                return ValidationResult(False, cost, number, f"{where}: {wrong}")
             mapping = dict(zip((p for p, _ in action.parameters), args, strict=True))
             full = self.close(state)
             unmet = self.unmet(substitute(action.precondition, mapping), full)  # type: ignore[arg-type]
@@ -311,6 +305,17 @@ class _Lifted:
         if unmet_goal is not None:
             return ValidationResult(False, cost, None, f"goal {unmet_goal} does not hold after the plan")
         return ValidationResult(True, cost, None, "")
+
+    def wrong_arguments(self, parameters: tuple[tuple[str, str], ...], args: tuple[str, ...]) -> str:
+        """What is wrong with ``args`` for ``parameters`` (their number, an unknown object, a type); empty if nothing."""
+        if len(args) != len(parameters):
+            return f"expected {len(parameters)} arguments, found {len(args)}"
+        for arg, (param, kind) in zip(args, parameters, strict=True):
+            if arg not in self.objects:
+                return f"unknown object '{arg}'"
+            if not self.domain.is_subtype(self.objects[arg], kind):
+                return f"'{arg}' is no {kind} (parameter {param})"
+        return ""
 
     def holds(self, formula: Formula, state: set[Atom]) -> bool:
         return self.true(formula, {}, state)

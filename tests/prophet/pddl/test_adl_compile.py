@@ -19,7 +19,7 @@ from alica.prophet.pddl.model import And, Atom, Equals, Exists, Forall, Formula,
 from alica.prophet.planner import PlanStatus, PlanStep
 from alica.prophet.planners import get_planner
 from alica.prophet.search.encoding import compile_task
-from alica.prophet.validate import _Lifted, validate_plan
+from alica.prophet.validate import LiftedSimulation, validate_plan
 from tests.conftest import benchmark_set
 
 # A tiny miconic-fulladl: the lift may stop at a floor only if every boarded passenger with the
@@ -152,7 +152,7 @@ def test_compiled_conditions_hold_exactly_where_the_formula_holds(formula: Formu
         f"(define (problem x) (:domain random) (:init {' '.join(init)}) (:goal {text}))",
         domain=domain,
     )
-    lifted = _Lifted(domain, problem)
+    lifted = LiftedSimulation(domain, problem)
     expected = lifted.holds(formula, lifted.close(set(problem.facts)))
     with ExitStack() as stack:
         stack.enter_context(mock.patch.object(normal, "MAX_CLAUSES", cap))
