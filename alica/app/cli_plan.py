@@ -26,7 +26,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from alica.errors import AlicaError
+from alica.errors import AlicaError, PlannerError
 from alica.prophet.planner import DEFAULT_MEMORY_MB, LimitReached, Limits, Plan, PlanResult, PlanStatus
 
 if TYPE_CHECKING:
@@ -187,7 +187,11 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
         problem = read_problem(args.problem, domain, limits)
     except PddlError as exc:
         return _refuse(args, exc)
+    if domain.durative_actions and args.planner == "builtin":  # durative actions: the builtin search, scheduled
+        args.planner = "temporal"
     planner = get_planner(args.planner)
+    if planner.name == "temporal":
+        return _plan_temporal(args, planner, domain, problem, limits)
     if planner.reads_files:
         _check_features(planner, domain, problem)
         result = planner.solve(args.domain, args.problem, anytime=args.anytime, limits=limits)
@@ -198,6 +202,44 @@ def _plan(args: argparse.Namespace, limits: Limits) -> int:
         planner.name,
         result,
         lambda plan: _validated_cost(planner.name, _checked_on(planner, domain, problem), plan),
+    )
+
+
+def _plan_temporal(args: argparse.Namespace, planner: Planner, domain: Domain, problem: Problem, limits: Limits) -> int:
+    """A temporal task: the schedule printed as ``START: (action args) [DURATION]`` lines, checked happening by
+    happening; the cost is the makespan."""
+    from alica.prophet.planners.temporal import TemporalPlanner
+    from alica.prophet.validate_temporal import validate_temporal_plan
+
+    try:
+        result = planner.solve(domain, problem, anytime=args.anytime, limits=limits)
+    except PlannerError as exc:
+        return _refuse(args, exc)
+    schedules: dict[int, Any] = {}
+
+    def timed(plan: Plan) -> Any:
+        if id(plan) not in schedules:
+            schedules[id(plan)] = TemporalPlanner.schedule_of(domain, problem, plan)
+        return schedules[id(plan)]
+
+    def makespan(plan: Plan) -> float:
+        checked = validate_temporal_plan(domain, problem, timed(plan).plan)
+        if not checked.valid:
+            raise AlicaError(f"planner '{planner.name}' returned an invalid schedule: {checked.reason}")
+        return checked.cost
+
+    def extra() -> dict[str, Any]:
+        assert result.plan is not None
+        return {"sequential_makespan": _number(timed(result.plan).sequential_makespan)}
+
+    return _report(
+        args,
+        planner.name,
+        result,
+        makespan,
+        extra,
+        lines_of=lambda plan: [str(t) for t in timed(plan).plan.steps],
+        checker="alica.prophet.validate_temporal",
     )
 
 
@@ -252,10 +294,13 @@ def _report(
     extra: Callable[[], dict[str, Any]] | None = None,
     *,
     always: bool = False,
+    lines_of: Callable[[Plan], list[str]] | None = None,
+    checker: str = "alica.prophet.validate",
 ) -> int:
     """Print the result; ``cost_of`` validates the plan (raising when it is not valid); ``extra`` adds fields (and lines).
 
-    ``extra`` is asked only with a plan, unless ``always``.
+    ``extra`` is asked only with a plan, unless ``always``. ``lines_of`` shows a plan otherwise than
+    its steps (a temporal plan's timed steps); ``checker`` names what validated it.
     """
     if result.status is PlanStatus.ERROR and result.plan is None:
         raise AlicaError(f"planner '{name}' failed: {result.message or 'no reason given'}")
@@ -265,10 +310,11 @@ def _report(
         cost = cost_of(result.plan)
     if extra is not None and (always or result.plan is not None):
         more = extra()
+    lines = None if result.plan is None else (lines_of or _step_lines)(result.plan)
     if args.json:
-        print(json.dumps({**_summary(result, cost), **more}))
+        print(json.dumps({**_summary(result, cost, lines), **more}))
     else:
-        _print_text(result, cost)
+        _print_text(result, cost, lines, checker)
         for key, value in more.items():
             print(f"; {key}: {value}")
     if result.plan is not None:
@@ -382,19 +428,26 @@ def _number(value: float) -> int | float:
     return int(value) if float(value).is_integer() else value
 
 
-def _summary(result: PlanResult, cost: float | None) -> dict[str, Any]:
-    plan = [str(step) for step in result.plan.steps] if result.plan is not None else None
+def _step_lines(plan: Plan) -> list[str]:
+    return [str(step) for step in plan.steps]
+
+
+def _summary(result: PlanResult, cost: float | None, lines: list[str] | None = None) -> dict[str, Any]:
+    if lines is None and result.plan is not None:
+        lines = _step_lines(result.plan)
     return {
         "solved": result.plan is not None,
         "cost": None if cost is None else _number(cost),
-        "plan": plan,
+        "plan": lines,
         "time_first_s": None if result.time_first_s is None else round(result.time_first_s, 6),
         "time_s": round(result.time_s, 6),
         "expansions": result.expansions,
     }
 
 
-def _print_text(result: PlanResult, cost: float | None) -> None:
+def _print_text(
+    result: PlanResult, cost: float | None, lines: list[str] | None = None, checker: str = "alica.prophet.validate"
+) -> None:
     if result.plan is None or cost is None:
         why = {PlanStatus.UNSOLVABLE: "proven unsolvable", PlanStatus.MEMORY: "memory limit reached"}.get(
             result.status, "time limit reached"
@@ -403,10 +456,10 @@ def _print_text(result: PlanResult, cost: float | None) -> None:
         if result.message:
             print(f"; {result.message}")
         return
-    for step in result.plan.steps:
-        print(step)
+    for line in lines if lines is not None else _step_lines(result.plan):
+        print(line)
     first = f"{result.time_first_s:.3f} s" if result.time_first_s is not None else "-"
-    print(f"; cost = {_number(cost)} ({len(result.plan)} steps, valid: checked with alica.prophet.validate)")
+    print(f"; cost = {_number(cost)} ({len(result.plan)} steps, valid: checked with {checker})")
     print(f"; time to first plan: {first}")
     print(f"; final cost: {_number(cost)} after {result.time_s:.3f} s ({result.status.value})")
     print(f"; expansions: {result.expansions}")

@@ -1,4 +1,5 @@
-"""The planner back-ends by name: the builtin search, Fast Downward and ProTaP (stepwise, for teams).
+"""The planner back-ends by name: the builtin search, Fast Downward, ProTaP (stepwise, for teams) and
+the temporal planner (durative actions, makespan).
 
 ``PLANNERS`` maps a name to ``"module:Class"``; :func:`get_planner` imports the
 back-end only when it is asked for, so an optional back-end that is not
@@ -22,6 +23,7 @@ PLANNERS: dict[str, str] = {
     "builtin": "alica.prophet.search.planner:BuiltinPlanner",
     "fd": "alica.prophet.planners.fd:FastDownward",
     "protap": "alica.prophet.protap.step_planner:ProtapStepPlanner",
+    "temporal": "alica.prophet.planners.temporal:TemporalPlanner",
 }
 """Every back-end: name -> ``"module:Class"`` of a :class:`~alica.prophet.planner.Planner` subclass."""
 

@@ -126,7 +126,7 @@ class FastDownward(Planner):
     """
 
     name = "fd"
-    features = frozenset(Feature)
+    features = frozenset(Feature) - {Feature.DURATIVE_ACTIONS}  # Fast Downward is a classical planner
     reads_files = True
     """The back-end runs on files: callers may hand it the original paths."""
 

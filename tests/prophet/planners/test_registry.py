@@ -15,6 +15,7 @@ def test_names() -> None:
         "builtin": "alica.prophet.search.planner:BuiltinPlanner",
         "fd": "alica.prophet.planners.fd:FastDownward",
         "protap": "alica.prophet.protap.step_planner:ProtapStepPlanner",
+        "temporal": "alica.prophet.planners.temporal:TemporalPlanner",
     }
 
 
@@ -37,7 +38,8 @@ def test_wrong_option_is_a_planner_error() -> None:
 
 
 def test_fd_features_cover_the_builtin_ones() -> None:
-    assert get_planner("builtin").features <= FastDownward.features == frozenset(Feature)
+    assert get_planner("builtin").features <= FastDownward.features == frozenset(Feature) - {Feature.DURATIVE_ACTIONS}
+    assert get_planner("temporal").features == get_planner("builtin").features | {Feature.DURATIVE_ACTIONS}
 
 
 def test_available_gives_a_reason_per_back_end() -> None:
