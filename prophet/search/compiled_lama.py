@@ -41,12 +41,15 @@ from alica.prophet.search.landmarks import LandmarkCount
 
 KERNEL_LOAD_S = JIT_LOAD_S + 0.35
 """What loading the search kernel costs a process, numba's import included (seconds, from a disk cache)."""
-PYTHON_S_PER_ACTION = 0.25e-6
-"""A pure-Python expansion's cost per relaxed action (FF's exploration dominates). Fitted with
-:data:`PYTHON_S_PER_EXPANSION` on eleven IPC and Rovers problems of 100-3,400 relaxed actions
-(measured 54-896 µs an expansion; the fit within 25 %, most within 10 %: Rovers p20 481 against 485,
-driverlog p08 107 against 100, freecell p05 880 against 896)."""
-PYTHON_S_PER_EXPANSION = 40e-6
+PYTHON_S_PER_ACTION = 0.5e-6
+"""A pure-Python expansion's cost per relaxed action (FF's exploration dominates; measured 0.2-0.75 µs).
+
+About twice the present cost (40 µs + 0.25 µs per relaxed action fits eleven IPC and Rovers problems
+within 25 %), which makes the switch come early. The fitted model was tried: it keeps Rovers p20 and
+driverlog p08 in pure Python (0.86 s and 0.77 s instead of 1.43 s and 1.24 s) but sends visitall p20
+and p22 and depot p04 through a later switch (1.7-1.8 s instead of 0.8 s; 1.83 s instead of 1.66 s),
+worse on the IPC suite as a whole, so these values stay."""
+PYTHON_S_PER_EXPANSION = 60e-6
 """A pure-Python expansion's fixed cost (successors, open lists, the landmark count)."""
 DEFAULT_BUDGET = 2 << 30
 """The bytes the arrays are sized for without a memory bound (mapped, not used, until written)."""
