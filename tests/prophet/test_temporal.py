@@ -16,7 +16,7 @@ from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.temporal import schedule, sequential_task
 from alica.prophet.validate import validate_plan
 from alica.prophet.validate_temporal import validate_temporal_plan
-from tests.prophet.test_validate_temporal import DOMAIN
+from tests.prophet.pddl.test_durative import DOMAIN
 
 APART = """(define (problem apart) (:domain rovers-t)
   (:objects r s - rover p q x y - place)

@@ -10,33 +10,7 @@ from alica.prophet.pddl import parse_domain, parse_problem
 from alica.prophet.temporal_plan import TemporalPlanError, parse_temporal_plan
 from alica.prophet.validate import ValidationResult
 from alica.prophet.validate_temporal import validate_temporal_plan
-
-DOMAIN = """(define (domain rovers-t)
-  (:requirements :typing :durative-actions)
-  (:types rover place)
-  (:predicates (at ?r - rover ?p - place) (path ?a ?b - place) (visited ?p - place) (charged ?r - rover))
-  (:functions (travel ?a ?b - place))
-  (:durative-action move
-    :parameters (?r - rover ?a ?b - place)
-    :duration (= ?duration (travel ?a ?b))
-    :condition (and (at start (at ?r ?a)) (over all (path ?a ?b)) (at start (charged ?r)) (at end (charged ?r)))
-    :effect (and (at start (not (at ?r ?a))) (at end (at ?r ?b)) (at end (visited ?b))))
-  (:durative-action recharge
-    :parameters (?r - rover)
-    :duration (= ?duration 2.5)
-    :condition ()
-    :effect (at end (charged ?r)))
-  (:durative-action close
-    :parameters (?a ?b - place)
-    :duration (= ?duration 1)
-    :condition (at start (path ?a ?b))
-    :effect (at end (not (path ?a ?b))))
-  (:durative-action drain
-    :parameters (?r - rover)
-    :duration (= ?duration 1)
-    :condition ()
-    :effect (at start (not (charged ?r)))))
-"""
+from tests.prophet.pddl.test_durative import DOMAIN
 
 PROBLEM = """(define (problem two) (:domain rovers-t)
   (:objects r s - rover p q - place)

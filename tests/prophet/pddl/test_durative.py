@@ -32,8 +32,19 @@ DOMAIN = """(define (domain rovers-t)
     :parameters (?r - rover)
     :duration (= ?duration 2.5)
     :condition ()
-    :effect (at end (charged ?r))))
+    :effect (at end (charged ?r)))
+  (:durative-action close
+    :parameters (?a ?b - place)
+    :duration (= ?duration 1)
+    :condition (at start (path ?a ?b))
+    :effect (at end (not (path ?a ?b))))
+  (:durative-action drain
+    :parameters (?r - rover)
+    :duration (= ?duration 1)
+    :condition ()
+    :effect (at start (not (charged ?r)))))
 """
+"""Rovers that drive for a function's time and recharge; ``close`` and ``drain`` break what a drive needs."""
 
 PROBLEM = """(define (problem two) (:domain rovers-t)
   (:objects r - rover p q - place)

@@ -6,9 +6,9 @@ import json
 from collections.abc import Callable
 from pathlib import Path
 
+from tests.prophet.pddl.test_durative import DOMAIN
 from tests.prophet.planners.conftest import Run
 from tests.prophet.test_temporal import APART
-from tests.prophet.test_validate_temporal import DOMAIN
 
 
 def _files(tmp_path: Path, domain: str, problem: str) -> tuple[Path, Path]:
