@@ -11,7 +11,10 @@
 3. Restarts: unbounded lazy searches with other heuristics and weights, each
    plan then cleaned up and window-swept (it may start worse than the best
    and end better); full window sweeps on the best; the plan neighbourhood
-   graph search (:mod:`alica.prophet.search.neighbourhood`).
+   graph search (:mod:`alica.prophet.search.neighbourhood`). When the first
+   search ran compiled (a large task), the full sweeps and the neighbourhood
+   search come first and the restarts are LAMA's search again, compiled, with
+   weights 5, 3, 2 and 1, pruned by the best plan's cost.
 4. Rounds over a portfolio of bounded passes, each pruning ``g >= best cost``
    and stopped after an expansion budget that doubles every round: lazy GBFS
    with FF on h_add supporters, lazy weighted A* with decreasing weights
