@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import gc
 import os
-import resource
 import sys
 import time
 from abc import ABC, abstractmethod
@@ -106,6 +105,8 @@ def resident_bytes() -> int:
         with open("/proc/self/statm", "rb") as f:
             return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError, IndexError):
+        import resource  # POSIX only; Linux reads /proc above
+
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
         return int(peak if sys.platform == "darwin" else peak * 1024)  # bytes on macOS, KiB elsewhere
 

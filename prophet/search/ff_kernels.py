@@ -154,8 +154,24 @@ def extract(state, goals, sup, pre_ptr, pre_idx, cost, unit, used, done, out):
     return h, n_out
 
 
+REACHED, UNREACHED, PAST_LEVELS = 1, 0, -1
+"""What the level pass of :func:`explore_levels` ends with."""
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _push_level(rec, head, n_rec, g, c, top):
+    """Fact ``g`` onto level ``c``'s list of records; returns the records used and the highest level."""
+    rec[n_rec, 0] = g
+    rec[n_rec, 1] = head[c]
+    head[c] = n_rec
+    if c > top:
+        top = c
+        head[head.shape[0] - 1] = top
+    return n_rec + 1, top
+
+
 @numba.njit(cache=True, nogil=True)
-def explore_levels(
+def _levels(
     state,
     is_goal,
     npre,
@@ -169,20 +185,12 @@ def explore_levels(
     sup,
     unsat,
     acc,
-    heap,
     rec,
     head,
     level,
 ):
-    """``explore`` for costs of at least 1, with a bucket per cost level instead of the heap.
-
-    Every action costs at least 1, so nothing joins the level being processed; each level's
-    facts are taken in increasing fact id, the heap's order, so costs, supporters and the early
-    stop are the same as ``explore``'s. ``rec`` holds (fact, next) records of the pushes, ``head``
-    each level's first record and, last, the highest level the previous call used (its levels are
-    emptied first), ``level`` the facts of one level as a bitset (all 0 between calls). A cost past
-    the levels goes over to ``explore`` (with ``heap``). Returns whether the goals are reached.
-    """
+    """The level pass of :func:`explore_levels`: ``REACHED``, ``UNREACHED``, or ``PAST_LEVELS`` (its levels
+    emptied) when a cost passes the levels."""
     n = state.shape[0]
     n_levels = head.shape[0] - 1
     for c in range(head[n_levels] + 1):
@@ -213,33 +221,12 @@ def explore_levels(
             g = add_idx[j]
             if c < cost_f[g]:
                 if c >= n_levels:
-                    return explore(
-                        state,
-                        is_goal,
-                        npre,
-                        pre_of_ptr,
-                        pre_of_idx,
-                        add_ptr,
-                        add_idx,
-                        cost,
-                        zero,
-                        cost_f,
-                        sup,
-                        unsat,
-                        acc,
-                        heap,
-                    )
+                    return PAST_LEVELS
                 cost_f[g] = c
                 sup[g] = a
-                rec[n_rec, 0] = g
-                rec[n_rec, 1] = head[c]
-                head[c] = n_rec
-                n_rec += 1
-                if c > top:
-                    top = c
-                    head[n_levels] = top
+                n_rec, top = _push_level(rec, head, n_rec, g, c, top)
     if goals_left == 0:
-        return True
+        return REACHED
     c = 0
     while c <= top:
         lo = n
@@ -269,7 +256,7 @@ def explore_levels(
                     if goals_left == 0:
                         for w2 in range(w + 1, hi + 1):
                             level[w2] = np.uint64(0)
-                        return True
+                        return REACHED
                 for k in range(pre_of_ptr[f], pre_of_ptr[f + 1]):
                     a = pre_of_idx[k]
                     left = unsat[a] - 1
@@ -283,30 +270,63 @@ def explore_levels(
                                 if ac >= n_levels:
                                     for w2 in range(w, hi + 1):
                                         level[w2] = np.uint64(0)
-                                    return explore(
-                                        state,
-                                        is_goal,
-                                        npre,
-                                        pre_of_ptr,
-                                        pre_of_idx,
-                                        add_ptr,
-                                        add_idx,
-                                        cost,
-                                        zero,
-                                        cost_f,
-                                        sup,
-                                        unsat,
-                                        acc,
-                                        heap,
-                                    )
+                                    return PAST_LEVELS
                                 cost_f[g] = ac
                                 sup[g] = a
-                                rec[n_rec, 0] = g
-                                rec[n_rec, 1] = head[ac]
-                                head[ac] = n_rec
-                                n_rec += 1
-                                if ac > top:
-                                    top = ac
-                                    head[n_levels] = top
+                                n_rec, top = _push_level(rec, head, n_rec, g, ac, top)
         c += 1
-    return goals_left == 0
+    return REACHED if goals_left == 0 else UNREACHED
+
+
+@numba.njit(cache=True, nogil=True)
+def explore_levels(
+    state,
+    is_goal,
+    npre,
+    pre_of_ptr,
+    pre_of_idx,
+    add_ptr,
+    add_idx,
+    cost,
+    zero,
+    cost_f,
+    sup,
+    unsat,
+    acc,
+    heap,
+    rec,
+    head,
+    level,
+):
+    """``explore`` for costs of at least 1, with a bucket per cost level instead of the heap.
+
+    Every action costs at least 1, so nothing joins the level being processed; each level's
+    facts are taken in increasing fact id, the heap's order, so costs, supporters and the early
+    stop are the same as ``explore``'s. ``rec`` holds (fact, next) records of the pushes, ``head``
+    each level's first record and, last, the highest level the previous call used (its levels are
+    emptied first), ``level`` the facts of one level as a bitset (all 0 between calls). A cost past
+    the levels goes over to ``explore`` (with ``heap``). Returns whether the goals are reached.
+    """
+    found = _levels(
+        state,
+        is_goal,
+        npre,
+        pre_of_ptr,
+        pre_of_idx,
+        add_ptr,
+        add_idx,
+        cost,
+        zero,
+        cost_f,
+        sup,
+        unsat,
+        acc,
+        rec,
+        head,
+        level,
+    )
+    if found == PAST_LEVELS:
+        return explore(
+            state, is_goal, npre, pre_of_ptr, pre_of_idx, add_ptr, add_idx, cost, zero, cost_f, sup, unsat, acc, heap
+        )
+    return found == REACHED
