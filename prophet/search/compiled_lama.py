@@ -17,8 +17,9 @@ the start; where :data:`EXPANSIONS_PER_STEP` times FF's estimate of the initial 
 the expansions a greedy search needs) is already past that budget, it starts compiled. Both rules
 are deterministic: the same task always switches at the same expansion, so a simulated run that
 counts expansions stays the same. One more rule holds where the memory bound covers the whole
-process (``alica plan``): when the room left under it is less than what loading numba costs
-(:data:`~alica.prophet.search.jit.NUMBA_BYTES`), the pure-Python search goes on alone.
+process (``alica plan``): when the room left under it is less than what loading numba and the kernel
+costs (:func:`~alica.prophet.search.jit.numba_bytes`: more where numba must compile it first, on a
+fresh install), the pure-Python search goes on alone.
 
 Between calls of the kernel (every :data:`~alica.prophet.search.gbfs.CHECK_EVERY` expansions, or at
 the next progress event) the deadline and the memory bound of the run are checked: the memory is
@@ -27,7 +28,6 @@ the arrays' own size, which is what the search holds.
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Generator
 from typing import Any
 
@@ -35,7 +35,7 @@ from alica.prophet.planner import LimitReached, Progress
 from alica.prophet.search.encoding import AxiomTask, CompiledTask, bits
 from alica.prophet.search.gbfs import Stats
 from alica.prophet.search.heuristics import INF, Evaluator, Relaxed
-from alica.prophet.search.jit import JIT_LOAD_S, NUMBA_BYTES, CompiledFF, available, room_for_numba
+from alica.prophet.search.jit import JIT_LOAD_S, CompiledFF, available, numba_bytes, room_for_numba
 from alica.prophet.search.lama import lama_search
 from alica.prophet.search.landmarks import LandmarkCount
 
@@ -66,6 +66,8 @@ EXPANSIONS_PER_STEP = 4
 least (measured on the large set: gripper about 1, satellite about 8, miconic 11, logistics 70-100)."""
 GROWTH = 1.5
 """How much a full array grows."""
+KERNEL = ("lama_kernels", "run")
+"""The kernel module and its entry (:func:`~alica.prophet.search.jit.numba_bytes`)."""
 
 
 def eligible(ct: CompiledTask, relaxed: Relaxed, weight: float | None, seed: int | None) -> bool:
@@ -94,7 +96,7 @@ def first_plan(
     seed: int | None = None,
 ) -> Generator[Progress, None, tuple[list[int] | None, bool]]:
     """LAMA's first search: pure Python on small searches, compiled beyond (see the module docstring)."""
-    if not eligible(ct, relaxed, weight, seed) or not room_for_numba(stats.limits):
+    if not eligible(ct, relaxed, weight, seed) or not room_for_numba(stats.limits, *KERNEL):
         return (yield from lama_search(ct, ff, lmcount, stats, weight=weight, seed=seed))
     budget = python_budget(relaxed)
     # a greedy search expands several times as many states as its plan is long, which FF's estimate of the
@@ -374,8 +376,8 @@ def compiled_lama_search(
     if not eligible(ct, relaxed, weight, None):
         raise ValueError("the compiled LAMA search covers STRIPS tasks without derived predicates or when-effects")
     room = None if stats.limits is None else stats.limits.room_bytes()
-    if room is not None and stats.limits is not None and stats.limits.whole_process and "numba" not in sys.modules:
-        room = max(0.0, room - NUMBA_BYTES)
+    if room is not None and stats.limits is not None and stats.limits.whole_process:
+        room = max(0.0, room - numba_bytes(*KERNEL))
     arrays = _Arrays(ct, relaxed, lmcount, weight, room)
     k = arrays.k
     sc = arrays.sc

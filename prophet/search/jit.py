@@ -22,9 +22,12 @@ against 75 in pure Python; on visitall (3,500) 3,600 against 360.
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
+import os
 import sys
 from collections.abc import Callable, Sequence
+from glob import glob
 from time import perf_counter
 from typing import Any
 
@@ -33,9 +36,15 @@ from alica.prophet.search.heuristics import INF, Relaxed
 
 JIT_LOAD_S = 0.65
 """What loading numba and the kernels costs a process (seconds; measured 0.6-0.7 s)."""
-NUMBA_BYTES = 140 << 20
-"""The resident memory loading numba and a kernel adds to a process (measured: 69 MB for numba's import,
-61 MB for the first call of a cached kernel: LLVM's code and tables)."""
+NUMBA_IMPORT_BYTES = 70 << 20
+"""The resident memory numba's import adds to a process (measured 51-69 MB)."""
+KERNEL_BYTES = 70 << 20
+"""What the first call of a kernel module cached on disk adds (measured 54-61 MB: LLVM's code and tables)."""
+COMPILE_BYTES = 160 << 20
+"""What the first call adds where the disk cache is cold (a fresh install): numba compiles, and LLVM keeps
+what it compiled with (measured 142 MB for the LAMA kernels with FF's, and 9 s)."""
+NUMBA_BYTES = NUMBA_IMPORT_BYTES + KERNEL_BYTES
+"""What loading numba and a cached kernel module adds to a process."""
 JIT_CALL_S = 20e-6
 """The fixed cost of one compiled evaluation (the state's conversion, the calls), seconds."""
 
@@ -57,13 +66,52 @@ def available() -> bool:
     return importlib.util.find_spec("numba") is not None
 
 
-def room_for_numba(limits: Limits | None) -> bool:
-    """Whether loading numba fits under a memory bound on the whole process (``alica plan``'s):
-    :data:`NUMBA_BYTES` left, unless numba is loaded already. Without such a bound, always."""
-    if limits is None or not limits.whole_process or "numba" in sys.modules:
+def kernel_source(module: str) -> str | None:
+    """The source file of kernel module ``alica.prophet.search.<module>``, found without importing it."""
+    spec = importlib.util.find_spec(f"alica.prophet.search.{module}")
+    return None if spec is None or spec.origin is None else os.path.realpath(spec.origin)
+
+
+def kernels_cached(module: str, entry: str) -> bool:
+    """Whether numba's disk cache holds the kernel ``entry`` of ``alica.prophet.search.<module>``, newer than
+    its source. numba keeps it under ``NUMBA_CACHE_DIR`` where that is set, else beside the source
+    (``__pycache__``) or, where that is read-only, in the user's cache folder; an index found nowhere counts
+    as cold."""
+    source = kernel_source(module)
+    if source is None:
+        return False
+    folder = os.path.dirname(source)
+    subpath = f"{os.path.basename(folder)}_{hashlib.sha1(folder.encode()).hexdigest()}"  # numba's naming
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        folders = [os.path.join(os.environ["NUMBA_CACHE_DIR"], subpath)]
+    else:
+        user = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+        folders = [os.path.join(folder, "__pycache__"), os.path.join(user, "numba", subpath)]
+    name = f"{module}.{entry}-*.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    try:
+        mtime = os.stat(source).st_mtime
+        return any(os.stat(index).st_mtime >= mtime for where in folders for index in glob(os.path.join(where, name)))
+    except OSError:
+        return False
+
+
+def numba_bytes(module: str, entry: str) -> int:
+    """The resident memory using kernel module ``module`` still adds to this process: numba's import unless
+    it is loaded, and the module's first call (:data:`KERNEL_BYTES`, or :data:`COMPILE_BYTES` with a cold
+    disk cache) unless it is loaded."""
+    more = 0 if "numba" in sys.modules else NUMBA_IMPORT_BYTES
+    if f"alica.prophet.search.{module}" not in sys.modules:
+        more += KERNEL_BYTES if kernels_cached(module, entry) else COMPILE_BYTES
+    return more
+
+
+def room_for_numba(limits: Limits | None, module: str = "ff_kernels", entry: str = "explore") -> bool:
+    """Whether using kernel module ``module`` fits under a memory bound on the whole process (``alica
+    plan``'s): :func:`numba_bytes` left. Without such a bound, always."""
+    if limits is None or not limits.whole_process:
         return True
     room = limits.room_bytes()
-    return room is None or room >= NUMBA_BYTES
+    return room is None or room >= numba_bytes(module, entry)
 
 
 class CompiledFF:
@@ -217,4 +265,18 @@ class SwitchingFF:
         return result
 
 
-__all__ = ["JIT_CALL_S", "JIT_LOAD_S", "NUMBA_BYTES", "CompiledFF", "SwitchingFF", "available", "room_for_numba"]
+__all__ = [
+    "COMPILE_BYTES",
+    "JIT_CALL_S",
+    "JIT_LOAD_S",
+    "KERNEL_BYTES",
+    "NUMBA_BYTES",
+    "NUMBA_IMPORT_BYTES",
+    "CompiledFF",
+    "SwitchingFF",
+    "available",
+    "kernel_source",
+    "kernels_cached",
+    "numba_bytes",
+    "room_for_numba",
+]

@@ -8,9 +8,12 @@ measures a real process against its bound).
 
 from __future__ import annotations
 
+import hashlib
+import os
 import sys
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 from types import FrameType
 from typing import Any
 
@@ -24,8 +27,16 @@ from alica.prophet.ground import ground
 from alica.prophet.pddl import Domain, Problem, parse_domain, parse_problem
 from alica.prophet.pipeline import Found
 from alica.prophet.planner import Done, LimitReached, Limits, PlanStatus
+from alica.prophet.search import jit
 from alica.prophet.search.gbfs import CHECK_EVERY
-from alica.prophet.search.jit import NUMBA_BYTES, room_for_numba
+from alica.prophet.search.jit import (
+    COMPILE_BYTES,
+    NUMBA_BYTES,
+    NUMBA_IMPORT_BYTES,
+    kernels_cached,
+    numba_bytes,
+    room_for_numba,
+)
 from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.world import read_world
 from tests.conftest import PLANS
@@ -250,5 +261,41 @@ def test_numba_is_loaded_only_where_it_fits_under_a_bound_on_the_process(monkeyp
     assert room_for_numba(None) and room_for_numba(Limits(memory_mb=150))  # estimates only: no rule
     assert not room_for_numba(Limits(memory_mb=150, whole_process=True))
     assert room_for_numba(Limits(memory_mb=100 + NUMBA_BYTES / 2**20, whole_process=True))
-    monkeypatch.setitem(sys.modules, "numba", object())  # loaded already: nothing more to spend
+    monkeypatch.setitem(sys.modules, "numba", object())  # loaded already: the kernel's first call is left
+    monkeypatch.setitem(sys.modules, "alica.prophet.search.ff_kernels", object())
     assert room_for_numba(Limits(memory_mb=150, whole_process=True))
+
+
+def test_a_kernel_numba_must_compile_first_needs_more_room(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    """A fresh install has no compiled kernels on disk: the first call compiles, and LLVM keeps what it
+    compiled with (CI's first run passed a 300 MB bound by 35 MB that way)."""
+    monkeypatch.setattr(planner_module, "resident_bytes", lambda: 100 << 20)
+    monkeypatch.delitem(sys.modules, "numba", raising=False)
+    monkeypatch.delitem(sys.modules, "alica.prophet.search.lama_kernels", raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    monkeypatch.delenv("NUMBA_CACHE_DIR", raising=False)
+    source = tmp_path / "site" / "lama_kernels.py"  # an installed kernel module, its cache still empty
+    (source.parent / "__pycache__").mkdir(parents=True)
+    source.write_text("", encoding="utf-8")
+    monkeypatch.setattr(jit, "kernel_source", lambda module: str(source))
+    assert not kernels_cached("lama_kernels", "run")
+    assert numba_bytes("lama_kernels", "run") == NUMBA_IMPORT_BYTES + COMPILE_BYTES
+    room = Limits(memory_mb=100 + (NUMBA_BYTES >> 20), whole_process=True)  # room for a cached kernel
+    assert not room_for_numba(room, "lama_kernels", "run")
+    index = f"lama_kernels.run-46.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    beside = source.parent / "__pycache__" / index
+    beside.write_bytes(b"")
+    assert kernels_cached("lama_kernels", "run") and room_for_numba(room, "lama_kernels", "run")
+    os.utime(beside, (0, 0))  # the source changed since: numba compiles again
+    assert not kernels_cached("lama_kernels", "run")
+    folder = str(source.parent.resolve())
+    subpath = f"{source.parent.name}_{hashlib.sha1(folder.encode()).hexdigest()}"  # numba's own naming
+    user = tmp_path / "cache" / "numba" / subpath  # where numba writes when the source's folder is read-only
+    user.mkdir(parents=True)
+    (user / index).write_bytes(b"")
+    assert kernels_cached("lama_kernels", "run")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "elsewhere"))  # numba looks only there
+    assert not kernels_cached("lama_kernels", "run")
+    (tmp_path / "elsewhere" / subpath).mkdir(parents=True)
+    (tmp_path / "elsewhere" / subpath / index).write_bytes(b"")
+    assert kernels_cached("lama_kernels", "run")
