@@ -57,6 +57,8 @@ class PlanShare:
             objects of the goal (the rest of the goal); empty: the whole goal.
         origin: the agent that made the plan (a leader repeating it keeps it).
         pins: ``(task index, robot)``: tasks the operator pinned to a robot when reviewing the plan.
+        barred: ``(robot, step label)``: robots kept off the tasks holding a step that failed with them
+            (:mod:`alica.prophet.keep_off`).
     """
 
     key: PlanKey
@@ -73,6 +75,7 @@ class PlanShare:
     goal: tuple[Literal, ...] = ()
     origin: str = ""
     pins: tuple[tuple[int, str], ...] = ()
+    barred: tuple[tuple[str, str], ...] = ()
 
     def plan_name(self, problem: str) -> str:
         """The name of the plan generated from this share: unique to its content.
@@ -86,6 +89,8 @@ class PlanShare:
         content = repr((self.steps, self.world, self.robots, self.entry_task, self.goal, self.key))
         if self.pins:
             content += repr(self.pins)
+        if self.barred:
+            content += repr(self.barred)
         digest = hashlib.blake2b(content.encode("utf-8"), digest_size=3).hexdigest()
         who = self.origin or self.leader
         return f"{problem}_g{self.generation}v{self.version}_{who}_{digest}"
@@ -99,6 +104,7 @@ class PlanShare:
             and self.robots == other.robots
             and self.goal == other.goal
             and self.pins == other.pins
+            and self.barred == other.barred
         )
 
     def supersedes(self, other: PlanShare) -> bool:
@@ -109,12 +115,14 @@ class PlanShare:
 
 @dataclass(frozen=True, slots=True)
 class ReplanRequest:
-    """A teammate asks the leader to replan: a step of generation ``generation`` failed."""
+    """A teammate asks the leader to replan: a step of generation ``generation`` failed (``step``: its
+    label, ``Unstack(c, a)``; the sender is kept off it for a while)."""
 
     key: PlanKey
     generation: int
     sender: str
     reason: str
+    step: str = ""
 
 
 class PlanBoard:

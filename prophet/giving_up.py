@@ -24,6 +24,19 @@ GIVE_UP_AFTER = 3
 GIVE_UP_ANYWAY_AFTER = 2 * GIVE_UP_AFTER
 
 
+STEP_FAILED = "a step of "
+
+
+def failure_cause(reason: str) -> str:
+    """What made a step fail, from a replan's reason: without the sender a teammate's request names
+    (``r2: ...``) and without the generated plan's name (``a step of StackBlocks_g2v0_r1_ab12cd failed: ...``),
+    so that the same cause counts alike whichever robot reports it, in every generation."""
+    text = reason if reason.startswith(STEP_FAILED) else reason.split(": ", 1)[-1]
+    if text.startswith(STEP_FAILED) and " failed: " in text:
+        text = text.split(" failed: ", 1)[1]
+    return text
+
+
 class GiveUp:
     """The leader's count of failed steps (see the module docstring)."""
 
@@ -39,7 +52,7 @@ class GiveUp:
         """Count a failed step; the reason to give up, or ``None`` to replan.
 
         Args:
-            reason: why the step failed (without the plan's name, so that each generation counts alike).
+            reason: why the step failed (:func:`failure_cause`: without the sender and the plan's name).
             world: the planning world's facts now.
             steps_done: how many steps of the team were carried out so far (``step_done`` facts).
 

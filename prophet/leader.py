@@ -32,7 +32,8 @@ from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ShareStatus
 from alica.prophet.budget import LeaderSearch, SearchBudget, advance
-from alica.prophet.giving_up import GiveUp
+from alica.prophet.giving_up import GiveUp, failure_cause
+from alica.prophet.keep_off import KeepOff
 from alica.prophet.leader_search import magic_events, positions
 from alica.prophet.magic.team import TeamMagic
 from alica.prophet.monitoring import PlanCheck, StepMarks, executing, stalled, task_progress
@@ -134,6 +135,8 @@ class Leader:
         """What the leader waits for: the world to change, the robots outside the team to come back."""
         self.give_up = GiveUp()
         """The leader's count of failed steps: when to stop replanning."""
+        self.keep_off = KeepOff()
+        """The failed steps and their robots, kept off them for a while."""
         self.step_over: float | None = None
         """When a stepwise plan's step was seen over while its effects had not all arrived yet."""
         self.predicates: dict[str, tuple[str, ...]] | None = None
@@ -179,7 +182,8 @@ class Leader:
         share = self.team.share
         requests = [r for r in self.board.take_requests(self.key) if share is None or r.generation >= share.generation]
         if requests and share is not None and share.status == PLAN:
-            self.replan(now, f"{requests[0].sender}: {requests[0].reason}", settle=True)
+            first = requests[0]
+            self.replan(now, f"{first.sender}: {first.reason}", settle=True, failed=(first.sender, first.step))
             return
         phase = self.phase(True)
         if phase is LeaderPhase.REVIEWING:
@@ -214,8 +218,11 @@ class Leader:
             me = self.host.name
             self.team.publish(share if share.leader == me else replace(share, leader=me), now)
 
-    def replan(self, now: float, reason: str, settle: bool = False) -> None:
+    def replan(self, now: float, reason: str, settle: bool = False, failed: tuple[str, str] = ("", "")) -> None:
         """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step).
+
+        ``failed`` is the robot and the label of the step that failed: the robot is kept off that step for
+        a while (:mod:`alica.prophet.keep_off`).
 
         A failed step (``settle``) that failed :data:`~alica.prophet.giving_up.GIVE_UP_AFTER` times for the
         same reason in the same world, or :data:`~alica.prophet.giving_up.GIVE_UP_ANYWAY_AFTER` times with no
@@ -228,10 +235,11 @@ class Leader:
         if not settle:
             self.start_search(now, reason)
             return
+        self.keep_off.failed(*failed, now)
         generation = self.team.next_generation()
         world = frozenset(self.team.read_world(self.team.problem).facts)
         done = sum(1 for fact in self.host.world.facts() if fact.predicate == STEP_DONE)
-        message = self.give_up.step_failed(reason.split(": ", 1)[-1], world, done)
+        message = self.give_up.step_failed(failure_cause(reason), world, done)
         if message is not None:
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=message)
             self._publish_failure(now, generation, message)
@@ -503,6 +511,7 @@ class Leader:
             goal=search.goal,
             origin=self.host.name,
             pins=pins,
+            barred=self.keep_off.active(now),
         )
         self.team.publish(share, now)
 

@@ -80,6 +80,7 @@ from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
 from alica.prophet.budget import SearchBudget
 from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER
+from alica.prophet.keep_off import bar
 from alica.prophet.leader import Leader, planner_traits
 from alica.prophet.leadership import is_leader, next_generation
 from alica.prophet.magic.team import TeamMagic
@@ -322,8 +323,12 @@ class ProblemRuntime:
         if share.status == PLAN:
             name = share.plan_name(self.model.name)
             try:
-                created = apply_pins(
-                    self._tasks_for(name, share.steps, share.world, share.robots, share.entry_task), share.pins
+                created = bar(
+                    apply_pins(
+                        self._tasks_for(name, share.steps, share.world, share.robots, share.entry_task), share.pins
+                    ),
+                    share.barred,
+                    share.robots,
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")
@@ -385,17 +390,26 @@ class ProblemRuntime:
 
     # -- failures --------------------------------------------------------------
 
+    def _running_step(self, node: RunningPlan) -> str:
+        """The label of the step of the generated plan that ``node`` is at (``""``: none)."""
+        created = self.created
+        place = created.place(node.state) if created is not None and node.plan is created.plan else None
+        if created is None or place is None or place.step >= len(created.tasks[place.task]):
+            return ""
+        return created.tasks[place.task][place.step].label
+
     def execution_failed(self, node: RunningPlan, now: float) -> None:
         """A step of the generated plan failed here: back to the WaitPlan; the leader replans."""
         share = self.share
         assert share is not None
         reason = f"a step of {node.plan.name} failed: {node.reason}"
+        step = self._running_step(node)
         self.failed_generation = share.generation
         self.revision += 1
         self.host.emit("problem", key=key_text(self.key), phase="wait", generation=share.generation, reason=reason)
         if self._is_leader():
-            self.leader.replan(now, reason, settle=True)
+            self.leader.replan(now, reason, settle=True, failed=(self.host.name, step))
         else:
-            self.request = ReplanRequest(self.key, share.generation, self.host.name, reason)
+            self.request = ReplanRequest(self.key, share.generation, self.host.name, reason, step)
             self.host.publish(self.request)
             self.leader.next_update = now + self.model.update_time

@@ -78,10 +78,12 @@ class BlockSkill(py_trees.behaviour.Behaviour):
 
 
 class BlockSkills:
-    """Skill factories for the blocks-world plans; ``fail`` lists skill names whose next run fails (once each)."""
+    """Skill factories for the blocks-world plans; ``fail`` lists skill names whose next run fails (once each),
+    ``broken`` (agent, skill name) pairs whose every run fails (a robot that cannot do it from where it is)."""
 
-    def __init__(self, fail: Iterable[str] = (), ticks: int = 3) -> None:
+    def __init__(self, fail: Iterable[str] = (), ticks: int = 3, broken: Iterable[tuple[str, str]] = ()) -> None:
         self.fail = list(fail)
+        self.broken = set(broken)
         self.ticks = ticks
         self.runs: list[tuple[str, str, dict[str, object]]] = []
 
@@ -90,6 +92,7 @@ class BlockSkills:
             fail = skill in self.fail
             if fail:
                 self.fail.remove(skill)
+            fail = fail or (context.agent, skill) in self.broken
             self.runs.append((context.agent, skill, dict(params)))
             # waiting never ends by itself (the WaitPlan's WaitAside, Idle); a drive to free space takes a tick
             ticks = None if skill in ("Idle", "WaitAside") else (1 if skill == "DriveToFreeSpace" else self.ticks)

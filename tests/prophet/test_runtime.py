@@ -458,6 +458,7 @@ def test_a_planner_that_fails_inside_its_search_fails_the_problem_with_the_reaso
 def test_a_step_that_fails_the_same_way_in_the_same_world_gives_up_with_the_alternative_plan(tmp_path):
     # an unreachable sample: the same plan would be made and fail again for ever; after GIVE_UP_AFTER tries
     # in an unchanged world the problem fails and the team runs the AlternativePlan
+    from alica.prophet.giving_up import failure_cause
     from alica.prophet.runtime import GIVE_UP_AFTER
 
     text = PROBLEM.replace("PLANNER", "builtin").replace("ALTERNATIVE", "alternative_plan: Home")
@@ -481,7 +482,19 @@ def test_a_step_that_fails_the_same_way_in_the_same_world_gives_up_with_the_alte
     sim.set_facts([(True, "ready", ())])
     summary = sim.run(until_done=True, max_time=60)
     replans = events(rec, "replan")
-    assert len({e["reason"].split(": ", 1)[-1] for e in replans}) == 1 and len(replans) >= GIVE_UP_AFTER
+    assert len({failure_cause(e["reason"]) for e in replans}) == 1 and len(replans) >= GIVE_UP_AFTER
     failed = events(rec, "problem", phase="alternative")
     assert failed and f"the same step failed {GIVE_UP_AFTER} times" in failed[-1]["reason"]
     assert summary["success"] and events(rec, "allocation", plan="Home")
+
+
+def test_a_robot_whose_step_failed_is_kept_off_that_step_and_another_robot_does_it():
+    # r1 cannot unstack (boxed in, say): every Unstack it runs fails. Kept off the step, r2 does it
+    skills = BlockSkills(broken=[("r1", "Unstack")])
+    sim, rec = blocks_team(["r1", "r2"], skills)
+    summary = sim.run(until_done=True, max_time=120)
+    assert summary["success"] and goal_holds(sim, "r2")
+    unstacks = [agent for agent, skill, _ in skills.runs if skill == "Unstack"]
+    assert unstacks.count("r1") <= 1 and unstacks[-1] == "r2"  # at most the failure itself
+    replans = events(rec, "replan")
+    assert len(replans) == unstacks.count("r1")

@@ -85,3 +85,12 @@ def test_a_new_generation_is_newer_than_any_seen():
     assert next_generation(0, -1, 0) == 1
     assert next_generation(4, 2, 3) == 5
     assert next_generation(1, 6, 3) == 7
+
+
+def test_a_failure_counts_by_its_cause_whichever_robot_reports_it_in_whichever_generation():
+    from alica.prophet.giving_up import failure_cause
+
+    cause = "reached failure state 'T0_Failed'"
+    assert failure_cause(f"a step of StackBlocks_g2v0_r1_ab12cd failed: {cause}") == cause  # the leader's own
+    assert failure_cause(f"r2: a step of StackBlocks_g3v1_r1_0f0f0f failed: {cause}") == cause  # a teammate's
+    assert failure_cause("r2: the world changed under the plan") == "the world changed under the plan"

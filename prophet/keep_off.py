@@ -1,0 +1,72 @@
+"""A robot whose step failed is kept off that step for a while.
+
+Allocation prefers the robot nearest to where a task starts, so after a failed step the replanned
+task that holds the same step goes to the same robot again: a robot boxed in near a corner, or one
+whose grasp keeps failing from where it stands, would try it until the problem gives up. The leader
+remembers each failed step with its robot (:class:`KeepOff`) for :data:`KEEP_OFF_S` seconds and
+shares the pairs with its plans (:attr:`~alica.prophet.board.PlanShare.barred`); every agent then
+leaves that robot out of the tasks that hold the step (:func:`bar`), as it leaves robots out of a
+pinned task. Where that leaves a task nobody (the robot holds the block the task needs, or the team
+is that robot alone), the task keeps its robots: a retry by the same robot beats no robot at all.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+from alica.prophet.tasks import CreatedTasks
+
+KEEP_OFF_S = 60.0
+"""How long a robot stays off a step that failed with it (simulated seconds): about the time the rest
+of the team needs for a few steps, long enough for another robot to take it."""
+
+
+class KeepOff:
+    """The leader's failed steps: (robot, step label) -> until when the robot stays off the step."""
+
+    def __init__(self, hold_s: float = KEEP_OFF_S) -> None:
+        self.hold_s = hold_s
+        self.until: dict[tuple[str, str], float] = {}
+
+    def failed(self, robot: str, step: str, now: float) -> None:
+        """``robot``'s step ``step`` (its label, ``Unstack(c, a)``) failed at ``now``."""
+        if robot and step:
+            self.until[(robot, step)] = now + self.hold_s
+
+    def active(self, now: float) -> tuple[tuple[str, str], ...]:
+        """The (robot, step) pairs still kept off at ``now``, sorted (the older ones are forgotten)."""
+        self.until = {pair: until for pair, until in self.until.items() if until > now}
+        return tuple(sorted(self.until))
+
+
+def bar(created: CreatedTasks, barred: Sequence[tuple[str, str]], robots: Sequence[str]) -> CreatedTasks:
+    """``created`` with each barred robot left out of the tasks that hold its barred step.
+
+    A task keeps its robots where leaving them out would leave it none (see the module docstring); an
+    entry that is not a pair of strings is ignored.
+    """
+    if not barred:
+        return created
+    allowed = list(created.allowed) + [None] * (len(created.tasks) - len(created.allowed))
+    changed = False
+    for index, task in enumerate(created.tasks):
+        labels = {step.label for step in task}
+        off = {pair[0] for pair in barred if _pair(pair) and pair[1] in labels}
+        if not off:
+            continue
+        pinned = allowed[index]
+        candidates = pinned if pinned is not None else tuple(robots)
+        kept = tuple(robot for robot in candidates if robot not in off)
+        if kept and kept != candidates:
+            allowed[index] = kept
+            changed = True
+    return replace(created, allowed=tuple(allowed)) if changed else created
+
+
+def _pair(value: object) -> bool:
+    """Whether a barred entry is a (robot, step) pair of strings (a share comes from the network)."""
+    return isinstance(value, tuple) and len(value) == 2 and all(isinstance(part, str) for part in value)
+
+
+__all__ = ["KEEP_OFF_S", "KeepOff", "bar"]

@@ -1,0 +1,69 @@
+"""A robot whose step failed is kept off that step for a while (alica.prophet.keep_off)."""
+
+from __future__ import annotations
+
+import pytest
+
+from alica.io import load_library
+from alica.prophet.keep_off import KEEP_OFF_S, KeepOff, bar
+from alica.prophet.planner import PlanStep
+from alica.prophet.tasks import create_tasks
+from tests.conftest import PLANS
+
+ROBOTS = ("r1", "r2", "r3")
+WORLD = [
+    ("on", ("c", "a")),
+    ("ontable", ("a",)),
+    ("ontable", ("b",)),
+    ("clear", ("c",)),
+    ("clear", ("b",)),
+    *(("handempty", (r,)) for r in ROBOTS),
+]
+PLAN = [
+    PlanStep("Unstack", ("r1", "c", "a")),
+    PlanStep("Putdown", ("r1", "c")),
+    PlanStep("Pickup", ("r2", "b")),
+    PlanStep("Stack", ("r2", "b", "c")),
+    PlanStep("Pickup", ("r3", "a")),
+    PlanStep("Stack", ("r3", "a", "b")),
+]
+
+
+@pytest.fixture(scope="module")
+def created():
+    library = load_library(PLANS / "blocksworld" / "mission.yaml")
+    roleset = next(iter(library.rolesets.values()))
+    return create_tasks("StackBlocksPlan", PLAN, library, WORLD, ROBOTS, roleset, "Default")
+
+
+def test_failed_steps_are_kept_off_for_a_while_then_forgotten() -> None:
+    keep = KeepOff()
+    keep.failed("r2", "Unstack(c, a)", now=10.0)
+    keep.failed("r1", "Pickup(b)", now=20.0)
+    keep.failed("", "Pickup(b)", now=20.0)  # no robot or no step: nothing to keep off
+    assert keep.active(11.0) == (("r1", "Pickup(b)"), ("r2", "Unstack(c, a)"))
+    assert keep.active(10.0 + KEEP_OFF_S + 1) == (("r1", "Pickup(b)"),)
+    assert keep.active(20.0 + KEEP_OFF_S + 1) == ()
+
+
+def test_a_barred_robot_is_left_out_of_every_task_holding_its_step(created) -> None:
+    labels = [[step.label for step in task] for task in created.tasks]
+    index = next(i for i, task in enumerate(labels) if "Pickup(b)" in task)
+    barred = bar(created, [("r2", "Pickup(b)")], ROBOTS)
+    assert barred.allowed[index] == ("r1", "r3")
+    assert barred.pins()[barred.plan.entry_points[index].name] == ("r1", "r3")
+    others = [allowed for i, allowed in enumerate(barred.allowed) if i != index]
+    assert others == [
+        created.allowed[i] if i < len(created.allowed) else None for i in range(len(labels)) if i != index
+    ]
+
+
+def test_a_task_nobody_else_may_take_keeps_its_robots(created) -> None:
+    everyone = [(robot, "Pickup(b)") for robot in ROBOTS]
+    assert bar(created, everyone, ROBOTS) is created  # a retry beats no robot at all
+    assert bar(created, [], ROBOTS) is created
+
+
+def test_malformed_entries_from_the_network_are_ignored(created) -> None:
+    junk = [("r2",), ("r2", 3), "r2:Pickup(b)", None, ("r2", "Pickup(b)", "x")]
+    assert bar(created, junk, ROBOTS) is created  # type: ignore[arg-type]
