@@ -32,6 +32,7 @@ from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ShareStatus
 from alica.prophet.budget import LeaderSearch, SearchBudget, advance
+from alica.prophet.durations import StepTimes
 from alica.prophet.giving_up import GiveUp, failure_cause
 from alica.prophet.keep_off import KeepOff
 from alica.prophet.leader_search import magic_events, positions
@@ -68,6 +69,10 @@ class Team(Protocol):
     @property
     def problem(self) -> PlanningProblem:
         """The planning problem with the operator's goal and world."""
+
+    @property
+    def times(self) -> StepTimes:
+        """How long the agent's steps took (the durations a temporal planner plans with)."""
 
     def publish(self, share: PlanShare, now: float) -> None:
         """Send a share to the team and follow it."""
@@ -337,10 +342,11 @@ class Leader:
             AlicaError: the problem's elements cannot be read.
         """
         host, me = self.host, self.host.name
-        options: dict[str, object] = {"progress_every": 100} if problem.planner == "builtin" else {}
+        options: dict[str, object] = {"progress_every": 100} if problem.planner in ("builtin", "temporal") else {}
         if (traits := planner_traits(problem.planner)) is not None and traits.reads_positions:
             options.update(positions=positions(host.world.values()), seed=generation)
-        planning = self.plan(problem, host.library, world, options=options)
+        durations = self.team.times.estimates(host.library, problem.elements) if problem.planner == "temporal" else None
+        planning = self.plan(problem, host.library, world, options=options, durations=durations)
         team = [a for a in self.slot.members() if a != me]
         if self.magic is not None and problem.planner == "builtin" and team:
             events = magic_events(

@@ -107,6 +107,8 @@ class ProblemPlanning:
         domain: the PDDL domain of the problem's elements.
         pddl: the PDDL problem of the world and the goal.
         planner: the planner.
+        temporal: the domain's actions are durative (``planner: temporal``): a plan is checked as the
+            temporal planner schedules it, and its cost is the makespan.
     """
 
     problem: PlanningProblem
@@ -114,6 +116,7 @@ class ProblemPlanning:
     domain: Domain
     pddl: Problem
     planner: Planner
+    temporal: bool = False
 
     def validated(self, plan: Plan) -> ValidPlan:
         """``plan`` checked against the PDDL, with the world's object names.
@@ -134,6 +137,11 @@ class ProblemPlanning:
         A stepwise planner's plan is the next step of a policy: its actions must apply, the goal need not hold after it.
         """
         pddl = replace(self.pddl, goal=And(())) if self.planner.stepwise else self.pddl
+        if self.temporal:
+            from alica.prophet.temporal import schedule  # lazy: only temporal problems need it
+            from alica.prophet.validate_temporal import validate_temporal_plan
+
+            return validate_temporal_plan(self.domain, pddl, schedule(self.domain, pddl, steps).plan)
         return validate_plan((self.domain, pddl), steps)
 
     def search(self, *, anytime: bool = True, limits: Limits | None = None) -> Iterator[ProblemEvent]:
@@ -181,6 +189,7 @@ def plan_problem(
     *,
     planner: str | None = None,
     options: Mapping[str, object] | None = None,
+    durations: Mapping[str, float] | None = None,
 ) -> ProblemPlanning:
     """Make the PDDL of ``problem`` in ``world`` and pick its planner (see the module docstring).
 
@@ -190,12 +199,15 @@ def plan_problem(
         world: the world to plan from (:func:`alica.prophet.world.read_world`).
         planner: the planner back-end (default: the problem's own ``planner``).
         options: options of the back-end's constructor.
+        durations: element name -> expected seconds, over the signatures' ``duration`` (the temporal
+            planner's; measured ones, say).
 
     Raises:
         PlannerError: the problem cannot be written as PDDL, or the planner is unknown.
     """
-    domain, pddl = to_pddl(problem, library, world.object_types(), world.facts)
     name = planner or problem.planner
+    temporal = name == "temporal"
+    domain, pddl = to_pddl(problem, library, world.object_types(), world.facts, temporal=temporal, durations=durations)
     chosen_options = dict(options or {})
     if name == "builtin":
         # A plan file's problem keeps FF's first search (FirstSearch("ff")): the shipped missions and
@@ -205,4 +217,4 @@ def plan_problem(
 
         chosen_options.setdefault("first", FirstSearch("ff"))
     chosen = get_planner(name, **chosen_options)
-    return ProblemPlanning(problem, world, domain, pddl, chosen)
+    return ProblemPlanning(problem, world, domain, pddl, chosen, temporal)

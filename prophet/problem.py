@@ -7,6 +7,12 @@ clear(?y)``). The robot parameter ``?r`` is the one agent of the
 single-agent plan (IMPERA 7.3); task creation spreads the plan over the team
 afterwards. World is the problem's ``world`` (offline use) or facts read from
 the world model; Goal is the problem's ``goal``.
+
+With ``temporal`` (the problem's ``planner: temporal``) each element becomes a PDDL 2.1 durative
+action of its signature's ``duration``, and the metric is the makespan (``total-time``). The
+precondition holds at the start; what the effect deletes of it is deleted at the start (the skill
+holds the block, the hand, the target from its first moment on, so no other robot's step can use
+them meanwhile); the rest of the effect holds at the end.
 """
 
 from __future__ import annotations
@@ -75,17 +81,39 @@ def predicate_types(problem: PlanningProblem, library: PlanLibrary) -> dict[str,
     return predicates
 
 
-def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
-    """The PDDL domain of a planning problem's elements.
+def domain_text(
+    problem: PlanningProblem,
+    library: PlanLibrary,
+    *,
+    temporal: bool = False,
+    durations: Mapping[str, float] | None = None,
+) -> str:
+    """The PDDL domain of a planning problem's elements (durative ones with ``temporal``, see the module docstring).
+
+    Args:
+        problem: the planning problem.
+        library: holds its elements.
+        temporal: write durative actions.
+        durations: element name -> seconds, over the signatures' own ``duration`` (measured ones, say).
 
     Raises:
-        PlannerError: an element has no signature, or a signature is not a conjunction of literals.
+        PlannerError: an element has no signature, or a signature is not a conjunction of literals; with
+            ``temporal``, an element has no duration.
     """
     actions, types = [], {"object"}
     predicates = predicate_types(problem, library)
-    for name, sig, typed, (pre, _), (eff, _) in _signatures(problem, library):
+    for name, sig, typed, (pre, pre_lits), (eff, eff_lits) in _signatures(problem, library):
         types.update(typed.values())
         params = " ".join(f"{_symbol(v)} - {_symbol(t)}" for v, t in typed.items())
+        if temporal:
+            duration = (durations or {}).get(name, sig.duration)
+            if duration is None:
+                raise PlannerError(
+                    f"planning problem '{problem.name}' plans with durations (planner: temporal), but element "
+                    f"'{name}' declares none: give its signature a 'duration' (expected seconds)"
+                )
+            actions.append(_durative(name, params, duration, pre, pre_lits, eff, eff_lits))
+            continue
         cost = int(sig.cost) if float(sig.cost).is_integer() else sig.cost
         effect_parts = eff + [f"(increase (total-cost) {cost})"]
         actions.append(
@@ -97,17 +125,47 @@ def domain_text(problem: PlanningProblem, library: PlanLibrary) -> str:
         for p, ts in sorted(predicates.items())
     )
     type_list = " ".join(sorted(_symbol(t) for t in types if t != "object"))
+    requirements = ":durative-actions" if temporal else ":action-costs"
     return (
-        f"(define (domain {_symbol(problem.name)})\n  (:requirements :strips :typing :negative-preconditions :action-costs)\n"
+        f"(define (domain {_symbol(problem.name)})\n  (:requirements :strips :typing :negative-preconditions {requirements})\n"
         + (f"  (:types {type_list} - object)\n" if type_list else "")
-        + f"  (:predicates {preds})\n  (:functions (total-cost) - number)\n"
+        + f"  (:predicates {preds})\n"
+        + ("" if temporal else "  (:functions (total-cost) - number)\n")
         + "\n".join(actions)
         + "\n)\n"
     )
 
 
-def problem_text(problem: PlanningProblem, objects: Mapping[str, str], facts: Iterable[Fact]) -> str:
-    """The PDDL problem: typed ``objects`` (name -> type), the initial ``facts`` and the problem's goal.
+def _durative(
+    name: str,
+    params: str,
+    duration: float,
+    pre: list[str],
+    pre_lits: list[tuple[bool, str, tuple[object, ...]]],
+    eff: list[str],
+    eff_lits: list[tuple[bool, str, tuple[object, ...]]],
+) -> str:
+    """One element as a durative action: what its effect deletes of its precondition goes at the start."""
+    held = {(n, tuple(map(str, a))) for positive, n, a in pre_lits if positive}
+    start = [
+        text
+        for text, (positive, n, a) in zip(eff, eff_lits, strict=True)
+        if not positive and (n, tuple(map(str, a))) in held
+    ]
+    end = [text for text in eff if text not in start]
+    conditions = [f"(at start {text})" for text in pre]
+    effects = [f"(at start {text})" for text in start] + [f"(at end {text})" for text in end]
+    return (
+        f"  (:durative-action {_symbol(name)}\n    :parameters ({params})\n    :duration (= ?duration {duration:g})\n"
+        f"    :condition {_and(conditions) if conditions else '(and)'}\n    :effect {_and(effects) if effects else '(and)'})"
+    )
+
+
+def problem_text(
+    problem: PlanningProblem, objects: Mapping[str, str], facts: Iterable[Fact], *, temporal: bool = False
+) -> str:
+    """The PDDL problem: typed ``objects`` (name -> type), the initial ``facts`` and the problem's goal
+    (for the makespan with ``temporal``).
 
     Raises:
         PlannerError: the goal is not a conjunction of literals.
@@ -115,9 +173,10 @@ def problem_text(problem: PlanningProblem, objects: Mapping[str, str], facts: It
     goal, _ = _conjunction(problem.goal.text, f"the goal of '{problem.name}'")
     objs = " ".join(f"{_symbol(o)} - {_symbol(t)}" for o, t in sorted(objects.items()))
     init = " ".join(sorted(_atom(n, a) for n, a in facts))
+    cost, metric = ("", "(total-time)") if temporal else (" (= (total-cost) 0)", "(total-cost)")
     return (
         f"(define (problem {_symbol(problem.name)}-now) (:domain {_symbol(problem.name)})\n  (:objects {objs})\n"
-        f"  (:init {init} (= (total-cost) 0))\n  (:goal {_and(goal) if goal else '(and)'})\n  (:metric minimize (total-cost)))\n"
+        f"  (:init {init}{cost})\n  (:goal {_and(goal) if goal else '(and)'})\n  (:metric minimize {metric}))\n"
     )
 
 
@@ -141,11 +200,20 @@ def offline_world(problem: PlanningProblem) -> tuple[dict[str, str], list[Fact]]
 
 
 def to_pddl(
-    problem: PlanningProblem, library: PlanLibrary, objects: Mapping[str, str], facts: Iterable[Fact]
+    problem: PlanningProblem,
+    library: PlanLibrary,
+    objects: Mapping[str, str],
+    facts: Iterable[Fact],
+    *,
+    temporal: bool = False,
+    durations: Mapping[str, float] | None = None,
 ) -> tuple[Domain, Problem]:
-    """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world."""
+    """The parsed PDDL ``(Domain, Problem)`` of a planning problem in a world (durative with ``temporal``)."""
     from alica.prophet.pddl import parse_domain, parse_problem
 
-    domain = parse_domain(domain_text(problem, library), file=f"<{problem.name} domain>")
-    pddl_problem = parse_problem(problem_text(problem, objects, facts), file=f"<{problem.name} problem>")
+    text = domain_text(problem, library, temporal=temporal, durations=durations)
+    domain = parse_domain(text, file=f"<{problem.name} domain>")
+    pddl_problem = parse_problem(
+        problem_text(problem, objects, facts, temporal=temporal), file=f"<{problem.name} problem>"
+    )
     return domain, pddl_problem

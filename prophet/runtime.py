@@ -79,6 +79,7 @@ from alica.lang.fact import Fact
 from alica.model import Condition, ConditionKind, Plan, PlanningProblem
 from alica.prophet.board import PlanBoard, PlanShare, ReplanRequest, ShareStatus
 from alica.prophet.budget import SearchBudget
+from alica.prophet.durations import StepTimes
 from alica.prophet.giving_up import GIVE_UP_AFTER, GIVE_UP_ANYWAY_AFTER
 from alica.prophet.keep_off import bar
 from alica.prophet.leader import Leader, planner_traits
@@ -150,6 +151,8 @@ class ProblemRuntime:
         self.request: ReplanRequest | None = None
         self.marks = StepMarks(host.world, host.name)
         """The steps this agent finished in the generated plan (``step_done``, with their effects)."""
+        self.times = StepTimes()
+        """How long this agent's steps took, per skill (a temporal planner's durations)."""
         self.stepwise = (traits := planner_traits(element.planner)) is not None and traits.stepwise
         """Whether the problem's planner plans one step at a time (the operator changes goal and world, not planner)."""
         self.overrides = dict(host.override(self.model.name))
@@ -300,6 +303,7 @@ class ProblemRuntime:
         if self.request is not None and self.share is not None and self.share.generation > self.request.generation:
             self.request = None
         self.marks.mark_done(self.slot.node, self.created)
+        self.times.observe(self.slot.node, self.created, now)
 
     def stop(self) -> None:
         """The agent leaves the state: stop planning, forget the generated plan."""

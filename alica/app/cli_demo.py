@@ -59,6 +59,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         metavar="FILE",
         help="a YAML file with 'goal' (and optionally 'start') stacks, bottom first: goal: [[a, b], [c]]",
     )
+    b.add_argument(
+        "--planner",
+        choices=("builtin", "temporal"),
+        default="builtin",
+        help="plan for the fewest steps (builtin, the mission's) or for the team's time (temporal: the skills' "
+        "durations, refined by what the team measures)",
+    )
     add_time_limit(b, 600.0, "give up after S simulated seconds (default 600)")
     add_fault_options(
         b,
@@ -351,6 +358,7 @@ def cmd_blocksworld(args: argparse.Namespace) -> int:
         start=start,
         goal=goal,
         time_limit=args.time_limit,
+        planner=args.planner,
     )
     actions = fault_actions(args.crash, args.recover, args.robots)
     if args.processes and (args.gui or args.center):

@@ -599,12 +599,15 @@ def _signature(plan: Fields, problems: Problems) -> PlanningSignature | None:
     node = plan.mapping("signature")
     if node is None:
         return None
-    f = Fields(node, f"the signature of {plan.what}", problems, ("parameters", "precondition", "effect", "cost"))
+    keys = ("parameters", "precondition", "effect", "cost", "duration")
+    f = Fields(node, f"the signature of {plan.what}", problems, keys)
+    duration = f.number("duration", -1.0, low=0.001) if "duration" in f.values else -1.0
     return PlanningSignature(
         _typed_list(f, "parameters"),
         _condition(f, "precondition", ConditionKind.PRE),
         _condition(f, "effect", ConditionKind.POST),
         f.number("cost", 1.0, low=0.0),
+        duration if duration >= 0.0 else None,
         span=node.span,
     )
 

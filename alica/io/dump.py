@@ -239,6 +239,8 @@ class _Dumper:
             _put(sig, "precondition", _cond(plan.signature.precondition), sig_written)
             _put(sig, "effect", _cond(plan.signature.effect), sig_written)
             _put(sig, "cost", _number(plan.signature.cost), sig_written, 1)
+            if plan.signature.duration is not None:
+                _put(sig, "duration", _number(plan.signature.duration), sig_written)
             out["signature"] = sig
         out["entry_points"] = [self.entry_point(ep) for ep in plan.entry_points]
         out["states"] = [self.state(s, plan.out_transitions(s.name)) for s in plan.states]

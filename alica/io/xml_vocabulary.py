@@ -169,7 +169,7 @@ _SPECS: dict[str, _Spec] = {
     "summand": _Spec(("name", "weight"), content="expression"),
     "constraint": _Spec(("name",), (_Child("variable", "variables", NAMES), _text("formula"), _text("utility"))),
     "signature": _Spec(
-        ("cost",),
+        ("cost", "duration"),
         (_Child("parameter", "parameters", LIST, "variable"), _text("precondition"), _text("effect")),
     ),
     "entrypoint": _Spec(("name", "task", "state", "min", "max", "success_required")),

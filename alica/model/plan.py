@@ -181,12 +181,15 @@ class PlanningSignature:
         precondition: a formula over the parameters.
         effect: a conjunction of literals over the parameters.
         cost: the action's cost.
+        duration: how long the skill is expected to take, seconds (``None``: not declared). A temporal
+            planner (``planner: temporal``) plans with it for the team's time, the makespan.
     """
 
     parameters: tuple[Variable, ...] = ()
     precondition: Condition | None = None
     effect: Condition | None = None
     cost: float = 1.0
+    duration: float | None = None
     span: SourceSpan | None = span_field()
 
 

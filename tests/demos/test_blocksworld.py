@@ -253,3 +253,24 @@ def test_with_ten_blocks_four_agents_finish_sooner_than_two():
         [r["sim_time_s"] for r in two],
         [r["sim_time_s"] for r in four],
     )
+
+
+def test_the_team_plans_for_its_time_with_the_temporal_planner(capsys):
+    # four single blocks into one tower: planned for the makespan, both robots carry blocks to it
+    from alica.app.cli import main
+
+    code = main(
+        ["demo", "blocksworld", "--robots", "2", "--blocks", "4", "--seed", "2", "--planner", "temporal"]
+        + ["--json", "--no-progress"]
+    )
+    summary = json.loads(capsys.readouterr().out)
+    assert code == 0 and summary["success"], summary
+    assert all(steps >= 1 for steps in summary["steps"].values())  # both robots worked
+
+
+def test_the_temporal_planner_is_for_the_in_process_demo():
+    run, _ = _demo_cli("--robots", "2", "--processes", "--planner", "temporal")
+    assert run.returncode == 1 and "--planner temporal runs only in the in-process demo" in run.stderr
+    run, _ = _demo_cli("--planner", "fastest")
+    assert run.returncode == 2 and "invalid choice: 'fastest'" in run.stderr
+    assert "Traceback" not in run.stderr

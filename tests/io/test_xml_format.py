@@ -149,6 +149,7 @@ plans:
       precondition: "onground(?x) and handempty(?r)"
       effect: "not onground(?x) and holding(?r, ?x)"
       cost: 2
+      duration: 4.5
   - name: Empty
     entry_points: [{task: Default, state: S}]
     states: [{name: S}]
@@ -1203,6 +1204,7 @@ TEXT = st.text(XML_CHARS, max_size=20)
 UNIT = st.floats(0, 1)
 #: Finite: the builder refuses infinity in every numeric field with a clear error ("too large"), as it should.
 NON_NEGATIVE = st.floats(min_value=0, allow_nan=False, allow_infinity=False)
+POSITIVE = st.floats(min_value=0.001, max_value=1e6, allow_nan=False, allow_infinity=False)
 TYPED = IDENT | st.tuples(IDENT, TYPE).map(" - ".join) | st.fixed_dictionaries({"name": IDENT}, optional={"type": TYPE})
 SCALARS = (
     st.none()

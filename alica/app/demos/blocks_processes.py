@@ -125,6 +125,11 @@ def run_demo_processes(
             "--processes runs the team's robots as processes; opponents run only in the in-process demo "
             "(leave out --opponents or --processes)"
         )
+    if config.planner != "builtin":
+        raise AlicaError(
+            f"--processes runs the mission's planner as shipped; --planner {config.planner} runs only in the "
+            "in-process demo (leave out --planner or --processes)"
+        )
     start, goal = configurations(config)
     library = load_library(MISSION)
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]

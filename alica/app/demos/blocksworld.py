@@ -21,7 +21,7 @@ import functools
 import itertools
 import time
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,6 +29,7 @@ from alica.app.demos.blocks_pictures import write_picture
 from alica.app.demos.common import StepCounter, plan_yaml_text, planning_leader
 from alica.errors import AlicaError
 from alica.io.loader import plans_dir
+from alica.model import PlanLibrary
 
 if TYPE_CHECKING:
     from alica.app.center.live import LiveSession
@@ -57,7 +58,8 @@ class DemoConfig:
         goal: the goal stacks; random from the seed when None.
         time_limit: simulated seconds before the run gives up.
         frequency: engine ticks per simulated second.
-        planner: the planner back-end.
+        planner: the planner of StackBlocks: ``builtin`` (the mission's, for the fewest steps) or ``temporal``
+            (for the team's time: the skills' declared durations, refined by what the team measures).
     """
 
     agents: int = 2
@@ -193,6 +195,25 @@ def configurations(config: DemoConfig) -> tuple[Stacks, Stacks]:
     return start, goal
 
 
+def with_planner(library: PlanLibrary, problem: str, planner: str) -> PlanLibrary:
+    """``library`` with planning problem ``problem`` planned by ``planner``.
+
+    Raises:
+        AlicaError: the planner is not one of the registered back-ends.
+    """
+    from alica.prophet.planners import PLANNERS
+
+    if planner not in PLANNERS:
+        raise AlicaError(f"unknown planner '{planner}': use one of {', '.join(sorted(PLANNERS))}")
+    if library.problems[problem].planner == planner:
+        return library
+    documents = tuple(
+        replace(d, problems=tuple(replace(p, planner=planner) if p.name == problem else p for p in d.problems))
+        for d in library.documents
+    )
+    return PlanLibrary(documents)
+
+
 def _renamed(stacks: Stacks, names: Sequence[str]) -> Stacks:
     """Random stacks of ``a, b, ...`` with the blocks named like ``names`` (sorted)."""
     order = sorted(b for s in stacks for b in s)
@@ -243,7 +264,7 @@ def run_demo(
             f"the demo needs at least 1 agent and 0 or more opponents, got {config.agents} and {config.opponents}"
         )
     start, goal = configurations(config)
-    library = load_library(MISSION)
+    library = with_planner(load_library(MISSION), PROBLEM, config.planner)
     world = blocksworld(
         [list(s) for s in start], agents=config.agents, seed=config.seed, opponents=config.opponents, gui=gui
     )
