@@ -147,6 +147,13 @@ def _navigation(registry: SkillRegistry) -> None:
             required=False,
         ),
         _p("guard_radius", "float", "metres from the guarded object within which the robot stays", default=0.9),
+        _p(
+            "threat_radius",
+            "float",
+            "guard only while a robot outside the team is within this many metres of the guarded object, else "
+            "stand by (0: always guard)",
+            default=0.0,
+        ),
         doc="wait out of the way of the team's work: near the next work site, guarding a finished stack, or away "
         "from every stack; clear of the other robots and of the stand-off points teammates reserved; moves on when "
         "a teammate needs the place; runs until its state is left",

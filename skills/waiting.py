@@ -23,7 +23,12 @@ A robot waits in three situations, and the skill serves all three:
   a robot stands that close (``blocking_radius`` of
   :class:`~alica.skills.opponent.RandomBlockSkill`), so they cannot undo it
   (IMPERA 8.2: "the opponents often were not able to act, because the stack
-  was blocked by an agent").
+  was blocked by an agent"). With ``threat_radius`` > 0 it guards only while a
+  robot outside the team is within that many metres of the guarded object
+  (or was, within :data:`THREAT_HOLD` seconds), and otherwise stands by: a guard that no opponent needs stands beside the
+  towers the team still builds, in the way of the robots that build them.
+  Every :data:`CHECK_PERIOD` it looks again, so it comes back to guard as
+  soon as an opponent approaches.
 
 Every waiting place is clear of the other robots and of the stand-off points
 teammates reserved (:mod:`alica.skills.reservations`). Once there the robot
@@ -55,6 +60,8 @@ GUARD_RADIUS = 0.9
 GUARD_RING = (0.78, 0.82)
 #: Directions tried on each ring.
 RING_POINTS = 24
+#: Seconds a guard keeps guarding after the last opponent left ``threat_radius`` (opponents come back).
+THREAT_HOLD = 30.0
 #: Room (m) a robot standing by leaves around another robot that holds something, to put it down.
 HOLDER_ROOM = 1.8
 #: A block this close (m) to a reserved stand-off point is being worked at.
@@ -77,6 +84,8 @@ class WaitAside(DriveToFreeSpace):
 
     def initialise(self) -> None:
         """Choose the waiting place and drive there (or stay, when the robot already waits well)."""
+        self.threat_seen: dict[str, float] = {}
+        """Guarded object -> when a robot outside the team was last seen within ``threat_radius`` of it."""
         self.waiting = False
         self.next_check = 0.0
         self.placing = False
@@ -99,16 +108,35 @@ class WaitAside(DriveToFreeSpace):
         radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
         found: list[tuple[float, tuple[float, float]]] = []
         held = holders(self.team_model, self.team_belief)
+        guards = [(p.x, p.y) for p in self.teammates() if p.robot != self.robot.name] if name == "guard" else []
         for label in value.split():
             obj = self.world.objects.get(label)
             if obj is None or label in held or (self.robot.arm is not None and self.robot.arm.held is obj):
                 continue  # no such object, or held (the team's holding facts): its work site is elsewhere
             position = obj.position()
             xy = (float(position[0]), float(position[1]))
-            if name == "guard" and any(distance(xy, (x, y)) <= radius for x, y, _ in super()._others()):
-                continue  # another robot guards it already
+            if name == "guard" and any(distance(xy, (x, y)) <= radius for x, y in guards):
+                continue  # a teammate guards it already (an opponent beside it is what a guard is for)
+            if name == "guard" and not self._threatened(label, xy):
+                continue  # no opponent near it: nothing to guard it from
             found.append((distance(xy, here), xy))
         return min(found)[1] if found else None
+
+    def _threatened(self, label: str, xy: tuple[float, float]) -> bool:
+        """Whether a robot outside the team is within ``threat_radius`` of object ``label`` at ``xy``, or was
+        within the last :data:`THREAT_HOLD` seconds (always, with no radius)."""
+        radius = float(self.param("threat_radius", 0.0))  # type: ignore[arg-type]
+        if radius <= 0:
+            return True
+        team = {pose.robot for pose in self.teammates()} | {self.robot.name}
+        now = self.now()
+        if any(
+            distance(xy, (float(robot.pose[0]), float(robot.pose[1]))) <= radius
+            for name, robot in self.world.robots.items()
+            if name not in team and not robot.crashed
+        ):
+            self.threat_seen[label] = now
+        return now - self.threat_seen.get(label, -math.inf) < THREAT_HOLD
 
     def _crowding(self) -> list[tuple[float, float, float]]:
         """Discs a waiting robot's centre must stay out of: other robots and reserved stand-off points."""

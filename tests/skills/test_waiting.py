@@ -129,3 +129,34 @@ def test_without_a_guard_the_opponent_takes_the_stack_apart():
         assert not all(tower <= facts for facts in seen)
         opponent.stop(Status.INVALID)
         away.stop(Status.INVALID)
+
+
+def test_with_no_opponent_near_a_guard_stands_by_instead():
+    # threat_radius: nothing to guard the stack from, so the robot does not stand beside it (where the
+    # team's builders need the room); it stays where it stands by
+    with blocksworld(stacks=[["a", "b", "c"], ["d"], ["e"]], agents=1) as world:
+        start = _xy(world, "r1")
+        params = {"clearance": 0.4, "max_distance": 5.0, "guard": "c", "keep_away": 1.15, "threat_radius": 2.5}
+        waiter = _skill(WaitAside, world, "r1", params, WorldModel("team", clock=world))
+        _run(world, [waiter], 10.0)
+        assert math.dist(_xy(world, "r1"), _block_xy(world, "c")) > GUARD_RADIUS
+        assert math.dist(_xy(world, "r1"), start) < 0.05
+        waiter.stop(Status.INVALID)
+
+
+def test_an_opponent_near_brings_the_guard_and_the_stack_survives():
+    # the opponent starts 1.5 m from the stack: within threat_radius, so the robot guards it as before
+    finished = [["a", "b", "c"]]
+    with blocksworld(stacks=[*finished, ["d"], ["e"]], agents=1, opponents=1) as world:
+        tower = {("on", "b", "a"), ("on", "c", "b"), ("ontable", "a")}
+        params = {"clearance": 0.4, "max_distance": 5.0, "guard": "c", "keep_away": 1.15, "threat_radius": 2.5}
+        team = WorldModel("team", clock=world)  # the team's own: the opponent is not in it
+        guard = _skill(WaitAside, world, "r1", params, team)
+        _run(world, [guard], 10.0)
+        assert math.dist(_xy(world, "r1"), _block_xy(world, "c")) <= GUARD_RADIUS
+        opponent = _skill(RandomBlockSkill, world, "o1", {}, seed=3)
+        seen = _run(world, [guard, opponent], 150.0)
+        assert all(tower <= facts for facts in seen), "the opponent undid the guarded stack"
+        assert len(set(seen)) >= 2, "the opponent never acted: the test shows nothing"
+        opponent.stop(Status.INVALID)
+        guard.stop(Status.INVALID)
