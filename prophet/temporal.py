@@ -44,7 +44,7 @@ from alica.prophet.pddl.model import (
     top_level_parts,
 )
 from alica.prophet.pddl.normal import substitute
-from alica.prophet.planner import Feature, PlanStep
+from alica.prophet.planner import Feature, Plan, PlanStep
 from alica.prophet.temporal_plan import EPSILON, TemporalPlan, TimedStep
 from alica.prophet.validate_temporal import Touches, interference, touches
 
@@ -205,6 +205,32 @@ def schedule(domain: Domain, problem: Problem, steps: Sequence[PlanStep]) -> Sch
     return Schedule(TemporalPlan(timed), tuple(after), round(sequential, 6))
 
 
+def timed_schedule(domain: Domain, problem: Problem, plan: TemporalPlan) -> Schedule:
+    """A timed plan found otherwise (by :mod:`~alica.prophet.temporal_search`) as a :class:`Schedule`: its steps
+    by start time, each with the earlier dependent steps (which it may overlap when their happenings allow).
+
+    Raises:
+        PlannerError: a step that is no action of the domain, or a duration missing from ``:init``.
+    """
+    values = problem.fluent_values
+    timed = tuple(sorted(plan.steps, key=lambda t: t.start))
+    ground = [_ground(domain, values, t.step) for t in timed]
+    after = tuple(tuple(i for i in range(j) if _dependent(ground[i], g)) for j, g in enumerate(ground))
+    sequential = sum(g.duration for g in ground) + EPSILON * max(0, len(ground) - 1)
+    return Schedule(TemporalPlan(timed), after, round(sequential, 6))
+
+
+@dataclass(frozen=True, slots=True)
+class ScheduledPlan(Plan):
+    """A plan whose timing is its own (not :func:`schedule` of its steps): the makespan search's.
+
+    Attributes:
+        schedule: the timed plan.
+    """
+
+    schedule: Schedule | None = None
+
+
 def _ground(domain: Domain, values: dict[FluentTerm, int | float], step: PlanStep) -> _Ground:
     action = domain.durative_action(step.action)
     if action is None:
@@ -253,4 +279,4 @@ def is_temporal(domain: Domain, problem: Problem) -> bool:
     )
 
 
-__all__ = ["SCALE", "Schedule", "is_temporal", "schedule", "sequential_task"]
+__all__ = ["SCALE", "Schedule", "ScheduledPlan", "is_temporal", "schedule", "sequential_task", "timed_schedule"]

@@ -1,56 +1,219 @@
-"""The temporal back-end: durative actions planned in sequence by the builtin search, then scheduled.
+"""The temporal back-end: two searches for a short makespan, taking turns; the shorter plan wins.
 
-See :mod:`alica.prophet.temporal`. Each sequential plan the builtin search improves to is
-deordered and scheduled; an ``Improved`` event comes for each schedule with a shorter makespan
-than every one before, its plan the sequential steps and its cost the makespan
-(:meth:`TemporalPlanner.schedule_of` gives the timed plan back).
+1. **Sequential, then scheduled** (:mod:`alica.prophet.temporal`): the builtin search plans the
+   sequential task (for the summed duration); each plan it improves to is deordered and scheduled.
+2. **Makespan search** (:mod:`alica.prophet.temporal_search`): a forward search over decision
+   epochs that starts actions side by side, ordered by an estimate of the makespan, pruned by the
+   best makespan either search has found.
+
+The two run in turns, one event of each (a ``Progress`` every so many expansions, an ``Improved``,
+the final ``Done``) before the other, so the run is deterministic for the same expansions; both
+stop at the run's :class:`~alica.prophet.planner.Limits`. The makespan search grounds nothing of
+its own: it takes the ground actions of the sequential task from the builtin planner's grounding.
+It refuses what it cannot take (instantaneous actions, conditions that are no conjunctions of
+literals): then only the first search runs, and the final ``Done`` says why.
+
+Every plan is checked by :func:`~alica.prophet.validate_temporal.validate_temporal_plan` before its
+``Improved`` event, which comes only for a makespan shorter than every one before; its plan's cost
+is the makespan. :meth:`TemporalPlanner.schedule_of` gives the timed plan back: a plan of the
+makespan search carries its own (:class:`~alica.prophet.temporal.ScheduledPlan`), a sequential
+plan's is its schedule.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import logging
+from collections import deque
+from collections.abc import Generator, Iterator
 from typing import Any
 
+from alica.errors import PlannerError
 from alica.prophet.pddl import Domain, Problem
-from alica.prophet.planner import Done, Feature, Improved, Limits, Plan, Planner, PlanStatus, SearchEvent
+from alica.prophet.planner import (
+    Done,
+    Feature,
+    Improved,
+    LimitReached,
+    Limits,
+    Plan,
+    Planner,
+    PlanStatus,
+    PlanStep,
+    Progress,
+    SearchEvent,
+)
 from alica.prophet.search.planner import BuiltinPlanner
-from alica.prophet.temporal import Schedule, schedule, sequential_task
+from alica.prophet.temporal import Schedule, ScheduledPlan, schedule, sequential_task, timed_schedule
+from alica.prophet.temporal_ground import TICKS, temporal_task
+from alica.prophet.temporal_plan import TemporalPlan
+from alica.prophet.temporal_search import MAKESPAN_WEIGHTS, Bound, TimedResult, makespan_search
+from alica.prophet.validate_temporal import validate_temporal_plan
+
+logger = logging.getLogger(__name__)
+
+SEQUENTIAL = "sequential"
+MAKESPAN = "makespan"
 
 
 class TemporalPlanner(Planner):
-    """Durative actions, makespan (see the module docstring); options go to the builtin planner."""
+    """Durative actions, makespan (see the module docstring).
+
+    Args:
+        makespan_search: whether the makespan search runs beside the sequential one.
+        makespan_weights: the makespan search's pass weights.
+        makespan_only: run the makespan search alone (the builtin planner still grounds the task, but does not search it).
+        options: go to the builtin planner.
+    """
 
     name = "temporal"
     features = BuiltinPlanner.features | {Feature.DURATIVE_ACTIONS}
     takes_limits = True
 
-    def __init__(self, **options: Any) -> None:
+    def __init__(
+        self,
+        *,
+        makespan_search: bool = True,
+        makespan_weights: tuple[float, ...] = MAKESPAN_WEIGHTS,
+        makespan_only: bool = False,
+        **options: Any,
+    ) -> None:
         self.inner = BuiltinPlanner(**options)
+        self.makespan_search = makespan_search or makespan_only
+        self.makespan_only = makespan_only
+        self.makespan_weights = tuple(makespan_weights)
+        self.sources: dict[str, int] = {}
+        """Per search, how many plans of the last run came from it (``sequential``, ``makespan``)."""
+        self.best_source = ""
+        """Which search found the last run's best plan (``""`` without one)."""
 
     def _search(
         self, domain: object, problem: object, *, anytime: bool, limits: Limits | None = None
     ) -> Iterator[SearchEvent]:
         if not isinstance(domain, Domain) or not isinstance(problem, Problem):
             raise TypeError(f"the temporal planner takes a pddl Domain and Problem, got {type(domain).__name__}")
-        best: float | None = None
-        for event in self.inner.search(*sequential_task(domain, problem), anytime=anytime, limits=limits):
-            if isinstance(event, Improved):
-                makespan = schedule(domain, problem, event.plan.steps).plan.makespan
-                if best is None or makespan < best:
-                    best = makespan
-                    yield Improved(Plan(event.plan.steps, makespan), event.expansions)
-                continue
-            if isinstance(event, Done) and event.status is PlanStatus.OPTIMAL:  # the sum's proof, not the makespan's
-                yield Done(
-                    PlanStatus.SOLVED, event.expansions, "the summed duration is optimal; the makespan is not proven"
+        self.sources = {SEQUENTIAL: 0, MAKESPAN: 0}
+        self.best_source = ""
+        bound = Bound()
+        timed: list[TimedResult] = []
+        streams: deque[tuple[str, Generator[SearchEvent, None, None]]] = deque(
+            [
+                (
+                    SEQUENTIAL,
+                    _generator(self.inner.search(*sequential_task(domain, problem), anytime=anytime, limits=limits)),
                 )
+            ]
+        )
+        expansions = {SEQUENTIAL: 0, MAKESPAN: 0}
+        ended: dict[str, Done] = {}
+        best: float | None = None
+        started = not self.makespan_search
+        while streams:
+            name, events = streams.popleft()
+            event = next(events, None)
+            if not started:  # the builtin planner has grounded the sequential task (or failed to)
+                started = True
+                streams.append((MAKESPAN, self._makespan(domain, problem, anytime, limits, bound, timed)))
+                if self.makespan_only and event is not None and not isinstance(event, Done):
+                    events.close()
+                    ended[SEQUENTIAL] = Done(PlanStatus.SOLVED, 0, "not searched (makespan search only)")
+                    continue
+            if event is None:
                 continue
-            yield event
+            expansions[name] = event.expansions
+            total = sum(expansions.values())
+            if isinstance(event, Done):
+                ended[name] = event
+                continue
+            streams.append((name, events))
+            if isinstance(event, Progress):
+                yield Progress(total)
+                continue
+            plan = self._checked(domain, problem, name, event.plan, timed)
+            if plan is not None and (best is None or plan.cost < best - 1e-9):
+                best = plan.cost
+                bound.ticks = round(best * TICKS) if bound.ticks is None else min(bound.ticks, round(best * TICKS))
+                self.sources[name] += 1
+                self.best_source = name
+                yield Improved(plan, total)
+        yield self._final(ended, best is not None, sum(expansions.values()))
+
+    def _makespan(
+        self,
+        domain: Domain,
+        problem: Problem,
+        anytime: bool,
+        limits: Limits | None,
+        bound: Bound,
+        timed: list[TimedResult],
+    ) -> Generator[SearchEvent, None, None]:
+        """The makespan search's events; a limit or a task it cannot take ends them with a ``Done``."""
+        ground = self.inner.last_ground_task
+        if ground is None:
+            yield Done(PlanStatus.ERROR, 0, "the sequential task was not grounded")
+            return
+        try:
+            task = temporal_task(domain, problem, (PlanStep(op.action, op.args) for op in ground.operators))
+        except PlannerError as exc:
+            yield Done(PlanStatus.ERROR, 0, str(exc))
+            return
+        bounding = limits if limits is not None and limits.bounds_search else None
+        try:
+            yield from makespan_search(
+                task, anytime=anytime, limits=bounding, bound=bound, weights=self.makespan_weights, on_plan=timed
+            )
+        except LimitReached as exc:
+            yield Done(exc.status, 0, str(exc))
+
+    def _checked(
+        self, domain: Domain, problem: Problem, name: str, plan: Plan, timed: list[TimedResult]
+    ) -> Plan | None:
+        """The plan with its makespan as its cost (and its timing, from the makespan search), when it validates."""
+        if name == MAKESPAN:
+            done = timed_schedule(domain, problem, timed[-1].plan)
+            result: Plan = ScheduledPlan(tuple(t.step for t in done.plan.steps), done.plan.makespan, done)
+        else:
+            done = schedule(domain, problem, plan.steps)
+            result = Plan(plan.steps, done.plan.makespan)
+        checked = validate_temporal_plan(domain, problem, done.plan)
+        if not checked.valid:  # a bug: never hand it on
+            logger.warning("the %s search's plan does not validate: %s", name, checked.reason)
+            return None
+        return result
+
+    def _final(self, ended: dict[str, Done], solved: bool, expansions: int) -> Done:
+        sequential = ended.get(SEQUENTIAL, Done(PlanStatus.ERROR, 0, "no result"))
+        makespan = ended.get(MAKESPAN)
+        notes = []
+        if sequential.status is PlanStatus.OPTIMAL:  # the sum's proof, not the makespan's
+            notes.append("the summed duration is optimal; the makespan is not proven")
+        elif sequential.message:
+            notes.append(f"sequential search: {sequential.message}")
+        if makespan is not None and makespan.message:
+            notes.append(f"makespan search: {makespan.message}")
+        message = "; ".join(notes)
+        if solved:
+            return Done(PlanStatus.SOLVED, expansions, message)
+        status = sequential.status
+        if status in (PlanStatus.SOLVED, PlanStatus.OPTIMAL):  # plans that did not validate
+            status = PlanStatus.ERROR
+        return Done(status, expansions, message)
 
     @staticmethod
     def schedule_of(domain: Domain, problem: Problem, plan: Plan) -> Schedule:
-        """The timed plan of a plan this planner found (the schedule is a function of the steps)."""
+        """The timed plan of a plan this planner found."""
+        if isinstance(plan, ScheduledPlan) and plan.schedule is not None:
+            return plan.schedule
         return schedule(domain, problem, plan.steps)
+
+    @staticmethod
+    def timed_plan(domain: Domain, problem: Problem, plan: Plan) -> TemporalPlan:
+        """The timed steps of a plan this planner found."""
+        return TemporalPlanner.schedule_of(domain, problem, plan).plan
+
+
+def _generator(events: Iterator[SearchEvent]) -> Generator[SearchEvent, None, None]:
+    """``events`` as a generator (closing it closes them)."""
+    yield from events
 
 
 __all__ = ["TemporalPlanner"]
