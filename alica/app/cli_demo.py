@@ -63,8 +63,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--planner",
         choices=("builtin", "temporal"),
         default="builtin",
-        help="plan for the fewest steps (builtin, the mission's) or for the team's time (temporal: the skills' "
-        "durations, refined by what the team measures)",
+        help="plan for the fewest steps (builtin, the mission's; the default) or for the team's time (temporal: "
+        "the skills' durations, refined by what the team measures)",
     )
     add_time_limit(b, 600.0, "give up after S simulated seconds (default 600)")
     add_fault_options(
