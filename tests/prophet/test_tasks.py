@@ -367,3 +367,88 @@ def test_proximity_only_decides_who_takes_which_task_never_which_tasks(blocks, p
 
     best = max(closeness(dict(zip(robots, p, strict=True))) for p in itertools.permutations(chosen.values()))
     assert closeness(chosen) >= best - 1e-6
+
+
+def test_tasks_come_in_the_order_they_can_start_after_what_they_wait_for(blocks):
+    # three robots, plan order: dig c out of a, stack a on b, then pick d up for e (which waits for nothing)
+    world = [
+        ("on", ("c", "a")),
+        ("ontable", ("a",)),
+        ("ontable", ("b",)),
+        ("ontable", ("d",)),
+        ("ontable", ("e",)),
+        *(("clear", (x,)) for x in ("c", "b", "d", "e")),
+        *(("handempty", (r,)) for r in ("r1", "r2", "r3")),
+    ]
+    plan = [
+        PlanStep("Unstack", ("r1", "c", "a")),
+        PlanStep("Putdown", ("r1", "c")),
+        PlanStep("Pickup", ("r2", "a")),
+        PlanStep("Stack", ("r2", "a", "b")),
+        PlanStep("Pickup", ("r3", "d")),
+        PlanStep("Stack", ("r3", "d", "e")),
+    ]
+    roleset = next(iter(blocks.rolesets.values()))
+    created = create_tasks("P", plan, blocks, world, ("r1", "r2", "r3"), roleset, "Default")
+    labels = [[s.label for s in task] for task in created.tasks]
+    # Pickup(d) can start at once: it comes before Pickup(a), which waits for c to come off a
+    assert labels == [
+        ["Unstack(c, a)", "Putdown(c)"],
+        ["Pickup(d)", "Stack(d, e)"],
+        ["Pickup(a)", "Stack(a, b)"],
+    ]
+    # and the priorities follow (Eq. 9): the earlier task, the higher
+    role = created.roleset.roles[0]
+    by_task = {p.task: p.value for p in role.priorities}
+    assert by_task["P_T0"] > by_task["P_T1"] > by_task["P_T2"]
+
+
+@st.composite
+def _task_sets(draw):
+    """Tasks of steps touching random objects (a step index is its place in the plan)."""
+    from alica.lang.fact import Fact
+    from alica.prophet.tasks import Step
+
+    library = load_library(PLANS / "blocksworld" / "mission.yaml")
+    n_tasks = draw(st.integers(1, 5))
+    owners = draw(st.lists(st.integers(0, n_tasks - 1), min_size=n_tasks, max_size=12))
+    owners = list(range(n_tasks)) + owners[n_tasks:]  # every task has a step
+    draw(st.randoms()).shuffle(owners)
+    tasks: list[list] = [[] for _ in range(n_tasks)]
+    for index, owner in enumerate(owners):
+        objects = draw(st.lists(st.sampled_from("abcdef"), min_size=1, max_size=2, unique=True))
+        skill = library.plans[draw(st.sampled_from(["Pickup", "Stack", "Putdown", "Unstack"]))]
+        pre = tuple((True, Fact("clear", (o,))) for o in objects)
+        tasks[owner].append(Step(index, skill, (), pre, (), f"r{owner}"))
+    return [t for t in tasks if t]
+
+
+@given(_task_sets())
+def test_a_task_never_comes_before_one_it_waits_for(tasks):
+    from alica.prophet.tasks import by_earliest_start
+
+    ordered, allowed = by_earliest_start(tasks, [None] * len(tasks))
+    assert len(ordered) == len(tasks) == len(allowed)
+    assert sorted(s.index for t in ordered for s in t) == sorted(s.index for t in tasks for s in t)
+    # task b waits for task a when a step of b touches an object an earlier step of a touched
+    objects = {s.index: {str(f.args[0]) for _, f in s.pre} for t in tasks for s in t}
+    owner = {s.index: k for k, t in enumerate(tasks) for s in t}
+    waits = {
+        (owner[i], owner[j])
+        for i in objects
+        for j in objects
+        if i < j and owner[i] != owner[j] and objects[i] & objects[j]
+    }
+    left, acyclic = set(range(len(tasks))), True
+    while left:
+        free = [b for b in left if not any(a in left for a, c in waits if c == b)]
+        if not free:
+            acyclic = False
+            break
+        left -= set(free)
+    where = {ordered[k][0].index: k for k in range(len(ordered))}
+    position = [where[t[0].index] for t in tasks]
+    if acyclic:
+        assert all(position[a] < position[b] for a, b in waits)
+    else:  # tasks waiting for each other in a cycle: the plan order stays
+        assert position == list(range(len(tasks)))
