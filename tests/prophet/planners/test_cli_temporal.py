@@ -8,7 +8,7 @@ from pathlib import Path
 
 from tests.prophet.pddl.test_durative import DOMAIN
 from tests.prophet.planners.conftest import Run
-from tests.prophet.test_temporal import APART
+from tests.prophet.test_temporal import APART, TWO_ROVERS
 
 
 def _files(tmp_path: Path, domain: str, problem: str) -> tuple[Path, Path]:
@@ -47,3 +47,20 @@ def test_a_durative_action_the_planner_cannot_take_is_refused_in_one_line(
     run = alica("plan", *files)
     assert run.code == 1 and "Traceback" not in run.err
     assert "durative action a: its over all condition (p) is broken by its own start effects" in run.err
+
+
+def test_alica_plan_gives_two_rovers_the_work_the_sequential_search_gives_one(
+    alica: Callable[..., Run], tmp_path: Path
+) -> None:
+    files = _files(tmp_path, DOMAIN, TWO_ROVERS)
+    run = alica("plan", *files)
+    assert run.code == 0, run.err
+    lines = run.out.splitlines()
+    assert lines[:4] == [
+        "0.000: (recharge r) [2.500]",
+        "0.000: (recharge s) [2.500]",
+        "2.501: (move r p q) [4.000]",
+        "2.501: (move s p x) [3.000]",
+    ]
+    assert "; cost = 6.501 (4 steps, valid: checked with alica.prophet.validate_temporal)" in lines
+    assert "; sequential_makespan: 12.003" in lines  # the same steps one after another
