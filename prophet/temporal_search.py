@@ -21,29 +21,70 @@ happening instead of group by group, which is stricter).
 The heuristic is a temporal delete relaxation: facts of the node at time 0, the end effects of
 running actions at their end times, and every ground action starting as soon as its positive
 conditions hold (a Dijkstra exploration over times). It gives ``h_time``, when the last goal fact
-is reached, and a relaxed plan through the earliest supporters, whose summed duration
-``rp_sum`` is the work left. Nodes are ordered by ``now + w * rp_sum``: starting an action of the
-relaxed plan costs no time and takes its duration off the work left, so actions that can run side
-by side start together; ties go to the lower bound and then to the order of generation (the search
-is deterministic). ``max(last end, now + h_time)`` is a lower bound on the makespan of every plan
-through the node: nodes that cannot beat the best plan (:class:`Bound`, shared with the sequential
-planner) are pruned. The passes run with the weights :data:`MAKESPAN_WEIGHTS` in turn, each
-pruned by the best plan so far, until one exhausts its nodes under the bound (then no plan with
-starts at the decision epochs is shorter) or the limits end the run.
+is reached, and a relaxed plan through the earliest supporters (among equally early ones, the one
+sharing the fewest objects with the plan so far, so work spreads over the agents). Two estimates
+come from the relaxed plan (:class:`Estimate`): the *work* left, its summed duration, and the
+*makespan* left, when it ends with its dependent actions (:meth:`Relaxation.dependent`: those that
+may not overlap, such as two drives of one rover) one after another, the running ones included.
+A pass orders its nodes by ``now + w * estimate`` (:class:`Pass`): starting an action of the relaxed
+plan costs no time and takes its duration off the work left, so actions that can run side by side
+start together; ties go to the other estimate, the lower bound, then the newest node (the search is
+deterministic). ``max(last end, now + h_time)`` is a lower bound on the makespan of every plan
+through the node (on temporally simple tasks, where an action's conditions hold by its start):
+nodes that cannot beat the best plan (:class:`Bound`, shared with the sequential planner) are
+pruned. The passes (:data:`MAKESPAN_PASSES`) run in turn, each pruned by the best plan so far: two
+greedy ones by the work left, each ended by its first plan, then two by the makespan left, all but
+the last starting only the actions of the relaxed plan (helpful actions). When the last exhausts its
+nodes under the bound, no plan with starts at the decision epochs is shorter; else the limits end
+the run.
 """
 
 from __future__ import annotations
 
 from collections.abc import Generator, Iterator
 from dataclasses import dataclass
+from enum import Enum
 from heapq import heappop, heappush
 
 from alica.prophet.planner import Done, Improved, Limits, Plan, PlanStatus, Progress, SearchEvent
 from alica.prophet.temporal_ground import EPSILON_TICKS, TICKS, Happening, TemporalTask
 from alica.prophet.temporal_plan import TemporalPlan, TimedStep
 
-MAKESPAN_WEIGHTS: tuple[float, ...] = (5.0, 2.0, 1.0)
-"""The weights of the relaxed plan's work in the passes; all but the last start only helpful actions."""
+
+class Estimate(Enum):
+    """What a pass orders its nodes by (``now`` plus its weight times the estimate)."""
+
+    WORK = "work"
+    """The relaxed plan's summed duration: greedy, so a first plan comes soon."""
+    SCHEDULED = "scheduled"
+    """When the relaxed plan ends with its dependent actions one after another: the makespan left."""
+
+
+@dataclass(frozen=True, slots=True)
+class Pass:
+    """One pass of the search.
+
+    Attributes:
+        estimate: what orders the nodes.
+        weight: the estimate's weight against ``now``.
+        helpful_only: whether it starts only actions of the relaxed plan.
+        first_plan_only: whether its first plan ends it (the next pass goes on under the new bound).
+    """
+
+    estimate: Estimate
+    weight: float
+    helpful_only: bool = True
+    first_plan_only: bool = False
+
+
+MAKESPAN_PASSES: tuple[Pass, ...] = (
+    Pass(Estimate.WORK, 5.0, first_plan_only=True),
+    Pass(Estimate.WORK, 1.0, first_plan_only=True),
+    Pass(Estimate.SCHEDULED, 1.0),
+    Pass(Estimate.SCHEDULED, 1.0, helpful_only=False),
+)
+"""The passes in turn: two by the work left, each until its first plan (a first plan soon), then two by the
+makespan left, the last starting any action."""
 PROGRESS_EVERY = 100
 """Expansions between two ``Progress`` events."""
 CHECK_EVERY = 16
@@ -106,7 +147,9 @@ class Relaxation:
                 self.pre_of[f].append(a)
         self.free = [a for a, pre in enumerate(self.pre) if not pre]
         self.goal = _ids(task.goal_pos)
+        self.ops = task.ops
         self.objects = [frozenset(op.step.args) for op in task.ops]
+        self._dependent: dict[tuple[int, int], bool] = {}
         self.achievers: list[list[tuple[int, bool]]] = [[] for _ in range(n)]
         for a in range(len(task.ops)):
             for f in self.start_adds[a]:
@@ -114,9 +157,9 @@ class Relaxation:
             for f in self.end_adds[a]:
                 self.achievers[f].append((a, True))
 
-    def evaluate(self, facts: int, running: Running, now: int) -> tuple[int, int, set[int]] | None:
-        """``(h_time, rp_sum, relaxed plan)`` (times in ticks, the plan's action indices) from the node, or None
-        when the relaxation cannot reach the goal."""
+    def evaluate(self, facts: int, running: Running, now: int) -> tuple[int, int, int, set[int]] | None:
+        """``(h_time, scheduled, rp_sum, relaxed plan)`` (times in ticks from ``now``, the plan's action indices)
+        from the node, or None when the relaxation cannot reach the goal."""
         time = [_INF] * self.n
         support = [-1] * self.n
         heap: list[tuple[int, int]] = []
@@ -164,15 +207,68 @@ class Relaxation:
         if left:
             return None
         h_time = max((time[g] for g in self.goal), default=0)
-        return h_time, *self._extract(time, support, began)
+        rp_sum, chosen, via = self._extract(time, support, began)
+        scheduled = self._schedule(chosen, via, time, began, running, now)
+        return h_time, max(h_time, scheduled), rp_sum, chosen
 
-    def _extract(self, time: list[int], support: list[int], began: list[int]) -> tuple[int, set[int]]:
+    def _schedule(
+        self,
+        chosen: set[int],
+        via: dict[int, tuple[int, bool]],
+        time: list[int],
+        began: list[int],
+        running: Running,
+        now: int,
+    ) -> int:
+        """When the relaxed plan ends when its dependent actions (those that may not overlap:
+        :meth:`dependent`) run one after another, the running ones included: each action in the order of its
+        relaxed start, after what it needs and after every dependent action placed before it."""
+        ticks = self.ticks
+        placed: list[tuple[int, int]] = [(end - now, i) for end, i, _start in running]
+        finish = max((end for end, _i in placed), default=0)
+        start_at: dict[int, int] = {}
+        for a in sorted(chosen, key=lambda c: (began[c], c)):
+            t = 0
+            for f in self.pre[a]:
+                by = via.get(f)
+                if by is not None and by[0] in start_at:
+                    t = max(t, start_at[by[0]] + (ticks[by[0]] if by[1] else 0))
+                else:
+                    t = max(t, time[f])
+            for end, other in placed:
+                if end > t and self.dependent(a, other):
+                    t = end
+            start_at[a] = t
+            placed.append((t + ticks[a], a))
+            finish = max(finish, t + ticks[a])
+        return finish
+
+    def dependent(self, a: int, b: int) -> bool:
+        """Whether two actions may not overlap: a happening of one interferes with one of the other's, or
+        changes what the other needs over all (the schedule's rule, :mod:`alica.prophet.temporal`)."""
+        key = (a, b) if a < b else (b, a)
+        hit = self._dependent.get(key)
+        if hit is None:
+            x, y = self.ops[a], self.ops[b]
+            hit = a == b or any(h.interferes(k) for h in (x.start, x.end) for k in (y.start, y.end))
+            for first, second in ((x, y), (y, x)):
+                hit = hit or bool(
+                    (first.start.delete | first.end.delete) & second.over_pos
+                    or (first.start.add | first.end.add) & second.over_neg
+                )
+            self._dependent[key] = hit
+        return hit
+
+    def _extract(
+        self, time: list[int], support: list[int], began: list[int]
+    ) -> tuple[int, set[int], dict[int, tuple[int, bool]]]:
         """The relaxed plan back from the goal through the earliest supporters; among those reaching a fact
         equally early, one already in the plan, else the one sharing the fewest objects with the plan (so that
         work spreads over the agents: two rovers rather than one rover twice)."""
         ticks, objects, achievers = self.ticks, self.objects, self.achievers
         chosen: set[int] = set()
         used: set[str] = set()
+        via: dict[int, tuple[int, bool]] = {}
         stack = list(reversed(self.goal))
         while stack:
             f = stack.pop()
@@ -180,14 +276,26 @@ class Relaxation:
                 continue
             t = time[f]
             candidates = [
-                a for a, at_end in achievers[f] if began[a] >= 0 and began[a] + (ticks[a] if at_end else 0) == t
+                (a, at_end)
+                for a, at_end in achievers[f]
+                if began[a] >= 0 and began[a] + (ticks[a] if at_end else 0) == t
             ]
-            a = min(candidates, key=lambda c: (c not in chosen, len(objects[c] & used), c))
+            a, at_end = min(candidates, key=lambda c: (c[0] not in chosen, len(objects[c[0]] & used), c[0]))
+            if f not in via:
+                via[f] = (a, at_end)
             if a not in chosen:
                 chosen.add(a)
                 used |= objects[a]
                 stack.extend(reversed(self.pre[a]))
-        return sum(ticks[a] for a in chosen), chosen
+        return sum(ticks[a] for a in chosen), chosen, via
+
+
+def _order(step: Pass, now: int, scored: tuple[int, int, int, set[int]]) -> tuple[float, int]:
+    """A node's place in a pass's open list: ``now`` plus the weighted estimate, then the other estimate."""
+    _lower, scheduled, work, _plan = scored
+    if step.estimate is Estimate.WORK:
+        return now + step.weight * work, scheduled
+    return now + step.weight * scheduled, work
 
 
 def _ids(mask: int) -> tuple[int, ...]:
@@ -205,7 +313,7 @@ def makespan_search(
     anytime: bool = True,
     limits: Limits | None = None,
     bound: Bound | None = None,
-    weights: tuple[float, ...] = MAKESPAN_WEIGHTS,
+    passes: tuple[Pass, ...] = MAKESPAN_PASSES,
     progress_every: int = PROGRESS_EVERY,
     on_plan: list[TimedResult] | None = None,
 ) -> Iterator[SearchEvent]:
@@ -216,7 +324,7 @@ def makespan_search(
         anytime: go on after the first plan (through all the passes).
         limits: the run's limits, checked every :data:`CHECK_EVERY` expansions.
         bound: the best makespan known, shared with another search (read for pruning, updated on each plan).
-        weights: the passes' weights.
+        passes: the passes (the last one should start any action: its exhausting the nodes is the proof).
         progress_every: expansions between two ``Progress`` events.
         on_plan: each plan found is appended here (the ``Improved`` event carries its steps and makespan).
 
@@ -229,9 +337,9 @@ def makespan_search(
         return
     search = _Search(task, limits, bound, max(1, progress_every), on_plan)
     exhausted = False
-    for k, weight in enumerate(weights):
-        exhausted = yield from search.run(weight, anytime, helpful_only=k < len(weights) - 1)
-        if exhausted or (search.found and not anytime):
+    for step in passes:
+        exhausted = yield from search.run(step, stop_at_plan=step.first_plan_only or not anytime)
+        if (exhausted and not step.helpful_only) or (search.found and not anytime):
             break
     if not search.found:
         why = "every node was expanded" if exhausted else "the passes ended"
@@ -262,7 +370,7 @@ class _Search:
         self.found = False
         self.table_size = 0
 
-    def run(self, weight: float, anytime: bool, helpful_only: bool) -> Generator[SearchEvent, None, bool]:
+    def run(self, step: Pass, *, stop_at_plan: bool) -> Generator[SearchEvent, None, bool]:
         """One pass; returns whether it exhausted its nodes under the bound (with every start, not only
         the helpful ones)."""
         task = self.task
@@ -276,7 +384,7 @@ class _Search:
         scored = self._score(root)
         if scored is None:
             return True
-        heappush(heap, (weight * scored[1], scored[1], scored[0], counter, root, scored[2]))
+        heappush(heap, (*_order(step, 0, scored), scored[0], counter, root, scored[3]))
         while heap:
             _f, _h, lower, _c, node, chosen = heappop(heap)
             if seen.get(node.key(), _INF) < node.now:
@@ -291,7 +399,7 @@ class _Search:
                 )
             if self.expansions % self.progress_every == 0:
                 yield Progress(self.expansions)
-            for child in self._successors(node, chosen if helpful_only else None):
+            for child in self._successors(node, chosen if step.helpful_only else None):
                 key = child.key()
                 if seen.get(key, _INF) <= child.now:
                     continue
@@ -300,24 +408,24 @@ class _Search:
                     if best is None or child.last < best:
                         yield from self._plan(child)
                         best = self.bound.ticks
-                        if not anytime:
+                        if stop_at_plan:
                             return False
                     continue
                 scored = self._score(child)
                 if scored is None or (best is not None and scored[0] >= best):
                     continue
                 counter -= 1  # among equals, the newest node first
-                heappush(heap, (child.now + weight * scored[1], scored[1], scored[0], counter, child, scored[2]))
-        return not helpful_only
+                heappush(heap, (*_order(step, child.now, scored), scored[0], counter, child, scored[3]))
+        return True
 
-    def _score(self, node: _Node) -> tuple[int, int, set[int]] | None:
-        """``(lower bound, rp_sum, relaxed plan)``, or None on a relaxed dead end."""
+    def _score(self, node: _Node) -> tuple[int, int, int, set[int]] | None:
+        """``(lower bound, scheduled, rp_sum, relaxed plan)``, or None on a relaxed dead end."""
         estimate = self.relax.evaluate(node.facts, node.running, node.now)
         if estimate is None:
             return None
-        h_time, rp_sum, chosen = estimate
+        h_time, scheduled, rp_sum, chosen = estimate
         lower = max(node.last, node.now + h_time if h_time > 0 else 0)
-        return lower, rp_sum, chosen
+        return lower, scheduled, rp_sum, chosen
 
     def _is_goal(self, node: _Node) -> bool:
         task = self.task
@@ -400,4 +508,4 @@ class _Search:
         return _Node(facts, running[k:], last_end + EPSILON_TICKS, node.last, node, None)
 
 
-__all__ = ["MAKESPAN_WEIGHTS", "Bound", "Relaxation", "TimedResult", "makespan_search"]
+__all__ = ["MAKESPAN_PASSES", "Bound", "Estimate", "Pass", "Relaxation", "TimedResult", "makespan_search"]

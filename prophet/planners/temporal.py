@@ -46,7 +46,7 @@ from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.temporal import Schedule, ScheduledPlan, schedule, sequential_task, timed_schedule
 from alica.prophet.temporal_ground import TICKS, temporal_task
 from alica.prophet.temporal_plan import TemporalPlan
-from alica.prophet.temporal_search import MAKESPAN_WEIGHTS, Bound, TimedResult, makespan_search
+from alica.prophet.temporal_search import MAKESPAN_PASSES, Bound, Pass, TimedResult, makespan_search
 from alica.prophet.validate_temporal import validate_temporal_plan
 
 logger = logging.getLogger(__name__)
@@ -60,7 +60,7 @@ class TemporalPlanner(Planner):
 
     Args:
         makespan_search: whether the makespan search runs beside the sequential one.
-        makespan_weights: the makespan search's pass weights.
+        makespan_passes: the makespan search's passes.
         makespan_only: run the makespan search alone (the builtin planner still grounds the task, but does not search it).
         options: go to the builtin planner.
     """
@@ -73,14 +73,14 @@ class TemporalPlanner(Planner):
         self,
         *,
         makespan_search: bool = True,
-        makespan_weights: tuple[float, ...] = MAKESPAN_WEIGHTS,
+        makespan_passes: tuple[Pass, ...] = MAKESPAN_PASSES,
         makespan_only: bool = False,
         **options: Any,
     ) -> None:
         self.inner = BuiltinPlanner(**options)
         self.makespan_search = makespan_search or makespan_only
         self.makespan_only = makespan_only
-        self.makespan_weights = tuple(makespan_weights)
+        self.makespan_passes = tuple(makespan_passes)
         self.sources: dict[str, int] = {}
         """Per search, how many plans of the last run came from it (``sequential``, ``makespan``)."""
         self.best_source = ""
@@ -159,7 +159,7 @@ class TemporalPlanner(Planner):
         bounding = limits if limits is not None and limits.bounds_search else None
         try:
             yield from makespan_search(
-                task, anytime=anytime, limits=bounding, bound=bound, weights=self.makespan_weights, on_plan=timed
+                task, anytime=anytime, limits=bounding, bound=bound, passes=self.makespan_passes, on_plan=timed
             )
         except LimitReached as exc:
             yield Done(exc.status, 0, str(exc))
