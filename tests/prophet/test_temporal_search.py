@@ -15,7 +15,7 @@ from alica.prophet.planners.temporal import TemporalPlanner
 from alica.prophet.search.planner import BuiltinPlanner
 from alica.prophet.temporal import ScheduledPlan, schedule, sequential_task
 from alica.prophet.temporal_ground import TemporalTask, temporal_task
-from alica.prophet.temporal_search import TimedResult, makespan_search
+from alica.prophet.temporal_search import Relaxation, TimedResult, makespan_search
 from alica.prophet.validate_temporal import validate_temporal_plan
 from tests.prophet.pddl.test_durative import DOMAIN
 from tests.prophet.test_temporal import TWO_ROVERS
@@ -238,3 +238,19 @@ def test_a_task_the_makespan_search_cannot_take_leaves_the_sequential_plan() -> 
         "makespan search: step (recharge r): the makespan search takes a condition that is a conjunction"
         in done.message
     )
+
+
+def test_the_makespan_left_puts_one_rovers_drives_one_after_another() -> None:
+    domain = parse_domain(DOMAIN)
+    one = TWO_ROVERS.replace("r s - rover", "r - rover").replace(" (at s p)", "")
+    task = _task(domain, parse_problem(one, domain=domain))
+    relax = Relaxation(task)
+    estimate = relax.evaluate(task.init, (), 0)
+    assert estimate is not None
+    h_time, scheduled, work, plan = estimate
+    names = sorted(str(task.ops[a].step) for a in plan)
+    assert names == ["(move r p q)", "(move r p x)", "(recharge r)"]  # relaxed: both drives from p
+    assert (h_time, work) == (6_500_000, 9_500_000)  # relaxed, the drives run at once
+    assert scheduled == 9_500_000  # but the rover drives once at a time: 2.5 + 4 + 3
+    first, second = (a for a in plan if task.ops[a].step.action == "move")
+    assert relax.dependent(first, second)
