@@ -6,15 +6,17 @@ whose grasp keeps failing from where it stands, would try it until the problem g
 remembers each failed step with its robot (:class:`KeepOff`) for :data:`KEEP_OFF_S` seconds and
 shares the pairs with its plans (:attr:`~alica.prophet.board.PlanShare.barred`); every agent then
 leaves that robot out of the tasks that hold the step (:func:`bar`), as it leaves robots out of a
-pinned task. Where that leaves a task nobody (the robot holds the block the task needs, or the team
-is that robot alone), the task keeps its robots: a retry by the same robot beats no robot at all.
+pinned task. Where that leaves a task nobody who can take it (the robot holds the block the task
+needs, the team is that robot alone, or the others' roles cannot do the task's skills), the task keeps
+its robots: a retry by the same robot beats no robot at all.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 
+from alica.model import Priority
 from alica.prophet.tasks import CreatedTasks
 
 KEEP_OFF_S = 60.0
@@ -40,15 +42,22 @@ class KeepOff:
         return tuple(sorted(self.until))
 
 
-def bar(created: CreatedTasks, barred: Sequence[tuple[str, str]], robots: Sequence[str]) -> CreatedTasks:
+def bar(
+    created: CreatedTasks,
+    barred: Sequence[tuple[str, str]],
+    robots: Sequence[str],
+    roles: Mapping[str, str] | None = None,
+) -> CreatedTasks:
     """``created`` with each barred robot left out of the tasks that hold its barred step.
 
-    A task keeps its robots where leaving them out would leave it none (see the module docstring); an
-    entry that is not a pair of strings is ignored.
+    A task keeps its robots where leaving them out would leave it none that can take it (with
+    ``roles``, robot -> role: a robot whose role's priority for the task is negative cannot), see the
+    module docstring; an entry that is not a pair of strings is ignored.
     """
     if not barred:
         return created
     allowed = list(created.allowed) + [None] * (len(created.tasks) - len(created.allowed))
+    priorities = created.priorities()
     changed = False
     for index, task in enumerate(created.tasks):
         labels = {step.label for step in task}
@@ -58,10 +67,20 @@ def bar(created: CreatedTasks, barred: Sequence[tuple[str, str]], robots: Sequen
         pinned = allowed[index]
         candidates = pinned if pinned is not None else tuple(robots)
         kept = tuple(robot for robot in candidates if robot not in off)
+        if roles is not None:
+            task_name = created.task_defs[index].name
+            able = [r for r in kept if _priority(priorities.get(roles.get(r, ""), ()), task_name) >= 0]
+            if not able:
+                continue  # nobody else can take it: the robot keeps it
         if kept and kept != candidates:
             allowed[index] = kept
             changed = True
     return replace(created, allowed=tuple(allowed)) if changed else created
+
+
+def _priority(priorities: Sequence[Priority], task: str) -> float:
+    """A role's priority for ``task`` (-1 where it has none: the role cannot take it)."""
+    return next((p.value for p in priorities if p.task == task), -1.0)
 
 
 def _pair(value: object) -> bool:

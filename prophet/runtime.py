@@ -333,6 +333,7 @@ class ProblemRuntime:
                     ),
                     share.barred,
                     share.robots,
+                    host.roles,
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")

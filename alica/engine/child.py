@@ -245,6 +245,10 @@ class ChildHost(Protocol):
         """The team's role set, without the priorities of generated plans."""
 
     @property
+    def roles(self) -> Mapping[str, str]:
+        """Every team member's role, by name."""
+
+    @property
     def world(self) -> WorldFacts:
         """The agent's replica of the shared world model."""
 

@@ -135,6 +135,10 @@ class EngineHost:
         return self._agent.generated.base
 
     @property
+    def roles(self) -> Mapping[str, str]:
+        return self._agent.team.roles
+
+    @property
     def world(self) -> WorldFacts:
         return self._world
 

@@ -67,3 +67,12 @@ def test_a_task_nobody_else_may_take_keeps_its_robots(created) -> None:
 def test_malformed_entries_from_the_network_are_ignored(created) -> None:
     junk = [("r2",), ("r2", 3), "r2:Pickup(b)", None, ("r2", "Pickup(b)", "x")]
     assert bar(created, junk, ROBOTS) is created  # type: ignore[arg-type]
+
+
+def test_a_task_no_other_role_can_take_keeps_its_robot(created) -> None:
+    # r2 and r3 in a role that cannot take the blocks tasks (a scout, say): r1 stays on its failed step
+    index = next(i for i, task in enumerate(created.tasks) if "Pickup(b)" in [s.label for s in task])
+    role = created.roleset.roles[0].name
+    assert bar(created, [("r1", "Pickup(b)")], ROBOTS, {"r1": role, "r2": "Scout", "r3": "Scout"}) is created
+    barred = bar(created, [("r1", "Pickup(b)")], ROBOTS, {"r1": role, "r2": role, "r3": "Scout"})
+    assert barred.allowed[index] == ("r2", "r3")  # r2 can: the bar holds (r3 is vetoed by the engine anyway)
