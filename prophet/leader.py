@@ -244,7 +244,9 @@ class Leader:
         generation = self.team.next_generation()
         world = frozenset(self.team.read_world(self.team.problem).facts)
         done = sum(1 for fact in self.host.world.facts() if fact.predicate == STEP_DONE)
-        message = self.give_up.step_failed(failure_cause(reason), world, done)
+        # the failed step's label where it is known (whichever robot failed it), else what made it fail
+        cause = f"{failed[1]} failed" if failed[1] else failure_cause(reason)
+        message = self.give_up.step_failed(cause, world, done)
         if message is not None:
             self.host.emit("planner", key=key_text(self.key), what="failed", reason=message)
             self._publish_failure(now, generation, message)
