@@ -124,12 +124,21 @@ class ProblemPlanning:
         Raises:
             PlannerError: the plan is not valid (the message names the planner and the reason).
         """
-        check = self.check(plan.steps)
+        check = self._check_timed(plan) if self.temporal else self.check(plan.steps)
         if not check.valid:
             raise PlannerError(f"planner '{self.planner.name}' returned an invalid plan: {check.reason}")
         names = {name.lower(): name for name, _ in self.world.objects}
         steps = tuple(PlanStep(s.action, tuple(names.get(a, a) for a in s.args)) for s in plan.steps)
         return ValidPlan(steps, check.cost, plan)
+
+    def _check_timed(self, plan: Plan) -> ValidationResult:
+        """A temporal planner's plan checked with its own timing (the makespan search's), else as scheduled."""
+        from alica.prophet.temporal import ScheduledPlan  # lazy: only temporal problems need it
+        from alica.prophet.validate_temporal import validate_temporal_plan
+
+        if isinstance(plan, ScheduledPlan) and plan.schedule is not None:
+            return validate_temporal_plan(self.domain, self.pddl, plan.schedule.plan)
+        return self.check(plan.steps)
 
     def check(self, steps: Sequence[PlanStep]) -> ValidationResult:
         """Validate ``steps`` (a planner's, or an operator's change of them) in the world and for the goal planned for.
