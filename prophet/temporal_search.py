@@ -336,15 +336,16 @@ def makespan_search(
         yield Done(PlanStatus.UNSOLVABLE, 0, task.unsolvable)
         return
     search = _Search(task, limits, bound, max(1, progress_every), on_plan)
-    exhausted = False
+    proven = False  # a pass starting any action exhausted its nodes under the bound
     for step in passes:
         exhausted = yield from search.run(step, stop_at_plan=step.first_plan_only or not anytime)
-        if (exhausted and not step.helpful_only) or (search.found and not anytime):
+        proven = exhausted and not step.helpful_only
+        if proven or (search.found and not anytime):
             break
     if not search.found:
-        why = "every node was expanded" if exhausted else "the passes ended"
+        why = "every node was expanded" if proven else "the passes ended"
         yield Done(PlanStatus.TIMEOUT, search.expansions, f"no plan with starts at the decision epochs ({why})")
-    elif exhausted:
+    elif proven:
         yield Done(PlanStatus.SOLVED, search.expansions, "no shorter plan with starts at the decision epochs")
     else:
         yield Done(PlanStatus.SOLVED, search.expansions)
