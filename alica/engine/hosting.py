@@ -136,7 +136,7 @@ class EngineHost:
 
     @property
     def roles(self) -> Mapping[str, str]:
-        return self._agent.team.roles
+        return self._ctx.team.roles
 
     @property
     def world(self) -> WorldFacts:
