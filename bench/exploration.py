@@ -16,27 +16,37 @@ its frontier, the frontier candidates and their information gain are computed
 from the team map with the library's own
 :func:`alica.skills.exploration.extract_frontiers` (Algorithm 1).
 
-Ways to choose a robot's next frontier, in the same run and on the same seeds
-(a robot asks when it has none: at the start, when it reached its frontier,
-when that one is no longer a frontier or is unreachable):
+Ways to choose a robot's next frontier, in the same run and on the same seeds:
 
 * **coordinated** (ours): the Explore plan of ``plans/skills/explore.yaml`` as
   shipped: its constraints SpreadFrontiers (Eq. 7), NearbyFrontiers (Eq. 8)
-  and its utility GainOverTravel are read from the plan file and solved with
+  and its utilities GainOverTravel and KeepFrontier (the hysteresis: a bonus
+  for every robot that keeps the frontier it drives to, read from
+  ``Targets(robot, frontier)``) are read from the plan file and solved with
   ``alica.solver.solve`` directly, as the engine would, but without running
-  the engine. Every bench robot is in ``agents(ExploreFrontiers)``
-  (``agents(ExploreAfterMapping)`` is empty: its terms are empty sums and
-  empty ``forall``). The other robots' frontiers are kept (their domains are
-  their current frontier), so robots are not re-routed while they drive. When
-  the constraints have no solution, or the solution lies within 4 m of a
-  frontier another robot heads for, the robot takes what ExploreFrontier
-  (``skills/exploration/skill.py``, ``_choose``) takes: the best usable
-  frontier by gain / (1 + distance) that is more than 4 m from the others'
-  frontiers (any usable one if none is) -- counted as ``fallbacks``.
+  the engine: one joint solve for the whole team, every robot's variable
+  ranging over the frontiers it may use. Every bench robot is in
+  ``agents(ExploreFrontiers)`` (``agents(ExploreAfterMapping)`` is empty: its
+  terms are empty sums and empty ``forall``). The team is solved again at
+  every reading of the map (every ``--period``, and when a robot reached its
+  frontier) and whenever a robot has no frontier; every robot then applies
+  the library's rule, the one ExploreFrontier applies with ``reassign: true``
+  (:func:`alica.skills.exploration.assign.decide`): a robot with a frontier
+  follows the solution when it moves it (``switches``), one without takes
+  the solution's; when the constraints have no solution, or the solution lies
+  within 4 m of a frontier another robot keeps heading for, a robot keeps its
+  frontier or, without one, takes the best usable frontier by gain /
+  (1 + distance) that is more than 4 m from the others' frontiers (any usable
+  one if none is) -- counted as ``fallbacks``. ``--no-periodic`` runs the
+  plan without KeepFrontier and with the others' frontiers fixed (only the
+  robot that needs a frontier is assigned): ExploreFrontier as shipped
+  (``reassign: false``), and this bench before the periodic reassignment.
+  ``--spacing`` replaces the plan's 4 m of Eq. 7 (an experiment).
 * **nearest frontier** (Yamauchi 1997): every robot drives to the usable
   frontier nearest to it by path length, uncoordinated.
-* **gain only** (ablation, ``--ablation``): Eq. 7-8 from the plan with the
-  utility the plan had before it counted travel (the summed gain alone).
+* **gain only** (ablation, ``--ablation``): the coordinated strategy with the
+  summed gain alone in place of GainOverTravel (the plan's utility before it
+  counted travel).
 
 As in ExploreFrontier, a frontier the robot reached is not chosen by it
 again, one it could not plan a path to is left out for 30 s.
@@ -54,6 +64,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import re
 import statistics
 import time
 from dataclasses import dataclass, field
@@ -62,18 +73,23 @@ from pathlib import Path
 import numpy as np
 from exploration_sim import RADIUS, Field, Planner, make_field, sense
 
-from alica.lang import FactBase, parse
+from alica.errors import AlicaError
+from alica.lang import parse
 from alica.skills.exploration import UNKNOWN, FrontierCandidate, extract_frontiers
-from alica.solver import Finite, Problem, Term, Var, solve
+from alica.skills.exploration.assign import Explorer, How, decide, explore_terms, solve_team
+from alica.solver import Term
 
 ROBOTS = ("scout", "stummel", "amparo")
-#: The plan's names: its constraints (Eq. 7, Eq. 8) and its utility.
+#: The plan's names: its constraints (Eq. 7, Eq. 8), its utility and its hysteresis.
 PLAN_CONSTRAINTS = ("SpreadFrontiers", "NearbyFrontiers")
 PLAN_UTILITY = "GainOverTravel"
+PLAN_KEEP = "KeepFrontier"
 #: The ablation's utility: the summed gain alone (the plan's utility before it counted the travel).
 GAIN_ONLY = "sum a in agents(ExploreFrontiers): gain(frontier(a))"
-#: Metres from the frontiers the others head for (ExploreFrontier's ``spacing``, eps1 of Eq. 7).
+#: Metres from the frontiers the others head for (ExploreFrontier's ``spacing``, eps1 of Eq. 7, the plan's 4 m).
 SPACING = 4.0
+#: Eq. 7's distance in the plan's SpreadFrontiers (``--spacing`` replaces it).
+EPS1 = re.compile(r"(MaximalDist\(frontier\(\w+\), frontier\(\w+\), )4\.0\)")
 #: Seconds a frontier the robot could not reach is left out (ExploreFrontier's UNREACHABLE_FOR).
 UNREACHABLE_FOR = 30.0
 LABELS = {
@@ -84,23 +100,42 @@ LABELS = {
 STYLES = {"coordinated": "-", "nearest": "--", "gain-only": ":"}
 
 
-def plan_terms() -> tuple[tuple[Term, ...], Term]:
-    """The Explore plan's constraints and utility, read from the shipped ``skills/explore.yaml``."""
-    from alica.io import load_document, plans_dir
+@dataclass(frozen=True)
+class Terms:
+    """The Explore plan's constraints, utility and hysteresis."""
 
-    path = plans_dir() / "skills" / "explore.yaml"
-    plan = next((p for p in load_document(path).plans if p.name == "Explore"), None)
-    if plan is None:
-        raise SystemExit(f"{path}: no plan 'Explore'; the bench solves that plan's constraints")
-    by_name = {c.name: c for c in plan.constraints}
-    missing = [n for n in (*PLAN_CONSTRAINTS, PLAN_UTILITY) if n not in by_name]
+    constraints: tuple[Term, ...]
+    utility: Term
+    keep: Term
+
+
+def plan_terms(spacing: float = SPACING) -> Terms:
+    """The Explore plan's constraints and utilities, read from the shipped ``skills/explore.yaml``.
+
+    ``spacing`` other than the plan's 4 m (``--spacing``) replaces Eq. 7's distance in SpreadFrontiers.
+    """
+    try:
+        terms = explore_terms()
+    except AlicaError as exc:
+        raise SystemExit(f"the bench solves the shipped Explore plan: {exc}") from None
+    by_name = {t.name: t for t in terms.constraints}
+    missing = [n for n in PLAN_CONSTRAINTS if n not in by_name]
+    try:
+        utility, keep = terms.utility(PLAN_UTILITY), terms.utility(PLAN_KEEP)
+    except KeyError as exc:
+        raise SystemExit(f"skills/explore.yaml: {exc}") from None
     if missing:
-        raise SystemExit(f"{path}: the Explore plan has no constraint {', '.join(missing)} (has {sorted(by_name)})")
-    constraints = tuple(Term(n, parse(by_name[n].text), by_name[n].text) for n in PLAN_CONSTRAINTS)
-    text = by_name[PLAN_UTILITY].utility
-    if not text:
-        raise SystemExit(f"{path}: the Explore plan's {PLAN_UTILITY} has no utility")
-    return constraints, Term(PLAN_UTILITY, parse(text), text)
+        raise SystemExit(f"skills/explore.yaml: the Explore plan has no constraint {', '.join(missing)}")
+    constraints = tuple(by_name[n] for n in PLAN_CONSTRAINTS)
+    if spacing != SPACING:
+        spread = by_name["SpreadFrontiers"]
+        text, found = EPS1.subn(lambda m: f"{m.group(1)}{spacing!r})", spread.text)
+        if not found:
+            raise SystemExit(
+                f"--spacing: SpreadFrontiers has no MaximalDist(frontier(a), frontier(b), 4.0): {spread.text}"
+            )
+        constraints = (Term(spread.name, parse(text), text), *(c for c in constraints if c is not spread))
+    return Terms(constraints, utility, keep)
 
 
 @dataclass
@@ -117,60 +152,48 @@ class Bot:
         return [c for c in cands if c.name not in self.reached and self.unreachable.get(c.name, -math.inf) <= now]
 
 
-def coordinated_choice(
+def team_solution(
     bots: list[Bot],
-    needy: Bot,
-    usable: list[FrontierCandidate],
     cands: list[FrontierCandidate],
+    now: float,
     constraints: tuple[Term, ...],
-    utility: Term,
+    utilities: tuple[Term, ...],
     time_limit: float,
-) -> tuple[FrontierCandidate, bool]:
-    """The solver's frontier for ``needy`` (the others' frontiers kept), else ExploreFrontier's own choice.
+    *,
+    fixed: Bot | None = None,
+) -> dict[str, str]:
+    """The plan's joint assignment, robot -> frontier (empty: no solution), solved as the engine would.
 
-    Returns the frontier and whether it was the fallback.
+    Every robot with a usable frontier is an explorer (the library's
+    :func:`~alica.skills.exploration.assign.solve_team`). With ``fixed``
+    (``--no-periodic``) only that robot is assigned: the others' domains are
+    their current frontier, a robot without one is left out.
     """
-    world = FactBase()
-    by_name = {c.name: c for c in cands}
-    for c in cands:
-        world.set("Pos", c.name, value=c.position)
-        world.set("gain", c.name, value=c.gain)
-    variables = []
+    names = {c.name for c in cands}
+    explorers = []
     for b in bots:
-        world.set("Pos", b.name, value=b.xy)
-        if b is needy:
-            domain: tuple[str, ...] = tuple(c.name for c in usable)
-        elif b.target is not None and b.target.name in by_name:
-            domain = (b.target.name,)
+        target = b.target.name if b.target is not None else None
+        if fixed is not None and b is not fixed:
+            domain: tuple[str, ...] = (target,) if target is not None and target in names else ()
         else:
-            continue  # a robot with no frontier yet is not among the explorers of this solve
-        world.add_object(b.name, "agents(ExploreFrontiers)")
-        variables.append(Var("frontier", b.name, Finite(domain)))
-    problem = Problem(variables=tuple(variables), constraints=constraints, utilities=(utility,), belief=world)
-    sol = solve(problem, time_limit=time_limit)
-    heading = [b.target.position for b in bots if b is not needy and b.target is not None]
-    mine = {c.name: c for c in usable}
-    if sol.status == "solved":
-        value = sol.of(needy.name)
-        name = value.get("frontier") if isinstance(value, dict) else value
-        if isinstance(name, str) and name in mine:
-            if all(math.dist(mine[name].position, o) > SPACING for o in heading):
-                return mine[name], False
-    apart = [c for c in usable if all(math.dist(c.position, o) > SPACING for o in heading)]
-    pool = apart or usable
-    return max(pool, key=lambda c: (c.gain / (1.0 + math.dist(needy.xy, c.position)), c.name)), True
+            domain = tuple(c.name for c in b.usable(cands, now))
+        explorers.append(Explorer(b.name, b.xy, target, domain))
+    return solve_team(explorers, cands, constraints, utilities, time_limit=time_limit)
 
 
 class Run:
     """One exploration run of ``n`` robots with one method on one field."""
 
-    def __init__(self, fld: Field, n: int, method: str, args: argparse.Namespace, terms) -> None:
+    def __init__(self, fld: Field, n: int, method: str, args: argparse.Namespace, terms: Terms) -> None:
         self.fld, self.method, self.args = fld, method, args
-        self.constraints, self.utility = terms
+        self.constraints = terms.constraints
+        utility = terms.utility if method == "coordinated" else Term("GainOnly", parse(GAIN_ONLY), GAIN_ONLY)
+        self.periodic = not args.no_periodic
+        self.utilities = (utility, terms.keep) if self.periodic else (utility,)
         self.occ = np.full(fld.truth.shape, UNKNOWN, dtype=np.int8)
         self.bots = [Bot(name, fld.starts[name]) for name in ROBOTS[:n]]
         self.planner = Planner(fld)
-        self.stats = {"solves": 0, "fallbacks": 0, "plans": 0, "contacts": 0, "idle": 0}
+        self.stats = {"solves": 0, "fallbacks": 0, "switches": 0, "plans": 0, "contacts": 0, "idle": 0}
         self.cands: list[FrontierCandidate] = []
 
     def go(self) -> tuple[float, list[tuple[float, float]]]:
@@ -194,6 +217,8 @@ class Run:
                 next_frontiers = t + args.period
                 if not self._frontiers():
                     break  # explored: no frontier with gain left
+                if self.method != "nearest" and self.periodic:
+                    self._reassign(t)  # every robot, jointly, with the plan's hysteresis
             for b in self.bots:
                 if b.path and self._runs_into(b.path):
                     b.path = self._plan(b, b.target.position) if b.target is not None else None
@@ -259,25 +284,71 @@ class Run:
             return None
         return self.planner.path(pred, k)[1:] + [goal]
 
-    def _assign(self, b: Bot, now: float) -> None:
+    def _solve(self, now: float, fixed: Bot | None = None) -> dict[str, str]:
+        self.stats["solves"] += 1
+        return team_solution(
+            self.bots,
+            self.cands,
+            now,
+            self.constraints,
+            self.utilities,
+            self.args.time_limit,
+            fixed=None if self.periodic else fixed,
+        )
+
+    def _decide(self, b: Bot, now: float, proposal: dict[str, str]) -> tuple[FrontierCandidate | None, How]:
+        by_name = {c.name: c for c in self.cands}
+        usable = {c.name for c in b.usable(self.cands, now)}
+        heading = {o.name: o.target.position for o in self.bots if o is not b and o.target is not None}
+        choice = decide(
+            b.name,
+            b.xy,
+            b.target,
+            by_name,
+            usable,
+            proposal,
+            heading,
+            spacing=self.args.spacing,
+            others_follow=self.periodic,
+        )
+        self.stats["fallbacks"] += int(choice.how is How.FALLBACK)
+        return choice.frontier, choice.how
+
+    def _reassign(self, now: float) -> None:
+        """The periodic joint reassignment: every robot applies ``decide`` to one team solution."""
+        proposal = self._solve(now)
+        for b in self.bots:
+            if b.target is None:
+                self._assign(b, now, proposal)
+                continue
+            frontier, how = self._decide(b, now, proposal)
+            if how is not How.SWITCHED or frontier is None:
+                continue
+            path = self._plan(b, frontier.position)
+            if path is None:  # it keeps its frontier
+                b.unreachable[frontier.name] = now + UNREACHABLE_FOR
+                continue
+            self.stats["switches"] += 1
+            b.target, b.path = frontier, path
+
+    def _assign(self, b: Bot, now: float, proposal: dict[str, str] | None = None) -> None:
         for _ in range(5):
-            usable = b.usable(self.cands, now)
-            if not usable:
+            if not b.usable(self.cands, now):
                 return
             if self.method == "nearest":
-                self._assign_nearest(b, usable)
+                self._assign_nearest(b, b.usable(self.cands, now))
                 return
-            self.stats["solves"] += 1
-            utility = self.utility if self.method == "coordinated" else Term("GainOnly", parse(GAIN_ONLY), GAIN_ONLY)
-            choice, fell_back = coordinated_choice(
-                self.bots, b, usable, self.cands, self.constraints, utility, self.args.time_limit
-            )
-            self.stats["fallbacks"] += int(fell_back)
+            if proposal is None:
+                proposal = self._solve(now, fixed=b)
+            choice, _how = self._decide(b, now, proposal)
+            if choice is None:
+                return
             path = self._plan(b, choice.position)
             if path is not None:
                 b.target, b.path = choice, path
                 return
             b.unreachable[choice.name] = now + UNREACHABLE_FOR
+            proposal = None
 
     def _assign_nearest(self, b: Bot, usable: list[FrontierCandidate]) -> None:
         self.stats["plans"] += 1
@@ -314,6 +385,17 @@ def main() -> None:
     parser.add_argument("--stop", type=float, default=0.95, help="coverage at which a run ends (>= 0.9)")
     parser.add_argument("--time-limit", type=float, default=0.2, help="seconds per solve")
     parser.add_argument("--ablation", action="store_true", help="also run the gain-only utility")
+    parser.add_argument(
+        "--spacing",
+        type=float,
+        default=SPACING,
+        help="eps1 of Eq. 7 in metres (the plan's 4 m; another value replaces it in SpreadFrontiers and the fallback)",
+    )
+    parser.add_argument(
+        "--no-periodic",
+        action="store_true",
+        help="assign only the robot that needs a frontier, the others' fixed, without KeepFrontier (as before)",
+    )
     parser.add_argument("--out", default="build/exploration_coverage.png")
     args = parser.parse_args()
     try:
@@ -322,7 +404,7 @@ def main() -> None:
         raise SystemExit(f"--robots takes robot counts separated by commas (1,2,3), got {args.robots!r}") from None
     if not counts or any(not 1 <= k <= len(ROBOTS) for k in counts) or args.seeds < 1 or not 0.9 <= args.stop <= 1.0:
         raise SystemExit("--robots counts must lie in 1..3, --seeds must be >= 1 and --stop within [0.9, 1]")
-    terms = plan_terms()
+    terms = plan_terms(args.spacing)
     methods = ("coordinated", "nearest") + (("gain-only",) if args.ablation else ())
     results: dict[tuple[str, int], list[float]] = {}
     curves: dict[tuple[str, int], list[list[tuple[float, float]]]] = {}
@@ -344,7 +426,8 @@ def main() -> None:
                     acc[k] = acc.get(k, 0) + v
                 print(
                     f"seed {seed} {method:11s} {n} robots: 90 % at {reached:.0f} s, "
-                    f"{run.stats['solves']} solves ({run.stats['fallbacks']} fallbacks) ({wall[key][-1]:.1f} s wall)",
+                    f"{run.stats['solves']} solves ({run.stats['fallbacks']} fallbacks, {run.stats['switches']} switches) "
+                    f"({wall[key][-1]:.1f} s wall)",
                     flush=True,
                 )
     table(results, wall, extra, counts, methods, args)
@@ -356,7 +439,8 @@ def table(results, wall, extra, counts, methods, args) -> None:
     print()
     print(
         f"Time to 90 % coverage (simulated s), {args.seeds} seeds, 40 x 40 m, 60 rocks, lidar {args.range:g} m, "
-        f"{args.speed:g} m/s, runs end at {args.max_time:g} s"
+        f"{args.speed:g} m/s, runs end at {args.max_time:g} s, Eq. 7 spacing {args.spacing:g} m"
+        + ("" if not args.no_periodic else ", --no-periodic")
     )
     print()
     head = "| robots | coordinated median | mean | x of 1 robot | nearest median | mean | x of 1 robot | coordinated faster by |"
@@ -364,7 +448,7 @@ def table(results, wall, extra, counts, methods, args) -> None:
     if "gain-only" in methods:
         head += " gain-only median | x of 1 robot |"
         rule += "---|---|"
-    print(head + " solves (fallbacks) | stalls (coord. / nearest) | contacts | wall s/run |")
+    print(head + " solves (fallbacks, switches) | stalls (coord. / nearest) | contacts | wall s/run |")
     print(rule + "---|---|---|---|")
     med = {k: describe(v, args.max_time)[2] for k, v in results.items()}
     base = {m: med[(m, 1)] if 1 in counts else math.nan for m in methods}
@@ -382,7 +466,7 @@ def table(results, wall, extra, counts, methods, args) -> None:
         co = extra[("coordinated", n)]
         stalls = [sum(math.isnan(x) for x in results[(m, n)]) for m in ("coordinated", "nearest")]
         cells += [
-            f"{co['solves']} ({co['fallbacks']})",
+            f"{co['solves']} ({co['fallbacks']}, {co['switches']})",
             f"{stalls[0]} / {stalls[1]}",
             str(sum(extra[(m, n)]["contacts"] for m in methods)),
             f"{statistics.fmean([w for m in methods for w in wall[(m, n)]]):.1f}",

@@ -218,6 +218,13 @@ def _navigation(registry: SkillRegistry) -> None:
         ),
         _p("period", "float", "seconds between two readings of the map (frontiers published to the team)", default=1.0),
         _p("tolerance", "float", "distance in metres at which a frontier counts as reached", default=0.5),
+        _p(
+            "reassign",
+            "bool",
+            "follow the team's solution at every reading of the map, not only when a frontier is needed "
+            "(with the Explore plan's KeepFrontier hysteresis)",
+            default=False,
+        ),
         doc="drive to frontier cells in order of information gain and boundary relation, updating the map",
         capabilities=("base",),
         implementation="alica.skills.exploration.skill:ExploreFrontier",

@@ -12,16 +12,25 @@ retracted (``Pos`` and ``gain`` removed; the world model's object sets only
 grow, so a retracted frontier stays listed but no constraint can pick it).
 
 The robot drives with an inner :class:`~alica.skills.navigation.MoveToPosition`
-to its frontier. It asks the team's solution (``context.solve("frontier")``:
-the plan's constraints, Eq. 7-8) when it needs a frontier: at the start, and
-when its frontier is reached, unreachable or gone, so it is not sent
-elsewhere while it drives. A ``frontier`` parameter (bound by a plan) names
-the first one. When the constraints have no solution, or give a frontier
-within ``spacing`` of one another robot heads for, it takes the best
-remaining one itself: gain over distance, more than ``spacing`` from the
-frontiers the other robots head for (``heading(robot) = (x, y)`` in the world
-model, written with a time to live while a robot drives to a frontier). With
-no frontier of gain left it writes ``explored`` and succeeds.
+to its frontier. It reads the team's solution (``context.solve("frontier")``:
+the plan's constraints, Eq. 7-8, and utilities) when it needs a frontier: at
+the start, and when its frontier is reached, unreachable or gone. With
+``reassign: true`` it also reads it at every reading of the map while it
+drives and follows when the solution moves it (the team reassigns every
+robot periodically); it then writes ``Targets(robot, frontier)`` while it
+drives to a frontier, which the plan's KeepFrontier utility reads: that is
+the hysteresis, a robot is moved only when that raises the team's gain over
+travel by more than the bonus (:mod:`alica.skills.exploration.assign`,
+:func:`~alica.skills.exploration.assign.decide`). Without it (the default) no
+``Targets`` fact is written and KeepFrontier adds nothing. A ``frontier``
+parameter (bound by a plan) names the first one. When the constraints have
+no solution, or give a frontier within ``spacing`` of one another robot
+heads for (with ``reassign``: and keeps heading for), a robot with a
+frontier keeps it and one without takes the best remaining one itself: gain
+over distance, more than ``spacing`` from the frontiers the other robots
+head for (``heading(robot) = (x, y)`` in the world model, written with a
+time to live while a robot drives to a frontier). With no frontier of gain
+left it writes ``explored`` and succeeds.
 
 Positions are the robot's pose *estimate* (odometry corrected by Localize),
 never the true pose.
@@ -37,12 +46,13 @@ from py_trees.common import Status
 
 from alica.errors import SkillError
 from alica.skills.context import SkillContextLike
+from alica.skills.exploration.assign import TARGETS, How, decide, proposal_of
 from alica.skills.exploration.frontiers import FrontierCandidate, extract_frontiers
 from alica.skills.exploration.maps import current_map
-from alica.skills.world_skill import WorldSkill, distance
+from alica.skills.world_skill import WorldSkill
 from alica.worldmodel import WorldModelLike
 
-__all__ = ["HEADING", "ExploreFrontier", "headings", "publish_frontiers"]
+__all__ = ["HEADING", "ExploreFrontier", "heading_of", "headings", "publish_frontiers"]
 
 #: Seconds a published frontier (and the robot's Pos) lives in the world model without being written again.
 PUBLISH_TTL = 10.0
@@ -102,15 +112,20 @@ def _putter(wm: WorldModelLike) -> Callable[[str, str, object], None]:
     return put
 
 
-def headings(wm: Any, but: str) -> list[tuple[float, float]]:
-    """Where the robots other than ``but`` are heading now (``heading(robot)`` in the world model)."""
+def heading_of(wm: Any, but: str) -> dict[str, tuple[float, float]]:
+    """Robot -> where it is heading now (``heading(robot)`` in the world model), for the robots other than ``but``."""
     if wm is None:
-        return []
-    out = []
+        return {}
+    out = {}
     for name, args, value in wm.values():
         if name == HEADING and args and args[0] != but and isinstance(value, (tuple, list)) and len(value) == 2:
-            out.append((float(value[0]), float(value[1])))
+            out[str(args[0])] = (float(value[0]), float(value[1]))
     return out
+
+
+def headings(wm: Any, but: str) -> list[tuple[float, float]]:
+    """Where the robots other than ``but`` are heading now (``heading(robot)`` in the world model)."""
+    return list(heading_of(wm, but).values())
 
 
 class ExploreFrontier(WorldSkill):
@@ -118,13 +133,14 @@ class ExploreFrontier(WorldSkill):
 
     Parameters (see :mod:`alica.skills.catalog`): ``frontier`` (a ``Frontier``
     object name, optional), ``spacing`` (m, Eq. 7), ``reach`` (m, wave-front
-    range of Algorithm 1), ``min_gain`` (m²), ``period`` (s), ``tolerance`` (m).
+    range of Algorithm 1), ``min_gain`` (m²), ``period`` (s), ``tolerance`` (m), ``reassign`` (bool).
 
     Attributes:
         candidates: the frontier candidates of the last update, best first.
         visited: the frontiers the robot drove to, in order.
-        solved: how many of them the team's constraints gave.
+        solved: how many of them the team's solution gave (switches included).
         fallbacks: how many it chose itself (no solution, or another robot heads there).
+        switches: how many times the team's solution moved it from the frontier it drove to.
     """
 
     def __init__(self, name: str, params: Mapping[str, object], context: SkillContextLike | None = None) -> None:
@@ -153,6 +169,10 @@ class ExploreFrontier(WorldSkill):
             )
         self.bound = frontier.strip() if isinstance(frontier, str) else None
         self.spacing = self._number("spacing", 4.0, positive=False)
+        reassign = self.param("reassign", False)
+        if not isinstance(reassign, bool):
+            raise SkillError(f"skill '{self.name}': parameter 'reassign' must be true or false, got {reassign!r}")
+        self.reassign = reassign
         self.reach = self._number("reach", 3.0)
         self.min_gain = self._number("min_gain", 1.0, positive=False)
         self.period = self._number("period", 1.0)
@@ -170,6 +190,8 @@ class ExploreFrontier(WorldSkill):
         self.first = True
         self.solved = 0
         self.fallbacks = 0
+        self.switches = 0
+        self.targeted: str | None = None  # the frontier of the Targets fact this robot wrote
 
     def update(self) -> Status:
         """Read the map and publish frontiers when due, pick a frontier, drive to it."""
@@ -194,29 +216,32 @@ class ExploreFrontier(WorldSkill):
             if self.target is not None and self.target.name not in self._by_name():
                 self._stop_inner()  # seen while driving there (or no longer a frontier)
                 self.target = None
+            elif self.target is not None and self.reassign:
+                self._reconsider(now)  # the team reassigns every robot periodically
         if self.target is None:
-            self.target = self._choose(now)
-            if self.target is None:
+            target = self._choose(now)
+            if target is None:
                 self._head(None)
                 self.robot.stop()
                 return self.running(f"waiting: every one of {len(self.candidates)} frontiers is taken or unreachable")
-            self.visited.append(self.target.name)
-            self._head(self.target.position)
-            self.inner = self._drive(self.target.position)
+            self._take(target)
+        target = self.target
+        assert target is not None
         self.inner.tick_once()
         status = self.inner.status
         if status == Status.RUNNING:
             return self.running(
-                f"to frontier {self.target.name} at ({self.target.position[0]:.1f}, {self.target.position[1]:.1f}), "
-                f"gain {self.target.gain:.1f} m²; {len(self.candidates)} frontiers"
+                f"to frontier {target.name} at ({target.position[0]:.1f}, {target.position[1]:.1f}), "
+                f"gain {target.gain:.1f} m²; {len(self.candidates)} frontiers"
             )
         if status == Status.FAILURE:
-            failures = self.failed_drives[self.target.name] = self.failed_drives.get(self.target.name, 0) + 1
-            self.unreachable[self.target.name] = now + UNREACHABLE_FOR if failures < GIVE_UP_AFTER else math.inf
+            failures = self.failed_drives[target.name] = self.failed_drives.get(target.name, 0) + 1
+            self.unreachable[target.name] = now + UNREACHABLE_FOR if failures < GIVE_UP_AFTER else math.inf
         else:  # reached: should it still be a frontier at the next reading, it is not one to drive to again
-            self.unreachable[self.target.name] = math.inf
+            self.unreachable[target.name] = math.inf
         self.inner = None
         self.target = None
+        self._claim(None)
         self.next_update = now  # read the map from where the robot stands now
         return self.running("frontier reached" if status == Status.SUCCESS else "frontier unreachable")
 
@@ -226,6 +251,7 @@ class ExploreFrontier(WorldSkill):
         if self.has_robot:
             self.robot.stop()
             self._head(None)
+            self._claim(None)
 
     # -- map and world model ----------------------------------------------------
 
@@ -253,6 +279,7 @@ class ExploreFrontier(WorldSkill):
         publish_frontiers(wm, self.context.scratch, self.candidates, self.robot.name, (float(x), float(y)))
         if self.target is not None:
             self._head(self.target.position)  # keep it alive
+            self._claim(self.target.name)
 
     def _head(self, goal: tuple[float, float] | None) -> None:
         """Tell the team where this robot heads (``None``: nowhere)."""
@@ -265,11 +292,49 @@ class ExploreFrontier(WorldSkill):
             return
         _putter(wm)(HEADING, self.robot.name, (round(goal[0], 3), round(goal[1], 3)))
 
+    def _claim(self, frontier: str | None) -> None:
+        """``Targets(robot, frontier)`` for the plan's KeepFrontier (``None``: no frontier), the one before retracted."""
+        wm = self.world_model
+        if wm is None or not self.reassign:
+            return
+        robot = self.robot.name
+        if self.targeted is not None and self.targeted != frontier:
+            wm.set(TARGETS, robot, self.targeted, value=None)
+        self.targeted = frontier
+        if frontier is None:
+            return
+        try:
+            wm.set(TARGETS, robot, frontier, value=True, ttl=PUBLISH_TTL)
+        except ValueError:  # a world model without a clock takes no time to live
+            wm.set(TARGETS, robot, frontier, value=True)
+
     # -- choosing ---------------------------------------------------------------
 
+    def _usable(self, now: float) -> dict[str, FrontierCandidate]:
+        return {n: c for n, c in self._by_name().items() if self.unreachable.get(n, -math.inf) <= now}
+
+    def _here(self) -> tuple[float, float]:
+        x, y, _ = self.robot.estimate
+        return (float(x), float(y))
+
+    def _proposal(self) -> dict[str, str]:
+        """The team's solution, robot -> frontier (empty without one: alone, no engine, or no solution)."""
+        context = self.context
+        if context is None or context.solver is None:  # alone, no engine: no constraints
+            return {}
+        result = context.solve("frontier")
+        if not result.ok:
+            return {}
+        # every robot's values: the engine's SolveResult.team (SolveAnswer, the skills' view of it, names only values)
+        team = getattr(result, "team", None)
+        proposal = proposal_of(team) if isinstance(team, Mapping) else {}
+        mine = result.values.get("frontier")
+        if isinstance(mine, str):
+            proposal[self.robot.name] = mine
+        return proposal
+
     def _choose(self, now: float) -> FrontierCandidate | None:
-        by_name = self._by_name()
-        usable = {n: c for n, c in by_name.items() if self.unreachable.get(n, -math.inf) <= now}
+        usable = self._usable(now)
         if not usable:
             return None
         # 1. the frontier the plan bound (once: after it, the team's current solution)
@@ -277,24 +342,55 @@ class ExploreFrontier(WorldSkill):
             self.first = False
             if self.bound is not None and self.bound in usable:
                 return usable[self.bound]
-        # 2. the team's assignment (Eq. 7-8), unless another robot already heads there
-        heading = headings(self.world_model, self.robot.name)
-        context = self.context
-        if context is not None and context.solver is not None:  # alone, no engine: no constraints
-            result = context.solve("frontier")
-            if result.ok:
-                mine = result.values.get("frontier")
-                if isinstance(mine, str) and mine in usable:
-                    if all(distance(usable[mine].position, o) > self.spacing for o in heading):
-                        self.solved += 1
-                        return usable[mine]
-        # 3. its own choice: gain over distance, away from where the others head (Eq. 7)
-        self.fallbacks += 1
-        x, y, _ = self.robot.estimate
-        here = (float(x), float(y))
-        apart = [c for c in usable.values() if all(distance(c.position, o) > self.spacing for o in heading)]
-        pool = apart or list(usable.values())
-        return max(pool, key=lambda c: (c.gain / (1.0 + distance(here, c.position)), c.name))
+        # 2. the team's assignment (Eq. 7-8), unless another robot heads (and keeps heading) there;
+        # 3. else its own choice: gain over distance, away from where the others head (Eq. 7)
+        heading = heading_of(self.world_model, self.robot.name)
+        choice = decide(
+            self.robot.name,
+            self._here(),
+            None,
+            self._by_name(),
+            usable,
+            self._proposal(),
+            heading,
+            spacing=self.spacing,
+            others_follow=self.reassign,
+        )
+        if choice.how is How.SOLVED:
+            self.solved += 1
+        elif choice.how is How.FALLBACK:
+            self.fallbacks += 1
+        return choice.frontier
+
+    def _reconsider(self, now: float) -> None:
+        """Follow the team's solution when it moves this robot to another frontier (hysteresis: the plan's KeepFrontier)."""
+        if self.target is None or self.context is None or self.context.solver is None:
+            return
+        usable = self._usable(now)
+        heading = heading_of(self.world_model, self.robot.name)
+        choice = decide(
+            self.robot.name,
+            self._here(),
+            self.target,
+            self._by_name(),
+            usable,
+            self._proposal(),
+            heading,
+            spacing=self.spacing,
+        )
+        if choice.how is How.SWITCHED and choice.frontier is not None:
+            self._stop_inner()
+            self.switches += 1
+            self.solved += 1
+            self._take(choice.frontier)
+
+    def _take(self, target: FrontierCandidate) -> None:
+        """Drive to ``target`` from now on."""
+        self.target = target
+        self.visited.append(target.name)
+        self._head(target.position)
+        self._claim(target.name)
+        self.inner = self._drive(target.position)
 
     def _drive(self, goal: tuple[float, float]) -> Any:
         from alica.skills.context import SkillEnv
