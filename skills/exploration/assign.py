@@ -11,10 +11,13 @@ travel by more than 3.0 per robot moved (m² of gain, or metres of travel):
 that is the hysteresis. A robot whose frontier is gone (seen, reached,
 unreachable) gets no bonus and simply gets the best one for the team.
 
-Every robot reads the team's solution periodically, not only when it needs a
-frontier (:func:`decide`), so a solution that reassigns several robots (two
-robots swapping frontiers, say) is followed by all of them. The bench of
-``bench/exploration.py`` runs the same rule on the same plan.
+With ExploreFrontier's ``reassign: true`` every robot reads the team's
+solution periodically, not only when it needs a frontier (:func:`decide`), so
+a solution that reassigns several robots (two robots swapping frontiers, say)
+is followed by all of them; as shipped it is off, no ``Targets`` fact is
+written and KeepFrontier adds nothing. The bench of ``bench/exploration.py``
+runs the same rule on the same plan (:func:`solve_team` stands in for the
+engine there).
 """
 
 from __future__ import annotations
