@@ -3,7 +3,8 @@
 Allocation prefers the robot nearest to where a task starts, so after a failed step the replanned
 task that holds the same step goes to the same robot again: a robot boxed in near a corner, or one
 whose grasp keeps failing from where it stands, would try it until the problem gives up. The leader
-remembers each failed step with its robot (:class:`KeepOff`) for :data:`KEEP_OFF_S` seconds and
+remembers each failed step that could still run (the robot failed it, not a world that changed under
+it) with its robot (:class:`KeepOff`) for :data:`KEEP_OFF_S` seconds and
 shares the pairs with its plans (:attr:`~alica.prophet.board.PlanShare.barred`); every agent then
 leaves that robot out of the tasks that hold the step (:func:`bar`), as it leaves robots out of a
 pinned task. Where that leaves a task nobody who can take it (the robot holds the block the task

@@ -44,7 +44,7 @@ from alica.prophet.planners import planner_class
 from alica.prophet.problem import predicate_types
 from alica.prophet.reviewing import Pins, Reviewing
 from alica.prophet.runtime_states import LeaderPhase, leader_phase
-from alica.prophet.tasks import STEP_DONE, CreatedTasks, Literal, conjunction, holds
+from alica.prophet.tasks import STEP_DONE, CreatedTasks, Literal, conjunction, for_robot, holds
 from alica.prophet.waiting import TEAM_WAIT, Waiting
 from alica.prophet.world import PlanningWorld, goal_literals, reachable_goal, remaining_fits
 
@@ -227,7 +227,9 @@ class Leader:
         """Plan again; with ``settle`` the team first runs the WaitPlan for an UpdateTime (after a failed step).
 
         ``failed`` is the robot and the label of the step that failed: the robot is kept off that step for
-        a while (:mod:`alica.prophet.keep_off`).
+        a while (:mod:`alica.prophet.keep_off`) when the step could still run now (its precondition holds
+        for the robot in the world read again): then the robot failed it, not a world that changed under it
+        (an opponent took the block).
 
         A failed step (``settle``) that failed :data:`~alica.prophet.giving_up.GIVE_UP_AFTER` times for the
         same reason in the same world, or :data:`~alica.prophet.giving_up.GIVE_UP_ANYWAY_AFTER` times with no
@@ -240,9 +242,10 @@ class Leader:
         if not settle:
             self.start_search(now, reason)
             return
-        self.keep_off.failed(*failed, now)
         generation = self.team.next_generation()
         world = frozenset(self.team.read_world(self.team.problem).facts)
+        if self._could_run(failed, world):
+            self.keep_off.failed(*failed, now)
         done = sum(1 for fact in self.host.world.facts() if fact.predicate == STEP_DONE)
         # the failed step's label where it is known (whichever robot failed it), else what made it fail
         cause = f"{failed[1]} failed" if failed[1] else failure_cause(reason)
@@ -258,6 +261,15 @@ class Leader:
             ),
             now,
         )
+
+    def _could_run(self, failed: tuple[str, str], world: frozenset[Fact]) -> bool:
+        """Whether the failed step (robot, label) of the plan followed could run now, for that robot."""
+        robot, label = failed
+        created = self.team.created
+        if not robot or not label or created is None:
+            return False
+        step = next((s for task in created.tasks for s in task if s.label == label), None)
+        return step is not None and holds(for_robot(step.pre, step.robot, robot), world)
 
     def start_search(self, now: float, reason: str, generation: int | None = None) -> None:
         """Read World and start a search of ``generation`` (default: a new one), sharing ``searching``.

@@ -76,3 +76,19 @@ def test_a_task_no_other_role_can_take_keeps_its_robot(created) -> None:
     assert bar(created, [("r1", "Pickup(b)")], ROBOTS, {"r1": role, "r2": "Scout", "r3": "Scout"}) is created
     barred = bar(created, [("r1", "Pickup(b)")], ROBOTS, {"r1": role, "r2": role, "r3": "Scout"})
     assert barred.allowed[index] == ("r2", "r3")  # r2 can: the bar holds (r3 is vetoed by the engine anyway)
+
+
+def test_a_robot_is_kept_off_only_a_step_that_could_still_run(created) -> None:
+    # the leader reads the world again after the failure: Pickup(b) still possible for r2 means r2 failed
+    # it; b gone from the table (an opponent took it) means the world changed, and r2 is not to blame
+    from types import SimpleNamespace
+
+    from alica.lang.fact import Fact
+    from alica.prophet.leader import Leader
+
+    leader = SimpleNamespace(team=SimpleNamespace(created=created))
+    world = frozenset(Fact(p, a) for p, a in WORLD)
+    assert Leader._could_run(leader, ("r2", "Pickup(b)"), world)  # type: ignore[arg-type]
+    taken = world - {Fact("ontable", ("b",)), Fact("clear", ("b",))} | {Fact("holding", ("o1", "b"))}
+    assert not Leader._could_run(leader, ("r2", "Pickup(b)"), frozenset(taken))  # type: ignore[arg-type]
+    assert not Leader._could_run(leader, ("r2", "Stack(z, y)"), world)  # type: ignore[arg-type]  # no such step
