@@ -50,7 +50,6 @@ step's work site, and guards what its task finished.
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
@@ -293,52 +292,6 @@ def _parallelise(
             tasks[task_of.get(step.robot, len(tasks) - 1)].append(step)
         apply_effect(state, step.effect)
     return tasks, allowed
-
-
-def step_duration(step: Step) -> float:
-    """What a step is expected to take: its skill's declared ``duration``, else 1 (a step)."""
-    signature = step.skill.signature
-    return signature.duration if signature is not None and signature.duration is not None else 1.0
-
-
-def by_earliest_start(
-    tasks: Sequence[Sequence[Step]], allowed: Sequence[tuple[str, ...] | None]
-) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
-    """The tasks in the order they can start: a task after every task it waits for, and among the tasks
-    that may come next, the one whose first step can start earliest (then plan order).
-
-    A step can start once the step before it in its task and the earlier steps of other tasks on the
-    same objects (:func:`_predecessors`) are done, each taking :func:`step_duration`. Task order is
-    priority order (Eq. 9): with fewer robots than tasks, the robots take the tasks that can run soonest,
-    not the next ones of the plan's sequence, which may wait for each other while a task that could
-    start at once has nobody. Where the tasks wait for each other in a cycle, plan order is kept.
-    """
-    after = _predecessors(tasks)
-    task_of = {s.index: i for i, task in enumerate(tasks) for s in task}
-    start: dict[int, float] = {}
-    end: dict[int, float] = {}
-    previous: dict[int, int] = {}
-    for task in tasks:
-        for before, step in itertools.pairwise(task):
-            previous[step.index] = before.index
-    for step in sorted((s for task in tasks for s in task), key=lambda s: s.index):
-        ready = [end[h] for h in after[step.index] if h in end]
-        if step.index in previous and previous[step.index] in end:
-            ready.append(end[previous[step.index]])
-        start[step.index] = max(ready, default=0.0)
-        end[step.index] = start[step.index] + step_duration(step)
-    needs = [{task_of[h] for s in task for h in after[s.index]} - {i} for i, task in enumerate(tasks)]
-    order: list[int] = []
-    placed: set[int] = set()
-    while len(order) < len(tasks):
-        free = [i for i in range(len(tasks)) if i not in placed and needs[i] <= placed]
-        if not free:
-            return [list(t) for t in tasks], list(allowed)  # a cycle: plan order
-        chosen = min(free, key=lambda i: (start[tasks[i][0].index], i))
-        order.append(chosen)
-        placed.add(chosen)
-    padded = list(allowed) + [None] * (len(tasks) - len(allowed))
-    return [list(tasks[i]) for i in order], [padded[i] for i in order]
 
 
 def _by_robot(steps: Sequence[Step]) -> tuple[list[list[Step]], list[tuple[str, ...] | None]]:
@@ -642,7 +595,6 @@ def create_tasks(
     init = tuple(init)  # read twice: by the parallelisation and for the objects to guard
     steps = steps_of(plan_steps, library, team)
     tasks, allowed = _by_robot(steps) if per_robot else _parallelise(steps, init, team)
-    tasks, allowed = by_earliest_start(tasks, allowed)
     wait_plan = library.plans.get(standby) if standby is not None else None
     variables = tuple(v.name for v in wait_plan.variables) if wait_plan is not None else ()
     members = set(team)

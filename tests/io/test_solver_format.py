@@ -404,7 +404,7 @@ def test_explore_states_eq_7_8_per_agent() -> None:
     plan = next(p for p in load_document(PLANS / "skills" / "explore.yaml").plans if p.name == "Explore")
     assert plan.variables == (Variable("frontier", "Frontier", candidates="having(Frontier, gain)"),)
     by_name = {c.name: c for c in plan.constraints}
-    assert set(by_name) == {"SpreadFrontiers", "NearbyFrontiers", "GainOverTravel"}
+    assert set(by_name) == {"SpreadFrontiers", "NearbyFrontiers", "GainOverTravel", "KeepFrontier"}
     spread = parse(by_name["SpreadFrontiers"].text)
     assert {r.name for r in reads(spread) if r.per_agent and r.of_agent} == {"frontier"}
     assert {d.name for d in agent_domains(spread, by_name["SpreadFrontiers"].text)} == {
