@@ -14,11 +14,12 @@ its robots: a retry by the same robot beats no robot at all.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import replace
 
+from alica.lang.fact import Fact
 from alica.model import Priority
-from alica.prophet.tasks import CreatedTasks
+from alica.prophet.tasks import CreatedTasks, Step, apply_effect, for_robot, holds
 
 KEEP_OFF_S = 60.0
 """How long a robot stays off a step that failed with it (simulated seconds): about the time the rest
@@ -48,17 +49,21 @@ def bar(
     barred: Sequence[tuple[str, str]],
     robots: Sequence[str],
     roles: Mapping[str, str] | None = None,
+    world: Iterable[Fact] | None = None,
 ) -> CreatedTasks:
     """``created`` with each barred robot left out of the tasks that hold its barred step.
 
     A task keeps its robots where leaving them out would leave it none that can take it (with
-    ``roles``, robot -> role: a robot whose role's priority for the task is negative cannot), see the
-    module docstring; an entry that is not a pair of strings is ignored.
+    ``roles``, robot -> role: a robot whose role's priority for the task is negative cannot; with
+    ``world``, the facts the plan starts from: a robot whose own facts there do not let it run the
+    task's steps cannot either, say with its hand full: :func:`_fits`), see the module docstring; an
+    entry that is not a pair of strings is ignored.
     """
     if not barred:
         return created
     allowed = list(created.allowed) + [None] * (len(created.tasks) - len(created.allowed))
     priorities = created.priorities()
+    facts = frozenset(world) if world is not None else None
     changed = False
     for index, task in enumerate(created.tasks):
         labels = {step.label for step in task}
@@ -70,13 +75,27 @@ def bar(
         kept = tuple(robot for robot in candidates if robot not in off)
         if roles is not None:
             task_name = created.task_defs[index].name
-            able = [r for r in kept if _priority(priorities.get(roles.get(r, ""), ()), task_name) >= 0]
-            if not able:
+            kept_able = [r for r in kept if _priority(priorities.get(roles.get(r, ""), ()), task_name) >= 0]
+            if not kept_able:
                 continue  # nobody else can take it: the robot keeps it
+        if facts is not None and not any(_fits(task, r, facts) for r in kept):
+            continue  # nobody else could do it from where it is now: the robot keeps it
         if kept and kept != candidates:
             allowed[index] = kept
             changed = True
     return replace(created, allowed=tuple(allowed)) if changed else created
+
+
+def _fits(task: Sequence[Step], robot: str, facts: frozenset[Fact]) -> bool:
+    """Whether ``robot`` could run ``task``'s steps from ``facts`` as far as its own facts go (its hand,
+    where it is): each step's literals naming the robot hold, after the effects of the steps before."""
+    state = set(facts)
+    for step in task:
+        own = [literal for literal in for_robot(step.pre, step.robot, robot) if robot in literal[1].args]
+        if not holds(own, state):
+            return False
+        apply_effect(state, for_robot(step.effect, step.robot, robot))
+    return True
 
 
 def _priority(priorities: Sequence[Priority], task: str) -> float:

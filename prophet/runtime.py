@@ -334,6 +334,7 @@ class ProblemRuntime:
                     share.barred,
                     share.robots,
                     host.roles,
+                    share.world,
                 )
             except (PlannerError, AlicaError) as exc:
                 host.emit("warning", key=key_text(self.key), message=f"shared plan cannot be executed: {exc}")

@@ -92,3 +92,12 @@ def test_a_robot_is_kept_off_only_a_step_that_could_still_run(created) -> None:
     taken = world - {Fact("ontable", ("b",)), Fact("clear", ("b",))} | {Fact("holding", ("o1", "b"))}
     assert not Leader._could_run(leader, ("r2", "Pickup(b)"), frozenset(taken))  # type: ignore[arg-type]
     assert not Leader._could_run(leader, ("r2", "Stack(z, y)"), world)  # type: ignore[arg-type]  # no such step
+
+
+def test_a_task_no_other_robot_could_start_now_keeps_its_robot(created) -> None:
+    # r2 and r3 hold blocks: none of them could start Pickup(b), so r1 keeps the step it failed
+    index = next(i for i, task in enumerate(created.tasks) if "Pickup(b)" in [s.label for s in task])
+    busy = [(p, a) for p, a in WORLD if p != "handempty" or a == ("r1",)] + [("holding", ("r2", "x"))]
+    assert bar(created, [("r1", "Pickup(b)")], ROBOTS, world=busy) is created  # type: ignore[arg-type]
+    free = bar(created, [("r1", "Pickup(b)")], ROBOTS, world=WORLD)  # type: ignore[arg-type]
+    assert free.allowed[index] == ("r2", "r3")
