@@ -45,6 +45,7 @@ from alica.prophet.pddl.model import (
 )
 from alica.prophet.pddl.normal import substitute
 from alica.prophet.planner import Feature, Plan, PlanStep
+from alica.prophet.temporal_ground import split_effect
 from alica.prophet.temporal_plan import EPSILON, TemporalPlan, TimedStep
 from alica.prophet.validate_temporal import Touches, interference, touches
 
@@ -121,18 +122,12 @@ def _with_cost(action: Action, cost: int) -> Action:
 
 
 def _literals(effect: Effect, action: str) -> tuple[set[Atom], set[Atom]]:
-    adds: set[Atom] = set()
-    deletes: set[Atom] = set()
-    for part in top_level_parts(effect):
-        if isinstance(part, Atom):
-            adds.add(part)
-        elif isinstance(part, Not) and isinstance(part.formula, Atom):
-            deletes.add(part.formula)
-        elif not isinstance(part, Increase):
-            raise PlannerError(
-                f"durative action {action}: the temporal planner takes effects that are conjunctions of literals, "
-                f"not {type(part).__name__.lower()} effects"
-            )
+    adds, deletes, others = split_effect(effect)
+    if others:
+        raise PlannerError(
+            f"durative action {action}: the temporal planner takes effects that are conjunctions of literals, "
+            f"not {type(others[0]).__name__.lower()} effects"
+        )
     return adds, deletes
 
 

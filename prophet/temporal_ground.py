@@ -238,16 +238,25 @@ def _condition(formula: Formula, step: PlanStep | None) -> _Literals | None:
     return pos, neg
 
 
-def _effect(effect: Effect, step: PlanStep) -> _Literals:
+def split_effect(effect: Effect) -> tuple[set[Atom], set[Atom], list[object]]:
+    """An effect's added atoms, its deleted atoms, and its parts that are neither (numeric increases aside)."""
     adds: set[Atom] = set()
     deletes: set[Atom] = set()
+    others: list[object] = []
     for part in top_level_parts(effect):
         if isinstance(part, Atom):
             adds.add(part)
         elif isinstance(part, Not) and isinstance(part.formula, Atom):
             deletes.add(part.formula)
         elif not isinstance(part, Increase):
-            raise _not_literals("effect", step, part)
+            others.append(part)
+    return adds, deletes, others
+
+
+def _effect(effect: Effect, step: PlanStep) -> _Literals:
+    adds, deletes, others = split_effect(effect)
+    if others:
+        raise _not_literals("effect", step, others[0])
     return adds, deletes
 
 

@@ -108,7 +108,9 @@ class WaitAside(DriveToFreeSpace):
         radius = float(self.param("guard_radius", GUARD_RADIUS))  # type: ignore[arg-type]
         found: list[tuple[float, tuple[float, float]]] = []
         held = holders(self.team_model, self.team_belief)
-        guards = [(p.x, p.y) for p in self.teammates() if p.robot != self.robot.name] if name == "guard" else []
+        mates = [p for p in self.teammates() if p.robot != self.robot.name] if name == "guard" else []
+        guards = [(p.x, p.y) for p in mates]
+        team = {p.robot for p in mates} | {self.robot.name}
         for label in value.split():
             obj = self.world.objects.get(label)
             if obj is None or label in held or (self.robot.arm is not None and self.robot.arm.held is obj):
@@ -117,18 +119,17 @@ class WaitAside(DriveToFreeSpace):
             xy = (float(position[0]), float(position[1]))
             if name == "guard" and any(distance(xy, (x, y)) <= radius for x, y in guards):
                 continue  # a teammate guards it already (an opponent beside it is what a guard is for)
-            if name == "guard" and not self._threatened(label, xy):
+            if name == "guard" and not self._threatened(label, xy, team):
                 continue  # no opponent near it: nothing to guard it from
             found.append((distance(xy, here), xy))
         return min(found)[1] if found else None
 
-    def _threatened(self, label: str, xy: tuple[float, float]) -> bool:
+    def _threatened(self, label: str, xy: tuple[float, float], team: set[str]) -> bool:
         """Whether a robot outside the team is within ``threat_radius`` of object ``label`` at ``xy``, or was
-        within the last :data:`THREAT_HOLD` seconds (always, with no radius)."""
+        within the last :data:`THREAT_HOLD` seconds (always, with no radius); ``team``: the team's robots."""
         radius = float(self.param("threat_radius", 0.0))  # type: ignore[arg-type]
         if radius <= 0:
             return True
-        team = {pose.robot for pose in self.teammates()} | {self.robot.name}
         now = self.now()
         if any(
             distance(xy, (float(robot.pose[0]), float(robot.pose[1]))) <= radius
