@@ -19,22 +19,10 @@ from alica.prophet.problem import domain_text
 from alica.prophet.tasks import create_tasks
 from alica.prophet.world import read_world
 from tests.conftest import PLANS
+from tests.prophet.test_keep_off import PLAN as SUSSMAN
+from tests.prophet.test_keep_off import ROBOTS, WORLD
 
-ROBOTS = ("r1", "r2")
-WORLD = [
-    ("on", ("c", "a")),
-    ("ontable", ("a",)),
-    ("ontable", ("b",)),
-    ("clear", ("c",)),
-    ("clear", ("b",)),
-    *(("handempty", (r,)) for r in ROBOTS),
-]
-PLAN = [
-    PlanStep("Unstack", ("r1", "c", "a")),
-    PlanStep("Putdown", ("r1", "c")),
-    PlanStep("Pickup", ("r2", "b")),
-    PlanStep("Stack", ("r2", "b", "c")),
-]
+PLAN = SUSSMAN[:4]  # a robot digs c out and puts it down, another stacks b on c
 
 
 @pytest.fixture(scope="module")
