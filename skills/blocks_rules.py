@@ -16,6 +16,7 @@ failure), or ``None``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from alica.skills.arm_world import REACH, inside_field, mount_ahead
@@ -33,6 +34,7 @@ __all__ = [
     "grip_refusal",
     "pickup_refusal",
     "putdown_spots",
+    "spread_spots",
     "stack_refusal",
     "stacked_refusal",
     "unstack_refusal",
@@ -48,11 +50,57 @@ PUTDOWN_TURNS = (0.0, 0.6, -0.6, 1.2, -1.2, 1.8, -1.8, 3.14)
 PUTDOWN_ROOM = 0.15
 #: Room (m) between a put-down spot and the field's edge: robots must find sides of the block to stand on.
 EDGE_ROOM = 0.8
+#: Spacing (m) of the grid of spots a spread put-down looks through (:func:`spread_spots`).
+SPREAD_STEP = 0.2
 
 
 def blocks_state(world: RobotWorld) -> Facts:
     """The IPC blocks facts now, as the robot interface senses them."""
     return set(world.blocks_facts())
+
+
+def spread_spots(
+    world: RobotWorld, robot: MobileRobot, spread: float, taken: Sequence[tuple[float, float]] = ()
+) -> list[tuple[float, float]]:
+    """Spots at least ``spread`` metres from every block lying in the world and from ``taken``, nearest the arm first.
+
+    A block put down there starts a stack of its own, with room on every side
+    for robots to stand while others work at the stacks around: a team of
+    several robots does not crowd one corner of the field. ``taken`` are
+    points teammates will stand on (their reserved stand-off points), so two
+    robots putting blocks down at the same time choose places apart. The spots
+    come first from :func:`putdown_spots` (the arm reaches them where the robot
+    stands), then from a grid of :data:`SPREAD_STEP` metres, :data:`EDGE_ROOM`
+    inside the field and clear of robots by :data:`PUTDOWN_ROOM`, nearest first
+    to the point straight ahead at the arm's reach (the least driving); none
+    when the field has no such room left (the caller then puts the block down
+    where it stands).
+    """
+    held = {r.arm.held.name for r in world.robots.values() if r.arm is not None and r.arm.held is not None}
+    lying = [
+        (float(obj.position()[0]), float(obj.position()[1]))
+        for obj in world.objects.values()
+        if obj.kind == "block" and obj.name not in held
+    ]
+    avoid = [*lying, *taken]
+
+    def apart(spot: tuple[float, float]) -> bool:
+        return all(math.hypot(spot[0] - ax, spot[1] - ay) >= spread for ax, ay in avoid)
+
+    near = [spot for spot in putdown_spots(world, robot) if apart(spot)]  # the arm reaches them from here
+    xmin, ymin, xmax, ymax = world.bounds
+    x, y, yaw = robot.pose
+    ahead = REACH + mount_ahead(robot)
+    x0, y0 = x + ahead * math.cos(yaw), y + ahead * math.sin(yaw)  # where the arm reaches now: the least driving
+    found: list[tuple[float, float, float]] = []
+    nx = int((xmax - xmin - 2 * EDGE_ROOM) / SPREAD_STEP) + 1
+    ny = int((ymax - ymin - 2 * EDGE_ROOM) / SPREAD_STEP) + 1
+    for i in range(max(nx, 0)):
+        for j in range(max(ny, 0)):
+            spot = (xmin + EDGE_ROOM + i * SPREAD_STEP, ymin + EDGE_ROOM + j * SPREAD_STEP)
+            if apart(spot) and world.blocker(spot[0], spot[1], PUTDOWN_ROOM) is None:
+                found.append((math.hypot(spot[0] - x0, spot[1] - y0), spot[0], spot[1]))
+    return [*near, *((sx, sy) for _, sx, sy in sorted(found))]
 
 
 def pickup_refusal(facts: Facts, block: str, *, from_table: bool) -> str | None:

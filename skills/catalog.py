@@ -76,6 +76,13 @@ def _composite(registry: SkillRegistry) -> None:
             "where to place it: a position or a term such as pos(g); by default in front of the robot",
             required=False,
         ),
+        _p(
+            "spread",
+            "float",
+            "without a target: put it down at the nearest spot this many metres from every block "
+            "and every stand-off point a teammate reserved, where there is one (0: in front of the robot)",
+            default=0.0,
+        ),
         doc="place the held object, open the gripper, stow the arm and check the placement (Fig. 16)",
         capabilities=("arm", "gripper"),
         implementation="alica.skills.handling:Putdown",

@@ -34,7 +34,7 @@ import numpy as np
 from py_trees.common import Status
 
 from alica.errors import SkillError
-from alica.skills import blocks_rules
+from alica.skills import blocks_rules, reservations
 from alica.skills.arm_approach import Approach
 from alica.skills.arm_motion import ArmMotion, ArmStep, grasp_shape, held_object_box, object_box, planning_scene
 from alica.skills.arm_world import (
@@ -526,7 +526,11 @@ class Putdown(ArmSkill):
         """The target (a position, a place such as ``pos(g)``, or a block to put it on), or a free spot near the robot.
 
         The free spot lies at the arm's reach, straight ahead if nothing is there, else
-        turned to one side; a retry after a failed placement takes another spot.
+        turned to one side; a retry after a failed placement takes another spot. With
+        the parameter ``spread`` (metres) the robot first looks for the nearest spot that
+        far from every block and from the stand-off points teammates reserved
+        (:func:`~alica.skills.blocks_rules.spread_spots`), and drives there: the stacks
+        spread over the field instead of crowding where the blocks were taken from.
         """
         target = self.param("target")
         if target is not None and place_area(self, target) is None:
@@ -538,11 +542,15 @@ class Putdown(ArmSkill):
     def _free_spot(self) -> tuple[float, float]:
         tried = self._tried
         area = place_area(self, self.param("target"))
-        spots = (
-            blocks_rules.putdown_spots(self.world, self.robot)
-            if area is None
-            else area_spots(self.world, self.robot, area, AREA_ROOM, self._known_taken())
-        )
+        if area is not None:
+            spots = area_spots(self.world, self.robot, area, AREA_ROOM, self._known_taken())
+        else:
+            spread = float(self.param("spread", 0.0))  # type: ignore[arg-type]
+            taken = [(x, y) for x, y, _ in reservations.reserved(self)] if spread > 0 else []
+            spots = [
+                *(blocks_rules.spread_spots(self.world, self.robot, spread, taken) if spread > 0 else ()),
+                *blocks_rules.putdown_spots(self.world, self.robot),
+            ]
         for spot in spots:
             if not any(distance(spot, old) < blocks_rules.PUTDOWN_ROOM for old in tried):
                 return spot

@@ -11,9 +11,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from alica.skills.arm_world import REACH
-from alica.skills.blocks_rules import PUTDOWN_TURNS, putdown_spots
+from alica.skills.blocks_rules import EDGE_ROOM, PUTDOWN_TURNS, putdown_spots, spread_spots
 from alica.worldsim.arm_interface import RobotArm
 from alica.worldsim.grid import Obstacle2D
 from alica.worldsim.interface import Position, Quaternion, RobotWorld
@@ -94,3 +96,56 @@ def test_putdown_spots_on_a_robot_world_that_is_not_the_simulator() -> None:
     # the rock straight ahead rules out the first spot; every turned one is free
     expected = [(REACH * math.cos(t), REACH * math.sin(t)) for t in PUTDOWN_TURNS[1:]]
     assert spots == expected
+
+
+def _blocks(points: list[tuple[float, float]]) -> dict[str, _Rock]:
+    return {f"b{i}": _Rock(f"b{i}", x, y, radius=0.03, kind="block") for i, (x, y) in enumerate(points)}
+
+
+def test_spread_spots_keep_the_distance_from_blocks_and_reserved_points_nearest_first() -> None:
+    robot = _Robot("r1", (0.0, 0.0, 0.0))
+    world = _Driver({"r1": robot}, _blocks([(0.3, 0.0), (-1.0, 1.0)]), bounds=(-3.0, -3.0, 3.0, 3.0))
+    spots = spread_spots(world, robot, 1.2, taken=[(0.0, -1.5)])
+    assert spots
+    for x, y in spots:
+        assert math.hypot(x - 0.3, y) >= 1.2 and math.hypot(x + 1.0, y - 1.0) >= 1.2
+        assert math.hypot(x, y + 1.5) >= 1.2
+    # the spots the arm reaches from where the robot stands first (here none is far enough from
+    # the block ahead), then the grid's, nearest the point the arm reaches straight ahead
+    reach = [spot for spot in putdown_spots(world, robot) if spot in spots]
+    assert spots[: len(reach)] == reach
+    rest = [math.hypot(x - REACH, y) for x, y in spots[len(reach) :]]
+    assert rest == sorted(rest)
+
+
+def test_spread_spots_take_a_spot_within_the_arms_reach_first() -> None:
+    robot = _Robot("r1", (0.0, 0.0, 0.0))
+    world = _Driver({"r1": robot}, _blocks([(-0.5, 0.0)]), bounds=(-3.0, -3.0, 3.0, 3.0))
+    assert spread_spots(world, robot, 0.4)[0] == (REACH, 0.0)
+
+
+def test_spread_spots_are_none_where_the_field_has_no_room() -> None:
+    robot = _Robot("r1", (0.0, 0.0, 0.0))
+    world = _Driver({"r1": robot}, _blocks([(0.0, 0.0)]), bounds=(-1.5, -1.5, 1.5, 1.5))
+    assert spread_spots(world, robot, 2.0) == []
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.lists(st.tuples(st.floats(-2.5, 2.5), st.floats(-2.5, 2.5)), max_size=8),
+    st.floats(0.2, 2.0),
+    st.tuples(st.floats(-2.0, 2.0), st.floats(-2.0, 2.0)),
+)
+def test_every_spread_spot_is_inside_the_field_clear_of_blocks_and_robots(
+    points: list[tuple[float, float]], spread: float, at: tuple[float, float]
+) -> None:
+    robot = _Robot("r1", (at[0], at[1], 0.0))
+    other = _Robot("r2", (1.0, -1.0, 0.0))
+    world = _Driver({"r1": robot, "r2": other}, _blocks(points), bounds=(-3.0, -3.0, 3.0, 3.0))
+    spots = spread_spots(world, robot, spread)
+    for x, y in spots:
+        assert -3.0 + EDGE_ROOM - 1e-9 <= x <= 3.0 - EDGE_ROOM + 1e-9
+        assert -3.0 + EDGE_ROOM - 1e-9 <= y <= 3.0 - EDGE_ROOM + 1e-9
+        assert all(math.hypot(x - bx, y - by) >= spread for bx, by in points)
+        assert world.blocker(x, y, 0.15) is None
+    assert len(set(spots)) == len(spots)

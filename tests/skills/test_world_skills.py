@@ -120,6 +120,18 @@ def test_putdown_on_the_ground_and_stack_on_a_block(blocks_world, skill_run):
     assert ("on", "c", "b") in blocks_facts(blocks_world)
 
 
+def test_putdown_with_spread_puts_the_block_apart_from_every_other_block(blocks_world, skill_run):
+    from alica.worldsim.scenarios import blocks_facts
+
+    assert skill_run("Pickup", blocks_world, "r1", {"object": "c"}).ok
+    run = skill_run("Putdown", blocks_world, "r1", {"object": "c", "spread": 1.0})
+    assert run.ok, (run.reason, run.trace[-6:])
+    assert ("ontable", "c") in blocks_facts(blocks_world)
+    c = blocks_world.objects["c"].position()
+    others = [o.position() for name, o in blocks_world.objects.items() if o.kind == "block" and name != "c"]
+    assert others and min(math.hypot(c[0] - o[0], c[1] - o[1]) for o in others) >= 1.0 - 0.05
+
+
 def test_unstack_then_stack_follow_the_ipc_domain(blocks_world, skill_run):
     from alica.worldsim.scenarios import blocks_facts
 
