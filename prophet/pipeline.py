@@ -218,12 +218,17 @@ def plan_problem(
     temporal = name == "temporal"
     domain, pddl = to_pddl(problem, library, world.object_types(), world.facts, temporal=temporal, durations=durations)
     chosen_options = dict(options or {})
-    if name == "builtin":
+    if name in ("builtin", "temporal"):
         # A plan file's problem keeps FF's first search (FirstSearch("ff")): the shipped missions and
         # their fault tests were built on its plans, and with LAMA's the lunar team hands its fetch to
-        # another robot and replans a fenced sample without end. ``options`` may choose another.
+        # another robot and replans a fenced sample without end. ``options`` may choose another. The
+        # temporal planner's sequential search is the builtin planner's, so its plans are the same.
         from alica.prophet.search.anytime import FirstSearch  # lazy: the planning layer's search
 
         chosen_options.setdefault("first", FirstSearch("ff"))
+    if temporal:
+        # the team runs every step: a shorter makespan bought with more steps than the sequential
+        # plan's costs it more driving and waiting than the durations tell
+        chosen_options.setdefault("no_more_steps", True)
     chosen = get_planner(name, **chosen_options)
     return ProblemPlanning(problem, world, domain, pddl, chosen, temporal)

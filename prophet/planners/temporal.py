@@ -62,6 +62,10 @@ class TemporalPlanner(Planner):
         makespan_search: whether the makespan search runs beside the sequential one.
         makespan_passes: the makespan search's passes.
         makespan_only: run the makespan search alone (the builtin planner still grounds the task, but does not search it).
+        no_more_steps: a plan of the makespan search counts only when it has no more steps than the
+            best plan so far (one found before the sequential search's first plan waits for it), so
+            the makespan never shortens by adding steps to the sequential plan's; a team runs every step, so a shorter makespan bought with more steps
+            costs it more driving and waiting than the durations tell (what the leader plans with).
         options: go to the builtin planner.
     """
 
@@ -75,11 +79,13 @@ class TemporalPlanner(Planner):
         makespan_search: bool = True,
         makespan_passes: tuple[Pass, ...] = MAKESPAN_PASSES,
         makespan_only: bool = False,
+        no_more_steps: bool = False,
         **options: Any,
     ) -> None:
         self.inner = BuiltinPlanner(**options)
         self.makespan_search = makespan_search or makespan_only
         self.makespan_only = makespan_only
+        self.no_more_steps = no_more_steps
         self.makespan_passes = tuple(makespan_passes)
         self.sources: dict[str, int] = {}
         """Per search, how many plans of the last run came from it (``sequential``, ``makespan``)."""
@@ -106,6 +112,8 @@ class TemporalPlanner(Planner):
         expansions = {SEQUENTIAL: 0, MAKESPAN: 0}
         ended: dict[str, Done] = {}
         best: float | None = None
+        steps: int | None = None  # the best plan's steps (no_more_steps: a makespan plan has no more)
+        held: list[Plan] = []  # makespan plans waiting for the sequential search's first plan
         started = not self.makespan_search
         while streams:
             name, events = streams.popleft()
@@ -129,12 +137,33 @@ class TemporalPlanner(Planner):
                 yield Progress(total)
                 continue
             plan = self._checked(domain, problem, name, event.plan, timed)
-            if plan is not None and (best is None or plan.cost < best - 1e-9):
+            if plan is None:
+                continue
+            source = name
+            if self.no_more_steps:
+                if name == SEQUENTIAL and steps is None:
+                    kept = [p for p in held if len(p.steps) <= len(plan.steps)]
+                    held.clear()
+                    if kept and min(p.cost for p in kept) < plan.cost - 1e-9:
+                        plan, source = min(kept, key=lambda p: p.cost), MAKESPAN
+                elif name == MAKESPAN and steps is None:
+                    held.append(plan)
+                    continue
+                elif name == MAKESPAN and steps is not None and len(plan.steps) > steps:
+                    continue
+            if best is None or plan.cost < best - 1e-9:
                 best = plan.cost
+                steps = len(plan.steps)
                 bound.ticks = round(best * TICKS) if bound.ticks is None else min(bound.ticks, round(best * TICKS))
-                self.sources[name] += 1
-                self.best_source = name
+                self.sources[source] += 1
+                self.best_source = source
                 yield Improved(plan, total)
+        if held:  # the sequential search found no plan: the makespan search's best counts
+            plan = min(held, key=lambda p: p.cost)
+            best = plan.cost
+            self.sources[MAKESPAN] += 1
+            self.best_source = MAKESPAN
+            yield Improved(plan, sum(expansions.values()))
         yield self._final(ended, best is not None, sum(expansions.values()))
 
     def _makespan(

@@ -255,17 +255,25 @@ def test_with_ten_blocks_four_agents_finish_sooner_than_two():
     )
 
 
-def test_the_team_plans_for_its_time_with_the_temporal_planner(capsys):
+def test_the_team_plans_for_its_time_with_the_temporal_planner(capsys, tmp_path):
     # four single blocks into one tower: planned for the makespan, both robots carry blocks to it
     from alica.app.cli import main
 
     code = main(
         ["demo", "blocksworld", "--robots", "2", "--blocks", "4", "--seed", "2", "--planner", "temporal"]
-        + ["--json", "--no-progress"]
+        + ["--json", "--no-progress", "--out", str(tmp_path)]
     )
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["success"], summary
     assert all(steps >= 1 for steps in summary["steps"].values())  # both robots worked
+    # the leader shares a temporal problem's first plan when its search is done or after one UpdateTime (1 s)
+    events = [json.loads(line) for line in (tmp_path / "trace.jsonl").read_text().splitlines()]
+    planner = [e for e in events if e.get("event") == "planner" and e["what"] in ("started", "plan", "done")]
+    firsts = [(i, e) for i, e in enumerate(planner) if e["what"] == "plan" and e["version"] == 1]
+    assert firsts
+    for i, first in firsts:
+        done_then = any(e["what"] == "done" and e["t"] == first["t"] for e in planner[i + 1 : i + 2])
+        assert first["after_s"] >= 1.0 - 1e-9 or done_then, first
 
 
 def test_the_temporal_planner_is_for_the_in_process_demo():

@@ -68,6 +68,23 @@ def test_the_temporal_planner_returns_the_makespan_search_plan_with_its_own_timi
     assert off.cost == pytest.approx(7.502) and not isinstance(off.plan, ScheduledPlan)
 
 
+def test_with_no_more_steps_the_makespan_search_plan_must_not_outnumber_the_sequential_plan() -> None:
+    domain = parse_domain(DOMAIN)
+    problem = parse_problem(TWO_ROVERS, domain=domain)
+    # the sequential plan: one rover in 3 steps (7.502 s scheduled); the makespan search's: both rovers, 4 steps
+    planner = TemporalPlanner(no_more_steps=True)
+    events = list(planner.search(domain, problem, anytime=True, limits=Limits(60)))
+    improved = [e.plan for e in events if isinstance(e, Improved)]
+    assert improved and all(len(plan.steps) <= 3 for plan in improved)
+    assert improved[-1].cost == pytest.approx(7.502) and planner.best_source == "sequential"
+    assert planner.sources["makespan"] == 0
+    free = TemporalPlanner().solve(domain, problem, time_limit=60, anytime=True)
+    assert free.cost == pytest.approx(6.501) and len(free.plan.steps) == 4  # type: ignore[union-attr]
+    # without a sequential plan to compare with, the makespan search's best plan counts at the end
+    alone = TemporalPlanner(no_more_steps=True, makespan_only=True).solve(domain, problem, time_limit=60, anytime=True)
+    assert alone.cost == pytest.approx(6.501)
+
+
 def test_every_improvement_of_the_temporal_planner_validates_and_shortens_the_makespan() -> None:
     domain = parse_domain(DOMAIN)
     problem = parse_problem(TWO_ROVERS, domain=domain)
