@@ -64,8 +64,8 @@ class TemporalPlanner(Planner):
         makespan_only: run the makespan search alone (the builtin planner still grounds the task, but does not search it).
         no_more_steps: a plan of the makespan search counts only when it has no more steps than the
             best plan so far (one found before the sequential search's first plan waits for it), so
-            the makespan never shortens by adding steps to the sequential plan's; a team runs every step, so a shorter makespan bought with more steps
-            costs it more driving and waiting than the durations tell (what the leader plans with).
+            the makespan never shortens by adding steps: a team runs every step, and a shorter
+            makespan bought with more steps costs it more driving and waiting than the durations tell.
         options: go to the builtin planner.
     """
 
