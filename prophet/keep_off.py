@@ -73,13 +73,12 @@ def bar(
         pinned = allowed[index]
         candidates = pinned if pinned is not None else tuple(robots)
         kept = tuple(robot for robot in candidates if robot not in off)
+        able = kept
         if roles is not None:
             task_name = created.task_defs[index].name
-            kept_able = [r for r in kept if _priority(priorities.get(roles.get(r, ""), ()), task_name) >= 0]
-            if not kept_able:
-                continue  # nobody else can take it: the robot keeps it
-        if facts is not None and not any(_fits(task, r, facts) for r in kept):
-            continue  # nobody else could do it from where it is now: the robot keeps it
+            able = tuple(r for r in kept if _priority(priorities.get(roles.get(r, ""), ()), task_name) >= 0)
+        if not able or (facts is not None and not any(_fits(task, r, facts) for r in able)):
+            continue  # nobody else can take it (by role, or from where it is now): the robot keeps it
         if kept and kept != candidates:
             allowed[index] = kept
             changed = True

@@ -8,7 +8,7 @@ worked out by :meth:`Leader.phase`):
   (when the world changed): it reads World and starts an anytime search
   (:meth:`Leader.start_search`), or shares ``done``, or waits;
 * **searching**: it spends the tick's budget (:mod:`alica.prophet.budget`), shares the
-  first plan at once (a temporal problem's when the search ends or after one UpdateTime)
+  first plan at once (a temporal planner's when the search ends or after one UpdateTime)
   and cheaper ones every UpdateTime, and on no plan waits for the world or the team
   (:mod:`alica.prophet.waiting`) or shares ``failed``;
 * **reviewing**: it reads the operator's decisions (:mod:`alica.prophet.reviewing`);
@@ -421,19 +421,21 @@ class Leader:
     def _after_search(self, now: float, search: LeaderSearch, finished: Done | None) -> None:
         """Share what the search found; end it when it is done.
 
-        The first plan goes out at once, except a temporal problem's: its plan is shared when the
-        search ends or one UpdateTime after it began, whichever comes first. Execution ends the
-        search, and the sequential search's first plan comes before the makespan search's.
+        The first plan goes out at once, except a planner's whose first plan waits
+        (:attr:`~alica.prophet.planner.Planner.first_plan_waits`, the temporal planner's): it is
+        shared when the search ends or one UpdateTime after it began, whichever comes first, since
+        execution ends the search.
         """
         best = search.best
         if (
             best is not None
             and search.shared_cost is None
             and finished is None
-            and self.team.problem.planner == "temporal"
+            and search.planning is not None
+            and search.planning.planner.first_plan_waits
             and now - search.started < self.model.update_time
         ):
-            return  # a temporal problem's search goes on for its first UpdateTime
+            return  # the search goes on for its first UpdateTime
         if best is not None and search.shared_cost is None:
             if self.host.review:
                 self.search = None

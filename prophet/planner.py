@@ -327,6 +327,9 @@ class Planner(ABC):
     names, and once the step is over the runtime plans the next one from the world as it is then."""
     reads_positions: bool = False
     """Whether its constructor takes ``positions`` (object -> position in metres, the world model's ``pos``)."""
+    first_plan_waits: bool = False
+    """Whether a team waits a little for a better first plan (the leader shares it when the search ends or
+    after one UpdateTime): its first plan seldom is its best, and execution ends the search."""
     reads_files: bool = False
     """Whether :meth:`solve` takes the PDDL files' paths rather than the parsed domain and problem
     (a back-end that runs an outside planner on the files, such as Fast Downward)."""

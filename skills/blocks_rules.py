@@ -60,7 +60,11 @@ def blocks_state(world: RobotWorld) -> Facts:
 
 
 def spread_spots(
-    world: RobotWorld, robot: MobileRobot, spread: float, taken: Sequence[tuple[float, float]] = ()
+    world: RobotWorld,
+    robot: MobileRobot,
+    spread: float,
+    taken: Sequence[tuple[float, float]] = (),
+    reachable: Sequence[tuple[float, float]] | None = None,
 ) -> list[tuple[float, float]]:
     """Spots at least ``spread`` metres from every block lying in the world and from ``taken``, nearest the arm first.
 
@@ -70,7 +74,7 @@ def spread_spots(
     points teammates will stand on (their reserved stand-off points), so two
     robots putting blocks down at the same time choose places apart. The spots
     come first from :func:`putdown_spots` (the arm reaches them where the robot
-    stands), then from a grid of :data:`SPREAD_STEP` metres, :data:`EDGE_ROOM`
+    stands; ``reachable`` gives them when the caller has them already), then from a grid of :data:`SPREAD_STEP` metres, :data:`EDGE_ROOM`
     inside the field and clear of robots by :data:`PUTDOWN_ROOM`, nearest first
     to the point straight ahead at the arm's reach (the least driving); none
     when the field has no such room left (the caller then puts the block down
@@ -87,7 +91,8 @@ def spread_spots(
     def apart(spot: tuple[float, float]) -> bool:
         return all(math.hypot(spot[0] - ax, spot[1] - ay) >= spread for ax, ay in avoid)
 
-    near = [spot for spot in putdown_spots(world, robot) if apart(spot)]  # the arm reaches them from here
+    reach = putdown_spots(world, robot) if reachable is None else reachable
+    near = [spot for spot in reach if apart(spot)]  # the arm reaches them from here
     xmin, ymin, xmax, ymax = world.bounds
     x, y, yaw = robot.pose
     ahead = REACH + mount_ahead(robot)

@@ -546,11 +546,11 @@ class Putdown(ArmSkill):
             spots = area_spots(self.world, self.robot, area, AREA_ROOM, self._known_taken())
         else:
             spread = float(self.param("spread", 0.0))  # type: ignore[arg-type]
-            taken = [(x, y) for x, y, _ in reservations.reserved(self)] if spread > 0 else []
-            spots = [
-                *(blocks_rules.spread_spots(self.world, self.robot, spread, taken) if spread > 0 else ()),
-                *blocks_rules.putdown_spots(self.world, self.robot),
-            ]
+            near = blocks_rules.putdown_spots(self.world, self.robot)
+            spots = near
+            if spread > 0:
+                taken = [(x, y) for x, y, _ in reservations.reserved(self)]
+                spots = [*blocks_rules.spread_spots(self.world, self.robot, spread, taken, near), *near]
         for spot in spots:
             if not any(distance(spot, old) < blocks_rules.PUTDOWN_ROOM for old in tried):
                 return spot

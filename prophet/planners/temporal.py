@@ -72,6 +72,7 @@ class TemporalPlanner(Planner):
     name = "temporal"
     features = BuiltinPlanner.features | {Feature.DURATIVE_ACTIONS}
     takes_limits = True
+    first_plan_waits = True  # the sequential search's first plan comes before any of the makespan search's
 
     def __init__(
         self,

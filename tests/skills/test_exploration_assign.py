@@ -152,9 +152,23 @@ def test_proposal_of_reads_the_team_values():
     }
 
 
+def _another_frontier(world, behaviour, asked):
+    """A team solver that moves scout to a frontier other than the one it drives to; logs (time, current frontier)."""
+    from alica.engine.parts import SolveResult
+
+    def solver(names):
+        current = behaviour.target.name if behaviour.target is not None else None
+        others = sorted(c.name for c in behaviour.candidates if c.name != current)
+        asked.append((world.now(), current))
+        if not others:
+            return SolveResult("infeasible", {}, {}, math.nan, "no frontier")
+        return SolveResult("solved", {"frontier": others[0]}, {"scout": {"frontier": others[0]}}, 0.0)
+
+    return solver
+
+
 def test_explore_frontier_follows_the_team_when_it_moves_the_robot_while_it_drives(skill_run):
     """The skill reads the team's solution at every reading of the map, not only when it needs a frontier."""
-    from alica.engine.parts import SolveResult
     from alica.skills.exploration.assign import TARGETS
     from alica.worldmodel import WorldModel
     from alica.worldsim.scenarios import lunar
@@ -171,17 +185,8 @@ def test_explore_frontier_follows_the_team_when_it_moves_the_robot_while_it_driv
                 )
             )
 
-        def solver(names):
-            # the team moves scout to another frontier whenever it drives to one
-            current = behaviour.target.name if behaviour.target is not None else None
-            others = sorted(c.name for c in behaviour.candidates if c.name != current)
-            asked.append((world.now(), current))
-            if not others:
-                return SolveResult("infeasible", {}, {}, math.nan, "no frontier")
-            return SolveResult("solved", {"frontier": others[0]}, {"scout": {"frontier": others[0]}}, 0.0)
-
         if behaviour.context.solver is None:
-            behaviour.context.solver = solver
+            behaviour.context.solver = _another_frontier(world, behaviour, asked)
 
     world = lunar(seed=0, rocks=8, samples=0, size=14.0)
     try:
@@ -203,7 +208,6 @@ def test_explore_frontier_follows_the_team_when_it_moves_the_robot_while_it_driv
 
 def test_without_reassign_the_skill_keeps_its_frontier_and_writes_no_targets(skill_run):
     """As shipped (reassign false) a robot reads the team's solution only when it needs a frontier."""
-    from alica.engine.parts import SolveResult
     from alica.skills.exploration.assign import TARGETS
     from alica.worldmodel import WorldModel
     from alica.worldsim.scenarios import lunar
@@ -215,20 +219,14 @@ def test_without_reassign_the_skill_keeps_its_frontier_and_writes_no_targets(ski
         wm = behaviour.context.world_model
         targets.extend(f for f in wm.facts() if f.predicate == TARGETS)
 
-        def solver(names):
-            current = behaviour.target.name if behaviour.target is not None else None
-            others = sorted(c.name for c in behaviour.candidates if c.name != current)
-            asked.append(current)
-            return SolveResult("solved", {"frontier": others[0]}, {"scout": {"frontier": others[0]}}, 0.0)
-
         if behaviour.context.solver is None:
-            behaviour.context.solver = solver
+            behaviour.context.solver = _another_frontier(world, behaviour, asked)
 
     world = lunar(seed=0, rocks=8, samples=0, size=14.0)
     try:
         wm = WorldModel("scout", clock=world.clock)
         skill_run("ExploreFrontier", world, "scout", {}, timeout=4.5, world_model=wm, on_tick=install)
-        assert asked and all(current is None for current in asked)  # only when it needed a frontier
+        assert asked and all(current is None for _, current in asked)  # only when it needed a frontier
         assert not targets
     finally:
         world.close()
