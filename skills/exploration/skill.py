@@ -52,7 +52,7 @@ from alica.skills.exploration.maps import current_map
 from alica.skills.world_skill import WorldSkill
 from alica.worldmodel import WorldModelLike
 
-__all__ = ["HEADING", "ExploreFrontier", "heading_of", "headings", "publish_frontiers"]
+__all__ = ["HEADING", "ExploreFrontier", "heading_of", "publish_frontiers"]
 
 #: Seconds a published frontier (and the robot's Pos) lives in the world model without being written again.
 PUBLISH_TTL = 10.0
@@ -121,11 +121,6 @@ def heading_of(wm: Any, but: str) -> dict[str, tuple[float, float]]:
         if name == HEADING and args and args[0] != but and isinstance(value, (tuple, list)) and len(value) == 2:
             out[str(args[0])] = (float(value[0]), float(value[1]))
     return out
-
-
-def headings(wm: Any, but: str) -> list[tuple[float, float]]:
-    """Where the robots other than ``but`` are heading now (``heading(robot)`` in the world model)."""
-    return list(heading_of(wm, but).values())
 
 
 class ExploreFrontier(WorldSkill):
