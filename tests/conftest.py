@@ -58,3 +58,21 @@ def benchmark_set(name: str) -> Path:
 def plans_dir() -> Path:
     """The shipped plans/ folder."""
     return PLANS
+
+
+def blocks_mission_with_builtin(folder: Path) -> Path:
+    """A copy of the shipped plans in ``folder`` whose blocks mission plans StackBlocks with ``planner: builtin``.
+
+    The shipped mission plans for the team's time (``planner: temporal``); MAGiC splits the builtin
+    planner's search, so a test of MAGiC in a team of processes runs this copy.
+    """
+    import shutil
+
+    copy = folder / "plans"
+    shutil.copytree(PLANS, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    (folder / ".alica-project").touch()  # the mission imports ../tasks.yaml: the copy's folder is its project
+    mission = copy / "blocksworld" / "mission.yaml"
+    text = mission.read_text(encoding="utf-8")
+    assert text.count("    planner: temporal\n") == 1, "the blocks mission no longer names its planner once"
+    mission.write_text(text.replace("    planner: temporal\n", "    planner: builtin\n"), encoding="utf-8")
+    return mission

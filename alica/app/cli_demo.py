@@ -62,9 +62,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     b.add_argument(
         "--planner",
         choices=("builtin", "temporal"),
-        default="builtin",
-        help="plan for the fewest steps (builtin, the mission's; the default) or for the team's time (temporal: "
-        "the skills' durations, refined by what the team measures)",
+        default=None,
+        help="plan for the team's time (temporal, the mission's and the default: the skills' durations, refined "
+        "by what the team measures) or for the fewest steps (builtin)",
     )
     add_time_limit(b, 600.0, "give up after S simulated seconds (default 600)")
     add_fault_options(

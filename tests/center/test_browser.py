@@ -260,7 +260,7 @@ def replan_trace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A blocks demo with an opponent that makes the team replan (in a process of its own: OMPL's seed is per process)."""
     folder = tmp_path_factory.mktemp("replan")
     command = [sys.executable, "-m", "alica.app.cli", "demo", "blocksworld", "--robots", "2", "--blocks", "4"]
-    command += ["--opponents", "1", "--seed", "8", "--out", str(folder)]
+    command += ["--opponents", "1", "--seed", "2", "--out", str(folder)]
     subprocess.run(command, check=True, capture_output=True, timeout=300)
     return folder / "trace.jsonl"
 

@@ -257,11 +257,11 @@ def test_a_payload_the_receiver_cannot_decode_is_skipped_and_the_stream_goes_on(
         b.close()
 
 
-def test_every_payload_of_a_planning_team_crosses_the_codec(monkeypatch):
+def test_every_payload_of_a_planning_team_crosses_the_codec(monkeypatch, tmp_path):
     """What the engine, the world model and pRoPhEt MAS (MAGiC included) publish, encoded and decoded."""
     from alica.app.cli import main
     from alica.comm import simnet
-    from tests.conftest import PLANS
+    from tests.conftest import blocks_mission_with_builtin
 
     publish = simnet.SimNetwork._publish
     kinds: set[str] = set()
@@ -274,7 +274,7 @@ def test_every_payload_of_a_planning_team_crosses_the_codec(monkeypatch):
     monkeypatch.setattr(simnet.SimNetwork, "_publish", checked)
     facts = "ontable(a) and on(c, a) and clear(c) and ontable(b) and clear(b) and handempty(r1) and handempty(r2)@0"
     argv = ["--agents", "r1:Manipulator,r2:Manipulator", "--stand-ins", "--fact", facts, "--parallel-planning"]
-    assert main(["run", str(PLANS / "blocksworld" / "mission.yaml"), *argv]) == 0
+    assert main(["run", str(blocks_mission_with_builtin(tmp_path)), *argv]) == 0  # MAGiC: the builtin planner
     assert {"TeamMessage", "Delta", "PlanShare", "Share", "Final"} <= kinds
 
 

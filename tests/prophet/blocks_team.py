@@ -106,9 +106,11 @@ class BlockSkills:
         return {n: self.factory(n) for n in names}
 
 
-def blocks_library() -> PlanLibrary:
-    """The shipped blocks-world mission."""
-    return load_library(PLANS / "blocksworld" / "mission.yaml")
+def blocks_library(planner: str | None = None) -> PlanLibrary:
+    """The shipped blocks-world mission; ``planner`` plans StackBlocks instead of the mission's (temporal)."""
+    from alica.app.demos.blocksworld import with_planner
+
+    return with_planner(load_library(PLANS / "blocksworld" / "mission.yaml"), "StackBlocks", planner)
 
 
 def world_facts(stacks: Iterable[Iterable[str]], robots: Iterable[str]) -> list[Literal]:
@@ -128,9 +130,15 @@ SUSSMAN = [["a", "c"], ["b"]]
 
 
 def blocks_team(
-    agents: Iterable[str], skills: BlockSkills, stacks=SUSSMAN, seed: int = 0, **config: Any
+    agents: Iterable[str],
+    skills: BlockSkills,
+    stacks=SUSSMAN,
+    seed: int = 0,
+    planner: str | None = None,
+    **config: Any,
 ) -> tuple[SimulatedTeam, TraceRecorder]:  # type: ignore[no-untyped-def]
-    """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model (``config``: engine settings)."""
+    """A Manipulator team on BlocksWorldMission with ``stacks`` in every world model (``config``: engine settings;
+    ``planner``: StackBlocks's planner instead of the mission's)."""
     names = list(agents)
     recorder = TraceRecorder()
     settings = {
@@ -141,7 +149,7 @@ def blocks_team(
         **config,
     }
     sim = SimulatedTeam(
-        blocks_library(),
+        blocks_library(planner),
         "BlocksWorldMission",
         dict.fromkeys(names, "Manipulator"),
         seed=seed,

@@ -1,4 +1,7 @@
-"""MAGiC inside a team: with parallel planning the leader splits its search over the agents in the problem's state."""
+"""MAGiC inside a team: with parallel planning the leader splits its search over the agents in the problem's state.
+
+MAGiC splits the builtin planner's search, so the team plans StackBlocks with ``planner: builtin``
+(the mission's temporal planner plans alone)."""
 
 from __future__ import annotations
 
@@ -12,7 +15,9 @@ def events(recorder, kind, **match):
 
 
 def test_the_leader_plans_with_every_teammate_and_the_team_reaches_the_goal():
-    sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(), parallel_planning=True, planner_expansions=200)
+    sim, rec = blocks_team(
+        ["r1", "r2", "r3"], BlockSkills(), parallel_planning=True, planner="builtin", planner_expansions=200
+    )
     summary = sim.run(until_done=True, max_time=120)
     assert summary["success"] and goal_holds(sim, "r3")
     [start] = events(rec, "planner", what="magic")[:1]
@@ -24,7 +29,7 @@ def test_the_leader_plans_with_every_teammate_and_the_team_reaches_the_goal():
 
 
 def test_a_teammate_that_crashes_as_the_round_starts_is_not_waited_for():
-    sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(), stacks=TOWER, parallel_planning=True)
+    sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(), stacks=TOWER, parallel_planning=True, planner="builtin")
     sim.tick()
     assert events(rec, "planner", agent="r1", what="started")
     sim.crash("r3")  # before its share reaches it: it never answers
@@ -36,7 +41,7 @@ def test_a_teammate_that_crashes_as_the_round_starts_is_not_waited_for():
 
 def test_parallel_planning_is_deterministic():
     def trace():
-        sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(), seed=3, parallel_planning=True)
+        sim, rec = blocks_team(["r1", "r2", "r3"], BlockSkills(), seed=3, parallel_planning=True, planner="builtin")
         sim.run(until_done=True, max_time=60)
         return list(rec.events)
 

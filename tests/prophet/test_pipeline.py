@@ -27,8 +27,10 @@ def blocks():
 
 
 def _sussman(blocks, world: str = SUSSMAN, goal: str = "on(a, b) and on(b, c) and ontable(c)"):
+    # planned for the fewest steps (the mission plans for the team's time: the temporal planner)
     problem = replace(
         blocks.problems["StackBlocks"],
+        planner="builtin",
         world=Condition(ConditionKind.PRE, world),
         goal=Condition(ConditionKind.POST, goal),
     )

@@ -38,7 +38,7 @@ def team_on_table(skills, agents=("r1",)):
 
 def test_with_review_on_nothing_runs_before_the_operator_accepts_then_the_team_runs_the_plan():
     skills = BlockSkills()
-    sim, rec = blocks_team(["r1", "r2"], skills, review=True)
+    sim, rec = blocks_team(["r1", "r2"], skills, review=True, planner="builtin")  # the cost counts the steps
     proposal = wait_for_proposal(sim, rec)
     assert proposal["agent"] == "r1" and proposal["leader"] == "r1"
     assert proposal["problem"] == PROBLEM and proposal["generation"] == 1 and proposal["cost"] == 6
@@ -104,7 +104,8 @@ def test_dropping_a_needed_step_is_refused_with_the_validators_reason_then_accep
     sim.decide_plan(PROBLEM, 1, PlanDecision("modify", order=(1, 2, 3)))  # the first pickup is gone
     refused = wait_for_proposal(sim, rec, count=2)
     assert refused["generation"] == 1 and refused["steps"] == proposal["steps"]
-    assert "step 1" in refused["error"] and "precondition" in refused["error"] and "holding" in refused["error"]
+    # the validator's reason: the mission's temporal plan checks the step's at-start condition (builtin: precondition)
+    assert "step 1" in refused["error"] and "condition" in refused["error"] and "(holding r1 c)" in refused["error"]
     assert refused["decision"] == {"action": "modify", "order": [1, 2, 3]}
     for _ in range(30):
         sim.tick()

@@ -125,13 +125,13 @@ def run_demo_processes(
             "--processes runs the team's robots as processes; opponents run only in the in-process demo "
             "(leave out --opponents or --processes)"
         )
-    if config.planner != "builtin":
+    start, goal = configurations(config)
+    library = load_library(MISSION)
+    if config.planner is not None and config.planner != library.problems[PROBLEM].planner:
         raise AlicaError(
             f"--processes runs the mission's planner as shipped; --planner {config.planner} runs only in the "
             "in-process demo (leave out --planner or --processes)"
         )
-    start, goal = configurations(config)
-    library = load_library(MISSION)
     counter = StepCounter(library.abstract(PROBLEM).elements, PROBLEM)  # type: ignore[union-attr]
     world = blocksworld([list(s) for s in start], agents=config.agents, seed=config.seed)
     names = [f"r{i + 1}" for i in range(config.agents)]

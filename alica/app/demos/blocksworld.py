@@ -58,8 +58,8 @@ class DemoConfig:
         goal: the goal stacks; random from the seed when None.
         time_limit: simulated seconds before the run gives up.
         frequency: engine ticks per simulated second.
-        planner: the planner of StackBlocks: ``builtin`` (the mission's, for the fewest steps) or ``temporal``
-            (for the team's time: the skills' declared durations, refined by what the team measures).
+        planner: the planner of StackBlocks: None for the mission's (``temporal``: for the team's time, the
+            skills' declared durations refined by what the team measures), or ``builtin`` (the fewest steps).
     """
 
     agents: int = 2
@@ -70,7 +70,7 @@ class DemoConfig:
     goal: Stacks | None = None
     time_limit: float = 600.0
     frequency: float = 10.0
-    planner: str = "builtin"
+    planner: str | None = None
 
 
 @dataclass(slots=True)
@@ -195,18 +195,18 @@ def configurations(config: DemoConfig) -> tuple[Stacks, Stacks]:
     return start, goal
 
 
-def with_planner(library: PlanLibrary, problem: str, planner: str) -> PlanLibrary:
-    """``library`` with planning problem ``problem`` planned by ``planner``.
+def with_planner(library: PlanLibrary, problem: str, planner: str | None) -> PlanLibrary:
+    """``library`` with planning problem ``problem`` planned by ``planner`` (None: the library's own).
 
     Raises:
         AlicaError: the planner is not one of the registered back-ends.
     """
     from alica.prophet.planners import PLANNERS
 
+    if planner is None or library.problems[problem].planner == planner:
+        return library
     if planner not in PLANNERS:
         raise AlicaError(f"unknown planner '{planner}': use one of {', '.join(sorted(PLANNERS))}")
-    if library.problems[problem].planner == planner:
-        return library
     documents = tuple(
         replace(d, problems=tuple(replace(p, planner=planner) if p.name == problem else p for p in d.problems))
         for d in library.documents

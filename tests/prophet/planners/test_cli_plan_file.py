@@ -15,7 +15,9 @@ def test_a_problem_of_a_plan_file_is_planned_and_split_into_tasks(alica) -> None
     run = alica("plan", MISSION, "--world", SUSSMAN, "--json")
     assert run.code == 0, run.err
     out = json.loads(run.out)
-    assert out["solved"] and out["cost"] == 6
+    # the mission plans for the team's time: one robot r runs the six steps one after another, for their declared
+    # durations (Unstack 7 s, Putdown 8, Pickup 7, Stack 8, Pickup 7, Stack 8) and 0.001 s between two of them
+    assert out["solved"] and len(out["plan"]) == 6 and out["cost"] == 45.005
     assert out["tasks"] == [["Unstack(c, a)", "Putdown(c)"], ["Pickup(b)", "Stack(b, c)"], ["Pickup(a)", "Stack(a, b)"]]
 
 
@@ -43,7 +45,10 @@ def test_emit_plan_writes_a_plan_file_that_loads(alica, tmp_path) -> None:
 def test_a_goal_given_on_the_command_line(alica) -> None:
     run = alica("plan", MISSION, "--world", SUSSMAN, "--goal", "on(b, a)", "--json")
     assert run.code == 0, run.err
-    assert json.loads(run.out)["cost"] == 4  # unstack c, put it down, pick b up, stack it on a
+    out = json.loads(run.out)  # unstack c, put it down, pick b up, stack it on a: 7 + 8 + 7 + 8 s
+    assert (
+        out["plan"] == ["(unstack r c a)", "(putdown r c)", "(pickup r b)", "(stack r b a)"] and out["cost"] == 30.003
+    )
 
 
 def test_plan_file_errors_are_one_line_messages(alica, tmp_path) -> None:
