@@ -39,8 +39,9 @@ Ways to choose a robot's next frontier, in the same run and on the same seeds:
   (1 + distance) that is more than 4 m from the others' frontiers (any usable
   one if none is) -- counted as ``fallbacks``. ``--no-periodic`` runs the
   plan without KeepFrontier and with the others' frontiers fixed (only the
-  robot that needs a frontier is assigned): ExploreFrontier as shipped
-  (``reassign: false``), and this bench before the periodic reassignment.
+  robot that needs a frontier is assigned): ExploreFrontier with
+  ``reassign: false`` (the skill's default; the shipped plan sets it true),
+  and this bench before the periodic reassignment.
   ``--spacing`` replaces the plan's 4 m of Eq. 7 (an experiment).
 * **nearest frontier** (Yamauchi 1997): every robot drives to the usable
   frontier nearest to it by path length, uncoordinated.

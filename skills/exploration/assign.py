@@ -14,8 +14,9 @@ unreachable) gets no bonus and simply gets the best one for the team.
 With ExploreFrontier's ``reassign: true`` every robot reads the team's
 solution periodically, not only when it needs a frontier (:func:`decide`), so
 a solution that reassigns several robots (two robots swapping frontiers, say)
-is followed by all of them; as shipped it is off, no ``Targets`` fact is
-written and KeepFrontier adds nothing. The bench of ``bench/exploration.py``
+is followed by all of them; the Explore plan's DriveToFrontier sets it.
+Without it (the skill's default) no ``Targets`` fact is written and
+KeepFrontier adds nothing. The bench of ``bench/exploration.py``
 runs the same rule on the same plan (:func:`solve_team` stands in for the
 engine there).
 """

@@ -21,8 +21,9 @@ robot periodically); it then writes ``Targets(robot, frontier)`` while it
 drives to a frontier, which the plan's KeepFrontier utility reads: that is
 the hysteresis, a robot is moved only when that raises the team's gain over
 travel by more than the bonus (:mod:`alica.skills.exploration.assign`,
-:func:`~alica.skills.exploration.assign.decide`). Without it (the default) no
-``Targets`` fact is written and KeepFrontier adds nothing. A ``frontier``
+:func:`~alica.skills.exploration.assign.decide`); the Explore plan's
+DriveToFrontier sets it. Without it (the skill's default) no ``Targets``
+fact is written and KeepFrontier adds nothing. A ``frontier``
 parameter (bound by a plan) names the first one. When the constraints have
 no solution, or give a frontier within ``spacing`` of one another robot
 heads for (with ``reassign``: and keeps heading for), a robot with a

@@ -207,7 +207,7 @@ def test_explore_frontier_follows_the_team_when_it_moves_the_robot_while_it_driv
 
 
 def test_without_reassign_the_skill_keeps_its_frontier_and_writes_no_targets(skill_run):
-    """As shipped (reassign false) a robot reads the team's solution only when it needs a frontier."""
+    """Without reassign (the skill's default) a robot reads the team's solution only when it needs a frontier."""
     from alica.skills.exploration.assign import TARGETS
     from alica.worldmodel import WorldModel
     from alica.worldsim.scenarios import lunar
