@@ -22,12 +22,15 @@ from alica.worldsim.objects import WorldObject
 if TYPE_CHECKING:
     from alica.worldsim.arm_host import ArmMount
 
-__all__ = ["FINGER_OPEN", "GRASP_TOLERANCE", "GRIP_FORCE", "GripperMixin"]
+__all__ = ["FINGER_OPEN", "GRASP_TOLERANCE", "GRIP_FORCE", "GRIP_SLACK", "GripperMixin"]
 
 logger = logging.getLogger(__name__)
 
 #: How far (m) the point between the fingers may be from an object's bounding box for an attach.
 GRASP_TOLERANCE = 0.015
+#: How far (m) from the middle between the closed fingers a held object may stay: the fingers centre it
+#: along their axis (see :meth:`GripperMixin.attach`) up to the give of their pads.
+GRIP_SLACK = 0.001
 #: The finger force (N) that :meth:`GripperMixin.grip_force` reports while holding.
 GRIP_FORCE = 20.0
 #: The opening of each finger (m) when the gripper is open.
@@ -122,7 +125,8 @@ class GripperMixin:
         """Grasp ``obj`` (an object or its name) if the point between the fingers is at it.
 
         On success the object moves with the end-effector (kinematic, massless
-        in physics) and the fingers close on it. With a grasp slip set (see
+        in physics) and the fingers close on it, centring it between them
+        along their axis (to within :data:`GRIP_SLACK`). With a grasp slip set (see
         :mod:`alica.worldsim.faults`) the grasp may fail a short time later.
 
         Returns:
@@ -159,7 +163,11 @@ class GripperMixin:
             return False
         pos, quat = obj.pose()
         inv = pose_inverse(tuple(ee_pos), ee_quat)
-        self._grasp = pose_multiply(inv[0], inv[1], pos, quat)
+        (gx, gy, gz), grasp_quat = pose_multiply(inv[0], inv[1], pos, quat)
+        # The fingers close symmetrically (their joints are coupled): the first to touch the object pushes it
+        # towards the middle until the other touches too. So it is held centred along the finger (tool y) axis,
+        # up to the pads' give (GRIP_SLACK); along the tool x and z axes nothing pushes it.
+        self._grasp = ((gx, max(-GRIP_SLACK, min(GRIP_SLACK, gy)), gz), grasp_quat)
         self._held = obj
         self._grip_physics(obj, True)
         self._fingers = min(FINGER_OPEN, _half_width(obj))

@@ -256,6 +256,41 @@ def test_opening_the_gripper_releases(world: World, manipulator: Robot) -> None:
     assert arm.finger_opening() == pytest.approx(0.05)  # closes on the block still between the fingers
 
 
+def _in_hand(arm: Arm, obj_name: str) -> tuple[float, float, float]:
+    """Where object ``obj_name`` is in the end-effector's frame."""
+    from alica.worldsim.geometry import pose_inverse, pose_multiply
+
+    ee_pos, ee_quat = arm.ee_pose()
+    inv = pose_inverse(tuple(ee_pos), ee_quat)
+    pos, _ = pose_multiply(inv[0], inv[1], *arm.robot.world.objects[obj_name].pose())
+    return pos
+
+
+@pytest.mark.parametrize(("off_x", "off_y"), [(0.0, 0.012), (0.006, -0.015), (0.004, 0.0005)])
+def test_closing_fingers_centre_the_object_between_them(
+    world: World, manipulator: Robot, off_x: float, off_y: float
+) -> None:
+    # the hand comes down off the block's centre; the fingers close along the tool's y axis (the world's -y here)
+    from alica.worldsim.gripper import GRIP_SLACK
+
+    arm = manipulator.arm
+    block = world.add_block("b", (arm.mount_offset[0] + 0.5, 0.0))
+    x, y, z = block.position()
+    q = ik(arm, (x - off_x, y + off_y, z))
+    assert q is not None
+    arm.open()
+    arm.set_q(q)
+    arm.close()
+    before = _in_hand(arm, "b")
+    assert arm.attach("b")
+    world.step(0.1)
+    held = _in_hand(arm, "b")
+    # pushed to the middle along the fingers (an offset within the pads' give stays), not moved along the others
+    assert held[1] == pytest.approx(max(-GRIP_SLACK, min(GRIP_SLACK, before[1])), abs=1e-6)
+    assert (held[0], held[2]) == pytest.approx((before[0], before[2]), abs=1e-6)
+    assert abs(before[1]) <= GRIP_SLACK or abs(held[1]) < abs(before[1])
+
+
 def test_samples_are_graspable(world: World, manipulator: Robot) -> None:
     arm = manipulator.arm
     sample = world.add_sample("a", "red-white-red", (arm.mount_offset[0] + 0.5, 0.0))
