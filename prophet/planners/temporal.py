@@ -112,9 +112,8 @@ class TemporalPlanner(Planner):
         )
         expansions = {SEQUENTIAL: 0, MAKESPAN: 0}
         ended: dict[str, Done] = {}
-        best: float | None = None
-        steps: int | None = None  # the best plan's steps (no_more_steps: a makespan plan has no more)
-        held: list[Plan] = []  # makespan plans waiting for the sequential search's first plan
+        best: Plan | None = None
+        held: list[Plan] = []  # no_more_steps: makespan plans waiting for the sequential search's first plan
         started = not self.makespan_search
         while streams:
             name, events = streams.popleft()
@@ -141,31 +140,32 @@ class TemporalPlanner(Planner):
             if plan is None:
                 continue
             source = name
-            if self.no_more_steps:
-                if name == SEQUENTIAL and steps is None:
-                    kept = [p for p in held if len(p.steps) <= len(plan.steps)]
-                    held.clear()
-                    if kept and min(p.cost for p in kept) < plan.cost - 1e-9:
-                        plan, source = min(kept, key=lambda p: p.cost), MAKESPAN
-                elif name == MAKESPAN and steps is None:
+            if self.no_more_steps and name == MAKESPAN:
+                if best is None:
                     held.append(plan)
                     continue
-                elif name == MAKESPAN and steps is not None and len(plan.steps) > steps:
+                if len(plan.steps) > len(best.steps):
                     continue
-            if best is None or plan.cost < best - 1e-9:
-                best = plan.cost
-                steps = len(plan.steps)
-                bound.ticks = round(best * TICKS) if bound.ticks is None else min(bound.ticks, round(best * TICKS))
-                self.sources[source] += 1
-                self.best_source = source
-                yield Improved(plan, total)
+            elif self.no_more_steps and held:  # the sequential search's first plan: the held ones no longer compete
+                fewer = min((p for p in held if len(p.steps) <= len(plan.steps)), key=lambda p: p.cost, default=None)
+                held.clear()
+                if fewer is not None and fewer.cost < plan.cost - 1e-9:
+                    plan, source = fewer, MAKESPAN
+            if best is None or plan.cost < best.cost - 1e-9:
+                best = plan
+                ticks = round(plan.cost * TICKS)
+                bound.ticks = ticks if bound.ticks is None else min(bound.ticks, ticks)
+                yield self._improved(plan, source, total)
         if held:  # the sequential search found no plan: the makespan search's best counts
-            plan = min(held, key=lambda p: p.cost)
-            best = plan.cost
-            self.sources[MAKESPAN] += 1
-            self.best_source = MAKESPAN
-            yield Improved(plan, sum(expansions.values()))
+            best = min(held, key=lambda p: p.cost)
+            yield self._improved(best, MAKESPAN, sum(expansions.values()))
         yield self._final(ended, best is not None, sum(expansions.values()))
+
+    def _improved(self, plan: Plan, source: str, expansions: int) -> Improved:
+        """``plan`` as the best so far, credited to the search it came from (``sources``, ``best_source``)."""
+        self.sources[source] += 1
+        self.best_source = source
+        return Improved(plan, expansions)
 
     def _makespan(
         self,
